@@ -1,0 +1,119 @@
+# Makefile - builds mechc, its tests, benches and examples. `make help` lists targets.
+
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BUILD   ?= build
+CC      ?= cc
+V       ?= 0
+Q        = $(if $(filter 1,$(V)),,@)
+
+VERSION := 0.1.0
+WARN    := -Wall -Wextra -Wshadow -Wpointer-arith -Wwrite-strings -Wundef \
+           -Wmissing-prototypes -Wstrict-prototypes -Wformat=2
+OPT     ?= -O2 -g
+SAN     ?=
+CFLAGS_TOOL    := -std=c11 $(OPT) $(WARN) $(SAN) -D_DEFAULT_SOURCE \
+                  -DMECHC_VERSION='"$(VERSION)"' -MMD -MP
+CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) -MMD -MP
+
+# libtcc: Debian ships only a static, non-PIC libtcc.a, so the tool links it
+# statically and is itself linked without PIE.
+LDFLAGS_TOOL := -no-pie $(SAN)
+LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic -lgsl -lgslcblas -ldl -lm -lpthread
+LDLIBS_TEST  := -lcmocka
+
+GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))
+CLI_SRC   := generator/cli/main.c
+RT_SRC    := $(wildcard runtime/*.c)
+HOST_SRC  := $(wildcard runtime/host/*.c)
+TEST_SRC  := $(wildcard tests/test_*.c)
+TMPL      := $(wildcard templates/*.tmpl)
+
+GEN_OBJ   := $(GEN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/gen/templates.o
+RT_OBJ    := $(RT_SRC:%.c=$(BUILD)/%.o)
+HOST_OBJ  := $(HOST_SRC:%.c=$(BUILD)/%.o)
+LIB       := $(BUILD)/libmechc.a
+MECHC     := $(BUILD)/mechc
+TESTS     := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+
+.PHONY: all deps check test demo bench check-asan sanitize install uninstall clean help examples-check
+all: $(MECHC)
+
+help:
+	@echo "make            build $(MECHC)"
+	@echo "make deps       install missing Debian packages (as root) or name them"
+	@echo "make demo       set up, build and run mechc on examples/slider_crank.mech"
+	@echo "make check      set up, build and run every test (cmocka + CLI + generated C)"
+	@echo "make check-asan the same tests under AddressSanitizer and UBSan"
+	@echo "make bench      time the engines side by side (bench/run)"
+	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
+
+deps:
+	$(Q)sh .ci/deps
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	@$(if $(filter 1,$(V)),,echo "  CC      $<")
+	$(Q)$(CC) $(if $(filter runtime/%,$(filter-out runtime/host/%,$<)),$(CFLAGS_RUNTIME),$(CFLAGS_TOOL)) -c $< -o $@
+
+# Templates become C string arrays compiled into mechc: gen never reads files.
+$(BUILD)/gen/templates.c: $(TMPL) Makefile
+	@mkdir -p $(dir $@)
+	@$(if $(filter 1,$(V)),,echo "  EMBED   templates/*.tmpl")
+	$(Q){ echo '/* Generated from the templates folder by the Makefile. Do not edit. */'; \
+	  echo '#include "../../generator/emit/templates.h"'; \
+	  for f in $(TMPL); do \
+	    n=$$(basename $$f .tmpl | tr '.-' '__'); \
+	    echo "const char template_$$n[] ="; \
+	    sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$$/\\n"/' $$f; \
+	    echo ';'; \
+	  done; } > $@
+
+$(BUILD)/gen/templates.o: $(BUILD)/gen/templates.c
+	$(Q)$(CC) $(CFLAGS_TOOL) -c $< -o $@
+
+$(LIB): $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)
+	@$(if $(filter 1,$(V)),,echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(MECHC): $(BUILD)/generator/cli/main.o $(LIB)
+	@$(if $(filter 1,$(V)),,echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS_TOOL) $^ $(LDLIBS_TOOL) -o $@
+
+$(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
+	@mkdir -p $(dir $@)
+	@$(if $(filter 1,$(V)),,echo "  TEST-CC $<")
+	$(Q)$(CC) $(CFLAGS_TOOL) -Wno-missing-prototypes $(LDFLAGS_TOOL) $< $(LIB) $(LDLIBS_TEST) $(LDLIBS_TOOL) -o $@
+
+# The README's test command. Runs every cmocka suite, the CLI script and the
+# generated-C compile checks; stops at the first failing suite.
+check: deps $(MECHC) $(TESTS)
+	$(Q)sh tests/run_all $(BUILD)
+
+test: check
+
+check-asan:
+	$(Q)$(MAKE) --no-print-directory BUILD=build-asan OPT="-O1 -g -fno-omit-frame-pointer" \
+	  SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined" check
+sanitize: check-asan
+
+demo: deps $(MECHC)
+	$(Q)sh examples/demo $(MECHC)
+
+bench: deps $(MECHC)
+	$(Q)sh bench/run $(MECHC)
+
+install: $(MECHC)
+	install -d $(DESTDIR)$(PREFIX)/bin
+	install -m 755 $(MECHC) $(DESTDIR)$(PREFIX)/bin/mechc
+	install -d $(DESTDIR)$(PREFIX)/include/mechc $(DESTDIR)$(PREFIX)/share/mechc/runtime
+	install -m 644 runtime/*.h runtime/*.c $(DESTDIR)$(PREFIX)/share/mechc/runtime/
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
+	rm -rf $(DESTDIR)$(PREFIX)/share/mechc
+
+clean:
+	rm -rf build build-asan
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,47 @@
+/* cli.h - the subcommands and the small argument helpers they share. */
+#ifndef MECHC_CLI_H
+#define MECHC_CLI_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+/* Exit statuses of spec section 3. */
+enum { EXIT_OK = 0, EXIT_ANALYSIS = 1, EXIT_USAGE = 2 };
+
+/* Walks argv: positional FILE and --options (as "--opt value" or "--opt=value"). */
+typedef struct Args {
+    int argc, i;
+    char **argv;
+    const char *command;
+    const char *file;       /* the one positional argument */
+    const char *pending;    /* value given as --opt=value */
+    char name[64];          /* the option name split off --opt=value */
+    bool failed;
+} Args;
+
+void args_init(Args *a, const char *command, int argc, char **argv);
+/* Next option name (without its value), or NULL at the end. Positional
+   arguments are consumed into a->file along the way. */
+const char *args_next(Args *a);
+/* The value of the option just returned. */
+const char *args_value(Args *a, const char *option);
+bool args_double(Args *a, const char *option, double *out);
+bool args_int(Args *a, const char *option, int min, int max, int *out);
+/* A comma-separated list of exactly n numbers. */
+bool args_vector(const char *command, const char *option, const char *text, int n, double *out);
+void args_unknown(Args *a, const char *option);
+bool args_need_file(Args *a);
+bool args_is_help(const char *option);
+
+int cmd_gen(int argc, char **argv);
+int cmd_eval(int argc, char **argv);
+int cmd_run(int argc, char **argv);
+int cmd_check(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
+
+/* JSON number: %.17g, or null for NaN and infinities (JSON has neither). */
+void json_number(FILE *out, double v);
+void json_string(FILE *out, const char *s);
+
+#endif

@@ -1,0 +1,535 @@
+/* dag.c - hash-consed expression graph with construction-time simplification.
+ *
+ * Every node is unique: building (op, a, b) twice returns the same id, so a
+ * subexpression shared by several rows, or by a row and its derivatives,
+ * exists once and is computed once in the generated code. Simplifications
+ * are local rewrites applied before the lookup; each is exact in real
+ * arithmetic and folding happens only when the IEEE result is finite, so
+ * no NaN or infinity is baked into the generated code.
+ */
+#include "dag.h"
+
+#include "../base/arena.h"
+#include "../base/strbuf.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const DagOpInfo dag_op_info[OP_COUNT] = {
+#define X(e, spell, arity, cd, cf) {spell, arity, cd, cf},
+#include "ops.def"
+#undef X
+};
+
+int dag_function_from_name(const char *word, int len)
+{
+    for (int op = OP_SIN; op < OP_COUNT; op++) {
+        const char *s = dag_op_info[op].spelling;
+        if ((int)strlen(s) == len && memcmp(s, word, (size_t)len) == 0)
+            return op;
+    }
+    return -1;
+}
+
+/* ---- table ---- */
+
+static uint32_t hash_key(DagOp op, int32_t a, int32_t b, double value)
+{
+    uint64_t bits;
+    memcpy(&bits, &value, sizeof bits);
+    uint64_t h = 1469598103934665603ull;
+    uint64_t parts[4] = {(uint64_t)op, (uint64_t)(uint32_t)a, (uint64_t)(uint32_t)b, bits};
+    for (int i = 0; i < 4; i++) {
+        h ^= parts[i];
+        h *= 1099511628211ull;
+        h ^= h >> 29;
+    }
+    return (uint32_t)(h ^ (h >> 32));
+}
+
+static bool same_key(const DagNode *n, DagOp op, int32_t a, int32_t b, double value)
+{
+    return n->op == op && n->a == a && n->b == b
+           && memcmp(&n->value, &value, sizeof value) == 0;
+}
+
+static void table_grow(Dag *dag)
+{
+    uint32_t cap = dag->table_cap ? dag->table_cap * 2 : 1024;
+    free(dag->table);
+    dag->table = xmalloc(cap * sizeof *dag->table);
+    memset(dag->table, 0xff, cap * sizeof *dag->table);
+    dag->table_cap = cap;
+    for (int32_t id = 0; id < dag->count; id++) {
+        const DagNode *n = &dag->nodes[id];
+        uint32_t h = hash_key((DagOp)n->op, n->a, n->b, n->value) & (cap - 1);
+        while (dag->table[h] >= 0)
+            h = (h + 1) & (cap - 1);
+        dag->table[h] = id;
+    }
+}
+
+/* The one place nodes are created: look (op, a, b, value) up, else append. */
+static NodeId intern(Dag *dag, DagOp op, int32_t a, int32_t b, double value)
+{
+    if ((uint32_t)dag->count * 2 >= dag->table_cap)
+        table_grow(dag);
+    uint32_t mask = dag->table_cap - 1;
+    uint32_t h = hash_key(op, a, b, value) & mask;
+    for (; dag->table[h] >= 0; h = (h + 1) & mask) {
+        if (same_key(&dag->nodes[dag->table[h]], op, a, b, value))
+            return dag->table[h];
+    }
+    if (dag->count >= dag->max_nodes) {
+        diag_error_nopos(dag->diag,
+                         "the expression graph passed its limit of %d nodes "
+                         "(the mechanism is too large)", (int)dag->max_nodes);
+        if (dag->diag->escape)
+            longjmp(*dag->diag->escape, 1);
+        abort();
+    }
+    if (dag->count == dag->cap) {
+        dag->cap = dag->cap ? dag->cap * 2 : 1024;
+        dag->nodes = xrealloc(dag->nodes, (size_t)dag->cap, sizeof *dag->nodes);
+    }
+    NodeId id = dag->count++;
+    dag->nodes[id] = (DagNode){.op = (uint8_t)op, .a = a, .b = b, .value = value};
+    dag->table[h] = id;
+    return id;
+}
+
+void dag_init(Dag *dag, int32_t max_nodes, Diag *diag)
+{
+    memset(dag, 0, sizeof *dag);
+    dag->max_nodes = max_nodes > 2 ? max_nodes : 2;
+    dag->diag = diag;
+    NodeId zero = dag_const(dag, 0.0), one = dag_const(dag, 1.0);
+    (void)zero, (void)one;      /* DAG_ZERO and DAG_ONE by construction */
+}
+
+void dag_free(Dag *dag)
+{
+    free(dag->nodes);
+    free(dag->table);
+    memset(dag, 0, sizeof *dag);
+}
+
+/* ---- leaves and queries ---- */
+
+NodeId dag_const(Dag *dag, double value) { return intern(dag, OP_CONST, -1, -1, value); }
+NodeId dag_var(Dag *dag, int index)      { return intern(dag, OP_VAR, index, -1, 0.0); }
+NodeId dag_vard(Dag *dag, int index)     { return intern(dag, OP_VARD, index, -1, 0.0); }
+NodeId dag_time(Dag *dag)                { return intern(dag, OP_TIME, -1, -1, 0.0); }
+
+bool dag_is_const(const Dag *dag, NodeId id, double *value)
+{
+    if (dag->nodes[id].op != OP_CONST)
+        return false;
+    if (value)
+        *value = dag->nodes[id].value;
+    return true;
+}
+
+bool dag_is_zero(const Dag *dag, NodeId id)
+{
+    double v;
+    return dag_is_const(dag, id, &v) && v == 0.0;
+}
+
+static bool is_value(const Dag *dag, NodeId id, double want)
+{
+    double v;
+    return dag_is_const(dag, id, &v) && v == want;
+}
+
+double dag_op_eval(DagOp op, double a, double b)
+{
+    switch (op) {
+    case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: return NAN;
+    case OP_NEG:   return -a;
+    case OP_ADD:   return a + b;
+    case OP_SUB:   return a - b;
+    case OP_MUL:   return a * b;
+    case OP_DIV:   return a / b;
+    case OP_POW:   return pow(a, b);
+    case OP_SIN:   return sin(a);
+    case OP_COS:   return cos(a);
+    case OP_TAN:   return tan(a);
+    case OP_ASIN:  return asin(a);
+    case OP_ACOS:  return acos(a);
+    case OP_ATAN:  return atan(a);
+    case OP_ATAN2: return atan2(a, b);
+    case OP_SQRT:  return sqrt(a);
+    case OP_EXP:   return exp(a);
+    case OP_LOG:   return log(a);
+    case OP_SINH:  return sinh(a);
+    case OP_COSH:  return cosh(a);
+    case OP_TANH:  return tanh(a);
+    case OP_COUNT: break;
+    }
+    return NAN;
+}
+
+/* Folds op over constant operands when the result is finite. */
+static bool try_fold(Dag *dag, DagOp op, NodeId a, NodeId b, NodeId *out)
+{
+    double va, vb = 0.0;
+    if (!dag_is_const(dag, a, &va))
+        return false;
+    if (b != DAG_NONE && !dag_is_const(dag, b, &vb))
+        return false;
+    double r = dag_op_eval(op, va, vb);
+    if (!isfinite(r))
+        return false;
+    *out = dag_const(dag, r);
+    return true;
+}
+
+/* Splits e into coefficient * term (term = DAG_NONE for a pure constant). */
+static double split_coefficient(const Dag *dag, NodeId e, NodeId *term)
+{
+    const DagNode *n = &dag->nodes[e];
+    double c;
+    if (n->op == OP_CONST) {
+        *term = DAG_NONE;
+        return n->value;
+    }
+    if (n->op == OP_MUL && dag_is_const(dag, n->a, &c)) {
+        *term = n->b;
+        return c;
+    }
+    if (n->op == OP_NEG) {
+        *term = n->a;
+        return -1.0;
+    }
+    *term = e;
+    return 1.0;
+}
+
+static NodeId scale(Dag *dag, double c, NodeId term)
+{
+    return dag_mul(dag, dag_const(dag, c), term);
+}
+
+/* ---- operators ---- */
+
+NodeId dag_neg(Dag *dag, NodeId a)
+{
+    NodeId r;
+    if (dag_is_zero(dag, a))        /* -0 would be a distinct node printing as -0 */
+        return DAG_ZERO;
+    if (try_fold(dag, OP_NEG, a, DAG_NONE, &r))
+        return r;
+    const DagNode *n = &dag->nodes[a];
+    double c;
+    if (n->op == OP_NEG)
+        return n->a;
+    if (n->op == OP_SUB)
+        return dag_sub(dag, n->b, n->a);
+    if (n->op == OP_MUL && dag_is_const(dag, n->a, &c))
+        return scale(dag, -c, n->b);
+    return intern(dag, OP_NEG, a, -1, 0.0);
+}
+
+/* Constants first, then the smaller id: one spelling per commutative pair. */
+static void order_commutative(const Dag *dag, NodeId *a, NodeId *b)
+{
+    bool ca = dag->nodes[*a].op == OP_CONST, cb = dag->nodes[*b].op == OP_CONST;
+    if ((cb && !ca) || (ca == cb && *b < *a)) {
+        NodeId t = *a;
+        *a = *b;
+        *b = t;
+    }
+}
+
+/* a + sign*b when both are multiples of the same term: (ca + sign*cb) term. */
+static bool merge_terms(Dag *dag, NodeId a, NodeId b, double sign, NodeId *out)
+{
+    NodeId ta, tb;
+    double ca = split_coefficient(dag, a, &ta);
+    double cb = split_coefficient(dag, b, &tb);
+    if (ta == DAG_NONE || ta != tb)
+        return false;
+    double c = ca + sign * cb;
+    *out = c == 0.0 ? DAG_ZERO : scale(dag, c, ta);
+    return true;
+}
+
+NodeId dag_add(Dag *dag, NodeId a, NodeId b)
+{
+    NodeId r;
+    if (try_fold(dag, OP_ADD, a, b, &r))
+        return r;
+    if (dag_is_zero(dag, a))
+        return b;
+    if (dag_is_zero(dag, b))
+        return a;
+    if (dag->nodes[b].op == OP_NEG)
+        return dag_sub(dag, a, dag->nodes[b].a);
+    if (dag->nodes[a].op == OP_NEG)
+        return dag_sub(dag, b, dag->nodes[a].a);
+    if (merge_terms(dag, a, b, 1.0, &r))
+        return r;
+    order_commutative(dag, &a, &b);
+    /* c1 + (c2 + y) = (c1 + c2) + y: keeps constants together. */
+    double c1, c2;
+    const DagNode *nb = &dag->nodes[b];
+    if (dag_is_const(dag, a, &c1) && nb->op == OP_ADD && dag_is_const(dag, nb->a, &c2)
+        && isfinite(c1 + c2))
+        return dag_add(dag, dag_const(dag, c1 + c2), nb->b);
+    return intern(dag, OP_ADD, a, b, 0.0);
+}
+
+NodeId dag_sub(Dag *dag, NodeId a, NodeId b)
+{
+    NodeId r;
+    if (try_fold(dag, OP_SUB, a, b, &r))
+        return r;
+    if (a == b)
+        return DAG_ZERO;
+    if (dag_is_zero(dag, b))
+        return a;
+    if (dag_is_zero(dag, a))
+        return dag_neg(dag, b);
+    if (dag->nodes[b].op == OP_NEG)
+        return dag_add(dag, a, dag->nodes[b].a);
+    if (dag->nodes[a].op == OP_NEG)     /* -x - b = -(x + b) */
+        return dag_neg(dag, dag_add(dag, dag->nodes[a].a, b));
+    if (merge_terms(dag, a, b, -1.0, &r))
+        return r;
+    return intern(dag, OP_SUB, a, b, 0.0);
+}
+
+NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
+{
+    NodeId r;
+    if (try_fold(dag, OP_MUL, a, b, &r))
+        return r;
+    if (dag_is_zero(dag, a) || dag_is_zero(dag, b))
+        return DAG_ZERO;
+    order_commutative(dag, &a, &b);
+    if (is_value(dag, a, 1.0))
+        return b;
+    if (is_value(dag, a, -1.0))
+        return dag_neg(dag, b);
+    const DagNode *na = &dag->nodes[a], *nb = &dag->nodes[b];
+    if (na->op == OP_NEG)
+        return dag_neg(dag, dag_mul(dag, na->a, b));
+    if (nb->op == OP_NEG)
+        return dag_neg(dag, dag_mul(dag, a, nb->a));
+    double c1, c2;
+    bool a_const = dag_is_const(dag, a, &c1);
+    if (nb->op == OP_MUL && dag_is_const(dag, nb->a, &c2)) {
+        if (a_const && isfinite(c1 * c2))       /* c1 (c2 y) = (c1 c2) y */
+            return dag_mul(dag, dag_const(dag, c1 * c2), nb->b);
+        if (!a_const)                           /* x (c y) = c (x y) */
+            return dag_mul(dag, nb->a, dag_mul(dag, a, nb->b));
+    }
+    if (!a_const && na->op == OP_MUL && dag_is_const(dag, na->a, &c1))
+        return dag_mul(dag, na->a, dag_mul(dag, na->b, b));
+    return intern(dag, OP_MUL, a, b, 0.0);
+}
+
+NodeId dag_div(Dag *dag, NodeId a, NodeId b)
+{
+    NodeId r;
+    double c;
+    if (try_fold(dag, OP_DIV, a, b, &r))
+        return r;
+    if (dag_is_const(dag, b, &c) && c == 0.0)
+        return intern(dag, OP_DIV, a, b, 0.0);    /* leave x/0 to IEEE at run time */
+    if (is_value(dag, b, 1.0))
+        return a;
+    if (dag_is_zero(dag, a))
+        return DAG_ZERO;
+    if (a == b)
+        return DAG_ONE;
+    const DagNode *na = &dag->nodes[a], *nb = &dag->nodes[b];
+    if (na->op == OP_NEG)
+        return dag_neg(dag, dag_div(dag, na->a, b));
+    if (nb->op == OP_NEG)
+        return dag_neg(dag, dag_div(dag, a, nb->a));
+    /* Division by a power of two is an exact multiplication. */
+    int e;
+    if (dag_is_const(dag, b, &c) && isfinite(c) && frexp(c, &e) == 0.5 * copysign(1.0, c))
+        return dag_mul(dag, dag_const(dag, 1.0 / c), a);
+    double ca;
+    if (na->op == OP_MUL && dag_is_const(dag, na->a, &ca))  /* (c x)/y = c (x/y) */
+        return dag_mul(dag, na->a, dag_div(dag, na->b, b));
+    return intern(dag, OP_DIV, a, b, 0.0);
+}
+
+NodeId dag_pow(Dag *dag, NodeId a, NodeId b)
+{
+    NodeId r;
+    if (try_fold(dag, OP_POW, a, b, &r))
+        return r;
+    double c;
+    if (dag_is_const(dag, b, &c)) {
+        if (c == 0.0)
+            return DAG_ONE;
+        if (c == 1.0)
+            return a;
+        if (c == 2.0)
+            return dag_mul(dag, a, a);
+        if (c == 3.0)
+            return dag_mul(dag, dag_mul(dag, a, a), a);
+        if (c == 4.0) {
+            NodeId sq = dag_mul(dag, a, a);
+            return dag_mul(dag, sq, sq);
+        }
+        if (c == -1.0)
+            return dag_div(dag, DAG_ONE, a);
+        if (c == -2.0)
+            return dag_div(dag, DAG_ONE, dag_mul(dag, a, a));
+        if (c == 0.5)
+            return dag_call(dag, OP_SQRT, a, DAG_NONE);
+    }
+    return intern(dag, OP_POW, a, b, 0.0);
+}
+
+NodeId dag_call(Dag *dag, DagOp fn, NodeId a, NodeId b)
+{
+    NodeId r;
+    if (try_fold(dag, fn, a, b, &r))
+        return r;
+    /* Even and odd functions of -x: share the node of x. */
+    if (dag->nodes[a].op == OP_NEG && b == DAG_NONE) {
+        NodeId x = dag->nodes[a].a;
+        switch (fn) {
+        case OP_COS: case OP_COSH:
+            return dag_call(dag, fn, x, DAG_NONE);
+        case OP_SIN: case OP_TAN: case OP_ASIN: case OP_ATAN: case OP_SINH: case OP_TANH:
+            return dag_neg(dag, dag_call(dag, fn, x, DAG_NONE));
+        default:
+            break;
+        }
+    }
+    return intern(dag, fn, a, b == DAG_NONE ? -1 : b, 0.0);
+}
+
+NodeId dag_apply(Dag *dag, DagOp op, NodeId a, NodeId b)
+{
+    switch (op) {
+    case OP_NEG: return dag_neg(dag, a);
+    case OP_ADD: return dag_add(dag, a, b);
+    case OP_SUB: return dag_sub(dag, a, b);
+    case OP_MUL: return dag_mul(dag, a, b);
+    case OP_DIV: return dag_div(dag, a, b);
+    case OP_POW: return dag_pow(dag, a, b);
+    default:     return dag_call(dag, op, a, b);
+    }
+}
+
+/* ---- traversal and printing ---- */
+
+int dag_mark_reachable(const Dag *dag, const NodeId *roots, int nroots,
+                       uint32_t *mark, uint32_t stamp, NodeId *stack)
+{
+    int top = 0, marked = 0;
+    for (int i = 0; i < nroots; i++) {
+        if (roots[i] >= 0 && mark[roots[i]] != stamp) {
+            mark[roots[i]] = stamp;
+            stack[top++] = roots[i];
+        }
+    }
+    while (top > 0) {
+        NodeId id = stack[--top];
+        marked++;
+        const DagNode *n = &dag->nodes[id];
+        int arity = dag_op_info[n->op].arity;
+        NodeId kids[2] = {n->a, n->b};
+        for (int k = 0; k < arity; k++) {
+            if (mark[kids[k]] != stamp) {
+                mark[kids[k]] = stamp;
+                stack[top++] = kids[k];
+            }
+        }
+    }
+    return marked;
+}
+
+static int precedence(DagOp op)
+{
+    switch (op) {
+    case OP_ADD: case OP_SUB: return 1;
+    case OP_MUL: case OP_DIV: return 2;
+    case OP_NEG: return 3;
+    case OP_POW: return 4;
+    default: return 5;
+    }
+}
+
+static void format_node(const Dag *dag, NodeId id, const char *const *names,
+                        StrBuf *out, int depth)
+{
+    const DagNode *n = &dag->nodes[id];
+    DagOp op = (DagOp)n->op;
+    if (depth > 200) {
+        sb_puts(out, "...");
+        return;
+    }
+    switch (op) {
+    case OP_CONST:
+        if (n->value < 0)
+            sb_printf(out, "(%.17g)", n->value);
+        else
+            sb_printf(out, "%.17g", n->value);
+        return;
+    case OP_VAR:
+        if (names)
+            sb_puts(out, names[n->a]);
+        else
+            sb_printf(out, "q[%d]", n->a);
+        return;
+    case OP_VARD:
+        if (names)
+            sb_printf(out, "der(%s)", names[n->a]);
+        else
+            sb_printf(out, "qd[%d]", n->a);
+        return;
+    case OP_TIME:
+        sb_puts(out, "t");
+        return;
+    case OP_NEG:
+        sb_putc(out, '-');
+        if (precedence((DagOp)dag->nodes[n->a].op) <= precedence(op)) {
+            sb_putc(out, '(');
+            format_node(dag, n->a, names, out, depth + 1);
+            sb_putc(out, ')');
+        } else {
+            format_node(dag, n->a, names, out, depth + 1);
+        }
+        return;
+    case OP_ADD: case OP_SUB: case OP_MUL: case OP_DIV: case OP_POW: {
+        int p = precedence(op);
+        int pl = precedence((DagOp)dag->nodes[n->a].op);
+        int pr = precedence((DagOp)dag->nodes[n->b].op);
+        bool paren_l = op == OP_POW ? pl <= p : pl < p;
+        bool paren_r = op == OP_POW ? pr < p : (op == OP_SUB || op == OP_DIV) ? pr <= p : pr < p;
+        if (paren_l) sb_putc(out, '(');
+        format_node(dag, n->a, names, out, depth + 1);
+        if (paren_l) sb_putc(out, ')');
+        sb_printf(out, op == OP_POW ? "%s" : " %s ", dag_op_info[op].spelling);
+        if (paren_r) sb_putc(out, '(');
+        format_node(dag, n->b, names, out, depth + 1);
+        if (paren_r) sb_putc(out, ')');
+        return;
+    }
+    default:
+        sb_printf(out, "%s(", dag_op_info[op].spelling);
+        format_node(dag, n->a, names, out, depth + 1);
+        if (dag_op_info[op].arity == 2) {
+            sb_puts(out, ", ");
+            format_node(dag, n->b, names, out, depth + 1);
+        }
+        sb_putc(out, ')');
+        return;
+    }
+}
+
+void dag_format(const Dag *dag, NodeId id, const char *const *coord_names, StrBuf *out)
+{
+    format_node(dag, id, coord_names, out, 0);
+}

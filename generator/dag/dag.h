@@ -1,0 +1,76 @@
+/* dag.h - the expression graph: hash-consed nodes with integer ids, simplified at construction. */
+#ifndef MECHC_DAG_H
+#define MECHC_DAG_H
+
+#include "../base/diag.h"
+#include "dag_ops.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Nodes are referred to by index. A node's operands always have smaller
+   ids, so id order is a topological order: every pass is a loop over ids,
+   and identical input yields identical ids and byte-identical output. */
+typedef int32_t NodeId;
+
+enum { DAG_ZERO = 0, DAG_ONE = 1, DAG_NONE = -1 };
+
+typedef struct DagNode {
+    uint8_t op;         /* DagOp */
+    int32_t a, b;       /* operands; VAR/VARD: coordinate index in a */
+    double value;       /* CONST */
+} DagNode;
+
+typedef struct Dag {
+    DagNode *nodes;
+    int32_t count, cap;
+    int32_t *table;         /* open addressing: node id or -1 */
+    uint32_t table_cap;     /* power of two */
+    int32_t max_nodes;      /* limit; passing it fails through diag */
+    Diag *diag;             /* receives the node-limit error (longjmp) */
+} Dag;
+
+void dag_init(Dag *dag, int32_t max_nodes, Diag *diag);
+void dag_free(Dag *dag);
+
+static inline const DagNode *dag_node(const Dag *dag, NodeId id) { return &dag->nodes[id]; }
+static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes[id].op; }
+bool dag_is_const(const Dag *dag, NodeId id, double *value);
+bool dag_is_zero(const Dag *dag, NodeId id);
+
+/* Leaves. */
+NodeId dag_const(Dag *dag, double value);
+NodeId dag_var(Dag *dag, int index);     /* q[index] */
+NodeId dag_vard(Dag *dag, int index);    /* qd[index] */
+NodeId dag_time(Dag *dag);
+
+/* Operators, simplified as they are built: constants folded when the
+   result is finite, 0/1 identities, x - x, double negation, numeric
+   coefficients merged (2*(3*x) = 6*x, x + x = 2*x, 3*x - x = 2*x),
+   operands of + and * put in canonical order. */
+NodeId dag_neg(Dag *dag, NodeId a);
+NodeId dag_add(Dag *dag, NodeId a, NodeId b);
+NodeId dag_sub(Dag *dag, NodeId a, NodeId b);
+NodeId dag_mul(Dag *dag, NodeId a, NodeId b);
+NodeId dag_div(Dag *dag, NodeId a, NodeId b);
+NodeId dag_pow(Dag *dag, NodeId a, NodeId b);   /* small integer powers become products */
+NodeId dag_call(Dag *dag, DagOp fn, NodeId a, NodeId b);  /* b = DAG_NONE for unary */
+/* Any operator or function by op (what the AST lowering uses). */
+NodeId dag_apply(Dag *dag, DagOp op, NodeId a, NodeId b);
+
+/* Evaluates one operator on numbers: the single definition of what every
+   op means, shared by constant folding and the interpreters. */
+double dag_op_eval(DagOp op, double a, double b);
+
+/* Marks in mark[] (size dag->count, caller-owned, set to stamp) every node
+   reachable from the roots; returns how many were newly marked. Iterative:
+   deep graphs do not recurse. stack must hold dag->count ids. */
+int dag_mark_reachable(const Dag *dag, const NodeId *roots, int nroots,
+                       uint32_t *mark, uint32_t stamp, NodeId *stack);
+
+/* Prints a node as an infix expression (for dumps, messages and the
+   integrability law); coord_names may be NULL (prints q[i]). */
+struct StrBuf;
+void dag_format(const Dag *dag, NodeId id, const char *const *coord_names, struct StrBuf *out);
+
+#endif

@@ -1,0 +1,42 @@
+/* kinematics.h - per row: Phi, the sparse Jacobian row, nu and gamma, as graph nodes. */
+#ifndef MECHC_KINEMATICS_H
+#define MECHC_KINEMATICS_H
+
+#include "../model/model.h"
+
+typedef struct JacEntry {
+    int row, col;
+    NodeId value;
+} JacEntry;
+
+/* Everything the emitter and the interpreters need, row by row. */
+typedef struct Kinematics {
+    const Model *model;
+    NodeId *phi;        /* nh: holonomic residuals */
+    NodeId *nu;         /* nr */
+    NodeId *gamma;      /* nr */
+    JacEntry *jac;      /* nnz structural nonzeros, row-major, columns ascending */
+    int nnz;
+    int *row_start;     /* nr + 1: row r's entries are jac[row_start[r] .. row_start[r+1]) */
+} Kinematics;
+
+/* Differentiates every row of the model. Returns false with diag filled
+   when a velocity row is not affine in der(). Arrays live in the model's
+   arena; the derivative nodes in its graph. */
+bool kinematics_build(Model *model, Kinematics *kin, Diag *diag);
+
+/* Finds which coordinates an expression depends on; reusable across calls. */
+typedef struct SupportScan {
+    uint32_t *mark;     /* per node: stamp of the last scan that reached it */
+    NodeId *stack;
+    int cap;
+    uint32_t stamp;
+} SupportScan;
+
+void support_init(SupportScan *scan);
+void support_free(SupportScan *scan);
+/* Indices of the leaves of kind leaf (OP_VAR: coordinates, OP_VARD:
+   velocities) that e depends on, ascending, into out (room for nq). */
+int support_collect(SupportScan *scan, const Dag *dag, NodeId e, DagOp leaf, int *out);
+
+#endif

@@ -1,0 +1,455 @@
+/* emit.c - renders scheduled straight-line code into the templates.
+ *
+ * Each generated function is: one `const real uN = ...;` per node that
+ * needs a temporary (see sched.c), the other nodes written inline, then
+ * one store per output. Constants are printed with the fewest digits
+ * that read back to the same value, so folded params round-trip exactly.
+ * Text from the input reaches the output only as escaped string literals
+ * (coordinate and row names) or as a sanitized identifier (the prefix).
+ */
+#include "emit.h"
+
+#include "../base/arena.h"
+#include "../sched/sched.h"
+#include "template.h"
+#include "templates.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const emit_function_names[EMIT_FUNCTION_COUNT] = {
+    "phi", "jac", "jac_nz", "nu", "gamma", "all",
+};
+
+/* Parameters of each generated function, in order (all are void-cast so
+   no mechanism triggers an unused-parameter warning). */
+static const char *const function_params[EMIT_FUNCTION_COUNT] = {
+    "q, t, phi", "q, t, jac", "q, t, vals", "q, t, nu", "q, qd, t, gamma",
+    "q, qd, t, phi, jac, nu, gamma",
+};
+
+EmitOptions emit_default_options(void)
+{
+    return (EmitOptions){.chunk_nodes = 2000, .source_name = "input.mech"};
+}
+
+static const char *const c_keywords[] = {
+    "auto", "break", "case", "char", "const", "continue", "default", "do", "double",
+    "else", "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long",
+    "register", "restrict", "return", "short", "signed", "sizeof", "static", "struct",
+    "switch", "typedef", "union", "unsigned", "void", "volatile", "while", "asm",
+    "fortran", "bool", "true", "false", "alignas", "alignof", "noreturn",
+    "static_assert", "thread_local", NULL,
+};
+
+static bool is_keyword(const char *s)
+{
+    for (int i = 0; c_keywords[i]; i++)
+        if (strcmp(s, c_keywords[i]) == 0)
+            return true;
+    return false;
+}
+
+const char *emit_check_prefix(const char *p)
+{
+    if (!p[0])
+        return "it is empty";
+    if (strlen(p) > 64)
+        return "it is longer than 64 characters";
+    if (!(isalpha((unsigned char)p[0]) || p[0] == '_'))
+        return "it must start with a letter or '_'";
+    for (const char *c = p; *c; c++)
+        if (!(isalnum((unsigned char)*c) || *c == '_'))
+            return "it may contain only letters, digits and '_'";
+    if (p[0] == '_' && (p[1] == '_' || isupper((unsigned char)p[1])))
+        return "identifiers starting with '__' or '_' and a capital are reserved for the C implementation";
+    if (is_keyword(p))
+        return "it is a C keyword";
+    return NULL;
+}
+
+/* The default prefix: the mechanism name made a safe identifier. */
+static void sanitize_prefix(const char *name, char *out, size_t size)
+{
+    size_t n = 0;
+    for (const char *c = name; *c && n + 1 < size && n < 64; c++)
+        out[n++] = isalnum((unsigned char)*c) ? *c : '_';
+    out[n] = '\0';
+    if (emit_check_prefix(out) != NULL) {
+        memmove(out + 2, out, strlen(out) + 1 < size - 2 ? strlen(out) + 1 : size - 2);
+        out[size - 1] = '\0';
+        out[0] = 'm';
+        out[1] = '_';
+    }
+    if (emit_check_prefix(out) != NULL)
+        snprintf(out, size, "mech");
+}
+
+/* Shortest decimal that reads back exactly (as double, or as float). */
+static void put_literal(StrBuf *sb, double v, bool real_float)
+{
+    char buf[64];
+    for (int digits = real_float ? 6 : 15; digits <= (real_float ? 9 : 17); digits++) {
+        snprintf(buf, sizeof buf, "%.*g", digits, real_float ? (double)(float)v : v);
+        double back = strtod(buf, NULL);
+        if (real_float ? (float)back == (float)v : back == v)
+            break;
+    }
+    if (!strpbrk(buf, ".eEn"))
+        strcat(buf, ".0");
+    bool negative = buf[0] == '-';
+    if (negative)
+        sb_putc(sb, '(');
+    sb_puts(sb, buf);
+    if (real_float)
+        sb_putc(sb, 'f');
+    if (negative)
+        sb_putc(sb, ')');
+}
+
+typedef struct Emitter {
+    const Kinematics *kin;
+    const Dag *dag;
+    const EmitOptions *opt;
+    const char *prefix;
+    Scheduler sched;
+} Emitter;
+
+static int c_precedence(const Emitter *e, NodeId id)
+{
+    if (e->sched.temp[id] >= 0)
+        return 4;
+    switch (dag_op(e->dag, id)) {
+    case OP_ADD: case OP_SUB: return 1;
+    case OP_MUL: case OP_DIV: return 2;
+    case OP_NEG: return 3;
+    default: return 4;
+    }
+}
+
+static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top);
+
+static void put_operand(Emitter *e, StrBuf *sb, NodeId id, int parent, bool right)
+{
+    int p = c_precedence(e, id);
+    /* Equal precedence on the right keeps the graph's grouping: a - (b - c),
+       a * (b / c); floating point is not associative. */
+    bool paren = p < parent || (right && p == parent);
+    if (paren)
+        sb_putc(sb, '(');
+    put_expr(e, sb, id, false);
+    if (paren)
+        sb_putc(sb, ')');
+}
+
+static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top)
+{
+    const DagNode *n = dag_node(e->dag, id);
+    if (!top && e->sched.temp[id] >= 0) {
+        sb_printf(sb, "u%d", e->sched.temp[id]);
+        return;
+    }
+    DagOp op = (DagOp)n->op;
+    switch (op) {
+    case OP_CONST: put_literal(sb, n->value, e->opt->real_float); return;
+    case OP_VAR:   sb_printf(sb, "q[%d]", n->a); return;
+    case OP_VARD:  sb_printf(sb, "qd[%d]", n->a); return;
+    case OP_TIME:  sb_puts(sb, "t"); return;
+    case OP_NEG:
+        sb_putc(sb, '-');
+        put_operand(e, sb, n->a, 4, false);
+        return;
+    case OP_ADD: case OP_SUB: case OP_MUL: case OP_DIV: {
+        int p = op == OP_ADD || op == OP_SUB ? 1 : 2;
+        put_operand(e, sb, n->a, p, false);
+        sb_printf(sb, " %s ", dag_op_info[op].spelling);
+        put_operand(e, sb, n->b, p, true);
+        return;
+    }
+    default:
+        sb_printf(sb, "%s(", e->opt->real_float ? dag_op_info[op].c_float : dag_op_info[op].c_double);
+        put_expr(e, sb, n->a, false);
+        if (dag_op_info[op].arity == 2) {
+            sb_puts(sb, ", ");
+            put_expr(e, sb, n->b, false);
+        }
+        sb_putc(sb, ')');
+        return;
+    }
+}
+
+/* The statements of one chunk: temporaries in id order, then the stores. */
+static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
+                      EmitFunction which)
+{
+    sched_prepare_chunk(&e->sched, fn, chunk);
+    const SchedChunk *c = &fn->chunks[chunk];
+    sb_puts(sb, "    ");
+    const char *params = function_params[which];
+    for (const char *p = params; *p;) {
+        size_t len = strcspn(p, ",");
+        sb_puts(sb, "(void)");
+        sb_putn(sb, p, len);
+        sb_puts(sb, ";");
+        p += len;
+        while (*p == ',' || *p == ' ')
+            p++;
+        if (*p)
+            sb_putc(sb, ' ');
+    }
+    sb_putc(sb, '\n');
+    for (int i = 0; i < c->nnodes; i++) {
+        NodeId id = c->nodes[i];
+        if (e->sched.temp[id] < 0)
+            continue;
+        sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
+        put_expr(e, sb, id, true);
+        sb_puts(sb, ";\n");
+    }
+    for (int i = c->first; i < c->first + c->count; i++) {
+        const SchedOutput *o = &fn->outputs[i];
+        sb_printf(sb, "    %s[%d] = ", o->array, o->index);
+        put_expr(e, sb, o->value, false);
+        sb_puts(sb, ";\n");
+    }
+}
+
+/* "q, qd, t, gamma" -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
+static void put_signature(StrBuf *sb, const char *prefix, EmitFunction which)
+{
+    const char *p = function_params[which];
+    bool first = true;
+    while (*p) {
+        size_t len = strcspn(p, ",");
+        bool input = (len == 1 && p[0] == 'q') || (len == 2 && memcmp(p, "qd", 2) == 0);
+        bool scalar = len == 1 && p[0] == 't';
+        sb_printf(sb, "%s%s%s_real %s", first ? "" : ", ", input ? "const " : "", prefix,
+                  scalar ? "" : "*");
+        sb_putn(sb, p, len);
+        first = false;
+        p += len;
+        while (*p == ',' || *p == ' ')
+            p++;
+    }
+}
+
+/* Fills parts (static helpers, one per chunk) and body (the function's
+   statements) for one generated function. */
+static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
+                         StrBuf *parts, StrBuf *body)
+{
+    if (fn->nchunks == 1) {
+        put_chunk(e, body, fn, 0, which);
+        return;
+    }
+    const char *p = e->prefix;
+    for (int c = 0; c < fn->nchunks; c++) {
+        sb_printf(parts, "static void %s_%s_part%d(", p, emit_function_names[which], c);
+        put_signature(parts, p, which);
+        sb_puts(parts, ")\n{\n");
+        put_chunk(e, parts, fn, c, which);
+        sb_puts(parts, "}\n\n");
+        sb_printf(body, "    %s_%s_part%d(%s);\n", p, emit_function_names[which], c,
+                  function_params[which]);
+    }
+}
+
+static void add_output(SchedOutput **outs, int *n, const char *array, int index, NodeId value)
+{
+    (*outs)[(*n)++] = (SchedOutput){array, index, value};
+}
+
+/* The outputs of each function, in the order the spec lists them. */
+static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
+{
+    const Model *m = kin->model;
+    *outs = xmalloc((size_t)(m->nh + 2 * m->nr + 2 * kin->nnz + 1) * sizeof **outs);
+    *n = 0;
+    bool all = which == EMIT_ALL;
+    if (which == EMIT_PHI || all)
+        for (int r = 0; r < m->nh; r++)
+            add_output(outs, n, "phi", r, kin->phi[r]);
+    if (which == EMIT_JAC || all)
+        for (int k = 0; k < kin->nnz; k++)
+            add_output(outs, n, "jac", kin->jac[k].row * m->nq + kin->jac[k].col, kin->jac[k].value);
+    if (which == EMIT_JAC_NZ)
+        for (int k = 0; k < kin->nnz; k++)
+            add_output(outs, n, "vals", k, kin->jac[k].value);
+    if (which == EMIT_JAC_NZ && kin->nnz == 0)     /* the one placeholder slot */
+        add_output(outs, n, "vals", 0, DAG_ZERO);
+    if (which == EMIT_NU || all)
+        for (int r = 0; r < m->nr; r++)
+            add_output(outs, n, "nu", r, kin->nu[r]);
+    if (which == EMIT_GAMMA || all)
+        for (int r = 0; r < m->nr; r++)
+            add_output(outs, n, "gamma", r, kin->gamma[r]);
+}
+
+static void put_string_list(StrBuf *sb, const char *const *names, int n)
+{
+    for (int i = 0; i < n; i++) {
+        sb_puts(sb, "    ");
+        sb_put_c_string(sb, names[i]);
+        sb_puts(sb, ",\n");
+    }
+}
+
+static void put_int_list(StrBuf *sb, const Kinematics *kin, bool rows)
+{
+    for (int k = 0; k < kin->nnz; k++) {
+        sb_printf(sb, "%s%d,", k % 16 == 0 ? "    " : " ", rows ? kin->jac[k].row : kin->jac[k].col);
+        if (k % 16 == 15 || k == kin->nnz - 1)
+            sb_putc(sb, '\n');
+    }
+    if (kin->nnz == 0)
+        sb_puts(sb, "    0\n");
+}
+
+/* The banner names the input by its base name, with anything that could
+   end the comment or confuse a reader replaced. */
+static void put_banner(StrBuf *sb, const char *source)
+{
+    const char *base = strrchr(source, '/');
+    base = base ? base + 1 : source;
+    sb_printf(sb, "Code generated by mechc %s from ", MECHC_VERSION);
+    for (const char *c = base; *c; c++)
+        sb_putc(sb, isalnum((unsigned char)*c) || strchr("._+-", *c) ? *c : '_');
+    sb_puts(sb, ". DO NOT EDIT.");
+}
+
+bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag)
+{
+    const Model *m = kin->model;
+    memset(out, 0, sizeof *out);
+    if (opt->prefix) {
+        const char *why = emit_check_prefix(opt->prefix);
+        if (why) {
+            diag_error_nopos(diag, "--prefix '%s' cannot be used: %s", opt->prefix, why);
+            return false;
+        }
+        snprintf(out->prefix, sizeof out->prefix, "%s", opt->prefix);
+    } else {
+        sanitize_prefix(m->name, out->prefix, sizeof out->prefix);
+    }
+    char upper[128];
+    size_t plen = strlen(out->prefix);
+    for (size_t i = 0; i <= plen; i++)
+        upper[i] = (char)toupper((unsigned char)out->prefix[i]);
+
+    Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix};
+    sched_init(&e.sched, &m->dag, opt->chunk_nodes > 0 ? opt->chunk_nodes : 2000);
+    StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        sb_init(&parts[f]);
+        sb_init(&bodies[f]);
+        SchedOutput *outs;
+        int n;
+        collect_outputs(kin, (EmitFunction)f, &outs, &n);
+        SchedFunction fn;
+        sched_function(&e.sched, outs, n, &fn);
+        put_function(&e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
+        out->ops[f] = fn.ops;
+        out->chunks[f] = fn.nchunks;
+        sched_function_free(&fn);
+        sb_puts(&parts[f], "");         /* never NULL below */
+        sb_puts(&bodies[f], "");
+    }
+    sched_free(&e.sched);
+
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface;
+    StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface};
+    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
+        sb_init(all_bufs[i]);
+        sb_puts(all_bufs[i], "");
+    }
+    put_banner(&banner, opt->source_name ? opt->source_name : m->file);
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
+    for (int i = 0; i < m->nq; i++) {
+        sb_puts(&q0, "    ");
+        put_literal(&q0, m->q0[i], opt->real_float);
+        sb_puts(&q0, ",\n");
+    }
+    put_string_list(&coords, m->coord_names, m->nq);
+    for (int r = 0; r < m->nr; r++) {
+        sb_puts(&rows, "    ");
+        sb_put_c_string(&rows, m->rows[r].name);
+        sb_puts(&rows, ",\n");
+    }
+    put_int_list(&jrow, kin, true);
+    put_int_list(&jcol, kin, false);
+    if (opt->declare_math) {
+        sb_puts(&math, "/* libm, declared rather than included: no system headers needed */\n");
+        for (int op = OP_POW; op < OP_COUNT; op++)
+            sb_printf(&math, "double %s(double%s);\n", dag_op_info[op].c_double,
+                      dag_op_info[op].arity == 2 ? ", double" : "");
+    } else {
+        sb_puts(&math, "#include <math.h>\n");
+    }
+
+    char nq[32], nh[32], nv[32], nnz[32], guard[160];
+    snprintf(nq, sizeof nq, "%d", m->nq);
+    snprintf(nh, sizeof nh, "%d", m->nh);
+    snprintf(nv, sizeof nv, "%d", m->nv);
+    /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
+       placeholder entry (row 0, column 0, value 0). */
+    snprintf(nnz, sizeof nnz, "%d", kin->nnz > 0 ? kin->nnz : 1);
+    snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
+    TemplateVar vars[] = {
+        {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
+        {"REAL", opt->real_float ? "float" : "double"}, {"NQ", nq}, {"NH", nh}, {"NV", nv},
+        {"NNZ", nnz}, {"GUARD", guard}, {"MATH", math.data}, {"INTERFACE", ""},
+        {"Q0", q0.data}, {"COORD_NAMES", coords.data}, {"ROW_NAMES", rows.data},
+        {"JAC_ROW", jrow.data}, {"JAC_COL", jcol.data},
+        {"PHI_PARTS", parts[EMIT_PHI].data}, {"PHI_BODY", bodies[EMIT_PHI].data},
+        {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
+        {"JAC_NZ_PARTS", parts[EMIT_JAC_NZ].data}, {"JAC_NZ_BODY", bodies[EMIT_JAC_NZ].data},
+        {"NU_PARTS", parts[EMIT_NU].data}, {"NU_BODY", bodies[EMIT_NU].data},
+        {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
+        {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
+    };
+    int nvars = (int)(sizeof vars / sizeof *vars);
+    const char *bad = template_render(&iface, template_interface, vars, nvars);
+    vars[11].value = iface.data;                    /* INTERFACE */
+    StrBuf header, source;
+    sb_init(&header);
+    sb_init(&source);
+    if (!bad)
+        bad = template_render(&header, template_mech_h, vars, nvars);
+    if (opt->header_name) {
+        StrBuf inc;
+        sb_init(&inc);
+        sb_puts(&inc, "#include ");
+        sb_put_c_string(&inc, opt->header_name);
+        sb_puts(&inc, "\n");
+        vars[11].value = inc.data;
+        if (!bad)
+            bad = template_render(&source, template_mech_c, vars, nvars);
+        sb_free(&inc);
+    } else if (!bad) {
+        bad = template_render(&source, template_mech_c, vars, nvars);
+    }
+    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++)
+        sb_free(all_bufs[i]);
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        sb_free(&parts[f]);
+        sb_free(&bodies[f]);
+    }
+    if (bad) {
+        fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", bad);
+        abort();
+    }
+    out->c_text = sb_take(&source);
+    out->h_text = sb_take(&header);
+    return true;
+}
+
+void emit_result_free(EmitResult *out)
+{
+    free(out->c_text);
+    free(out->h_text);
+    out->c_text = out->h_text = NULL;
+}

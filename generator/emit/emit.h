@@ -1,0 +1,48 @@
+/* emit.h - C text for a differentiated mechanism, through the templates (spec section 4). */
+#ifndef MECHC_EMIT_H
+#define MECHC_EMIT_H
+
+#include "../base/diag.h"
+#include "../diff/kinematics.h"
+
+#include <stdbool.h>
+
+typedef struct EmitOptions {
+    const char *prefix;         /* NULL: the mechanism name, sanitized */
+    bool real_float;            /* float kernels (sinf, 1.5f, ...) */
+    const char *header_name;    /* non-NULL: the .c includes this header
+                                   instead of carrying the interface */
+    bool declare_math;          /* declare libm functions instead of
+                                   #include <math.h> (the in-process JIT
+                                   needs no system headers) */
+    int chunk_nodes;            /* most operations per C function (default 2000) */
+    const char *source_name;    /* the input file, named in the banner */
+} EmitOptions;
+
+/* The spec's function order, for op counts and reports. */
+typedef enum EmitFunction {
+    EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_FUNCTION_COUNT
+} EmitFunction;
+
+extern const char *const emit_function_names[EMIT_FUNCTION_COUNT];
+
+typedef struct EmitResult {
+    char *c_text;               /* malloc'ed */
+    char *h_text;               /* malloc'ed; the header (always produced) */
+    char prefix[128];           /* the prefix used */
+    int ops[EMIT_FUNCTION_COUNT];
+    int chunks[EMIT_FUNCTION_COUNT];
+} EmitResult;
+
+EmitOptions emit_default_options(void);
+
+/* Checks a --prefix value: NULL when it is a usable C identifier, else
+   the reason it is not. */
+const char *emit_check_prefix(const char *prefix);
+
+/* Writes the C source and header. Returns false (diag filled) only for an
+   unusable prefix; everything else in the model is already valid. */
+bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag);
+void emit_result_free(EmitResult *out);
+
+#endif

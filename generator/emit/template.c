@@ -1,0 +1,40 @@
+/* template.c - placeholder substitution: @NAME@ (upper case, digits, _) becomes its value. */
+#include "template.h"
+
+#include <string.h>
+
+static int placeholder_length(const char *p)
+{
+    int n = 0;
+    while ((p[n] >= 'A' && p[n] <= 'Z') || (p[n] >= '0' && p[n] <= '9') || p[n] == '_')
+        n++;
+    return n > 0 && p[n] == '@' ? n : 0;
+}
+
+const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *vars, int nvars)
+{
+    const char *p = tmpl;
+    while (*p) {
+        const char *at = strchr(p, '@');
+        if (!at) {
+            sb_puts(out, p);
+            break;
+        }
+        sb_putn(out, p, (size_t)(at - p));
+        int n = placeholder_length(at + 1);
+        if (n == 0) {
+            sb_putc(out, '@');
+            p = at + 1;
+            continue;
+        }
+        int i = 0;
+        while (i < nvars && !(strlen(vars[i].name) == (size_t)n
+                              && memcmp(vars[i].name, at + 1, (size_t)n) == 0))
+            i++;
+        if (i == nvars)
+            return at + 1;
+        sb_puts(out, vars[i].value);
+        p = at + n + 2;
+    }
+    return NULL;
+}

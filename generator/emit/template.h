@@ -1,0 +1,16 @@
+/* template.h - fills @NAME@ placeholders of an embedded template. */
+#ifndef MECHC_TEMPLATE_H
+#define MECHC_TEMPLATE_H
+
+#include "../base/strbuf.h"
+
+typedef struct TemplateVar {
+    const char *name;       /* without the @ signs */
+    const char *value;
+} TemplateVar;
+
+/* Appends tmpl to out with every @NAME@ replaced. A placeholder with no
+   value is a bug in mechc: returns its name so the caller can report it. */
+const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *vars, int nvars);
+
+#endif

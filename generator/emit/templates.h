@@ -1,0 +1,9 @@
+/* templates.h - the templates (templates/NAME.tmpl), embedded by the Makefile as C strings. */
+#ifndef MECHC_TEMPLATES_H
+#define MECHC_TEMPLATES_H
+
+extern const char template_interface[];
+extern const char template_mech_c[];
+extern const char template_mech_h[];
+
+#endif

@@ -1,0 +1,136 @@
+/* jit.c - libtcc behind one owning wrapper: compile to memory, relocate, look the kernels up.
+ *
+ * The generated source declares the libm functions it uses instead of
+ * including <math.h>, and is compiled with -nostdlib: nothing is read
+ * from the file system, and every external symbol is one we add here.
+ */
+#include "jit.h"
+
+#include "../base/arena.h"
+#include "../base/strbuf.h"
+
+#include <libtcc.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+struct Jit {
+    TCCState *state;
+    Kernels kernels;
+};
+
+static void collect_error(void *opaque, const char *msg)
+{
+    StrBuf *sb = opaque;
+    if (sb->len < 4000)
+        sb_printf(sb, "%s\n", msg);
+}
+
+static void add_libm(TCCState *s)
+{
+    /* Casting through the exact prototype keeps the table honest. */
+    double (*const unary[])(double) = {sin, cos, tan, asin, acos, atan, sqrt, exp, log, sinh, cosh, tanh};
+    const char *const unary_names[] = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt",
+                                       "exp", "log", "sinh", "cosh", "tanh"};
+    for (size_t i = 0; i < sizeof unary / sizeof *unary; i++)
+        tcc_add_symbol(s, unary_names[i], (const void *)unary[i]);
+    tcc_add_symbol(s, "pow", (const void *)pow);
+    tcc_add_symbol(s, "atan2", (const void *)atan2);
+}
+
+/* Keeps the source of a failed compile for the bug report. */
+static void save_failed_source(const char *source, const char *prefix, char *path, size_t size)
+{
+    const char *dir = getenv("TMPDIR");
+    snprintf(path, size, "%s/mechc-jit-%s-XXXXXX.c", dir && *dir ? dir : "/tmp", prefix);
+    int fd = mkstemps(path, 2);
+    if (fd < 0) {
+        snprintf(path, size, "(could not save the source)");
+        return;
+    }
+    FILE *f = fdopen(fd, "w");
+    if (f) {
+        fputs(source, f);
+        fclose(f);
+    } else {
+        close(fd);
+    }
+}
+
+static void *lookup(TCCState *s, const char *prefix, const char *name)
+{
+    char symbol[256];
+    snprintf(symbol, sizeof symbol, "%s_%s", prefix, name);
+    return tcc_get_symbol(s, symbol);
+}
+
+Jit *jit_compile(const char *source, const char *prefix, Diag *diag)
+{
+    StrBuf errors;
+    sb_init(&errors);
+    sb_puts(&errors, "");
+    TCCState *s = tcc_new();
+    if (!s) {
+        diag_error_nopos(diag, "internal error: libtcc could not start");
+        return NULL;
+    }
+    tcc_set_error_func(s, &errors, collect_error);
+    tcc_set_options(s, "-nostdlib");
+    tcc_set_output_type(s, TCC_OUTPUT_MEMORY);
+    StrBuf unit;
+    sb_init(&unit);
+    sb_printf(&unit, "#line 1 \"<mechc:%s.c>\"\n", prefix);
+    sb_puts(&unit, source);
+    int rc = tcc_compile_string(s, unit.data);
+    sb_free(&unit);
+    if (rc == 0) {
+        add_libm(s);
+#ifdef TCC_RELOCATE_AUTO
+        rc = tcc_relocate(s, TCC_RELOCATE_AUTO);       /* libtcc 0.9.27 (Debian) */
+#else
+        rc = tcc_relocate(s);                          /* libtcc after 0.9.27 */
+#endif
+    }
+    Jit *jit = NULL;
+    if (rc == 0) {
+        jit = xcalloc(1, sizeof *jit);
+        jit->state = s;
+        Kernels *k = &jit->kernels;
+        k->phi = (KernelPhi)lookup(s, prefix, "phi");
+        k->jac = (KernelPhi)lookup(s, prefix, "jac");
+        k->jac_nz = (KernelPhi)lookup(s, prefix, "jac_nz");
+        k->nu = (KernelPhi)lookup(s, prefix, "nu");
+        k->gamma = (KernelGamma)lookup(s, prefix, "gamma");
+        k->all = (KernelAll)lookup(s, prefix, "all");
+        k->jac_row = lookup(s, prefix, "jac_row");
+        k->jac_col = lookup(s, prefix, "jac_col");
+        if (!k->phi || !k->jac || !k->jac_nz || !k->nu || !k->gamma || !k->all
+            || !k->jac_row || !k->jac_col) {
+            sb_puts(&errors, "a generated function is missing after compilation\n");
+            rc = -1;
+            free(jit);
+            jit = NULL;
+        }
+    }
+    if (rc != 0) {
+        char path[512];
+        save_failed_source(source, prefix, path, sizeof path);
+        diag_error_nopos(diag, "internal error: the generated C did not compile with libtcc "
+                         "(a bug in mechc; source saved to %s):\n%s", path, errors.data);
+        tcc_delete(s);
+    }
+    sb_free(&errors);
+    return jit;
+}
+
+const Kernels *jit_kernels(const Jit *jit) { return &jit->kernels; }
+
+void jit_free(Jit *jit)
+{
+    if (!jit)
+        return;
+    tcc_delete(jit->state);
+    free(jit);
+}

@@ -1,0 +1,32 @@
+/* jit.h - compiles generated C in memory with libtcc and hands back the kernels. */
+#ifndef MECHC_JIT_H
+#define MECHC_JIT_H
+
+#include "../base/diag.h"
+
+typedef void (*KernelPhi)(const double *q, double t, double *out);
+typedef void (*KernelGamma)(const double *q, const double *qd, double t, double *gamma);
+typedef void (*KernelAll)(const double *q, const double *qd, double t,
+                          double *phi, double *jac, double *nu, double *gamma);
+
+/* The generated functions of one mechanism, however they were obtained
+   (libtcc, dlopen of a cc-built library). */
+typedef struct Kernels {
+    KernelPhi phi, jac, jac_nz, nu;
+    KernelGamma gamma;
+    KernelAll all;
+    const int *jac_row, *jac_col;
+} Kernels;
+
+typedef struct Jit Jit;
+
+/* Compiles source (double kernels, emitted with declare_math) whose
+   symbols start with prefix. On failure (a bug in mechc: generated code
+   must always compile) the source is saved to a file named in diag's
+   message and NULL is returned. */
+Jit *jit_compile(const char *source, const char *prefix, Diag *diag);
+const Kernels *jit_kernels(const Jit *jit);
+/* Frees the compiled code: the kernel pointers die with it. */
+void jit_free(Jit *jit);
+
+#endif

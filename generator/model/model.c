@@ -1,0 +1,518 @@
+/* model.c - statements to a resolved mechanism: names, coordinates, joints and rows.
+ *
+ * Walks the statements in order, so "declared before used" falls out of
+ * the walk. Params and initial values are folded to constants through the
+ * expression graph itself (a constant expression simplifies to one CONST
+ * node); anything else is a position-carrying error. Rows are collected
+ * holonomic first, velocity level after, each group in statement order.
+ */
+#include "model.h"
+
+#include "../base/hashmap.h"
+#include "../parse/parse.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT } EntityKind;
+
+typedef struct Entity {
+    EntityKind kind;
+    const char *name;
+    SrcPos pos;
+    int q;              /* first coordinate (body, point, coord) */
+    double value;       /* param */
+} Entity;
+
+typedef struct Builder {
+    Model *model;
+    Diag *diag;
+    const MechLimits *limits;
+    StrMap names;
+    Entity *entities;
+    int nentities, cap_entities;
+    int cap_coords, cap_joints;
+    Row *pos_rows, *vel_rows;
+    int npos, nvel, cap_pos, cap_vel;
+} Builder;
+
+static const char *entity_word(EntityKind kind)
+{
+    switch (kind) {
+    case ENT_PARAM: return "a param";
+    case ENT_BODY:  return "a body";
+    case ENT_POINT: return "a point";
+    case ENT_COORD: return "a coord";
+    case ENT_JOINT: return "a joint";
+    }
+    return "a name";
+}
+
+static void grow(void **p, int *cap, int need, size_t size)
+{
+    if (need <= *cap)
+        return;
+    int c = *cap ? *cap * 2 : 16;
+    while (c < need)
+        c *= 2;
+    *p = xrealloc(*p, (size_t)c, size);
+    *cap = c;
+}
+
+static int line_of(const Builder *b, SrcPos pos)
+{
+    int line, col;
+    diag_locate(b->diag, pos.offset, &line, &col);
+    return line;
+}
+
+static Entity *lookup(Builder *b, const char *name, SrcPos pos)
+{
+    int index;
+    if (!strmap_get(&b->names, name, &index))
+        diag_fail(b->diag, pos, "unknown name '%s' (names must be declared before use)", name);
+    return &b->entities[index];
+}
+
+static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos)
+{
+    int index;
+    if (strmap_get(&b->names, name, &index))
+        diag_fail(b->diag, pos, "duplicate name '%s' (first declared as %s on line %d)",
+                  name, entity_word(b->entities[index].kind),
+                  line_of(b, b->entities[index].pos));
+    grow((void **)&b->entities, &b->cap_entities, b->nentities + 1, sizeof *b->entities);
+    Entity *e = &b->entities[b->nentities];
+    *e = (Entity){.kind = kind, .name = name, .pos = pos, .q = -1};
+    strmap_put(&b->names, name, b->nentities++);
+    return e;
+}
+
+static int add_coord(Builder *b, const char *owner, const char *suffix, double q0, SrcPos pos)
+{
+    Model *m = b->model;
+    if (m->nq >= b->limits->max_coords)
+        diag_fail(b->diag, pos, "too many coordinates (the limit is %d)", b->limits->max_coords);
+    grow((void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
+    /* q0 shares the capacity of coord_names */
+    m->q0 = xrealloc(m->q0, (size_t)b->cap_coords, sizeof *m->q0);
+    char *name = arena_alloc(&m->arena, strlen(owner) + strlen(suffix) + 1);
+    strcpy(name, owner);
+    strcat(name, suffix);
+    m->coord_names[m->nq] = name;
+    m->q0[m->nq] = q0;
+    return m->nq++;
+}
+
+/* ---- expressions ---- */
+
+typedef enum ExprContext {
+    EXPR_CONSTANT,      /* params, initial values, offsets, axes */
+    EXPR_HOLONOMIC,     /* may use coordinates and t */
+    EXPR_VELOCITY,      /* may also use der() */
+} ExprContext;
+
+static const char *context_what(ExprContext ctx)
+{
+    return ctx == EXPR_CONSTANT ? "a constant expression (numbers, pi and earlier params)"
+                                : "a holonomic row (use a 'velocity' or 'driver' statement for der())";
+}
+
+/* The coordinate index an AST_NAME / AST_MEMBER names, or fails. */
+static int coordinate_of(Builder *b, const Ast *ast)
+{
+    Entity *e = lookup(b, ast->name, ast->pos);
+    if (ast->kind == AST_NAME) {
+        if (e->kind == ENT_COORD)
+            return e->q;
+        if (e->kind == ENT_BODY)
+            diag_fail(b->diag, ast->pos, "'%s' is a body: write %s.x, %s.y or %s.phi",
+                      e->name, e->name, e->name, e->name);
+        if (e->kind == ENT_POINT)
+            diag_fail(b->diag, ast->pos, "'%s' is a point: write %s.x or %s.y",
+                      e->name, e->name, e->name);
+        diag_fail(b->diag, ast->pos, "'%s' is %s, not a coordinate", e->name, entity_word(e->kind));
+    }
+    if (e->kind != ENT_BODY && e->kind != ENT_POINT)
+        diag_fail(b->diag, ast->pos, "'%s' is %s and has no components", e->name,
+                  entity_word(e->kind));
+    if (strcmp(ast->member, "x") == 0)
+        return e->q;
+    if (strcmp(ast->member, "y") == 0)
+        return e->q + 1;
+    if (e->kind == ENT_BODY && strcmp(ast->member, "phi") == 0)
+        return e->q + 2;
+    diag_fail(b->diag, ast->member_pos, "%s '%s' has no coordinate '%s' (it has %s)",
+              e->kind == ENT_BODY ? "body" : "point", e->name, ast->member,
+              e->kind == ENT_BODY ? "x, y and phi" : "x and y");
+}
+
+static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
+{
+    Dag *dag = &b->model->dag;
+    switch (ast->kind) {
+    case AST_NUM:
+        return dag_const(dag, ast->num);
+    case AST_TIME:
+        if (ctx == EXPR_CONSTANT)
+            diag_fail(b->diag, ast->pos, "'t' cannot appear in %s", context_what(ctx));
+        return dag_time(dag);
+    case AST_NAME: {
+        Entity *e = lookup(b, ast->name, ast->pos);
+        if (e->kind == ENT_PARAM)
+            return dag_const(dag, e->value);
+        if (ctx == EXPR_CONSTANT)
+            diag_fail(b->diag, ast->pos, "'%s' is %s; only params may appear in %s",
+                      e->name, entity_word(e->kind), context_what(ctx));
+        return dag_var(dag, coordinate_of(b, ast));
+    }
+    case AST_MEMBER:
+        if (ctx == EXPR_CONSTANT) {
+            lookup(b, ast->name, ast->pos);
+            diag_fail(b->diag, ast->pos, "coordinate '%s.%s' cannot appear in %s",
+                      ast->name, ast->member, context_what(ctx));
+        }
+        return dag_var(dag, coordinate_of(b, ast));
+    case AST_DER:
+        if (ctx != EXPR_VELOCITY)
+            diag_fail(b->diag, ast->pos, "der() cannot appear in %s", context_what(ctx));
+        if (ast->lhs->kind != AST_NAME && ast->lhs->kind != AST_MEMBER)
+            diag_fail(b->diag, ast->lhs->pos, "der() takes a coordinate, not %s",
+                      ast_describe(ast->lhs));
+        return dag_vard(dag, coordinate_of(b, ast->lhs));
+    case AST_NEG:
+        return dag_neg(dag, lower_expr(b, ast->lhs, ctx));
+    case AST_BINARY:
+        return dag_apply(dag, ast->op, lower_expr(b, ast->lhs, ctx), lower_expr(b, ast->rhs, ctx));
+    case AST_CALL: {
+        NodeId x = lower_expr(b, ast->lhs, ctx);
+        NodeId y = ast->rhs ? lower_expr(b, ast->rhs, ctx) : DAG_NONE;
+        return dag_apply(dag, ast->op, x, y);
+    }
+    }
+    diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
+}
+
+static double constant_value(Builder *b, const Ast *ast, const char *what)
+{
+    if (!ast)
+        return 0.0;
+    NodeId id = lower_expr(b, ast, EXPR_CONSTANT);
+    double v;
+    if (!dag_is_const(&b->model->dag, id, &v) || !isfinite(v))
+        diag_fail(b->diag, ast->pos, "%s is not a finite number", what);
+    return v;
+}
+
+static bool mentions_der(const Ast *ast)
+{
+    if (!ast)
+        return false;
+    if (ast->kind == AST_DER)
+        return true;
+    return mentions_der(ast->lhs) || mentions_der(ast->rhs);
+}
+
+/* ---- statements ---- */
+
+static void declare_coordinates(Builder *b, const Stmt *s)
+{
+    static const char *const suffix[3] = {".x", ".y", ".phi"};
+    static const char *const word[3] = {"x", "y", "phi"};
+    char what[64];
+    if (s->kind == STMT_COORD) {
+        Entity *e = declare(b, ENT_COORD, s->name, s->name_pos);
+        double v = constant_value(b, s->value, "the initial value");
+        e->q = add_coord(b, s->name, "", v, s->name_pos);
+        return;
+    }
+    int n = s->kind == STMT_BODY ? 3 : 2;
+    double v[3];
+    for (int i = 0; i < n; i++) {
+        snprintf(what, sizeof what, "the initial %s", word[i]);
+        v[i] = constant_value(b, s->init[i], what);
+    }
+    Entity *e = declare(b, s->kind == STMT_BODY ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
+    for (int i = 0; i < n; i++) {
+        int q = add_coord(b, s->name, suffix[i], v[i], s->name_pos);
+        if (i == 0)
+            e->q = q;
+    }
+}
+
+static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
+                             const char *keyword)
+{
+    Attach r = {.q = -1};
+    if (at->has_offset) {
+        r.sx = constant_value(b, at->sx, "an attachment offset");
+        r.sy = constant_value(b, at->sy, "an attachment offset");
+    }
+    if (strcmp(at->name, "ground") == 0) {
+        if (rule == ATTACH_BODY || rule == ATTACH_BODY_ONLY)
+            diag_fail(b->diag, at->pos, "%s needs a body here, not ground", keyword);
+        return r;
+    }
+    Entity *e = lookup(b, at->name, at->pos);
+    switch (e->kind) {
+    case ENT_BODY:
+        if (rule == ATTACH_BODY_ONLY && at->has_offset)
+            diag_fail(b->diag, at->pos, "%s takes the body name alone, without an offset", keyword);
+        r.q = e->q;
+        r.has_phi = true;
+        return r;
+    case ENT_POINT:
+        if (rule != ATTACH_ANY)
+            diag_fail(b->diag, at->pos, "%s needs a body%s here; '%s' is a point (it has no angle)",
+                      keyword, rule == ATTACH_FRAME ? " or ground" : "", e->name);
+        if (at->has_offset)
+            diag_fail(b->diag, at->pos, "'%s' is a point: it has no local frame, write '%s' without an offset",
+                      e->name, e->name);
+        r.q = e->q;
+        return r;
+    case ENT_PARAM: case ENT_COORD: case ENT_JOINT:
+        break;
+    }
+    diag_fail(b->diag, at->pos, "'%s' is %s; %s attaches to bodies, points or ground",
+              e->name, entity_word(e->kind), keyword);
+}
+
+static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
+{
+    Model *m = b->model;
+    const JointInfo *info = &joint_info[j->kind];
+    if (b->npos + b->nvel >= b->limits->max_rows)
+        diag_fail(b->diag, j->pos, "too many rows (the limit is %d)", b->limits->max_rows);
+    const char *suffix = info->suffix[index];
+    char *name = arena_alloc(&m->arena, strlen(j->name) + strlen(suffix) + 1);
+    strcpy(name, j->name);
+    strcat(name, suffix);
+    Row row = {.name = name, .kind = j->kind, .velocity = j->velocity, .expr = expr,
+               .joint = (int)(j - m->joints), .pos = j->pos};
+    if (j->velocity) {
+        grow((void **)&b->vel_rows, &b->cap_vel, b->nvel + 1, sizeof *b->vel_rows);
+        b->vel_rows[b->nvel++] = row;
+    } else {
+        grow((void **)&b->pos_rows, &b->cap_pos, b->npos + 1, sizeof *b->pos_rows);
+        b->pos_rows[b->npos++] = row;
+    }
+}
+
+static void build_joint(Builder *b, const Stmt *s)
+{
+    Model *m = b->model;
+    const JointInfo *info = &joint_info[s->joint];
+    declare(b, ENT_JOINT, s->name, s->name_pos);
+    grow((void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
+    Joint *j = &m->joints[m->njoints];
+    *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
+                 .option = DAG_ZERO, .expr = DAG_NONE};
+    for (int i = 0; i < info->attachments; i++) {
+        Attach at = resolve_attach(b, &s->attach[i], info->slot[i], info->keyword);
+        if (i == 0)
+            j->a = at;
+        else
+            j->b = at;
+    }
+    if (info->axis) {
+        j->ux = constant_value(b, s->axis[0], "the axis component ux");
+        j->uy = constant_value(b, s->axis[1], "the axis component uy");
+        if (j->ux == 0.0 && j->uy == 0.0)
+            diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
+    }
+    if (s->option) {
+        if (mentions_der(s->option))
+            diag_fail(b->diag, s->option_pos, "der() cannot appear in %s", context_what(EXPR_HOLONOMIC));
+        j->option = lower_expr(b, s->option, EXPR_HOLONOMIC);
+    }
+    switch (info->level) {
+    case LEVEL_POSITION: j->velocity = false; break;
+    case LEVEL_VELOCITY: j->velocity = true; break;
+    case LEVEL_EITHER:   j->velocity = mentions_der(s->lhs) || mentions_der(s->rhs); break;
+    }
+    if (info->attachments == 0) {
+        if (s->joint == JOINT_VELOCITY && !j->velocity)
+            diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
+                      "write it as a 'constraint' or use der(coordinate)", s->name);
+        ExprContext ctx = j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC;
+        j->expr = dag_sub(&m->dag, lower_expr(b, s->lhs, ctx), lower_expr(b, s->rhs, ctx));
+    }
+    m->njoints++;
+    NodeId rows[3];
+    joints_lower(m, j, rows);
+    j->nrows = info->rows;
+    for (int i = 0; i < info->rows; i++)
+        push_row(b, j, i, rows[i]);
+}
+
+static void build(Builder *b, const Program *prog, const char *default_name)
+{
+    Model *m = b->model;
+    m->name = default_name;
+    const Stmt *last = NULL;
+    for (const Stmt *s = prog->first; s; s = s->next) {
+        last = s;
+        switch (s->kind) {
+        case STMT_MECHANISM:
+            m->name = s->name;
+            break;
+        case STMT_PARAM: {
+            double v = constant_value(b, s->value, "the param value");
+            declare(b, ENT_PARAM, s->name, s->name_pos)->value = v;
+            break;
+        }
+        case STMT_BODY: case STMT_POINT: case STMT_COORD:
+            declare_coordinates(b, s);
+            break;
+        case STMT_JOINT:
+            build_joint(b, s);
+            break;
+        }
+    }
+    SrcPos where = last ? last->pos : (SrcPos){0};
+    if (m->nq == 0)
+        diag_fail(b->diag, where, "the mechanism has no coordinates: declare a body, point or coord");
+    if (b->npos + b->nvel == 0)
+        diag_fail(b->diag, where, "the mechanism has no constraint rows: add a joint, constraint or driver");
+    /* Holonomic rows first, then velocity-level rows. */
+    m->nh = b->npos;
+    m->nv = b->nvel;
+    m->nr = m->nh + m->nv;
+    m->rows = arena_alloc_array(&m->arena, (size_t)m->nr, sizeof *m->rows);
+    if (m->nh)
+        memcpy(m->rows, b->pos_rows, (size_t)m->nh * sizeof *m->rows);
+    if (m->nv)
+        memcpy(m->rows + m->nh, b->vel_rows, (size_t)m->nv * sizeof *m->rows);
+    /* first_row: position of each joint's first row in the final order */
+    int pos_seen = 0, vel_seen = 0;
+    for (int i = 0; i < m->njoints; i++) {
+        Joint *j = &m->joints[i];
+        j->first_row = j->velocity ? m->nh + vel_seen : pos_seen;
+        if (j->velocity)
+            vel_seen += j->nrows;
+        else
+            pos_seen += j->nrows;
+    }
+}
+
+Model *model_load(const char *text, int text_len, const char *file,
+                  const char *default_name, const MechLimits *limits, Diag *diag)
+{
+    Model *m = xcalloc(1, sizeof *m);
+    arena_init(&m->arena);
+    dag_init(&m->dag, limits->max_nodes, diag);
+    m->file = arena_strdup(&m->arena, file);
+    diag->file = file;
+    diag->text = text;
+    diag->text_len = text_len;
+    Program prog;
+    if (!parse_program(&m->arena, diag, limits, &prog)) {
+        model_free(m);
+        return NULL;
+    }
+    Builder b = {.model = m, .diag = diag, .limits = limits};
+    strmap_init(&b.names);
+    jmp_buf escape;
+    jmp_buf *saved = diag->escape;
+    diag->escape = &escape;
+    bool ok = false;
+    if (setjmp(escape) == 0) {
+        build(&b, &prog, arena_strdup(&m->arena, default_name));
+        ok = true;
+    }
+    diag->escape = saved;
+    /* coord_names and q0 move into the arena so the model has one owner */
+    if (ok) {
+        const char **names = arena_alloc_array(&m->arena, (size_t)m->nq, sizeof *names);
+        double *q0 = arena_alloc_array(&m->arena, (size_t)m->nq, sizeof *q0);
+        memcpy(names, m->coord_names, (size_t)m->nq * sizeof *names);
+        memcpy(q0, m->q0, (size_t)m->nq * sizeof *q0);
+        Joint *joints = arena_alloc_array(&m->arena, (size_t)m->njoints, sizeof *joints);
+        memcpy(joints, m->joints, (size_t)m->njoints * sizeof *joints);
+        free(m->coord_names);
+        free(m->q0);
+        free(m->joints);
+        m->coord_names = names;
+        m->q0 = q0;
+        m->joints = joints;
+    } else {
+        free(m->coord_names);
+        free(m->q0);
+        free(m->joints);
+        m->coord_names = NULL;
+        m->q0 = NULL;
+        m->joints = NULL;
+    }
+    free(b.entities);
+    free(b.pos_rows);
+    free(b.vel_rows);
+    strmap_free(&b.names);
+    if (!ok) {
+        model_free(m);
+        return NULL;
+    }
+    return m;
+}
+
+void model_free(Model *model)
+{
+    if (!model)
+        return;
+    dag_free(&model->dag);
+    arena_free(&model->arena);
+    free(model);
+}
+
+char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag)
+{
+    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "rb");
+    if (!f) {
+        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 4096, n = 0;
+    char *buf = xmalloc(cap);
+    for (;;) {
+        if (n + 1 >= cap) {
+            cap *= 2;
+            buf = xrealloc(buf, cap, 1);
+        }
+        size_t got = fread(buf + n, 1, cap - n - 1, f);
+        n += got;
+        if (n > (size_t)limits->max_file_bytes) {
+            diag_error_nopos(diag, "'%s' is larger than the limit of %d bytes", path,
+                             limits->max_file_bytes);
+            free(buf);
+            if (f != stdin)
+                fclose(f);
+            return NULL;
+        }
+        if (got == 0)
+            break;
+    }
+    bool bad = ferror(f);
+    if (f != stdin)
+        fclose(f);
+    if (bad) {
+        diag_error_nopos(diag, "cannot read '%s'", path);
+        free(buf);
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = (int)n;
+    return buf;
+}
+
+char *model_file_stem(Arena *arena, const char *path)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    if (n == 0 || strcmp(path, "-") == 0)
+        return arena_strdup(arena, "mechanism");
+    return arena_strndup(arena, base, n);
+}

@@ -1,0 +1,70 @@
+/* model.h - a resolved mechanism: coordinates, joints and constraint rows as graph nodes. */
+#ifndef MECHC_MODEL_H
+#define MECHC_MODEL_H
+
+#include "../base/arena.h"
+#include "../base/diag.h"
+#include "../base/limits.h"
+#include "../dag/dag.h"
+#include "../parse/ast.h"
+
+/* A joint operand after name resolution: P = r + A(phi) s. */
+typedef struct Attach {
+    int q;              /* index of the x coordinate; -1 for ground */
+    bool has_phi;       /* a body: phi is coordinate q + 2 */
+    double sx, sy;      /* body-local offset, or global point for ground */
+} Attach;
+
+typedef struct Joint {
+    JointKind kind;
+    const char *name;
+    SrcPos pos;
+    Attach a, b;
+    double ux, uy;      /* axis, as written */
+    NodeId option;      /* length, angle or radius (angle absent: 0) */
+    NodeId expr;        /* expression statements: lhs - rhs */
+    bool velocity;      /* its rows are velocity level */
+    int first_row, nrows;
+} Joint;
+
+typedef struct Row {
+    const char *name;   /* J, J.x, ... */
+    JointKind kind;
+    bool velocity;      /* velocity level (Pfaffian) */
+    NodeId expr;        /* Phi (position) or Psi (velocity, with qd leaves) */
+    int joint;          /* index into joints */
+    SrcPos pos;         /* the statement, for diagnostics */
+} Row;
+
+typedef struct Model {
+    Arena arena;        /* owns every string and array below */
+    Dag dag;            /* owns the expression graph (rows and derivatives) */
+    const char *name;   /* mechanism name */
+    const char *file;   /* input file name as given */
+    int nq;
+    const char **coord_names;
+    double *q0;
+    int nh, nv, nr;     /* rows: nh holonomic first, then nv velocity level */
+    Row *rows;
+    int njoints;
+    Joint *joints;
+} Model;
+
+/* Reads, parses and resolves a .mech text. Returns NULL with diag filled
+   on bad input. default_name: the mechanism name when the file has no
+   `mechanism` statement (the file stem). */
+Model *model_load(const char *text, int text_len, const char *file,
+                  const char *default_name, const MechLimits *limits, Diag *diag);
+void model_free(Model *model);
+
+/* Reads a whole file ("-" = stdin) into a NUL-terminated buffer (free()).
+   Returns NULL with diag filled when it cannot be read or is too large. */
+char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag);
+
+/* The file stem of a path: "dir/slider_crank.mech" -> "slider_crank". */
+char *model_file_stem(Arena *arena, const char *path);
+
+/* Lowers one joint's rows into the graph (generator/model/joints.c). */
+void joints_lower(Model *model, const Joint *joint, NodeId rows_out[3]);
+
+#endif

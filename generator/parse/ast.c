@@ -1,0 +1,44 @@
+/* ast.c - the joint vocabulary expanded from joints.def, and names for AST kinds. */
+#include "ast.h"
+
+#include <string.h>
+
+const JointInfo joint_info[JOINT_KIND_COUNT] = {
+#define X(e, kw, na, sa, sb, ax, opt, nr, lvl, s0, s1, s2) \
+    [JOINT_##e] = {kw, na, {sa, sb}, ax, opt, nr, lvl, {s0, s1, s2}},
+#include "joints.def"
+#undef X
+};
+
+int joint_kind_from_keyword(const char *word, int len)
+{
+    for (int k = 0; k < JOINT_KIND_COUNT; k++) {
+        const char *kw = joint_info[k].keyword;
+        if ((int)strlen(kw) == len && memcmp(kw, word, (size_t)len) == 0)
+            return k;
+    }
+    return -1;
+}
+
+const char *ast_describe(const Ast *ast)
+{
+    switch (ast->kind) {
+    case AST_NUM:    return "a number";
+    case AST_NAME:   return "a name";
+    case AST_MEMBER: return "a coordinate";
+    case AST_TIME:   return "the time t";
+    case AST_NEG:    return "a negation";
+    case AST_BINARY:
+        switch (ast->op) {
+        case OP_ADD: return "a sum";
+        case OP_SUB: return "a difference";
+        case OP_MUL: return "a product";
+        case OP_DIV: return "a quotient";
+        case OP_POW: return "a power";
+        default:     return "an operation";   /* not produced by the parser */
+        }
+    case AST_CALL:   return "a function call";
+    case AST_DER:    return "der()";
+    }
+    return "an expression";
+}

@@ -1,0 +1,120 @@
+/* ast.h - the statements and expressions of a .mech file, as the parser produces them. */
+#ifndef MECHC_AST_H
+#define MECHC_AST_H
+
+#include "../base/diag.h"
+#include "../dag/dag_ops.h"
+
+#include <stdbool.h>
+
+/* ---- joint vocabulary (generator/parse/joints.def) ---- */
+
+typedef enum AttachRule {
+    ATTACH_NONE,        /* slot unused */
+    ATTACH_ANY,         /* body(sx, sy), body, point, ground(x, y), ground */
+    ATTACH_FRAME,       /* a body or ground, with optional offset */
+    ATTACH_BODY,        /* a body (not ground), with optional offset */
+    ATTACH_BODY_ONLY,   /* a body name alone, no offset */
+} AttachRule;
+
+typedef enum JointOption { OPTION_NONE, OPTION_ANGLE, OPTION_LENGTH, OPTION_RADIUS } JointOption;
+typedef enum JointLevel { LEVEL_POSITION, LEVEL_VELOCITY, LEVEL_EITHER } JointLevel;
+
+typedef enum JointKind {
+#define X(e, kw, na, sa, sb, ax, opt, nr, lvl, s0, s1, s2) JOINT_##e,
+#include "joints.def"
+#undef X
+    JOINT_KIND_COUNT
+} JointKind;
+
+typedef struct JointInfo {
+    const char *keyword;
+    int attachments;            /* 0: "lhs = rhs" statement */
+    AttachRule slot[2];
+    bool axis;
+    JointOption option;
+    int rows;
+    JointLevel level;
+    const char *suffix[3];
+} JointInfo;
+
+extern const JointInfo joint_info[JOINT_KIND_COUNT];
+
+/* Keyword lookup: the joint kind, or -1. */
+int joint_kind_from_keyword(const char *word, int len);
+
+/* ---- expressions ---- */
+
+typedef enum AstKind {
+    AST_NUM,        /* number literal or pi: num */
+    AST_NAME,       /* a param or a coord: name */
+    AST_MEMBER,     /* name.member: a body's or point's coordinate */
+    AST_TIME,       /* t */
+    AST_NEG,        /* -lhs (unary plus is dropped by the parser) */
+    AST_BINARY,     /* lhs op rhs, op one of OP_ADD OP_SUB OP_MUL OP_DIV OP_POW */
+    AST_CALL,       /* op(lhs) or op(lhs, rhs) for a function op (OP_SIN ...) */
+    AST_DER,        /* der(lhs): lhs is AST_NAME or AST_MEMBER */
+} AstKind;
+
+typedef struct Ast {
+    AstKind kind;
+    DagOp op;               /* AST_BINARY, AST_CALL */
+    SrcPos pos;             /* first character of the construct; for a binary
+                               operator, the operator itself */
+    double num;             /* AST_NUM */
+    const char *name;       /* AST_NAME, AST_MEMBER (the object) */
+    const char *member;     /* AST_MEMBER (any identifier; checked later) */
+    SrcPos member_pos;      /* AST_MEMBER: position of the member name */
+    struct Ast *lhs, *rhs;
+} Ast;
+
+/* ---- statements ---- */
+
+typedef enum StmtKind {
+    STMT_MECHANISM,     /* mechanism NAME */
+    STMT_PARAM,         /* param NAME = value */
+    STMT_BODY,          /* body NAME [x = e] [y = e] [phi = e] */
+    STMT_POINT,         /* point NAME [x = e] [y = e] */
+    STMT_COORD,         /* coord NAME [= value] */
+    STMT_JOINT,         /* KIND NAME: operands [axis(ux, uy)] [option = e] */
+} StmtKind;
+
+typedef struct AstAttach {
+    const char *name;       /* "ground" for the ground frame */
+    SrcPos pos;
+    bool has_offset;        /* NAME(sx, sy) rather than NAME */
+    Ast *sx, *sy;
+} AstAttach;
+
+typedef struct Stmt {
+    StmtKind kind;
+    SrcPos pos;             /* the keyword */
+    const char *name;       /* declared name (NULL for none) */
+    SrcPos name_pos;
+
+    Ast *value;             /* PARAM, COORD (NULL: coord defaults to 0) */
+    Ast *init[3];           /* BODY x, y, phi; POINT x, y (NULL: 0) */
+    SrcPos init_pos[3];
+
+    JointKind joint;        /* JOINT */
+    AstAttach attach[2];    /* JOINT: joint_info[joint].attachments used */
+    Ast *axis[2];           /* JOINT with axis: ux, uy */
+    SrcPos axis_pos;
+    Ast *option;            /* JOINT: angle, length or radius (NULL: absent) */
+    SrcPos option_pos;
+    Ast *lhs, *rhs;         /* JOINT with attachments == 0 */
+    SrcPos eq_pos;
+
+    struct Stmt *next;
+} Stmt;
+
+typedef struct Program {
+    Stmt *first;
+    int count;
+    int line_count;
+} Program;
+
+/* A readable name for an AST kind, for messages. */
+const char *ast_describe(const Ast *ast);
+
+#endif

@@ -1,0 +1,33 @@
+/* pipeline.h - the whole front to back: file -> model -> derivatives -> C -> machine code. */
+#ifndef MECHC_PIPELINE_H
+#define MECHC_PIPELINE_H
+
+#include "../base/limits.h"
+#include "../diff/kinematics.h"
+#include "../emit/emit.h"
+#include "../jit/jit.h"
+
+/* One loaded mechanism and whatever stages have been run on it. */
+typedef struct Mech {
+    char *text;             /* the input, owned */
+    Model *model;
+    Kinematics kin;
+    double load_seconds;    /* read + parse + resolve */
+    double diff_seconds;    /* derivatives */
+} Mech;
+
+/* Reads, parses, resolves and differentiates FILE. Returns NULL with diag
+   filled (and its text kept valid) on bad input. diag must stay alive as
+   long as the Mech, since it points into the text. */
+Mech *pipeline_load(const char *path, const MechLimits *limits, Diag *diag);
+/* The same from text in memory (tests, fuzzing). */
+Mech *pipeline_load_text(const char *text, const char *name, const MechLimits *limits, Diag *diag);
+void pipeline_free(Mech *mech);
+
+/* Emits double kernels for the JIT and compiles them with libtcc. */
+Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
+                  double *tcc_seconds, Diag *diag);
+
+double pipeline_now(void);
+
+#endif
