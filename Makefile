@@ -61,7 +61,7 @@ $(BUILD)/gen/templates.c: $(TMPL) Makefile
 	@mkdir -p $(dir $@)
 	@$(if $(filter 1,$(V)),,echo "  EMBED   templates/*.tmpl")
 	$(Q){ echo '/* Generated from the templates folder by the Makefile. Do not edit. */'; \
-	  echo '#include "../../generator/emit/templates.h"'; \
+	  echo '#include "generator/emit/templates.h"'; \
 	  for f in $(TMPL); do \
 	    n=$$(basename $$f .tmpl | tr '.-' '__'); \
 	    echo "const char template_$$n[] ="; \
@@ -70,7 +70,7 @@ $(BUILD)/gen/templates.c: $(TMPL) Makefile
 	  done; } > $@
 
 $(BUILD)/gen/templates.o: $(BUILD)/gen/templates.c
-	$(Q)$(CC) $(CFLAGS_TOOL) -c $< -o $@
+	$(Q)$(CC) $(CFLAGS_TOOL) -I. -c $< -o $@
 
 $(LIB): $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)
 	@$(if $(filter 1,$(V)),,echo "  AR      $@")

@@ -199,14 +199,21 @@ MechrtStatus mechrt_step(const MechrtKernels *k, const MechrtOptions *opts,
     MechrtNewton s;
     MechrtStatus st;
     mechrt_real tn;
+    size_t need;
     int i, n;
 
     an_report_init(report);
-    if (!an_kernels_ok(k) || !q || !qd || !qdd || !isfinite(h))
+    if (!an_kernels_ok(k) || !q || !qd || !qdd || !work || !isfinite(h))
         return MECHRT_EINVAL;
     if (k->nh != k->nq || k->nv != 0)
         return MECHRT_ENOTSQUARE;
     n = k->nq;
+    /* checked here too, before the predictor touches q */
+    need = mechrt_workspace_size(n, n);
+    if (need == 0)
+        return MECHRT_EINVAL;
+    if (lwork < need)
+        return MECHRT_EBADLEN;
     if (h != 0)
         for (i = 0; i < n; i++)
             q[i] += h * qd[i] + MECHRT_R(0.5) * h * h * qdd[i];

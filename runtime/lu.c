@@ -16,9 +16,6 @@
 
 #include "mechrt.h"
 
-/* Largest row count the float build can index through piv. */
-#define LU_FLOAT_INDEX_MAX 16777216L
-
 const char *mechrt_strerror(MechrtStatus status)
 {
     switch (status) {
@@ -108,7 +105,7 @@ MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
     if (n < 0 || lda < n || (n > 0 && (!a || !piv)))
         return MECHRT_EINVAL;
 #ifdef MECHRT_REAL_FLOAT
-    if ((long)n > LU_FLOAT_INDEX_MAX)
+    if ((long)n > 16777216L)   /* 2^24: beyond it float cannot hold piv exactly */
         return MECHRT_EINVAL;
 #endif
     ld = (size_t)lda;

@@ -101,7 +101,8 @@ typedef double mechrt_real;
 
 /* The generated kernels of one mechanism (spec section 4), taken by pointer so
    the runtime never depends on the generated names. NR = nh + nv rows:
-   holonomic rows first, then velocity-level rows. */
+   holonomic rows first, then velocity-level rows. phi, jac, nu and gamma
+   are required; all is optional (Newton uses it when present). */
 typedef struct MechrtKernels {
     int nq;   /* coordinates, >= 1 */
     int nh;   /* holonomic rows (drivers included), >= 0 */
@@ -141,7 +142,9 @@ typedef struct MechrtOptions {
     mechrt_real cond_warn;
 } MechrtOptions;
 
-/* What an assembly or an analysis step did, for messages and logs. */
+/* What an assembly or an analysis step did, for messages and logs. The
+   analysis-only calls (mechrt_velocity...) leave the Newton fields at
+   0 / -1 and fill sing_index and cond. */
 typedef struct MechrtReport {
     int iterations;        /* Newton iterations taken */
     mechrt_real residual;  /* ||Phi||_inf at the returned q (holonomic rows) */
@@ -211,7 +214,7 @@ void mechrt_lu_solve_t(int n, const mechrt_real *lu, int lda, const mechrt_real 
 
 /* Estimate of the 1-norm condition number ||A||_1 ||A^-1||_1 from the factors
    and anorm = mechrt_norm1(A) taken before factoring; work holds 2n reals.
-   A lower bound, almost always within a factor 3 of the truth. */
+   A lower bound, usually within a factor 3 of the truth (Higham 1988). */
 mechrt_real mechrt_lu_cond1(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,
                             mechrt_real anorm, mechrt_real *work);
 

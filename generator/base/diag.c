@@ -14,10 +14,13 @@ void diag_init(Diag *diag, const char *file, const char *text, int text_len)
 
 void diag_locate(const Diag *diag, int offset, int *line, int *col)
 {
-    int l = 1, c = 1;
+    int l = 1, c = 1, i = 0;
     if (offset > diag->text_len)
         offset = diag->text_len;
-    for (int i = 0; i < offset; i++) {
+    /* A UTF-8 byte-order mark takes no column. */
+    if (diag->text_len >= 3 && memcmp(diag->text, "\xEF\xBB\xBF", 3) == 0 && offset >= 3)
+        i = 3;
+    for (; i < offset; i++) {
         if (diag->text[i] == '\n')
             l++, c = 1;
         else
@@ -40,6 +43,8 @@ static void record(Diag *diag, const SrcPos *pos, const char *fmt, va_list ap)
     int start = pos->offset < diag->text_len ? pos->offset : diag->text_len;
     while (start > 0 && diag->text[start - 1] != '\n')
         start--;
+    if (start == 0 && diag->text_len >= 3 && memcmp(diag->text, "\xEF\xBB\xBF", 3) == 0)
+        start = 3;
     int n = 0;
     while (start + n < diag->text_len && diag->text[start + n] != '\n'
            && n < DIAG_LINE_MAX - 1)

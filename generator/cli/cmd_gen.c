@@ -20,7 +20,8 @@ static const char usage[] =
     "                    its upper case\n"
     "  --real TYPE       double (default) or float (float literals, sinf, ...)\n"
     "  --chunk N         most operations per C function before it is split into\n"
-    "                    static parts (default 2000; keeps optimizing compilers fast)\n"
+    "                    static parts, counting operations and stores (default 150;\n"
+    "                    keeps optimizing compilers fast)\n"
     "  --stats           print the operation count of each function to stderr\n";
 
 static bool write_file(const char *path, const char *text)

@@ -33,7 +33,7 @@ static const char *const function_params[EMIT_FUNCTION_COUNT] = {
 
 EmitOptions emit_default_options(void)
 {
-    return (EmitOptions){.chunk_nodes = 2000, .source_name = "input.mech"};
+    return (EmitOptions){.chunk_nodes = 150, .source_name = "input.mech"};
 }
 
 static const char *const c_keywords[] = {
@@ -115,6 +115,7 @@ typedef struct Emitter {
     const Dag *dag;
     const EmitOptions *opt;
     const char *prefix;
+    const char *prefix_upper;
     Scheduler sched;
 } Emitter;
 
@@ -247,7 +248,7 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
     }
     const char *p = e->prefix;
     for (int c = 0; c < fn->nchunks; c++) {
-        sb_printf(parts, "static void %s_%s_part%d(", p, emit_function_names[which], c);
+        sb_printf(parts, "%s_PART void %s_%s_part%d(", e->prefix_upper, p, emit_function_names[which], c);
         put_signature(parts, p, which);
         sb_puts(parts, ")\n{\n");
         put_chunk(e, parts, fn, c, which);
@@ -262,30 +263,32 @@ static void add_output(SchedOutput **outs, int *n, const char *array, int index,
     (*outs)[(*n)++] = (SchedOutput){array, index, value};
 }
 
-/* The outputs of each function, in the order the spec lists them. */
+/* The outputs of each function. The fused _all goes row by row (phi,
+   Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk holds
+   whole rows and shares their sin/cos and products across the four. */
 static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
 {
     const Model *m = kin->model;
     *outs = xmalloc((size_t)(m->nh + 2 * m->nr + 2 * kin->nnz + 1) * sizeof **outs);
     *n = 0;
     bool all = which == EMIT_ALL;
-    if (which == EMIT_PHI || all)
-        for (int r = 0; r < m->nh; r++)
+    for (int r = 0; r < m->nr; r++) {
+        if ((which == EMIT_PHI || all) && r < m->nh)
             add_output(outs, n, "phi", r, kin->phi[r]);
-    if (which == EMIT_JAC || all)
-        for (int k = 0; k < kin->nnz; k++)
-            add_output(outs, n, "jac", kin->jac[k].row * m->nq + kin->jac[k].col, kin->jac[k].value);
-    if (which == EMIT_JAC_NZ)
-        for (int k = 0; k < kin->nnz; k++)
-            add_output(outs, n, "vals", k, kin->jac[k].value);
+        for (int k = kin->row_start[r]; k < kin->row_start[r + 1]; k++) {
+            const JacEntry *j = &kin->jac[k];
+            if (all)
+                add_output(outs, n, "jac", j->row * m->nq + j->col, j->value);
+            else if (which == EMIT_JAC_NZ)
+                add_output(outs, n, "vals", k, j->value);
+        }
+        if (which == EMIT_NU || all)
+            add_output(outs, n, "nu", r, kin->nu[r]);
+        if (which == EMIT_GAMMA || all)
+            add_output(outs, n, "gamma", r, kin->gamma[r]);
+    }
     if (which == EMIT_JAC_NZ && kin->nnz == 0)     /* the one placeholder slot */
         add_output(outs, n, "vals", 0, DAG_ZERO);
-    if (which == EMIT_NU || all)
-        for (int r = 0; r < m->nr; r++)
-            add_output(outs, n, "nu", r, kin->nu[r]);
-    if (which == EMIT_GAMMA || all)
-        for (int r = 0; r < m->nr; r++)
-            add_output(outs, n, "gamma", r, kin->gamma[r]);
 }
 
 static void put_string_list(StrBuf *sb, const char *const *names, int n)
@@ -339,12 +342,17 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     for (size_t i = 0; i <= plen; i++)
         upper[i] = (char)toupper((unsigned char)out->prefix[i]);
 
-    Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix};
+    Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
+                 .prefix_upper = upper};
     sched_init(&e.sched, &m->dag, opt->chunk_nodes > 0 ? opt->chunk_nodes : 2000);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
         sb_init(&parts[f]);
         sb_init(&bodies[f]);
+        sb_puts(&parts[f], "");
+        sb_puts(&bodies[f], "");
+        if (f == EMIT_JAC)      /* the template builds it on jac_nz */
+            continue;
         SchedOutput *outs;
         int n;
         collect_outputs(kin, (EmitFunction)f, &outs, &n);
@@ -354,10 +362,10 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         out->ops[f] = fn.ops;
         out->chunks[f] = fn.nchunks;
         sched_function_free(&fn);
-        sb_puts(&parts[f], "");         /* never NULL below */
-        sb_puts(&bodies[f], "");
     }
     sched_free(&e.sched);
+    out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
+    out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
 
     StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface};
@@ -405,7 +413,6 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         {"Q0", q0.data}, {"COORD_NAMES", coords.data}, {"ROW_NAMES", rows.data},
         {"JAC_ROW", jrow.data}, {"JAC_COL", jcol.data},
         {"PHI_PARTS", parts[EMIT_PHI].data}, {"PHI_BODY", bodies[EMIT_PHI].data},
-        {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
         {"JAC_NZ_PARTS", parts[EMIT_JAC_NZ].data}, {"JAC_NZ_BODY", bodies[EMIT_JAC_NZ].data},
         {"NU_PARTS", parts[EMIT_NU].data}, {"NU_BODY", bodies[EMIT_NU].data},
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},

@@ -15,7 +15,7 @@ typedef struct EmitOptions {
     bool declare_math;          /* declare libm functions instead of
                                    #include <math.h> (the in-process JIT
                                    needs no system headers) */
-    int chunk_nodes;            /* most operations per C function (default 2000) */
+    int chunk_nodes;            /* most operations plus stores per C function (default 150) */
     const char *source_name;    /* the input file, named in the banner */
 } EmitOptions;
 

@@ -96,7 +96,8 @@ void sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunct
     for (int i = 0; i < noutputs; i++) {
         int before = n;
         collect(s, outputs[i].value, &nodes, &n, &cap);
-        if (n > s->chunk_nodes && i > first) {
+        /* Stores count too: gcc's store passes are quadratic per block. */
+        if (n + (i - first + 1) > s->chunk_nodes && i > first) {
             /* Cut before output i; it starts the next chunk afresh. */
             n = before;
             close_chunk(fn, first, i - first, nodes, n);

@@ -32,7 +32,7 @@ typedef struct SchedFunction {
 /* Scratch state reused across functions; per-node arrays sized to the graph. */
 typedef struct Scheduler {
     const Dag *dag;
-    int chunk_nodes;        /* most operation nodes per chunk */
+    int chunk_nodes;        /* most operations plus stores per chunk */
     uint32_t *mark;
     uint32_t stamp;
     int32_t *uses;          /* uses within the current chunk */

@@ -1,0 +1,9 @@
+/* cmd_bench.c - mechc bench (not implemented yet: says so and exits 2). */
+#include "cli.h"
+
+int cmd_bench(int argc, char **argv)
+{
+    (void)argc, (void)argv;
+    fprintf(stderr, "mechc bench: error: this command is not implemented yet in mechc %s\n", MECHC_VERSION);
+    return EXIT_USAGE;
+}
