@@ -1,6 +1,7 @@
 /* cmd_gen.c - mechc gen: writes the generated C (and optionally its header). */
 #include "cli.h"
 
+#include "../base/strbuf.h"
 #include "../pipeline/pipeline.h"
 
 #include <errno.h>
@@ -22,7 +23,24 @@ static const char usage[] =
     "  --chunk N         most operations per C function before it is split into\n"
     "                    static parts, counting operations and stores (default 150;\n"
     "                    keeps optimizing compilers fast)\n"
-    "  --stats           print the operation count of each function to stderr\n";
+    "  --stats           print the operation count of each function to stderr\n"
+    "  --dump rows       print each row as an expression of q[i], qd[i] and t\n"
+    "                    (Phi, or Psi for velocity rows) instead of C\n";
+
+/* One row per line: "name level expression"; the input for outside tools
+   (bench/sympy_ops.py) that compare against other derivations. */
+static void dump_rows(const Mech *mech)
+{
+    const Model *m = mech->model;
+    StrBuf sb;
+    sb_init(&sb);
+    for (int r = 0; r < m->nr; r++) {
+        sb_clear(&sb);
+        dag_format(&m->dag, m->rows[r].expr, NULL, &sb);
+        printf("%s %s %s\n", m->rows[r].name, m->rows[r].velocity ? "velocity" : "position", sb.data);
+    }
+    sb_free(&sb);
+}
 
 static bool write_file(const char *path, const char *text)
 {
@@ -43,7 +61,7 @@ int cmd_gen(int argc, char **argv)
     Args a;
     args_init(&a, "gen", argc, argv);
     const char *out_path = NULL, *header_path = NULL, *opt_name;
-    bool stats = false;
+    bool stats = false, dump = false;
     EmitOptions opt = emit_default_options();
     while ((opt_name = args_next(&a)) && !a.failed) {
         if (args_is_help(opt_name)) {
@@ -65,6 +83,13 @@ int cmd_gen(int argc, char **argv)
             }
         } else if (strcmp(opt_name, "--chunk") == 0) {
             args_int(&a, opt_name, 50, 1000000, &opt.chunk_nodes);
+        } else if (strcmp(opt_name, "--dump") == 0) {
+            const char *v = args_value(&a, opt_name);
+            if (v && strcmp(v, "rows") != 0) {
+                fprintf(stderr, "mechc gen: error: --dump takes 'rows', not '%s'\n", v);
+                a.failed = true;
+            }
+            dump = true;
         } else if (strcmp(opt_name, "--stats") == 0) {
             stats = true;
         } else {
@@ -80,6 +105,11 @@ int cmd_gen(int argc, char **argv)
     if (!mech) {
         diag_print(&diag, stderr);
         return EXIT_USAGE;
+    }
+    if (dump) {
+        dump_rows(mech);
+        pipeline_free(mech);
+        return EXIT_OK;
     }
     if (header_path) {
         const char *base = strrchr(header_path, '/');

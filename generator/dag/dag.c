@@ -271,6 +271,15 @@ NodeId dag_add(Dag *dag, NodeId a, NodeId b)
         return dag_sub(dag, b, dag->nodes[a].a);
     if (merge_terms(dag, a, b, 1.0, &r))
         return r;
+    /* a + (-c) y = a - c y: positive coefficients, so c y is shared with
+       the rows that add it. */
+    NodeId term;
+    double coef = split_coefficient(dag, b, &term);
+    if (term != DAG_NONE && term != b && coef < 0.0)
+        return dag_sub(dag, a, scale(dag, -coef, term));
+    coef = split_coefficient(dag, a, &term);
+    if (term != DAG_NONE && term != a && coef < 0.0)
+        return dag_sub(dag, b, scale(dag, -coef, term));
     order_commutative(dag, &a, &b);
     /* c1 + (c2 + y) = (c1 + c2) + y: keeps constants together. */
     double c1, c2;
@@ -298,6 +307,10 @@ NodeId dag_sub(Dag *dag, NodeId a, NodeId b)
         return dag_neg(dag, dag_add(dag, dag->nodes[a].a, b));
     if (merge_terms(dag, a, b, -1.0, &r))
         return r;
+    NodeId term;
+    double coef = split_coefficient(dag, b, &term);
+    if (term != DAG_NONE && term != b && coef < 0.0)      /* a - (-c) y = a + c y */
+        return dag_add(dag, a, scale(dag, -coef, term));
     return intern(dag, OP_SUB, a, b, 0.0);
 }
 
@@ -328,6 +341,12 @@ NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
     }
     if (!a_const && na->op == OP_MUL && dag_is_const(dag, na->a, &c1))
         return dag_mul(dag, na->a, dag_mul(dag, na->b, b));
+    /* (x y) y = x (y y): squares of velocities become one shared node
+       (the chain rule builds (cos(phi) phid) phid). */
+    if (nb->op == OP_MUL && nb->a != nb->b && (nb->a == a || nb->b == a))
+        return dag_mul(dag, nb->a == a ? nb->b : nb->a, dag_mul(dag, a, a));
+    if (na->op == OP_MUL && na->a != na->b && (na->a == b || na->b == b))
+        return dag_mul(dag, na->a == b ? na->b : na->a, dag_mul(dag, b, b));
     return intern(dag, OP_MUL, a, b, 0.0);
 }
 
