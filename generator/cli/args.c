@@ -160,7 +160,9 @@ bool args_is_help(const char *option)
 
 void json_number(FILE *out, double v)
 {
-    if (isfinite(v))
+    if (v == 0.0)
+        fputs("0", out);            /* not -0 */
+    else if (isfinite(v))
         fprintf(out, "%.17g", v);
     else
         fputs("null", out);

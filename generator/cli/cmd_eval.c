@@ -76,16 +76,19 @@ static int name_width(const char *const *names, int n, int min)
     return w;
 }
 
+/* -0 and 0 are the same answer; print one of them. */
+static double tidy(double v) { return v == 0.0 ? 0.0 : v; }
+
 static void print_text(const Model *m, double t, const double *q, const double *qd, const double *phi,
                        const double *jac, const double *nu, const double *gamma)
 {
-    printf("mechanism %s: %d coordinates, %d rows (%d holonomic, %d velocity level)\n",
-           m->name, m->nq, m->nr, m->nh, m->nv);
+    printf("mechanism %s: %d coordinate%s, %d row%s (%d holonomic, %d velocity level)\n",
+           m->name, m->nq, m->nq == 1 ? "" : "s", m->nr, m->nr == 1 ? "" : "s", m->nh, m->nv);
     printf("t = %.17g\n\n", t);
     int cw = name_width(m->coord_names, m->nq, 5);
     printf("%-*s  %24s  %24s\n", cw, "coord", "q", "qd");
     for (int i = 0; i < m->nq; i++)
-        printf("%-*s  %24.17g  %24.17g\n", cw, m->coord_names[i], q[i], qd[i]);
+        printf("%-*s  %24.17g  %24.17g\n", cw, m->coord_names[i], tidy(q[i]), tidy(qd[i]));
     int rw = 5;
     for (int r = 0; r < m->nr; r++)
         if ((int)strlen(m->rows[r].name) > rw)
@@ -94,9 +97,9 @@ static void print_text(const Model *m, double t, const double *q, const double *
     for (int r = 0; r < m->nr; r++) {
         char phibuf[32] = "-";
         if (r < m->nh)
-            snprintf(phibuf, sizeof phibuf, "%.17g", phi[r]);
+            snprintf(phibuf, sizeof phibuf, "%.17g", tidy(phi[r]));
         printf("%-*s  %-10s %-8s  %24s  %24.17g  %24.17g\n", rw, m->rows[r].name,
-               joint_info[m->rows[r].kind].keyword, row_level(&m->rows[r]), phibuf, nu[r], gamma[r]);
+               joint_info[m->rows[r].kind].keyword, row_level(&m->rows[r]), phibuf, tidy(nu[r]), tidy(gamma[r]));
     }
     printf("\nJacobian Phi_q (nonzero entries, row by row):\n");
     for (int r = 0; r < m->nr; r++) {
