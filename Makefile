@@ -36,7 +36,7 @@ LIB       := $(BUILD)/libmechc.a
 MECHC     := $(BUILD)/mechc
 TESTS     := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 
-.PHONY: all deps check test demo bench check-asan sanitize install uninstall clean help examples-check
+.PHONY: all deps check test demo bench check-asan check-valgrind fuzz sanitize install uninstall clean help examples-check
 all: $(MECHC)
 
 help:
@@ -45,6 +45,8 @@ help:
 	@echo "make demo       set up, build and run mechc on examples/slider_crank.mech"
 	@echo "make check      set up, build and run every test (cmocka + CLI + generated C)"
 	@echo "make check-asan the same tests under AddressSanitizer and UBSan"
+	@echo "make check-valgrind  the cmocka suites under valgrind memcheck"
+	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make bench      time the engines side by side (bench/run)"
 	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
 
@@ -97,6 +99,28 @@ check-asan:
 	  SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined" check
 sanitize: check-asan
 
+# The cmocka suites under memcheck (the JIT's code included): any error or
+# definite leak fails.
+check-valgrind: deps $(TESTS)
+	$(Q)sh .ci/deps valgrind
+	$(Q)sh tests/run_valgrind $(BUILD)
+
+# libFuzzer over the whole front end (tests/fuzz/README.md). New inputs go
+# to $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.
+FUZZ_SECONDS ?= 60
+FUZZ_BUILD   := build-fuzz
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
+fuzz:
+	$(Q)sh .ci/deps fuzz
+	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang OPT="-O1 -g" \
+	  SAN="$(FUZZ_SAN) -fsanitize=fuzzer-no-link" $(FUZZ_BUILD)/libmechc.a
+	$(Q)clang -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -no-pie tests/fuzz/fuzz_frontend.c \
+	  $(FUZZ_BUILD)/libmechc.a $(LDLIBS_TOOL) -o $(FUZZ_BUILD)/fuzz_frontend
+	$(Q)mkdir -p $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/artifacts
+	$(Q)$(FUZZ_BUILD)/fuzz_frontend -max_total_time=$(FUZZ_SECONDS) -timeout=1 -rss_limit_mb=2048 \
+	  -dict=tests/fuzz/mech.dict -artifact_prefix=$(FUZZ_BUILD)/artifacts/ \
+	  $(FUZZ_BUILD)/corpus tests/fuzz/corpus tests/fuzz/regressions
+
 demo: deps $(MECHC)
 	$(Q)sh examples/demo $(MECHC)
 
@@ -114,6 +138,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/share/mechc
 
 clean:
-	rm -rf build build-asan
+	rm -rf build build-asan $(FUZZ_BUILD)
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -74,9 +74,27 @@ static MechrtStatus an_setup(const MechrtKernels *k, mechrt_real *work, size_t l
     return MECHRT_OK;
 }
 
+/* max|u_kk| / min|u_kk| over the diagonal of the LU factors (U has no zero
+   pivot after a successful factorisation). Cheap: the screen of an_factor. */
+static mechrt_real an_pivot_spread(int n, const mechrt_real *lu)
+{
+    mechrt_real lo = MECHRT_FABS(lu[0]), hi = lo;
+    int k;
+
+    for (k = 1; k < n; k++) {
+        mechrt_real u = MECHRT_FABS(lu[(size_t)k * (size_t)n + (size_t)k]);
+        if (u < lo)
+            lo = u;
+        if (u > hi)
+            hi = u;
+    }
+    return hi / lo;
+}
+
 /* Factors the n x n Jacobian in place. When a report is wanted and
-   cond_warn > 0, also estimates its 1-norm condition number (the norm must
-   be taken before the factorisation overwrites the matrix). */
+   cond_warn > 0, also estimates its 1-norm condition number if the pivot
+   spread passes the screen (the norm must be taken before the factorisation
+   overwrites the matrix). */
 static MechrtStatus an_factor(int n, const MechrtOptions *o, mechrt_real *jac,
                               mechrt_real *piv, mechrt_real *cwork, MechrtReport *r)
 {
@@ -89,6 +107,9 @@ static MechrtStatus an_factor(int n, const MechrtOptions *o, mechrt_real *jac,
         r->sing_index = sing;
     if (st != MECHRT_OK)
         return st;
+    if (want_cond && o->cond_screen > 0
+        && an_pivot_spread(n, jac) <= o->cond_screen * o->cond_warn)
+        want_cond = false;
     if (want_cond) {
         r->cond = mechrt_lu_cond1(n, jac, n, piv, anorm, cwork);
         r->cond_warning = !(r->cond <= o->cond_warn);   /* NaN warns too */
@@ -124,8 +145,8 @@ MechrtStatus mechrt_velocity(const MechrtKernels *k, const MechrtOptions *opts,
     st = an_setup(k, work, lwork, &w);
     if (st != MECHRT_OK)
         return st;
-    k->jac(q, t, w.jac);
-    k->nu(q, t, w.rhs);
+    k->jac(k->ctx, q, t, w.jac);
+    k->nu(k->ctx, q, t, w.rhs);
     st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
     if (st != MECHRT_OK)
         return st;
@@ -147,8 +168,8 @@ MechrtStatus mechrt_acceleration(const MechrtKernels *k, const MechrtOptions *op
     st = an_setup(k, work, lwork, &w);
     if (st != MECHRT_OK)
         return st;
-    k->jac(q, t, w.jac);
-    k->gamma(q, qd, t, w.rhs);
+    k->jac(k->ctx, q, t, w.jac);
+    k->gamma(k->ctx, q, qd, t, w.rhs);
     st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
     if (st != MECHRT_OK)
         return st;
@@ -171,15 +192,15 @@ MechrtStatus mechrt_velocity_acceleration(const MechrtKernels *k, const MechrtOp
     st = an_setup(k, work, lwork, &w);
     if (st != MECHRT_OK)
         return st;
-    k->jac(q, t, w.jac);
-    k->nu(q, t, w.rhs);
+    k->jac(k->ctx, q, t, w.jac);
+    k->nu(k->ctx, q, t, w.rhs);
     st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
     if (st != MECHRT_OK)
         return st;
     st = an_solve(k->nq, w.jac, w.piv, w.rhs, qd_out);
     if (st != MECHRT_OK)
         return st;
-    k->gamma(q, qd_out, t, w.rhs);   /* gamma needs the velocities just found */
+    k->gamma(k->ctx, q, qd_out, t, w.rhs);   /* gamma needs the velocities just found */
     return an_solve(k->nq, w.jac, w.piv, w.rhs, qdd_out);
 }
 
@@ -232,13 +253,13 @@ MechrtStatus mechrt_step(const MechrtKernels *k, const MechrtOptions *opts,
         return st;
 
     if (!s.have_nu)
-        k->nu(q, tn, s.nu);
+        k->nu(k->ctx, q, tn, s.nu);
     st = an_factor(n, &o, s.jac, s.piv, s.cwork, report);
     if (st != MECHRT_OK)
         return st;
     st = an_solve(n, s.jac, s.piv, s.nu, qd);
     if (st != MECHRT_OK)
         return st;
-    k->gamma(q, qd, tn, s.gamma);
+    k->gamma(k->ctx, q, qd, tn, s.gamma);
     return an_solve(n, s.jac, s.piv, s.gamma, qdd);
 }

@@ -27,6 +27,7 @@ const char *mechrt_strerror(MechrtStatus status)
     case MECHRT_ENOTFINITE: return "NaN or infinity met";
     case MECHRT_ENOTSQUARE: return "system is not square";
     case MECHRT_EINVAL:     return "invalid argument";
+    case MECHRT_ESTEP:      return "integration step size became too small";
     }
     return "unknown status";
 }
@@ -40,11 +41,13 @@ MechrtOptions mechrt_default_options(void)
     o.tol_dq = MECHRT_R(1e-3);
     o.pivot_tol = MECHRT_R(1e-5);
     o.cond_warn = MECHRT_R(1e5);
+    o.cond_screen = MECHRT_R(1e-2);
 #else
     o.tol_phi = 1e-8;
     o.tol_dq = 1e-8;
     o.pivot_tol = 1e-12;
     o.cond_warn = 1e10;
+    o.cond_screen = 1e-4;
 #endif
     o.max_iter = 25;
     return o;

@@ -27,11 +27,11 @@ static MechrtStatus newton_eval(MechrtNewton *s)
     int i;
 
     if (k->all) {
-        k->all(s->q, s->qd0, s->t, s->phi, s->jac, s->nu, s->gamma);
+        k->all(k->ctx, s->q, s->qd0, s->t, s->phi, s->jac, s->nu, s->gamma);
         s->have_nu = true;
     } else {
-        k->phi(s->q, s->t, s->phi);
-        k->jac(s->q, s->t, s->jac);
+        k->phi(k->ctx, s->q, s->t, s->phi);
+        k->jac(k->ctx, s->q, s->t, s->jac);
         s->have_nu = false;
     }
     s->residual = 0;

@@ -81,31 +81,35 @@ static double gsl_cond1(int n, const double *a, int lda)
 #define SC_W  2.3
 #define SC_AL 0.9
 
-static void sc_phi(const double *q, double t, double *phi)
+static void sc_phi(void *ctx, const double *q, double t, double *phi)
 {
+    (void)ctx;
     phi[0] = SC_R * cos(q[0]) + SC_L * cos(q[1]) - q[2];
     phi[1] = SC_R * sin(q[0]) - SC_L * sin(q[1]);
     phi[2] = q[0] - (SC_A + SC_W * t + 0.5 * SC_AL * t * t);
 }
 
-static void sc_jac(const double *q, double t, double *jac)
+static void sc_jac(void *ctx, const double *q, double t, double *jac)
 {
+    (void)ctx;
     (void)t;
     jac[0] = -SC_R * sin(q[0]); jac[1] = -SC_L * sin(q[1]); jac[2] = -1;
     jac[3] = SC_R * cos(q[0]);  jac[4] = -SC_L * cos(q[1]); jac[5] = 0;
     jac[6] = 1;                 jac[7] = 0;                 jac[8] = 0;
 }
 
-static void sc_nu(const double *q, double t, double *nu)
+static void sc_nu(void *ctx, const double *q, double t, double *nu)
 {
+    (void)ctx;
     (void)q;
     nu[0] = 0;
     nu[1] = 0;
     nu[2] = SC_W + SC_AL * t;
 }
 
-static void sc_gamma(const double *q, const double *qd, double t, double *g)
+static void sc_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
 {
+    (void)ctx;
     (void)t;
     g[0] = SC_R * cos(q[0]) * qd[0] * qd[0] + SC_L * cos(q[1]) * qd[1] * qd[1];
     g[1] = SC_R * sin(q[0]) * qd[0] * qd[0] - SC_L * sin(q[1]) * qd[1] * qd[1];
@@ -114,42 +118,46 @@ static void sc_gamma(const double *q, const double *qd, double t, double *g)
 
 static int sc_all_calls;   /* proves mechrt used `all` when offered */
 
-static void sc_all(const double *q, const double *qd, double t,
+static void sc_all(void *ctx, const double *q, const double *qd, double t,
                    double *phi, double *jac, double *nu, double *gamma)
 {
+    (void)ctx;
     sc_all_calls++;
-    sc_phi(q, t, phi);
-    sc_jac(q, t, jac);
-    sc_nu(q, t, nu);
-    sc_gamma(q, qd, t, gamma);
+    sc_phi(ctx, q, t, phi);
+    sc_jac(ctx, q, t, jac);
+    sc_nu(ctx, q, t, nu);
+    sc_gamma(ctx, q, qd, t, gamma);
 }
 
-static const MechrtKernels sc_kernels = {3, 3, 0, sc_phi, sc_jac, sc_nu, sc_gamma, sc_all};
+static const MechrtKernels sc_kernels = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, sc_all};
 
 /* The slider crank with one redundant velocity-level row appended,
    Psi = thd - (w + al t): NH == NQ, NR = 4. Newton uses the top 3 rows. */
-static void scv_jac(const double *q, double t, double *jac)
+static void scv_jac(void *ctx, const double *q, double t, double *jac)
 {
-    sc_jac(q, t, jac);
+    (void)ctx;
+    sc_jac(ctx, q, t, jac);
     jac[9] = 1;
     jac[10] = 0;
     jac[11] = 0;
 }
 
-static void scv_nu(const double *q, double t, double *nu)
+static void scv_nu(void *ctx, const double *q, double t, double *nu)
 {
-    sc_nu(q, t, nu);
+    (void)ctx;
+    sc_nu(ctx, q, t, nu);
     nu[3] = SC_W + SC_AL * t;
 }
 
-static void scv_gamma(const double *q, const double *qd, double t, double *g)
+static void scv_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
 {
-    sc_gamma(q, qd, t, g);
+    (void)ctx;
+    sc_gamma(ctx, q, qd, t, g);
     g[3] = SC_AL;
 }
 
-static const MechrtKernels scv_kernels = {3, 3, 1, sc_phi, scv_jac, scv_nu, scv_gamma, NULL};
-static const MechrtKernels sc_kernels_noall = {3, 3, 0, sc_phi, sc_jac, sc_nu, sc_gamma, NULL};
+static const MechrtKernels scv_kernels = {3, 3, 1, NULL, sc_phi, scv_jac, scv_nu, scv_gamma, NULL};
+static const MechrtKernels sc_kernels_noall = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, NULL};
 
 static void sc_exact(double t, double *q, double *qd, double *qdd)
 {
@@ -175,34 +183,38 @@ static void sc_exact(double t, double *q, double *qd, double *qdd)
 #define CI_C 0.6
 #define CI_W 1.1
 
-static void ci_phi(const double *q, double t, double *phi)
+static void ci_phi(void *ctx, const double *q, double t, double *phi)
 {
+    (void)ctx;
     phi[0] = q[0] * q[0] + q[1] * q[1] - CI_R * CI_R;
     phi[1] = q[0] - CI_R * cos(CI_C + CI_W * t);
 }
 
-static void ci_jac(const double *q, double t, double *jac)
+static void ci_jac(void *ctx, const double *q, double t, double *jac)
 {
+    (void)ctx;
     (void)t;
     jac[0] = 2 * q[0]; jac[1] = 2 * q[1];
     jac[2] = 1;        jac[3] = 0;
 }
 
-static void ci_nu(const double *q, double t, double *nu)
+static void ci_nu(void *ctx, const double *q, double t, double *nu)
 {
+    (void)ctx;
     (void)q;
     nu[0] = 0;
     nu[1] = -CI_R * CI_W * sin(CI_C + CI_W * t);
 }
 
-static void ci_gamma(const double *q, const double *qd, double t, double *g)
+static void ci_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
 {
+    (void)ctx;
     (void)q;
     g[0] = -2 * (qd[0] * qd[0] + qd[1] * qd[1]);
     g[1] = -CI_R * CI_W * CI_W * cos(CI_C + CI_W * t);
 }
 
-static const MechrtKernels ci_kernels = {2, 2, 0, ci_phi, ci_jac, ci_nu, ci_gamma, NULL};
+static const MechrtKernels ci_kernels = {2, 2, 0, NULL, ci_phi, ci_jac, ci_nu, ci_gamma, NULL};
 
 /* ---- mechanism 3: knife-edge cart driven by heading and speed ----------
  * q = (x, y, th). One holonomic row, two velocity-level rows:
@@ -220,13 +232,15 @@ static const MechrtKernels ci_kernels = {2, 2, 0, ci_phi, ci_jac, ci_nu, ci_gamm
 #define KN_W 0.45
 #define KN_V 1.9
 
-static void kn_phi(const double *q, double t, double *phi)
+static void kn_phi(void *ctx, const double *q, double t, double *phi)
 {
+    (void)ctx;
     phi[0] = q[2] - (KN_B + KN_W * t);
 }
 
-static void kn_jac(const double *q, double t, double *jac)
+static void kn_jac(void *ctx, const double *q, double t, double *jac)
 {
+    (void)ctx;
     double c = cos(q[2]), s = sin(q[2]);
     (void)t;
     jac[0] = 0;  jac[1] = 0; jac[2] = 1;
@@ -234,8 +248,9 @@ static void kn_jac(const double *q, double t, double *jac)
     jac[6] = c;  jac[7] = s; jac[8] = 0;
 }
 
-static void kn_nu(const double *q, double t, double *nu)
+static void kn_nu(void *ctx, const double *q, double t, double *nu)
 {
+    (void)ctx;
     (void)q;
     (void)t;
     nu[0] = KN_W;
@@ -243,8 +258,9 @@ static void kn_nu(const double *q, double t, double *nu)
     nu[2] = KN_V;
 }
 
-static void kn_gamma(const double *q, const double *qd, double t, double *g)
+static void kn_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
 {
+    (void)ctx;
     double c = cos(q[2]), s = sin(q[2]);
     (void)t;
     g[0] = 0;
@@ -252,16 +268,17 @@ static void kn_gamma(const double *q, const double *qd, double t, double *g)
     g[2] = (s * qd[0] - c * qd[1]) * qd[2];
 }
 
-static const MechrtKernels kn_kernels = {3, 1, 2, kn_phi, kn_jac, kn_nu, kn_gamma, NULL};
+static const MechrtKernels kn_kernels = {3, 1, 2, NULL, kn_phi, kn_jac, kn_nu, kn_gamma, NULL};
 
 /* A kernel set whose second row is NaN: the runtime must say so. */
-static void nan_phi(const double *q, double t, double *phi)
+static void nan_phi(void *ctx, const double *q, double t, double *phi)
 {
-    sc_phi(q, t, phi);
+    (void)ctx;
+    sc_phi(ctx, q, t, phi);
     phi[1] = NAN;
 }
 
-static const MechrtKernels nan_kernels = {3, 3, 0, nan_phi, sc_jac, sc_nu, sc_gamma, NULL};
+static const MechrtKernels nan_kernels = {3, 3, 0, NULL, nan_phi, sc_jac, sc_nu, sc_gamma, NULL};
 
 /* ---- LU ---------------------------------------------------------------- */
 
@@ -502,7 +519,7 @@ static void test_options_and_strings(void **state)
 
     const MechrtStatus all[] = {MECHRT_OK, MECHRT_CONTINUE, MECHRT_ESING, MECHRT_EMAXITER,
                                 MECHRT_EBADLEN, MECHRT_ENOTFINITE, MECHRT_ENOTSQUARE,
-                                MECHRT_EINVAL};
+                                MECHRT_EINVAL, MECHRT_ESTEP};
     const int n = (int)(sizeof all / sizeof all[0]);
     for (int i = 0; i < n; i++) {
         const char *s = mechrt_strerror(all[i]);
@@ -658,10 +675,15 @@ static void test_velocity_acceleration(void **state)
     const double t = 0.83;
     double q[3], qd[3], qdd[3], v[3], a[3], v2[3], a2[3], work[64];
     MechrtReport rep;
+    MechrtOptions always = mechrt_default_options();
 
+    always.cond_screen = 0;   /* estimate even when the pivots say it is not needed */
     sc_exact(t, q, qd, qdd);
-    assert_int_equal(mechrt_velocity(&sc_kernels, NULL, q, t, v, work, 64, &rep), MECHRT_OK);
+    assert_int_equal(mechrt_velocity(&sc_kernels, &always, q, t, v, work, 64, &rep), MECHRT_OK);
     assert_true(rep.cond >= 1 && !rep.cond_warning);
+    /* by default the pivots' spread screens the well-conditioned matrix out */
+    assert_int_equal(mechrt_velocity(&sc_kernels, NULL, q, t, v, work, 64, &rep), MECHRT_OK);
+    assert_true(rep.cond == 0 && !rep.cond_warning);
     assert_int_equal(mechrt_acceleration(&sc_kernels, NULL, q, qd, t, a, work, 64, NULL),
                      MECHRT_OK);
     assert_int_equal(mechrt_velocity_acceleration(&sc_kernels, NULL, q, t, v2, a2, work, 64,
@@ -682,8 +704,10 @@ static void test_velocity_rows(void **state)
     const double t = 0.6, th = KN_B + KN_W * t;
     double q[3] = {0.3, -0.2, th}, qd[3], qdd[3], work[64];
     MechrtReport rep;
+    MechrtOptions always = mechrt_default_options();
 
-    assert_int_equal(mechrt_velocity_acceleration(&kn_kernels, NULL, q, t, qd, qdd, work, 64,
+    always.cond_screen = 0;
+    assert_int_equal(mechrt_velocity_acceleration(&kn_kernels, &always, q, t, qd, qdd, work, 64,
                                                   &rep),
                      MECHRT_OK);
     assert_near(qd[0], KN_V * cos(th), 1e-13, 1e-15);
@@ -716,6 +740,13 @@ static void test_condition_warning(void **state)
     assert_int_equal(mechrt_velocity(&ci_kernels, &o, q, 0.0, qd, work, 64, &rep), MECHRT_OK);
     assert_near(rep.cond, 0.0, 0, 0);
     assert_false(rep.cond_warning);
+    /* with the defaults the pivot screen opens and the estimate warns
+       (cond ~ 2.6 / (1.6 * 0.8 * eps'), about 5e10) */
+    q[0] = CI_R * cos(5e-11);
+    q[1] = CI_R * sin(5e-11);
+    assert_int_equal(mechrt_velocity(&ci_kernels, NULL, q, 0.0, qd, work, 64, &rep), MECHRT_OK);
+    assert_true(rep.cond > 1e10);
+    assert_true(rep.cond_warning);
     /* exactly on it: singular, column 1 */
     q[0] = CI_R;
     q[1] = 0;
@@ -729,8 +760,9 @@ static void test_condition_warning(void **state)
                      MECHRT_ENOTSQUARE);
 }
 
-static void huge_gamma(const double *q, const double *qd, double t, double *g)
+static void huge_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
 {
+    (void)ctx;
     (void)q;
     (void)qd;
     (void)t;
@@ -738,9 +770,10 @@ static void huge_gamma(const double *q, const double *qd, double t, double *g)
     g[1] = -1e305;
 }
 
-static void nan_nu(const double *q, double t, double *nu)
+static void nan_nu(void *ctx, const double *q, double t, double *nu)
 {
-    ci_nu(q, t, nu);
+    (void)ctx;
+    ci_nu(ctx, q, t, nu);
     nu[0] = NAN;
 }
 
@@ -769,7 +802,9 @@ static void test_step_run(void **state)
     double work[64];
     MechrtReport rep;
     const MechrtKernels *ks[2] = {&sc_kernels, &sc_kernels_noall};
+    MechrtOptions always = mechrt_default_options();
 
+    always.cond_screen = 0;
     for (int v = 0; v < 2; v++) {
         double t = 0;
         sc_exact(0, eq, eqd, eqdd);
@@ -780,7 +815,7 @@ static void test_step_run(void **state)
             qd[i] = qdd[i] = 0;
         for (int step = 0; step <= 40; step++) {
             double hh = step == 0 ? 0 : h;
-            MechrtStatus st = mechrt_step(ks[v], NULL, q, qd, qdd, t, hh, work, 64, &rep);
+            MechrtStatus st = mechrt_step(ks[v], &always, q, qd, qdd, t, hh, work, 64, &rep);
             if (st != MECHRT_OK)
                 fail_msg("t = %g: %s", t + hh, mechrt_strerror(st));
             t += hh;
@@ -831,6 +866,107 @@ static void test_step_predictor(void **state)
         assert_near(q[i], eq[i], 0, 1e-7);   /* one step: error ~ step^2 */
 }
 
+/* ---- kernel wrappers and the context pointer ---------------------------
+ * MECHRT_DEFINE_KERNELS is what firmware writes next to `mechc gen` output:
+ * here over context-free functions named like generated ones (gc_phi ...,
+ * GC_NQ ...), built from the point-on-circle kernels. A host engine passes
+ * its state as ctx instead; the runtime must hand it to every kernel.
+ */
+#define GC_NQ 2
+#define GC_NH 2
+#define GC_NV 0
+
+static void gc_phi(const double *q, double t, double *phi) { ci_phi(NULL, q, t, phi); }
+static void gc_jac(const double *q, double t, double *jac) { ci_jac(NULL, q, t, jac); }
+static void gc_nu(const double *q, double t, double *nu) { ci_nu(NULL, q, t, nu); }
+
+static void gc_gamma(const double *q, const double *qd, double t, double *g)
+{
+    ci_gamma(NULL, q, qd, t, g);
+}
+
+static int gc_all_calls;
+
+static void gc_all(const double *q, const double *qd, double t,
+                   double *phi, double *jac, double *nu, double *gamma)
+{
+    gc_all_calls++;
+    gc_phi(q, t, phi);
+    gc_jac(q, t, jac);
+    gc_nu(q, t, nu);
+    gc_gamma(q, qd, t, gamma);
+}
+
+MECHRT_DEFINE_KERNELS(gc, GC);
+
+typedef struct CountCtx {
+    int magic, phi, jac, nu, gamma;
+} CountCtx;
+
+static void cc_phi(void *ctx, const double *q, double t, double *phi)
+{
+    CountCtx *c = ctx;
+    assert_int_equal(c->magic, 4242);
+    c->phi++;
+    ci_phi(NULL, q, t, phi);
+}
+
+static void cc_jac(void *ctx, const double *q, double t, double *jac)
+{
+    CountCtx *c = ctx;
+    assert_int_equal(c->magic, 4242);
+    c->jac++;
+    ci_jac(NULL, q, t, jac);
+}
+
+static void cc_nu(void *ctx, const double *q, double t, double *nu)
+{
+    CountCtx *c = ctx;
+    assert_int_equal(c->magic, 4242);
+    c->nu++;
+    ci_nu(NULL, q, t, nu);
+}
+
+static void cc_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
+{
+    CountCtx *c = ctx;
+    assert_int_equal(c->magic, 4242);
+    c->gamma++;
+    ci_gamma(NULL, q, qd, t, g);
+}
+
+static void test_kernel_wrappers(void **state)
+{
+    (void)state;
+    const double t = 0.37, h = 0.01;
+    double q[2] = {0.5, 0.6}, qd[2] = {0}, qdd[2] = {0}, q2[2], qd2[2] = {0}, qdd2[2] = {0};
+    double work[64];
+    MechrtReport rep;
+    CountCtx cc = {4242, 0, 0, 0, 0};
+    MechrtKernels ck = {2, 2, 0, &cc, cc_phi, cc_jac, cc_nu, cc_gamma, NULL};
+
+    assert_int_equal(gc_kernels.nq, 2);
+    assert_int_equal(gc_kernels.nh, 2);
+    assert_int_equal(gc_kernels.nv, 0);
+    assert_null(gc_kernels.ctx);
+    q2[0] = q[0];
+    q2[1] = q[1];
+    gc_all_calls = 0;
+    assert_int_equal(mechrt_step(&gc_kernels, NULL, q, qd, qdd, t, 0, work, 64, &rep), MECHRT_OK);
+    assert_true(gc_all_calls >= 2);   /* Newton evaluates through `all` */
+    assert_int_equal(mechrt_step(&gc_kernels, NULL, q, qd, qdd, t, h, work, 64, &rep), MECHRT_OK);
+    /* the context-taking kernels give the same numbers and see their ctx */
+    assert_int_equal(mechrt_step(&ck, NULL, q2, qd2, qdd2, t, 0, work, 64, &rep), MECHRT_OK);
+    assert_int_equal(mechrt_step(&ck, NULL, q2, qd2, qdd2, t, h, work, 64, &rep), MECHRT_OK);
+    assert_true(cc.phi >= 2 && cc.jac >= 2 && cc.nu >= 2 && cc.gamma == 2);
+    for (int i = 0; i < 2; i++) {
+        assert_near(q2[i], q[i], 0, 1e-14);
+        assert_near(qd2[i], qd[i], 1e-13, 1e-14);
+        assert_near(qdd2[i], qdd[i], 1e-12, 1e-13);
+    }
+    assert_near(q[0], CI_R * cos(CI_C + CI_W * (t + h)), 0, 1e-12);
+}
+
 /* ---- the float build ---------------------------------------------------
  * The runtime compiled again in this translation unit with
  * MECHRT_REAL_FLOAT: its external names become mechrtf_*, so it links beside
@@ -854,36 +990,40 @@ static void d2f(int n, const double *d, float *f)
         f[i] = (float)d[i];
 }
 
-static void fsc_phi(const float *q, float t, float *phi)
+static void fsc_phi(void *ctx, const float *q, float t, float *phi)
 {
+    (void)ctx;
     double dq[3], r[3];
     f2d(3, q, dq);
-    sc_phi(dq, t, r);
+    sc_phi(ctx, dq, t, r);
     d2f(3, r, phi);
 }
 
-static void fsc_jac(const float *q, float t, float *jac)
+static void fsc_jac(void *ctx, const float *q, float t, float *jac)
 {
+    (void)ctx;
     double dq[3], r[9];
     f2d(3, q, dq);
-    sc_jac(dq, t, r);
+    sc_jac(ctx, dq, t, r);
     d2f(9, r, jac);
 }
 
-static void fsc_nu(const float *q, float t, float *nu)
+static void fsc_nu(void *ctx, const float *q, float t, float *nu)
 {
+    (void)ctx;
     double dq[3], r[3];
     f2d(3, q, dq);
-    sc_nu(dq, t, r);
+    sc_nu(ctx, dq, t, r);
     d2f(3, r, nu);
 }
 
-static void fsc_gamma(const float *q, const float *qd, float t, float *g)
+static void fsc_gamma(void *ctx, const float *q, const float *qd, float t, float *g)
 {
+    (void)ctx;
     double dq[3], dqd[3], r[3];
     f2d(3, q, dq);
     f2d(3, qd, dqd);
-    sc_gamma(dq, dqd, t, r);
+    sc_gamma(ctx, dq, dqd, t, r);
     d2f(3, r, g);
 }
 
@@ -914,7 +1054,7 @@ static void test_float_build(void **state)
     assert_true(cf > 0);
 
     /* assembly and a short run of the slider crank */
-    MechrtKernels k = {3, 3, 0, fsc_phi, fsc_jac, fsc_nu, fsc_gamma, NULL};
+    MechrtKernels k = {3, 3, 0, NULL, fsc_phi, fsc_jac, fsc_nu, fsc_gamma, NULL};
     float q[3], qd[3] = {0}, qdd[3] = {0}, work[64];
     double eq[3], eqd[3], eqdd[3];
     MechrtReport rep;
@@ -959,6 +1099,7 @@ int main(void)
         cmocka_unit_test(test_analysis_not_finite),
         cmocka_unit_test(test_step_run),
         cmocka_unit_test(test_step_predictor),
+        cmocka_unit_test(test_kernel_wrappers),
         cmocka_unit_test(test_float_build),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

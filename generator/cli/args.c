@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -100,6 +101,47 @@ bool args_int(Args *a, const char *option, int min, int max, int *out)
     return true;
 }
 
+/* Each limit's option and the range it accepts. The upper bounds keep what
+   the limits protect: the parser's and differentiator's recursion stays
+   far from the stack's end, and int indices (file offsets, the dense
+   Jacobian of the generated C) cannot overflow. */
+static const struct LimitOption {
+    const char *option;
+    size_t offset;
+    int min, max;
+} limit_options[] = {
+    {"--max-file-bytes", offsetof(MechLimits, max_file_bytes), 1, INT_MAX - 1},
+    {"--max-line-length", offsetof(MechLimits, max_line_length), 1, INT_MAX - 1},
+    {"--max-name-length", offsetof(MechLimits, max_name_length), 1, 4000},
+    {"--max-depth", offsetof(MechLimits, max_depth), 1, 1000},
+    {"--max-expr-tokens", offsetof(MechLimits, max_expr_tokens), 1, 20000},
+    {"--max-coords", offsetof(MechLimits, max_coords), 1, 10000000},
+    {"--max-rows", offsetof(MechLimits, max_rows), 1, 10000000},
+    {"--max-jac-entries", offsetof(MechLimits, max_jac_entries), 1, INT_MAX},
+    {"--max-nodes", offsetof(MechLimits, max_nodes), 16, INT_MAX - 1},
+    {"--max-code-ops", offsetof(MechLimits, max_code_ops), 1, INT_MAX},
+};
+
+const char args_limits_usage[] =
+    "limits (defaults in examples/README.md, section Limits; a value N each):\n"
+    "  --max-file-bytes --max-line-length --max-name-length --max-depth\n"
+    "  --max-expr-tokens --max-coords --max-rows --max-jac-entries --max-nodes\n"
+    "  --max-code-ops\n";
+
+bool args_limit(Args *a, const char *option, MechLimits *limits)
+{
+    for (size_t i = 0; i < sizeof limit_options / sizeof *limit_options; i++) {
+        const struct LimitOption *l = &limit_options[i];
+        if (strcmp(option, l->option) != 0)
+            continue;
+        int value;
+        if (args_int(a, option, l->min, l->max, &value))
+            memcpy((char *)limits + l->offset, &value, sizeof value);
+        return true;
+    }
+    return false;
+}
+
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out)
 {
     int count = 0;
@@ -116,6 +158,13 @@ bool args_vector(const char *command, const char *option, const char *text, int 
         double v;
         if (!parse_double(item, &v)) {
             fprintf(stderr, "mechc %s: error: %s: '%s' is not a number\n", command, option, item);
+            return false;
+        }
+        /* NaN and infinities (also 1e999, which overflows) are refused, as
+           for --t: the kernels would only pass them on. */
+        if (!isfinite(v)) {
+            fprintf(stderr, "mechc %s: error: %s: value %d, '%s', is not a finite number\n",
+                    command, option, count + 1, item);
             return false;
         }
         if (count < n)

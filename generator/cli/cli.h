@@ -2,6 +2,8 @@
 #ifndef MECHC_CLI_H
 #define MECHC_CLI_H
 
+#include "../base/limits.h"
+
 #include <stdbool.h>
 #include <stdio.h>
 
@@ -27,7 +29,12 @@ const char *args_next(Args *a);
 const char *args_value(Args *a, const char *option);
 bool args_double(Args *a, const char *option, double *out);
 bool args_int(Args *a, const char *option, int min, int max, int *out);
-/* A comma-separated list of exactly n numbers. */
+/* The --max-... options every command takes (examples/README.md, Limits):
+   true when option is one of them, its value then parsed into limits
+   (a->failed set on a bad value). args_limits_usage is their --help text. */
+bool args_limit(Args *a, const char *option, MechLimits *limits);
+extern const char args_limits_usage[];
+/* A comma-separated list of exactly n finite numbers. */
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out);
 void args_unknown(Args *a, const char *option);
 bool args_need_file(Args *a);

@@ -124,10 +124,14 @@ int cmd_eval(int argc, char **argv)
     double t = 0.0;
     bool json = false;
     int engine = ENGINE_JIT;
+    MechLimits limits = mech_default_limits();
     while ((opt = args_next(&a)) && !a.failed) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
             return EXIT_OK;
+        } else if (args_limit(&a, opt, &limits)) {
+            continue;
         } else if (strcmp(opt, "--q") == 0) {
             q_text = args_value(&a, opt);
         } else if (strcmp(opt, "--qd") == 0) {
@@ -148,7 +152,6 @@ int cmd_eval(int argc, char **argv)
     }
     if (!args_need_file(&a))
         return EXIT_USAGE;
-    MechLimits limits = mech_default_limits();
     Diag diag;
     Mech *mech = pipeline_load(a.file, &limits, &diag);
     if (!mech) {

@@ -63,10 +63,14 @@ int cmd_gen(int argc, char **argv)
     const char *out_path = NULL, *header_path = NULL, *opt_name;
     bool stats = false, dump = false;
     EmitOptions opt = emit_default_options();
+    MechLimits limits = mech_default_limits();
     while ((opt_name = args_next(&a)) && !a.failed) {
         if (args_is_help(opt_name)) {
             fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
             return EXIT_OK;
+        } else if (args_limit(&a, opt_name, &limits)) {
+            continue;
         } else if (strcmp(opt_name, "-o") == 0 || strcmp(opt_name, "--output") == 0) {
             out_path = args_value(&a, opt_name);
         } else if (strcmp(opt_name, "--header") == 0) {
@@ -98,8 +102,22 @@ int cmd_gen(int argc, char **argv)
     }
     if (!args_need_file(&a))
         return EXIT_USAGE;
+    /* Names that reach the C text are checked before any work. */
+    const char *why;
+    if (opt.prefix && (why = emit_check_prefix(opt.prefix))) {
+        fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n", opt.prefix, why);
+        return EXIT_USAGE;
+    }
+    if (header_path) {
+        const char *base = strrchr(header_path, '/');
+        opt.header_name = base ? base + 1 : header_path;
+        if ((why = emit_check_header_name(opt.header_name))) {
+            fprintf(stderr, "mechc gen: error: --header '%s' cannot be used: %s\n", header_path, why);
+            return EXIT_USAGE;
+        }
+    }
+    opt.max_ops = limits.max_code_ops;
 
-    MechLimits limits = mech_default_limits();
     Diag diag;
     Mech *mech = pipeline_load(a.file, &limits, &diag);
     if (!mech) {
@@ -110,10 +128,6 @@ int cmd_gen(int argc, char **argv)
         dump_rows(mech);
         pipeline_free(mech);
         return EXIT_OK;
-    }
-    if (header_path) {
-        const char *base = strrchr(header_path, '/');
-        opt.header_name = base ? base + 1 : header_path;
     }
     opt.source_name = a.file;
     EmitResult res;

@@ -1,9 +1,327 @@
-/* cmd_info.c - mechc info (not implemented yet: says so and exits 2). */
+/* cmd_info.c - mechc info: coordinates, rows, mobility, rank, redundant rows, singularity, integrability. */
 #include "cli.h"
+
+#include "../analysis/analysis.h"
+#include "../base/arena.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: mechc info FILE.mech [--json] [--rank-tol T] [--t T] [--samples N]\n"
+    "\n"
+    "Reports the coordinates, every row with its joint, kind and level, the rows\n"
+    "per joint against the textbook table and the mobility count (coordinates -\n"
+    "rows, with and without drivers). Then assembles the mechanism at t = 0 by\n"
+    "minimum-norm Newton on its holonomic rows (any number of rows), takes the\n"
+    "rank of their Jacobian by SVD, names the redundant rows (a row that depends\n"
+    "on the rows before it), tells a singular position from a permanent\n"
+    "redundancy, and tests every velocity-level row for integrability\n"
+    "(holonomic in disguise, with its position law, or nonholonomic).\n"
+    "\n"
+    "  --json         print JSON (keys: coords, rows, nq, nh, nv, dof, rank,\n"
+    "                 redundant, and more)\n"
+    "  --rank-tol T   singular values above T count toward the rank\n"
+    "                 (default max(rows, coords) * eps * largest singular value)\n"
+    "  --t T          analyse at time T instead of 0 (drivers move with t)\n"
+    "  --samples N    random states for the numerical integrability check (default 8)\n"
+    "\n"
+    "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
+    "printed, at the last iterate), 2 bad usage or bad input.\n";
+
+static const char *level_name(const Row *row) { return row->velocity ? "velocity" : "position"; }
+
+static const char *evidence(const Integrability *it)
+{
+    return !it->decided ? "undecided" : it->symbolic ? "symbolic" : "numeric";
+}
+
+static const char *law_text(const Integrability *it)
+{
+    return it->law ? it->law : "integrable (law not found in closed form)";
+}
+
+/* ---- JSON ---- */
+
+static void json_names(const char *key, const InfoReport *rep, bool velocity)
+{
+    const Model *m = rep->model;
+    printf(",\n \"%s\": [", key);
+    int n = 0;
+    for (int r = velocity ? m->nh : 0; r < (velocity ? m->nr : m->nh); r++)
+        if (rep->rows[r].redundant) {
+            printf(n++ ? ", " : "");
+            json_string(stdout, m->rows[r].name);
+        }
+    printf("]");
+}
+
+static void json_int_or_null(const char *key, int v)
+{
+    if (v >= 0)
+        printf(",\n \"%s\": %d", key, v);
+    else
+        printf(",\n \"%s\": null", key);
+}
+
+static void json_num(const char *key, double v)
+{
+    printf(",\n \"%s\": ", key);
+    json_number(stdout, v);
+}
+
+static void print_json(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    printf("{\"mechanism\": ");
+    json_string(stdout, m->name);
+    printf(",\n \"coords\": [");
+    for (int i = 0; i < m->nq; i++) {
+        printf(i ? ", " : "");
+        json_string(stdout, m->coord_names[i]);
+    }
+    printf("],\n \"rows\": [");
+    for (int r = 0; r < m->nr; r++) {
+        const Row *row = &m->rows[r];
+        const InfoRow *ir = &rep->rows[r];
+        printf(r ? ",\n   {\"name\": " : "{\"name\": ");
+        json_string(stdout, row->name);
+        printf(", \"kind\": \"%s\", \"level\": \"%s\", \"joint\": ", joint_info[row->kind].keyword,
+               level_name(row));
+        json_string(stdout, m->joints[row->joint].name);
+        printf(", \"driver\": %s, \"redundant\": %s", ir->driver ? "true" : "false",
+               ir->redundant ? "true" : "false");
+        if (row->velocity) {
+            const Integrability *it = &ir->integ;
+            printf(", \"integrable\": %s", it->integrable ? "true" : "false");
+            if (it->integrable) {
+                printf(", \"law\": ");
+                json_string(stdout, law_text(it));
+                printf(", \"law_found\": %s", it->law ? "true" : "false");
+            }
+            printf(", \"evidence\": \"%s\", \"note\": ", evidence(it));
+            json_string(stdout, it->note ? it->note : "");
+        }
+        printf("}");
+    }
+    printf("],\n \"joints\": [");
+    for (int j = 0; j < m->njoints; j++) {
+        const Joint *jt = &m->joints[j];
+        bool vel;
+        int table = info_textbook_rows(jt->kind, &vel);
+        printf(j ? ",\n   {\"name\": " : "{\"name\": ");
+        json_string(stdout, jt->name);
+        printf(", \"kind\": \"%s\", \"rows\": %d, \"table_rows\": %d}", joint_info[jt->kind].keyword,
+               jt->nrows, table);
+    }
+    printf("]");
+    printf(",\n \"nq\": %d, \"nh\": %d, \"nv\": %d, \"nr\": %d", rep->nq, rep->nh, rep->nv, rep->nr);
+    printf(",\n \"dof\": %d", rep->dof);
+    json_int_or_null("rank", rep->rank);
+    json_names("redundant", rep, false);
+    printf(",\n \"drivers\": %d, \"mobility\": %d", rep->nh_drivers + rep->nv_drivers, rep->mobility);
+    if (rep->rank_all >= 0) {
+        printf(",\n \"dof_rank\": %d, \"mobility_rank\": %d", rep->dof_rank, rep->mobility_rank);
+    } else {
+        printf(",\n \"dof_rank\": null, \"mobility_rank\": null");
+    }
+    json_int_or_null("rank_all", rep->rank_all);
+    json_names("redundant_velocity", rep, true);
+    json_int_or_null("generic_rank", rep->generic_rank);
+    if (rep->rank >= 0) {
+        json_num("rank_tol", rep->rank_tol);
+        json_num("sigma_max", rep->sigma_max);
+        json_num("sigma_min", rep->sigma_min);
+        json_num("cond", rep->cond);        /* null when infinite */
+    }
+    json_num("t", rep->t);
+    printf(",\n \"assembled\": %s, \"iterations\": %d", rep->assembled ? "true" : "false",
+           rep->assembly.iterations);
+    json_num("residual", rep->assembly.residual);
+    printf(",\n \"q\": [");
+    for (int i = 0; i < m->nq; i++) {
+        printf(i ? ", " : "");
+        json_number(stdout, rep->q[i]);
+    }
+    printf("],\n \"singularity\": \"%s\"", singularity_names[rep->singularity]);
+    printf(",\n \"singular\": ");
+    json_string(stdout, rep->singular);
+    printf(",\n \"verdict\": ");
+    json_string(stdout, rep->verdict);
+    printf("}\n");
+}
+
+/* ---- text ---- */
+
+static int width(int n, const char *(*name)(const Model *, int), const Model *m, int min)
+{
+    int w = min;
+    for (int i = 0; i < n; i++)
+        if ((int)strlen(name(m, i)) > w)
+            w = (int)strlen(name(m, i));
+    return w;
+}
+
+static const char *coord_name(const Model *m, int i) { return m->coord_names[i]; }
+static const char *row_name(const Model *m, int i) { return m->rows[i].name; }
+static const char *joint_name(const Model *m, int i) { return m->joints[i].name; }
+
+static void print_text(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    printf("mechanism %s: %d coordinates, %d rows (%d holonomic, %d velocity level)\n\n",
+           m->name, m->nq, m->nr, m->nh, m->nv);
+
+    int cw = width(m->nq, coord_name, m, 5);
+    printf("coordinates (initial value, assembled at t = %g):\n", rep->t);
+    for (int i = 0; i < m->nq; i++)
+        printf("  %-*s  %14.8g  %14.8g\n", cw, m->coord_names[i], m->q0[i], rep->q[i]);
+
+    int rw = width(m->nr, row_name, m, 4), jw = width(m->njoints, joint_name, m, 5);
+    printf("\nrows:\n  %-*s  %-*s  %-10s  %-8s\n", rw, "row", jw, "joint", "kind", "level");
+    for (int r = 0; r < m->nr; r++) {
+        const Row *row = &m->rows[r];
+        printf("  %-*s  %-*s  %-10s  %-8s%s%s\n", rw, row->name, jw, m->joints[row->joint].name,
+               joint_info[row->kind].keyword, level_name(row),
+               rep->rows[r].driver ? "  driver" : "", rep->rows[r].redundant ? "  REDUNDANT" : "");
+    }
+
+    printf("\njoints (rows here / rows in the textbook table):\n");
+    for (int j = 0; j < m->njoints; j++) {
+        const Joint *jt = &m->joints[j];
+        bool vel;
+        int table = info_textbook_rows(jt->kind, &vel);
+        printf("  %-*s  %-10s  %d / %d%s%s\n", jw, jt->name, joint_info[jt->kind].keyword,
+               jt->nrows, table, vel || jt->velocity ? "  velocity level" : "",
+               jt->nrows == table ? "" : "  MISMATCH");
+    }
+
+    int drivers = rep->nh_drivers + rep->nv_drivers;
+    printf("\nmobility by the count:\n");
+    printf("  %d coordinates - %d holonomic - %d velocity-level rows = %d DOF\n",
+           rep->nq, rep->nh, rep->nv, rep->dof);
+    printf("  without the %d driver%s: %d DOF\n", drivers, drivers == 1 ? "" : "s", rep->mobility);
+
+    printf("\nassembly at t = %g (minimum-norm Newton on the holonomic rows):\n  ", rep->t);
+    if (rep->nh == 0)
+        printf("nothing to assemble (no holonomic rows)\n");
+    else if (!rep->dense && rep->assembled)
+        printf("the initial values fit (residual %.3g); not iterated (beyond the dense limit)\n",
+               rep->assembly.residual);
+    else if (!rep->dense)
+        printf("NOT ASSEMBLED: residual %.3g and the Jacobian is beyond the dense limit\n",
+               rep->assembly.residual);
+    else
+        printf("%s after %d iteration%s, residual %.3g%s%s\n",
+               rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
+               rep->assembly.iterations == 1 ? "" : "s", rep->assembly.residual,
+               rep->assembly.worst_row >= 0 && !rep->assembled ? ", worst row " : "",
+               rep->assembly.worst_row >= 0 && !rep->assembled
+                   ? m->rows[rep->assembly.worst_row].name : "");
+
+    printf("\nrank (SVD at the assembled configuration):\n");
+    if (rep->rank < 0) {
+        printf("  not computed (%s)\n", rep->dense ? "NaN or Inf in the Jacobian"
+                                                   : "the Jacobian is beyond the dense-SVD limit");
+    } else {
+        printf("  holonomic rows: rank %d of %d (tolerance %.3g)\n", rep->rank, rep->nh, rep->rank_tol);
+        if (rep->nv)
+            printf("  all rows:       rank %d of %d\n", rep->rank_all, rep->nr);
+        if (rep->nh)
+            printf("  singular values: largest %.6g, smallest %.6g, condition number %.6g\n",
+                   rep->sigma_max, rep->sigma_min, rep->cond);
+        printf("  configuration: %s\n", rep->singular);
+        printf("  redundant rows: ");
+        int n = 0;
+        for (int r = 0; r < m->nr; r++)
+            if (rep->rows[r].redundant)
+                printf("%s%s (joint %s)", n++ ? ", " : "", m->rows[r].name,
+                       m->joints[m->rows[r].joint].name);
+        printf("%s\n", n ? "" : "none");
+        printf("  DOF by the rank: %d with drivers, %d without\n", rep->dof_rank, rep->mobility_rank);
+    }
+
+    if (m->nv) {
+        printf("\nintegrability (each velocity-level row on its own, omega = a^T dq + b dt):\n");
+        for (int r = m->nh; r < m->nr; r++) {
+            const Integrability *it = &rep->rows[r].integ;
+            printf("  %-*s  ", rw, m->rows[r].name);
+            if (!it->decided)
+                printf("undecided\n");
+            else if (it->integrable && it->law)
+                printf("integrable (holonomic): %s\n", it->law);
+            else if (it->integrable)
+                printf("integrable (holonomic); law not found in closed form\n");
+            else
+                printf("not integrable (nonholonomic)\n");
+            printf("  %-*s  %s\n", rw, "", it->note);
+        }
+        if (m->nv > 1)
+            printf("  (the verdict is per row: rows that are nonholonomic alone may still\n"
+                   "  combine with the others; the test does not use the holonomic rows)\n");
+    }
+
+    printf("\nverdict: %s\n", rep->verdict);
+}
 
 int cmd_info(int argc, char **argv)
 {
-    (void)argc, (void)argv;
-    fprintf(stderr, "mechc info: error: this command is not implemented yet in mechc %s\n", MECHC_VERSION);
-    return EXIT_USAGE;
+    Args a;
+    args_init(&a, "info", argc, argv);
+    const char *opt;
+    bool json = false;
+    double t = 0.0;
+    AnalysisOptions o = analysis_default_options();
+    while ((opt = args_next(&a)) && !a.failed) {
+        if (args_is_help(opt)) {
+            fputs(usage, stdout);
+            return EXIT_OK;
+        } else if (strcmp(opt, "--json") == 0) {
+            json = true;
+        } else if (strcmp(opt, "--rank-tol") == 0) {
+            if (args_double(&a, opt, &o.rank_tol) && o.rank_tol < 0) {
+                fprintf(stderr, "mechc info: error: --rank-tol needs a number >= 0\n");
+                a.failed = true;
+            }
+        } else if (strcmp(opt, "--t") == 0) {
+            args_double(&a, opt, &t);
+        } else if (strcmp(opt, "--samples") == 0) {
+            args_int(&a, opt, 1, 1000, &o.samples);
+        } else {
+            args_unknown(&a, opt);
+        }
+    }
+    if (!args_need_file(&a))
+        return EXIT_USAGE;
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load(a.file, &limits, &diag);
+    if (!mech) {
+        diag_print(&diag, stderr);
+        return EXIT_USAGE;
+    }
+    InfoReport rep;
+    if (!info_analyse(mech, t, &o, &rep, &diag)) {
+        fprintf(stderr, "mechc info: error: %s\n", diag.message);
+        pipeline_free(mech);
+        return EXIT_USAGE;
+    }
+    if (json)
+        print_json(&rep);
+    else
+        print_text(&rep);
+    int status = EXIT_OK;
+    if (!rep.assembled) {
+        const Model *m = mech->model;
+        fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
+                t, rep.assembly.residual);
+        if (rep.assembly.worst_row >= 0)
+            fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
+        fprintf(stderr, ")%s\n", rep.dense ? "" : "; the Jacobian is too large to iterate on densely");
+        status = EXIT_ANALYSIS;
+    }
+    info_report_free(&rep);
+    pipeline_free(mech);
+    return status;
 }

@@ -1,9 +1,286 @@
-/* cmd_run.c - mechc run (not implemented yet: says so and exits 2). */
+/* cmd_run.c - mechc run: assembly, then position, velocity and acceleration analysis over time.
+ *
+ * Parses the options, loads the mechanism, opens the engine and hands the
+ * rest to run_analysis (generator/analysis/run.c), whose states stream to
+ * the CSV writer or are collected for JSON (runtime/host/output.c). On a
+ * failure the states computed before it are still written, JSON included
+ * ("ok": false and the error), and the message goes to stderr.
+ */
 #include "cli.h"
+
+#include "../analysis/run.h"
+#include "../base/arena.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: mechc run FILE.mech [--t0 T] [--t1 T] [--steps N] [--engine jit|generic|aot]\n"
+    "                 [--csv OUT.csv] [--json] [options]\n"
+    "\n"
+    "Assembles the mechanism at t0 (Newton from the file's initial values), then\n"
+    "does position, velocity and acceleration analysis on N equal intervals up to\n"
+    "t1: N + 1 states. Mechanisms with velocity-level rows (rolling, knife,\n"
+    "velocity drivers) have their positions integrated (GSL, adaptive step) and\n"
+    "projected back onto the holonomic rows after every step. Needs as many rows\n"
+    "as coordinates.\n"
+    "\n"
+    "  --t0 T, --t1 T   time interval (default 0 and 1)\n"
+    "  --steps N        intervals (default 100)\n"
+    "  --engine E       jit (default), generic or aot, as for eval\n"
+    "  --csv FILE       write the CSV to FILE ('-': stdout; the default when\n"
+    "                   there is no --json)\n"
+    "  --json           print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}\n"
+    "  --digits N       significant digits of numbers (default: the fewest that\n"
+    "                   read back exactly, at most 17)\n"
+    "  --tol X          Newton: converged when max |Phi_i| <= X and the last\n"
+    "                   step max |dq_j| <= X (default 1e-8)\n"
+    "  --max-iter N     Newton iterations per time step (default 25)\n"
+    "  --pivot-tol X    singular when an LU pivot <= X times the largest\n"
+    "                   Jacobian entry (default 1e-12)\n"
+    "  --cond-warn X    warn where the Jacobian's condition estimate exceeds X\n"
+    "                   (default 1e10; 0: no estimate)\n"
+    "  --ode M          integrator for velocity-level rows: rk8pd (default) or rkf45\n"
+    "  --ode-tol X      its error per step, absolute and relative (default 1e-10)\n"
+    "  --stats          print time per step, Newton iterations per step and the\n"
+    "                   step's cost in evaluations of the fused `all` kernel\n"
+    "  --svg FILE       (not implemented yet)\n"
+    "\n"
+    "CSV columns: t, then every coordinate by name (crank.x, ...), then the\n"
+    "velocities d(crank.x), ..., then the accelerations dd(crank.x), ...\n"
+    "Exit status: 0 done; 1 the analysis failed (the message names t = VALUE,\n"
+    "the cause and the rows and coordinates involved; the states before the\n"
+    "failure are written); 2 bad usage or input, or not as many rows as\n"
+    "coordinates.\n";
+
+/* Where the states go. */
+typedef struct Output {
+    FILE *csv;              /* NULL: no CSV */
+    MechrtTrace trace;      /* JSON rows, when json */
+    bool json, trace_full;
+    int digits;
+    int nq;
+} Output;
+
+static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
+{
+    Output *out = ctx;
+    if (out->csv)
+        mechrt_csv_row(out->csv, out->nq, t, q, qd, qdd, out->digits);
+    if (out->json && !mechrt_trace_push(&out->trace, t, q, qd, qdd))
+        out->trace_full = true;
+}
+
+static bool positive_option(Args *a, const char *opt, double *out, bool allow_zero)
+{
+    if (!args_double(a, opt, out))
+        return false;
+    if (*out < 0 || (!allow_zero && *out == 0)) {
+        fprintf(stderr, "mechc run: error: %s needs a %s number, not %g\n", opt,
+                allow_zero ? "non-negative" : "positive", *out);
+        a->failed = true;
+        return false;
+    }
+    return true;
+}
+
+static void print_stats(const RunResult *res, const MechrtKernels *k, const double *q,
+                        const double *qd, double t)
+{
+    int n = res->steps_done;
+    double ns_step = n > 0 ? 1e9 * res->step_seconds / n : 0;
+    fprintf(stderr, "mechc run: stats: %d %s after assembly (%d Newton %s at t0), %.6g ms "
+            "of analysis: %.0f ns per step\n", n, n == 1 ? "step" : "steps",
+            res->assembly_iterations, res->assembly_iterations == 1 ? "iteration" : "iterations",
+            1e3 * res->step_seconds, ns_step);
+    if (res->integrated) {
+        const MechrtHostStats *h = &res->host;
+        fprintf(stderr, "mechc run: stats: integrator: %ld accepted steps (%.3g per output "
+                "step), %ld rejected, %ld velocity solves; %.3g projection iterations per "
+                "integrator step\n", h->ode_steps, n > 0 ? (double)h->ode_steps / n : 0,
+                h->ode_rejected, h->rhs_calls,
+                h->ode_steps > 0 ? (double)h->project_iterations / (double)h->ode_steps : 0);
+    } else {
+        fprintf(stderr, "mechc run: stats: %.3g Newton iterations per step (%ld in all)\n",
+                n > 0 ? (double)res->newton_iterations / n : 0, res->newton_iterations);
+    }
+    double ns_all = run_time_all(k, q, qd, t, 0.05);
+    fprintf(stderr, "mechc run: stats: one `all` kernel call (Phi, Phi_q, nu, gamma) takes "
+            "%.1f ns: a step costs %.2f of them\n", ns_all, ns_all > 0 ? ns_step / ns_all : 0);
+    if (res->max_cond > 0)
+        fprintf(stderr, "mechc run: stats: largest condition estimate %.3g\n", res->max_cond);
+}
+
+/* The last state seen, for --stats' kernel timing. */
+typedef struct LastState {
+    Output *out;
+    double t;
+    double *q, *qd;
+} LastState;
+
+static void on_state_keep(void *ctx, double t, const double *q, const double *qd,
+                          const double *qdd)
+{
+    LastState *ls = ctx;
+    on_state(ls->out, t, q, qd, qdd);
+    ls->t = t;
+    memcpy(ls->q, q, (size_t)ls->out->nq * sizeof *q);
+    memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
+}
 
 int cmd_run(int argc, char **argv)
 {
-    (void)argc, (void)argv;
-    fprintf(stderr, "mechc run: error: this command is not implemented yet in mechc %s\n", MECHC_VERSION);
-    return EXIT_USAGE;
+    Args a;
+    args_init(&a, "run", argc, argv);
+    RunOptions ro = run_default_options();
+    const char *csv_path = NULL, *opt;
+    bool json = false, stats = false;
+    int engine = ENGINE_JIT, digits = 0;
+    double x;
+    MechLimits limits = mech_default_limits();
+    while ((opt = args_next(&a)) && !a.failed) {
+        if (args_is_help(opt)) {
+            fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
+            return EXIT_OK;
+        } else if (args_limit(&a, opt, &limits)) {
+            continue;
+        } else if (strcmp(opt, "--t0") == 0) {
+            args_double(&a, opt, &ro.t0);
+        } else if (strcmp(opt, "--t1") == 0) {
+            args_double(&a, opt, &ro.t1);
+        } else if (strcmp(opt, "--steps") == 0) {
+            args_int(&a, opt, 1, 100000000, &ro.steps);
+        } else if (strcmp(opt, "--engine") == 0) {
+            const char *v = args_value(&a, opt);
+            if (v && (engine = engine_from_name(v)) < 0) {
+                fprintf(stderr, "mechc run: error: --engine takes jit, generic or aot, not '%s'\n", v);
+                a.failed = true;
+            }
+        } else if (strcmp(opt, "--csv") == 0) {
+            csv_path = args_value(&a, opt);
+        } else if (strcmp(opt, "--json") == 0) {
+            json = true;
+        } else if (strcmp(opt, "--svg") == 0) {
+            fprintf(stderr, "mechc run: error: --svg is not implemented yet; use --csv or --json\n");
+            a.failed = true;
+        } else if (strcmp(opt, "--digits") == 0) {
+            args_int(&a, opt, 1, 17, &digits);
+        } else if (strcmp(opt, "--tol") == 0) {
+            if (positive_option(&a, opt, &x, false))
+                ro.mechrt.tol_phi = ro.mechrt.tol_dq = x;
+        } else if (strcmp(opt, "--max-iter") == 0) {
+            args_int(&a, opt, 1, 10000, &ro.mechrt.max_iter);
+        } else if (strcmp(opt, "--pivot-tol") == 0) {
+            if (positive_option(&a, opt, &x, true))
+                ro.mechrt.pivot_tol = x;
+        } else if (strcmp(opt, "--cond-warn") == 0) {
+            if (positive_option(&a, opt, &x, true))
+                ro.mechrt.cond_warn = x;
+        } else if (strcmp(opt, "--ode") == 0) {
+            const char *v = args_value(&a, opt);
+            if (v && !mechrt_ode_method_from_name(v, &ro.ode.method)) {
+                fprintf(stderr, "mechc run: error: --ode takes rk8pd or rkf45, not '%s'\n", v);
+                a.failed = true;
+            }
+        } else if (strcmp(opt, "--ode-tol") == 0) {
+            if (positive_option(&a, opt, &x, false))
+                ro.ode.tol = x;
+        } else if (strcmp(opt, "--stats") == 0) {
+            stats = true;
+        } else {
+            args_unknown(&a, opt);
+        }
+    }
+    if (!args_need_file(&a))
+        return EXIT_USAGE;
+    if (ro.t0 == ro.t1) {
+        fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", ro.t0);
+        return EXIT_USAGE;
+    }
+    bool csv_stdout = csv_path ? strcmp(csv_path, "-") == 0 : !json;
+    if (csv_stdout && json) {
+        fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
+        return EXIT_USAGE;
+    }
+
+    Diag diag;
+    Mech *mech = pipeline_load(a.file, &limits, &diag);
+    if (!mech) {
+        diag_print(&diag, stderr);
+        return EXIT_USAGE;
+    }
+    const Model *m = mech->model;
+    Engine e;
+    if (!engine_open(&e, (EngineKind)engine, mech, &diag)) {
+        fprintf(stderr, "mechc run: error: %s\n", diag.message);
+        pipeline_free(mech);
+        return EXIT_USAGE;
+    }
+
+    Output out = {.csv = NULL, .json = json, .digits = digits, .nq = m->nq};
+    mechrt_trace_init(&out.trace, m->nq);
+    int status = EXIT_OK;
+    if (csv_stdout) {
+        out.csv = stdout;
+    } else if (csv_path) {
+        out.csv = fopen(csv_path, "w");
+        if (!out.csv) {
+            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", csv_path, strerror(errno));
+            engine_close(&e);
+            pipeline_free(mech);
+            return EXIT_USAGE;
+        }
+    }
+
+    /* the header goes out only for a runnable mechanism, so that a
+       row-count error leaves the output empty */
+    MechrtKernels k = run_engine_kernels(&e);
+    RunResult res;
+    ro.notes = stderr;
+    if (out.csv && m->nr == m->nq)
+        mechrt_csv_header(out.csv, m->nq, m->coord_names);
+    LastState last = {&out, ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
+                      xcalloc((size_t)m->nq, sizeof(double))};
+    memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
+    RunStatus rs = run_analysis(m, &k, &ro, on_state_keep, &last, &res);
+
+    if (rs == RUN_BAD_INPUT) {
+        fprintf(stderr, "%s: error: %s\n", m->file, res.message);
+        status = EXIT_USAGE;
+    } else {
+        if (json)
+            mechrt_json_write(stdout, &out.trace, m->coord_names, digits,
+                              rs == RUN_FAILED ? res.message : NULL, res.t_fail);
+        if (rs == RUN_FAILED) {
+            fprintf(stderr, "%s: error: %s\n", m->file, res.message);
+            if (res.states > 0)
+                fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file,
+                        res.states, res.states == 1 ? "state" : "states", res.t_fail,
+                        res.states == 1 ? "is" : "are");
+            status = EXIT_ANALYSIS;
+        }
+        if (out.trace_full) {
+            fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
+            status = EXIT_ANALYSIS;
+        }
+        if (stats)
+            print_stats(&res, &k, last.q, last.qd, last.t);
+    }
+    if (out.csv && out.csv != stdout) {
+        if (fclose(out.csv) != 0) {
+            fprintf(stderr, "mechc run: error: writing '%s': %s\n", csv_path, strerror(errno));
+            status = status == EXIT_OK ? EXIT_USAGE : status;
+        }
+    } else if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "mechc run: error: writing the output: %s\n", strerror(errno));
+        status = status == EXIT_OK ? EXIT_USAGE : status;
+    }
+    free(last.q), free(last.qd);
+    mechrt_trace_free(&out.trace);
+    engine_close(&e);
+    pipeline_free(mech);
+    return status;
 }

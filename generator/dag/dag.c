@@ -82,9 +82,15 @@ static NodeId intern(Dag *dag, DagOp op, int32_t a, int32_t b, double value)
             return dag->table[h];
     }
     if (dag->count >= dag->max_nodes) {
-        diag_error_nopos(dag->diag,
-                         "the expression graph passed its limit of %d nodes "
-                         "(the mechanism is too large)", (int)dag->max_nodes);
+        if (dag->where >= 0)
+            diag_error(dag->diag, (SrcPos){dag->where},
+                       "the expression graph passed its limit of %d nodes at this statement "
+                       "(its rows or their derivatives are too large; see --max-nodes)",
+                       (int)dag->max_nodes);
+        else
+            diag_error_nopos(dag->diag,
+                             "the expression graph passed its limit of %d nodes "
+                             "(the mechanism is too large; see --max-nodes)", (int)dag->max_nodes);
         if (dag->diag->escape)
             longjmp(*dag->diag->escape, 1);
         abort();
@@ -104,6 +110,7 @@ void dag_init(Dag *dag, int32_t max_nodes, Diag *diag)
     memset(dag, 0, sizeof *dag);
     dag->max_nodes = max_nodes > 2 ? max_nodes : 2;
     dag->diag = diag;
+    dag->where = -1;
     NodeId zero = dag_const(dag, 0.0), one = dag_const(dag, 1.0);
     (void)zero, (void)one;      /* DAG_ZERO and DAG_ONE by construction */
 }
@@ -182,7 +189,7 @@ static bool try_fold(Dag *dag, DagOp op, NodeId a, NodeId b, NodeId *out)
     double r = dag_op_eval(op, va, vb);
     if (!isfinite(r))
         return false;
-    *out = dag_const(dag, r);
+    *out = r == 0.0 ? DAG_ZERO : dag_const(dag, r);     /* one zero: no -0 node */
     return true;
 }
 

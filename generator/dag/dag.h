@@ -28,6 +28,8 @@ typedef struct Dag {
     uint32_t table_cap;     /* power of two */
     int32_t max_nodes;      /* limit; passing it fails through diag */
     Diag *diag;             /* receives the node-limit error (longjmp) */
+    int32_t where;          /* offset of the statement being built, for that
+                               error; -1: none */
 } Dag;
 
 void dag_init(Dag *dag, int32_t max_nodes, Diag *diag);

@@ -89,7 +89,9 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     int *cols = xmalloc((size_t)m->nq * sizeof *cols);
     int *inner = xmalloc((size_t)m->nq * sizeof *inner);
     int cap = 16;
-    JacEntry *jac = xmalloc((size_t)cap * sizeof *jac);
+    /* volatile: reallocated between setjmp and a possible longjmp, after
+       which a register copy would be stale (C11 7.13.2.1) */
+    JacEntry *volatile jac = xmalloc((size_t)cap * sizeof *jac);
     bool ok = true;
     if (setjmp(escape) != 0) {
         ok = false;
@@ -97,6 +99,7 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     }
     for (int r = 0; r < m->nr; r++) {
         const Row *row = &m->rows[r];
+        dag->where = row->pos.offset;       /* a node-limit error names the row */
         kin->row_start[r] = kin->nnz;
         int ncols;
         if (!row->velocity) {
@@ -137,6 +140,7 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     kin->jac = arena_alloc_array(&m->arena, (size_t)kin->nnz + 1, sizeof *kin->jac);
     memcpy(kin->jac, jac, (size_t)kin->nnz * sizeof *jac);
 done:
+    dag->where = -1;
     diag->escape = saved;
     free(jac);
     free(cols);

@@ -33,7 +33,8 @@ static const char *const function_params[EMIT_FUNCTION_COUNT] = {
 
 EmitOptions emit_default_options(void)
 {
-    return (EmitOptions){.chunk_nodes = 150, .source_name = "input.mech"};
+    return (EmitOptions){.chunk_nodes = 150, .source_name = "input.mech",
+                         .max_ops = mech_default_limits().max_code_ops};
 }
 
 static const char *const c_keywords[] = {
@@ -71,6 +72,21 @@ const char *emit_check_prefix(const char *p)
     return NULL;
 }
 
+/* Header names are not string literals: escapes mean nothing there, and
+   ', \, " and trigraphs (??/) are undefined or worse. Only a plain file
+   name is accepted. */
+const char *emit_check_header_name(const char *name)
+{
+    if (!name[0])
+        return "it is empty";
+    if (strlen(name) > 255)
+        return "it is longer than 255 characters";
+    for (const char *c = name; *c; c++)
+        if (!(isalnum((unsigned char)*c) || strchr("._+-", *c)))
+            return "it goes into #include \"...\" and may contain only letters, digits and . _ + -";
+    return NULL;
+}
+
 /* The default prefix: the mechanism name made a safe identifier. */
 static void sanitize_prefix(const char *name, char *out, size_t size)
 {
@@ -92,6 +108,10 @@ static void sanitize_prefix(const char *name, char *out, size_t size)
 static void put_literal(StrBuf *sb, double v, bool real_float)
 {
     char buf[64];
+    if (real_float && isinf((float)v)) {    /* finite as double, not as float */
+        sb_puts(sb, v > 0 ? "HUGE_VALF" : "(-HUGE_VALF)");
+        return;
+    }
     for (int digits = real_float ? 6 : 15; digits <= (real_float ? 9 : 17); digits++) {
         snprintf(buf, sizeof buf, "%.*g", digits, real_float ? (double)(float)v : v);
         double back = strtod(buf, NULL);
@@ -337,6 +357,13 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     } else {
         sanitize_prefix(m->name, out->prefix, sizeof out->prefix);
     }
+    if (opt->header_name) {
+        const char *why = emit_check_header_name(opt->header_name);
+        if (why) {
+            diag_error_nopos(diag, "the header name '%s' cannot be used: %s", opt->header_name, why);
+            return false;
+        }
+    }
     char upper[128];
     size_t plen = strlen(out->prefix);
     for (size_t i = 0; i <= plen; i++)
@@ -345,25 +372,39 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
                  .prefix_upper = upper};
     sched_init(&e.sched, &m->dag, opt->chunk_nodes > 0 ? opt->chunk_nodes : 2000);
+    e.sched.max_ops = opt->max_ops;
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
+    bool too_big = false;
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
         sb_init(&parts[f]);
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
-        if (f == EMIT_JAC)      /* the template builds it on jac_nz */
+        if (f == EMIT_JAC || too_big)   /* the template builds jac on jac_nz */
             continue;
         SchedOutput *outs;
         int n;
         collect_outputs(kin, (EmitFunction)f, &outs, &n);
         SchedFunction fn;
-        sched_function(&e.sched, outs, n, &fn);
-        put_function(&e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
-        out->ops[f] = fn.ops;
-        out->chunks[f] = fn.nchunks;
+        if (sched_function(&e.sched, outs, n, &fn)) {
+            put_function(&e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
+            out->ops[f] = fn.ops;
+            out->chunks[f] = fn.nchunks;
+        } else {
+            too_big = true;
+        }
         sched_function_free(&fn);
     }
     sched_free(&e.sched);
+    if (too_big) {
+        for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+            sb_free(&parts[f]);
+            sb_free(&bodies[f]);
+        }
+        diag_error_nopos(diag, "the generated code would have more than %ld operations, "
+                         "the limit (see --max-code-ops)", opt->max_ops);
+        return false;
+    }
     out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
     out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
 

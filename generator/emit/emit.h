@@ -3,6 +3,7 @@
 #define MECHC_EMIT_H
 
 #include "../base/diag.h"
+#include "../base/limits.h"
 #include "../diff/kinematics.h"
 
 #include <stdbool.h>
@@ -17,6 +18,8 @@ typedef struct EmitOptions {
                                    needs no system headers) */
     int chunk_nodes;            /* most operations plus stores per C function (default 150) */
     const char *source_name;    /* the input file, named in the banner */
+    long max_ops;               /* most operations in all functions together
+                                   (default: MechLimits max_code_ops); 0: no limit */
 } EmitOptions;
 
 /* The spec's function order, for op counts and reports. */
@@ -40,8 +43,13 @@ EmitOptions emit_default_options(void);
    the reason it is not. */
 const char *emit_check_prefix(const char *prefix);
 
-/* Writes the C source and header. Returns false (diag filled) only for an
-   unusable prefix; everything else in the model is already valid. */
+/* Checks a --header file name (the part after the last '/', which goes
+   into #include "..."): NULL when usable, else the reason it is not. */
+const char *emit_check_header_name(const char *name);
+
+/* Writes the C source and header. Returns false (diag filled) for an
+   unusable prefix or header name, or code beyond max_ops; everything else
+   in the model is already valid. */
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag);
 void emit_result_free(EmitResult *out);
 

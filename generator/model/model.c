@@ -91,11 +91,21 @@ static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos
     return e;
 }
 
+/* Rows x coordinates: the dense Jacobian every engine fills (and the
+   generated C indexes with int). */
+static void check_jacobian_size(Builder *b, long long nr, long long nq, SrcPos pos)
+{
+    if (nr * nq > b->limits->max_jac_entries)
+        diag_fail(b->diag, pos, "the dense Jacobian would have %lld rows x %lld coordinates = %lld "
+                  "entries, more than the limit of %d", nr, nq, nr * nq, b->limits->max_jac_entries);
+}
+
 static int add_coord(Builder *b, const char *owner, const char *suffix, double q0, SrcPos pos)
 {
     Model *m = b->model;
     if (m->nq >= b->limits->max_coords)
         diag_fail(b->diag, pos, "too many coordinates (the limit is %d)", b->limits->max_coords);
+    check_jacobian_size(b, b->npos + b->nvel, m->nq + 1, pos);
     grow((void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
     /* q0 shares the capacity of coord_names */
     m->q0 = xrealloc(m->q0, (size_t)b->cap_coords, sizeof *m->q0);
@@ -286,6 +296,7 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     const JointInfo *info = &joint_info[j->kind];
     if (b->npos + b->nvel >= b->limits->max_rows)
         diag_fail(b->diag, j->pos, "too many rows (the limit is %d)", b->limits->max_rows);
+    check_jacobian_size(b, b->npos + b->nvel + 1, m->nq, j->pos);
     const char *suffix = info->suffix[index];
     char *name = arena_alloc(&m->arena, strlen(j->name) + strlen(suffix) + 1);
     strcpy(name, j->name);
@@ -324,8 +335,6 @@ static void build_joint(Builder *b, const Stmt *s)
             diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }
     if (s->option) {
-        if (mentions_der(s->option))
-            diag_fail(b->diag, s->option_pos, "der() cannot appear in %s", context_what(EXPR_HOLONOMIC));
         j->option = lower_expr(b, s->option, EXPR_HOLONOMIC);
     }
     switch (info->level) {
@@ -334,7 +343,7 @@ static void build_joint(Builder *b, const Stmt *s)
     case LEVEL_EITHER:   j->velocity = mentions_der(s->lhs) || mentions_der(s->rhs); break;
     }
     if (info->attachments == 0) {
-        if (s->joint == JOINT_VELOCITY && !j->velocity)
+        if (s->joint == JOINT_VELOCITY && !mentions_der(s->lhs) && !mentions_der(s->rhs))
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
         ExprContext ctx = j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC;
@@ -355,6 +364,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     const Stmt *last = NULL;
     for (const Stmt *s = prog->first; s; s = s->next) {
         last = s;
+        m->dag.where = s->pos.offset;
         switch (s->kind) {
         case STMT_MECHANISM:
             m->name = s->name;
@@ -372,6 +382,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             break;
         }
     }
+    m->dag.where = -1;
     SrcPos where = last ? last->pos : (SrcPos){0};
     if (m->nq == 0)
         diag_fail(b->diag, where, "the mechanism has no coordinates: declare a body, point or coord");

@@ -19,6 +19,7 @@ static Mech *load(char *text, int len, const char *path, const MechLimits *limit
     double t0 = pipeline_now();
     Mech *mech = xcalloc(1, sizeof *mech);
     mech->text = text;
+    mech->limits = *limits;
     Arena scratch;
     arena_init(&scratch);
     char *stem = model_file_stem(&scratch, path);
@@ -57,14 +58,20 @@ Mech *pipeline_load(const char *path, const MechLimits *limits, Diag *diag)
 
 Mech *pipeline_load_text(const char *text, const char *name, const MechLimits *limits, Diag *diag)
 {
-    size_t len = strlen(text);
+    return pipeline_load_bytes(text, strlen(text), name, limits, diag);
+}
+
+Mech *pipeline_load_bytes(const char *data, size_t len, const char *name, const MechLimits *limits,
+                          Diag *diag)
+{
     diag_init(diag, name, NULL, 0);
     if (len > (size_t)limits->max_file_bytes) {
         diag_error_nopos(diag, "'%s' is larger than the limit of %d bytes", name, limits->max_file_bytes);
         return NULL;
     }
     char *copy = xmalloc(len + 1);
-    memcpy(copy, text, len + 1);
+    memcpy(copy, data, len);
+    copy[len] = '\0';
     Mech *mech = load(copy, (int)len, name, limits, diag);
     if (!mech) {
         free(copy);
@@ -89,6 +96,7 @@ Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
     opt.declare_math = true;
     opt.prefix = "mechc_jit";
     opt.source_name = mech->model->file;
+    opt.max_ops = mech->limits.max_code_ops;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &opt, emitted, diag))
         return NULL;

@@ -79,13 +79,14 @@ static int compare_ids(const void *a, const void *b)
 
 static void close_chunk(SchedFunction *fn, int first, int count, NodeId *nodes, int nnodes)
 {
-    qsort(nodes, (size_t)nnodes, sizeof *nodes, compare_ids);
+    if (nnodes > 1)     /* an empty chunk may have nodes == NULL, which qsort must not get */
+        qsort(nodes, (size_t)nnodes, sizeof *nodes, compare_ids);
     fn->chunks = xrealloc(fn->chunks, (size_t)fn->nchunks + 1, sizeof *fn->chunks);
     fn->chunks[fn->nchunks++] = (SchedChunk){first, count, nodes, nnodes};
     fn->ops += nnodes;
 }
 
-void sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunction *fn)
+bool sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunction *fn)
 {
     memset(fn, 0, sizeof *fn);
     fn->outputs = outputs;
@@ -107,11 +108,17 @@ void sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunct
             s->stamp++;
             collect(s, outputs[i].value, &nodes, &n, &cap);
         }
+        if (s->max_ops > 0 && s->total_ops + fn->ops + n > s->max_ops) {
+            free(nodes);
+            return false;
+        }
     }
     if (noutputs > first || fn->nchunks == 0)
         close_chunk(fn, first, noutputs - first, nodes, n);
     else
         free(nodes);
+    s->total_ops += fn->ops;
+    return true;
 }
 
 void sched_function_free(SchedFunction *fn)

@@ -33,6 +33,8 @@ typedef struct SchedFunction {
 typedef struct Scheduler {
     const Dag *dag;
     int chunk_nodes;        /* most operations plus stores per chunk */
+    long max_ops;           /* most operations over all functions; 0: no limit */
+    long total_ops;         /* operations of the functions scheduled so far */
     uint32_t *mark;
     uint32_t stamp;
     int32_t *uses;          /* uses within the current chunk */
@@ -44,8 +46,12 @@ typedef struct Scheduler {
 void sched_init(Scheduler *s, const Dag *dag, int chunk_nodes);
 void sched_free(Scheduler *s);
 
-/* Partitions outputs into chunks (takes ownership of outputs). */
-void sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunction *fn);
+/* Partitions outputs into chunks (takes ownership of outputs). Returns
+   false, as soon as it is known, when the operations of this and the
+   functions before would pass max_ops (nodes shared across chunks are
+   recomputed in each, so the code can be much larger than the graph);
+   fn is then empty but must still be freed. */
+bool sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunction *fn);
 void sched_function_free(SchedFunction *fn);
 
 /* Prepares one chunk for emission: counts uses and decides temporaries

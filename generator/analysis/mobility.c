@@ -1,0 +1,330 @@
+/* mobility.c - the `info` report: counts, assembly, ranks, redundant rows, singularity, integrability.
+ *
+ * Mobility by the count (Gruebler-Kutzbach in coordinate form) is
+ * nq - nh - nv; the truth is nq - rank(Phi_q), the rank taken by SVD at the
+ * assembled configuration (Nikravesh, Computer-Aided Analysis of Mechanical
+ * Systems, 1988, 3.4 and 4.6; Haug, Computer-Aided Kinematics and Dynamics,
+ * 1989, 3.3). Where they differ some rows are redundant: row i is redundant
+ * when it depends on rows 0..i-1 (svd_redundant_rows), so the first rows of
+ * a file are the ones kept and the report names the late duplicate.
+ *
+ * A rank deficiency can be permanent (a redundant link, like the third crank
+ * of a parallelogram) or belong to the configuration (a dead-centre or
+ * toggle position). To tell them apart the rows without drivers are
+ * assembled again from a few random perturbations of the configuration
+ * (minimum-norm Newton lands on nearby generic configurations) and their
+ * rank there, the generic rank, is compared with the rank here.
+ */
+#include "analysis.h"
+
+#include "../base/arena.h"
+#include "../base/strbuf.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A condition number above this is reported as near-singular. */
+static const double NEAR_SINGULAR_COND = 1e8;
+
+const char *const singularity_names[] = {"none", "position", "drivers", "permanent", "unknown"};
+
+int info_textbook_rows(JointKind kind, bool *velocity)
+{
+    *velocity = false;
+    switch (kind) {
+    case JOINT_REVOLUTE:   return 2;    /* two translations */
+    case JOINT_PRISMATIC:  return 2;    /* one translation, the rotation */
+    case JOINT_DISTANCE:   return 1;
+    case JOINT_POINTLINE:  return 1;
+    case JOINT_WELD:       return 3;    /* everything */
+    case JOINT_CONSTRAINT: return 1;
+    case JOINT_DRIVER:     return 1;    /* either level */
+    case JOINT_ROLLING:    *velocity = true; return 1;
+    case JOINT_KNIFE:      *velocity = true; return 1;
+    case JOINT_VELOCITY:   *velocity = true; return 1;
+    case JOINT_KIND_COUNT: break;
+    }
+    return 0;
+}
+
+/* Copies the listed rows of jac (nq columns) into out. */
+static void pick_rows(const double *jac, int nq, const int *rows, int n, double *out)
+{
+    for (int i = 0; i < n; i++)
+        memcpy(out + (size_t)i * (size_t)nq, jac + (size_t)rows[i] * (size_t)nq,
+               (size_t)nq * sizeof *out);
+}
+
+static int rank_of(SvdWork *w, const double *a, int m, int nq, double tol)
+{
+    SvdResult r;
+    return analysis_svd(w, a, m, nq, nq, tol, &r) ? r.rank : -1;
+}
+
+/* Rank of the undriven holonomic rows at configurations assembled from random
+   perturbations of q; -1 when none assembled. */
+static int generic_rank(MechEval *me, const int *rows, int nrows, const double *q, double t,
+                        const AnalysisOptions *opt, SvdWork *w)
+{
+    int nq = me->nq, best = -1;
+    double *qs = xmalloc((size_t)nq * sizeof *qs);
+    double *jac = xmalloc((size_t)me->nr * (size_t)nq * sizeof *jac + 1);
+    double *sub = xmalloc((size_t)nrows * (size_t)nq * sizeof *sub + 1);
+    double size = 0.0;
+    for (int i = 0; i < nq; i++)
+        size = fmax(size, fabs(q[i]));
+    if (size == 0.0)
+        size = 1.0;
+    uint64_t state = opt->seed * 2654435761u + 1;
+    for (int s = 0; s < opt->generic_samples; s++) {
+        for (int i = 0; i < nq; i++) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            double u = (double)(state >> 11) * 0x1.0p-52 - 1.0;
+            qs[i] = q[i] + 0.2 * u * fmax(fabs(q[i]), 0.1 * size);
+        }
+        AssembleResult ar;
+        if (!analysis_assemble(me, rows, nrows, t, qs, opt, w, &ar))
+            continue;
+        mech_eval(me, qs, t, NULL, jac);
+        pick_rows(jac, nq, rows, nrows, sub);
+        int r = rank_of(w, sub, nrows, nq, opt->rank_tol);
+        if (r > best)
+            best = r;
+    }
+    free(qs), free(jac), free(sub);
+    return best;
+}
+
+static void list_rows(StrBuf *sb, const InfoReport *rep, bool redundant_only)
+{
+    int n = 0;
+    for (int r = 0; r < rep->nr; r++)
+        if (!redundant_only || rep->rows[r].redundant)
+            sb_printf(sb, "%s%s", n++ ? ", " : "", rep->model->rows[r].name);
+}
+
+static const char *plural(int n, const char *one, const char *many)
+{
+    return n == 1 ? one : many;
+}
+
+static char *make_verdict(const InfoReport *rep)
+{
+    StrBuf sb;
+    sb_init(&sb);
+    int drivers = rep->nh_drivers + rep->nv_drivers;
+    if (!rep->assembled)
+        sb_printf(&sb, "assembly failed (residual %.3g): ranks are those of the last iterate; ",
+                  rep->assembly.residual);
+    sb_printf(&sb, "the count says %d DOF", rep->dof);
+    if (rep->nv > 0)
+        sb_printf(&sb, " (%d coordinates - %d holonomic - %d velocity-level rows)",
+                  rep->nq, rep->nh, rep->nv);
+    if (rep->rank < 0) {
+        sb_puts(&sb, "; the rank was not computed (the Jacobian is beyond the dense-SVD limit)");
+        return sb_take(&sb);
+    }
+    const char *what = rep->nv > 0 ? "the holonomic rows of the Jacobian have" : "the Jacobian has";
+    if (rep->nh == 0)
+        sb_puts(&sb, "; no holonomic rows");
+    else if (rep->rank == rep->nh)
+        sb_printf(&sb, "; %s full rank %d", what, rep->rank);
+    else
+        sb_printf(&sb, "; %s rank %d of %d", what, rep->rank, rep->nh);
+    if (rep->nv > 0)
+        sb_printf(&sb, "%s all %d rows rank %d", rep->nh ? " and" : ",", rep->nr, rep->rank_all);
+    if (rep->singularity == SING_POSITION || rep->singularity == SING_DRIVERS)
+        sb_printf(&sb, ": at this singular position it moves, to first order, with %d DOF",
+                  rep->dof_rank);
+    else
+        sb_printf(&sb, ": the mechanism moves with %d DOF", rep->dof_rank);
+    if (rep->dof_rank == 0)
+        sb_puts(&sb, drivers ? " (fully driven)" : " (a structure)");
+    int nred = rep->nredundant + rep->nredundant_velocity;
+    if (nred > 0) {
+        sb_printf(&sb, ", %s ", plural(nred, "row", "rows"));
+        list_rows(&sb, rep, true);
+        sb_printf(&sb, " %s redundant", plural(nred, "is", "are"));
+    }
+    if (drivers)
+        sb_printf(&sb, "; without its %d %s: %d DOF by the count, %d by the rank", drivers,
+                  plural(drivers, "driver", "drivers"), rep->mobility, rep->mobility_rank);
+    return sb_take(&sb);
+}
+
+static char *make_singular(const InfoReport *rep, int nuh)
+{
+    StrBuf sb;
+    sb_init(&sb);
+    if (rep->rank < 0) {
+        sb_puts(&sb, "not computed");
+        return sb_take(&sb);
+    }
+    if (rep->nh == 0) {
+        sb_puts(&sb, "no holonomic rows: nothing to be singular");
+        return sb_take(&sb);
+    }
+    if (rep->rank == rep->nh) {
+        if (rep->cond > NEAR_SINGULAR_COND)
+            sb_printf(&sb, "near-singular (condition number %.3g: close to a dead-centre, toggle "
+                      "or branch point)", rep->cond);
+        else
+            sb_puts(&sb, "regular");
+        return sb_take(&sb);
+    }
+    sb_printf(&sb, "singular: rank-deficient by %d", rep->nh - rep->rank);
+    if (rep->singularity == SING_POSITION)
+        sb_printf(&sb, "; a singular position: without drivers the rows have rank %d here but %d "
+                  "at nearby assembled configurations (a dead-centre, toggle or branch point)",
+                  rep->rank_undriven_h, rep->generic_rank);
+    else if (rep->singularity == SING_DRIVERS)
+        sb_puts(&sb, "; the rows without drivers are independent, so the drivers depend on them "
+                "here (an input at its dead centre, or drivers that fight each other)");
+    else if (rep->singularity == SING_PERMANENT)
+        sb_printf(&sb, "; a permanent redundancy: without drivers the rows have rank %d of %d at "
+                  "nearby assembled configurations too", rep->generic_rank, nuh);
+    return sb_take(&sb);
+}
+
+bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
+{
+    Model *m = mech->model;
+    int nq = m->nq, nh = m->nh, nr = m->nr;
+    memset(rep, 0, sizeof *rep);
+    rep->model = m;
+    rep->t = t;
+    rep->nq = nq, rep->nh = nh, rep->nv = m->nv, rep->nr = nr;
+    rep->rows = xcalloc((size_t)nr + 1, sizeof *rep->rows);
+    int *undriven = xmalloc(((size_t)nr + 1) * sizeof *undriven);
+    int *hrows = xmalloc(((size_t)nh + 1) * sizeof *hrows);
+    int nu = 0, nuh = 0;
+    for (int r = 0; r < nr; r++) {
+        bool driver = m->rows[r].kind == JOINT_DRIVER;
+        rep->rows[r].driver = driver;
+        if (driver)
+            (r < nh ? rep->nh_drivers++ : rep->nv_drivers++);
+        else {
+            undriven[nu++] = r;
+            nuh += r < nh;
+        }
+        if (r < nh)
+            hrows[r] = r;
+    }
+    rep->dof = nq - nh - m->nv;
+    rep->mobility = nq - nu;
+    rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
+    rep->generic_rank = -1;
+    rep->q = xmalloc((size_t)nq * sizeof *rep->q);
+    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
+    rep->dense = (double)nr * (double)nq <= opt->max_dense;
+
+    MechEval me;
+    mech_eval_init(&me, &mech->kin);
+    SvdWork *w = rep->dense ? svd_work_new(nr, nq) : NULL;
+    double *jac = xcalloc((size_t)nr * (size_t)nq + 1, sizeof *jac);
+    double *sub = xcalloc((size_t)nr * (size_t)nq + 1, sizeof *sub);
+    bool *red = xcalloc((size_t)nr + 1, sizeof *red);
+
+    /* assembly at t */
+    if (nh == 0) {
+        rep->assembled = true;
+        rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
+    } else if (w) {
+        rep->assembled = analysis_assemble(&me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
+    } else {            /* too large to factor densely: accept the file's values if they fit */
+        double *phi = xcalloc((size_t)nh, sizeof *phi);
+        mech_eval(&me, rep->q, t, phi, NULL);
+        double res = 0.0;
+        int worst = -1;
+        for (int i = 0; i < nh; i++)
+            if (!(fabs(phi[i]) <= res)) {
+                res = fabs(phi[i]);
+                worst = i;
+            }
+        free(phi);
+        rep->assembly = (AssembleResult){.converged = res <= opt->tol_phi, .residual = res,
+                                         .step = -1, .worst_row = worst, .rank = -1};
+        rep->assembled = rep->assembly.converged;
+    }
+    mech_eval(&me, rep->q, t, NULL, jac);
+
+    if (w) {
+        /* holonomic rows */
+        SvdResult sv;
+        if (analysis_svd(w, jac, nh, nq, nq, opt->rank_tol, &sv)) {
+            rep->rank = sv.rank;
+            rep->rank_tol = sv.tol;
+            rep->sigma_max = sv.sigma_max;
+            rep->sigma_min = sv.sigma_min;
+            rep->cond = nh ? sv.cond : 0.0;
+            rep->nredundant = svd_redundant_rows(w, jac, nh, nq, nq, sv.tol, 0, sv.rank, red);
+            /* all rows, velocity level included (the same matrix when nv == 0) */
+            SvdResult sa = sv;
+            if (m->nv == 0 || analysis_svd(w, jac, nr, nq, nq, opt->rank_tol, &sa)) {
+                rep->rank_all = sa.rank;
+                rep->nredundant_velocity =
+                    svd_redundant_rows(w, jac, nr, nq, nq, sa.tol, nh, sa.rank, red);
+                if (sa.rank == nr) {        /* independent rows: so is every subset */
+                    rep->rank_undriven_h = nuh;
+                    rep->rank_undriven = nu;
+                } else {
+                    pick_rows(jac, nq, undriven, nu, sub);
+                    rep->rank_undriven_h = rank_of(w, sub, nuh, nq, sv.tol);
+                    rep->rank_undriven = rank_of(w, sub, nu, nq, sa.tol);
+                }
+            }
+        }
+        if (rep->rank < 0 || rep->rank_all < 0) {   /* NaN or Inf in the Jacobian */
+            rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
+            rep->nredundant = rep->nredundant_velocity = 0;
+        }
+        for (int r = 0; r < nr; r++)
+            rep->rows[r].redundant = red[r];
+        if (rep->rank >= 0 && rep->rank_undriven_h >= 0 && opt->generic_samples > 0
+            && (rep->rank < nh || rep->rank_undriven_h < nuh))
+            rep->generic_rank = generic_rank(&me, undriven, nuh, rep->q, t, opt, w);
+    }
+    if (rep->rank_all >= 0) {
+        rep->dof_rank = nq - rep->rank_all;
+        rep->mobility_rank = nq - rep->rank_undriven;
+    }
+    if (rep->rank < 0)
+        rep->singularity = SING_UNKNOWN;
+    else if (rep->rank == nh)
+        rep->singularity = SING_NONE;
+    else if (rep->generic_rank >= 0 && rep->rank_undriven_h < rep->generic_rank)
+        rep->singularity = SING_POSITION;
+    else if (rep->rank_undriven_h == nuh)
+        rep->singularity = SING_DRIVERS;
+    else if (rep->generic_rank >= 0 && rep->generic_rank == rep->rank_undriven_h)
+        rep->singularity = SING_PERMANENT;
+    else
+        rep->singularity = SING_UNKNOWN;
+    rep->verdict = make_verdict(rep);
+    rep->singular = make_singular(rep, nuh);
+
+    /* integrability of every velocity-level row, around the configuration */
+    bool ok = true;
+    for (int r = nh; r < nr && ok; r++)
+        ok = analysis_integrability(m, r, rep->q, opt, &rep->rows[r].integ, diag);
+
+    mech_eval_free(&me);
+    svd_work_free(w);
+    free(jac), free(sub), free(red), free(undriven), free(hrows);
+    if (!ok)
+        info_report_free(rep);
+    return ok;
+}
+
+void info_report_free(InfoReport *rep)
+{
+    if (rep->rows)
+        for (int r = 0; r < rep->nr; r++)
+            integrability_free(&rep->rows[r].integ);
+    free(rep->rows);
+    free(rep->q);
+    free(rep->verdict);
+    free(rep->singular);
+    memset(rep, 0, sizeof *rep);
+}

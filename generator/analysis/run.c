@@ -1,0 +1,533 @@
+/* run.c - kinematic analysis over time: assembly, predictor-corrector steps, integration.
+ *
+ * A mechanism with holonomic rows only (nh == nq) is stepped by the
+ * freestanding runtime (mechrt_step): second-order Taylor predictor from
+ * the last q, qd, qdd, Newton corrector on Phi(q, t) = 0 with one call of
+ * the fused `all` kernel per iteration, then velocity and acceleration
+ * from one LU of the converged Jacobian (Haug 1989, section 6.1).
+ * A mechanism with velocity-level rows (nh + nv == nq, nv > 0) has no
+ * position equations for nv of its directions: its positions are
+ * integrated (runtime/host: GSL odeiv2, projection onto Phi = 0 after every
+ * step) and its velocities and accelerations solved at each output time.
+ *
+ * Failures stop the run and say when, why and where: the time as
+ * `t = VALUE`, the runtime's cause, the row with the largest residual or
+ * the coordinate where elimination found no pivot, and, from an SVD of the
+ * Jacobian at the failing state, the rows and coordinates of the
+ * dependency (a toggle, a dead centre, redundant rows). Stretches where the
+ * condition estimate exceeds MechrtOptions.cond_warn are warned about once,
+ * when they begin, with a note when they end.
+ */
+#include "run.h"
+
+#include "../base/arena.h"
+#include "../pipeline/pipeline.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A singular value ratio below this names the dependency in a failure message. */
+#define RUN_NEAR_SINGULAR 1e-7
+/* Components of a singular vector at least this fraction of its largest are named. */
+#define RUN_NAME_SHARE 0.2
+#define RUN_NAME_MAX 6
+
+RunOptions run_default_options(void)
+{
+    RunOptions o;
+    o.t0 = 0;
+    o.t1 = 1;
+    o.steps = 100;
+    o.mechrt = mechrt_default_options();
+    o.ode = mechrt_ode_default_options();
+    o.move_note = 1e-3;
+    o.notes = NULL;
+    return o;
+}
+
+/* ---- the engine as runtime kernels ------------------------------------- */
+
+static void ek_phi(void *ctx, const double *q, double t, double *out)
+{
+    engine_phi(ctx, q, t, out);
+}
+
+static void ek_jac(void *ctx, const double *q, double t, double *out)
+{
+    engine_jac(ctx, q, t, out);
+}
+
+static void ek_nu(void *ctx, const double *q, double t, double *out)
+{
+    engine_nu(ctx, q, t, out);
+}
+
+static void ek_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    engine_gamma(ctx, q, qd, t, out);
+}
+
+static void ek_all(void *ctx, const double *q, const double *qd, double t,
+                   double *phi, double *jac, double *nu, double *gamma)
+{
+    engine_all(ctx, q, qd, t, phi, jac, nu, gamma);
+}
+
+MechrtKernels run_engine_kernels(const Engine *e)
+{
+    MechrtKernels k = {e->nq, e->nh, e->nv, (void *)e, ek_phi, ek_jac, ek_nu, ek_gamma, ek_all};
+    return k;
+}
+
+/* ---- the state of one run ---------------------------------------------- */
+
+typedef struct Run {
+    const Model *m;
+    const MechrtKernels *k;
+    const RunOptions *o;
+    RunResult *res;
+    int nq, nr;
+    double *q, *qd, *qdd;
+    double *work;
+    size_t lwork;
+    /* a nearly singular stretch in progress */
+    bool episode;
+    double ep_start, ep_end, ep_worst, ep_worst_t;
+} Run;
+
+static void notef(const Run *r, const char *kind, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void notef(const Run *r, const char *kind, const char *fmt, ...)
+{
+    if (!r->o->notes)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(r->o->notes, "%s: %s: ", r->m->file, kind);
+    vfprintf(r->o->notes, fmt, ap);
+    fputc('\n', r->o->notes);
+    va_end(ap);
+}
+
+/* Appends to res->message, truncating quietly at its size. */
+static void msgf(Run *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void msgf(Run *r, const char *fmt, ...)
+{
+    char *msg = r->res->message;
+    size_t len = strlen(msg);
+    if (len + 1 >= sizeof r->res->message)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg + len, sizeof r->res->message - len, fmt, ap);
+    va_end(ap);
+}
+
+/* " and " / ", " separated names of the largest components of w, largest first. */
+static void name_list(Run *r, const char *const *names, const double *w, int n)
+{
+    int picked[RUN_NAME_MAX], count = 0;
+    double wmax = 0;
+    for (int i = 0; i < n; i++)
+        if (w[i] > wmax)
+            wmax = w[i];
+    while (count < RUN_NAME_MAX) {
+        int best = -1;
+        for (int i = 0; i < n; i++) {
+            bool taken = false;
+            for (int c = 0; c < count; c++)
+                taken = taken || picked[c] == i;
+            if (!taken && w[i] >= RUN_NAME_SHARE * wmax && (best < 0 || w[i] > w[best]))
+                best = i;
+        }
+        if (best < 0)
+            break;
+        picked[count++] = best;
+    }
+    for (int c = 0; c < count; c++)
+        msgf(r, "%s%s", c == 0 ? "" : c + 1 == count ? " and " : ", ", names[picked[c]]);
+}
+
+/* The rows and coordinates of the Jacobian's (near) dependency at (q, t),
+   over the first `rows` rows; nothing when the Jacobian is well conditioned.
+   Returns sigma_min / sigma_max, or -1 when it could not be computed. */
+static double describe_dependency(Run *r, const double *q, double t, int rows, bool always)
+{
+    size_t nq = (size_t)r->nq;
+    double *jac = xcalloc((size_t)r->nr * nq + 1, sizeof *jac);
+    double *roww = xcalloc((size_t)r->nr + 1, sizeof *roww);
+    double *colw = xcalloc(nq, sizeof *colw);
+    const char **row_names = xcalloc((size_t)r->nr + 1, sizeof *row_names);
+    for (int i = 0; i < r->nr; i++)
+        row_names[i] = r->m->rows[i].name;
+    r->k->jac(r->k->ctx, q, t, jac);
+    double ratio = mechrt_host_singular_direction(rows, r->nq, jac, roww, colw);
+    if (ratio >= 0 && (always || ratio < RUN_NEAR_SINGULAR)) {
+        msgf(r, "; the Jacobian there is %s along rows ", always ? "singular" : "nearly singular");
+        name_list(r, row_names, roww, rows);
+        msgf(r, " and coordinates ");
+        name_list(r, r->m->coord_names, colw, r->nq);
+        msgf(r, " (smallest singular value %.2g of the largest)", ratio);
+    }
+    free(jac), free(roww), free(colw), free(row_names);
+    return ratio;
+}
+
+/* Names the first row whose Phi, Phi_q or nu is NaN or infinite at (q, t);
+   false when all are finite (then the solve overflowed). */
+static bool find_nonfinite(Run *r, const double *q, double t)
+{
+    const MechrtKernels *k = r->k;
+    size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
+    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(nr * nq + 1, sizeof *jac);
+    double *nu = xcalloc(nr + 1, sizeof *nu);
+    const char *what = NULL;
+    int row = -1;
+    k->phi(k->ctx, q, t, phi);
+    k->jac(k->ctx, q, t, jac);
+    k->nu(k->ctx, q, t, nu);
+    for (int i = 0; i < k->nh && !what; i++)
+        if (!isfinite(phi[i]))
+            what = "Phi", row = i;
+    for (size_t i = 0; i < nr * nq && !what; i++)
+        if (!isfinite(jac[i]))
+            what = "Phi_q", row = (int)(i / nq);
+    for (int i = 0; i < r->nr && !what; i++)
+        if (!isfinite(nu[i]))
+            what = "nu", row = i;
+    if (what)
+        msgf(r, "NaN or infinity in %s of row %s", what, r->m->rows[row].name);
+    free(phi), free(jac), free(nu);
+    return what != NULL;
+}
+
+static const char *plural(int n, const char *one, const char *many) { return n == 1 ? one : many; }
+
+/* Fills res with RUN_FAILED and the message for status st at time t, the
+ * state q the runtime stopped at and its report. what: the phase. */
+static void fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep,
+                 const char *what)
+{
+    RunResult *res = r->res;
+    const Model *m = r->m;
+    res->status = RUN_FAILED;
+    res->cause = st;
+    res->t_fail = t;
+    res->message[0] = '\0';
+    msgf(r, "t = %.10g: %s failed: ", t, what);
+    int rows = r->nr;
+    switch (st) {
+    case MECHRT_ESING:
+        msgf(r, "singular Jacobian");
+        if (rep && rep->sing_index >= 0 && rep->sing_index < r->nq)
+            msgf(r, " (no pivot for coordinate %s)", m->coord_names[rep->sing_index]);
+        msgf(r, ": a toggle or dead-centre position, or rows that depend on each other");
+        break;
+    case MECHRT_EMAXITER:
+        msgf(r, "no convergence in %d %s", rep ? rep->iterations : r->o->mechrt.max_iter,
+             plural(rep ? rep->iterations : 2, "iteration", "iterations"));
+        if (rep && rep->worst_row >= 0 && rep->worst_row < m->nr)
+            msgf(r, " (largest residual %.3g in row %s)", rep->residual,
+                 m->rows[rep->worst_row].name);
+        msgf(r, ": the driven position may be out of reach, or the motion passes a toggle");
+        break;
+    case MECHRT_ENOTFINITE:
+        if (q && find_nonfinite(r, q, t))
+            msgf(r, " (a function evaluated at or beyond the edge of its domain?)");
+        else
+            msgf(r, "NaN or infinity in the solution (a nearly singular Jacobian?)");
+        rows = 0;
+        break;
+    case MECHRT_ESTEP:
+        msgf(r, "the integrator's step size became too small to meet --ode-tol %.3g",
+             r->o->ode.tol);
+        break;
+    case MECHRT_OK:
+    case MECHRT_CONTINUE:
+    case MECHRT_EBADLEN:
+    case MECHRT_ENOTSQUARE:
+    case MECHRT_EINVAL:
+        msgf(r, "%s (an internal error)", mechrt_strerror(st));
+        rows = 0;
+        break;
+    }
+    if (q && rows > 0) {
+        /* projection works on the holonomic rows alone */
+        if (strcmp(what, "projection") == 0 || strcmp(what, "assembly (minimum-norm Newton)") == 0)
+            rows = r->k->nh;
+        if (rows > 0)
+            describe_dependency(r, q, t, rows, st == MECHRT_ESING);
+    }
+}
+
+/* A note when assembly moved the initial values much. */
+static void note_move(Run *r, const double *q0)
+{
+    double moved = 0, scale = 0;
+    int at = 0;
+    for (int i = 0; i < r->nq; i++) {
+        double d = fabs(r->q[i] - q0[i]);
+        if (d > moved) {
+            moved = d;
+            at = i;
+        }
+        if (fabs(q0[i]) > scale)
+            scale = fabs(q0[i]);
+    }
+    r->res->assembly_move = moved;
+    if (moved > r->o->move_note * (scale > 0 ? scale : 1))
+        notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
+              "(%s: %.6g -> %.6g); the file's values are only Newton's starting point",
+              r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at]);
+}
+
+/* Nearly singular stretches: a warning when one begins, a note when it ends. */
+static void watch_condition(Run *r, double t, const MechrtReport *rep)
+{
+    if (rep->cond > r->res->max_cond)
+        r->res->max_cond = rep->cond;
+    if (rep->cond_warning) {
+        if (!r->episode) {
+            r->episode = true;
+            r->ep_start = t;
+            r->ep_worst = 0;
+            r->res->warnings++;
+            notef(r, "warning", "t = %.10g: the Jacobian is nearly singular (condition "
+                  "estimate %.3g > %.3g): close to a toggle or dead-centre position; "
+                  "velocities and accelerations lose accuracy", t, rep->cond,
+                  r->o->mechrt.cond_warn);
+        }
+        r->ep_end = t;
+        if (!(rep->cond <= r->ep_worst)) {
+            r->ep_worst = rep->cond;
+            r->ep_worst_t = t;
+        }
+    } else {
+        if (r->episode)
+            notef(r, "note", "nearly singular from t = %.10g to t = %.10g (worst condition "
+                  "estimate %.3g at t = %.10g)", r->ep_start, r->ep_end, r->ep_worst,
+                  r->ep_worst_t);
+        r->episode = false;
+    }
+}
+
+static double time_at(const RunOptions *o, int i)
+{
+    if (i == o->steps)
+        return o->t1;
+    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
+}
+
+/* Holonomic rows only: the runtime's predictor-corrector step. */
+static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
+{
+    const RunOptions *o = r->o;
+    MechrtReport rep;
+    double *q0 = xmalloc((size_t)r->nq * sizeof *q0);
+    memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
+    MechrtStatus st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work,
+                                  r->lwork, &rep);
+    r->res->assembly_iterations = rep.iterations;
+    if (st != MECHRT_OK) {
+        fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
+        free(q0);
+        return RUN_FAILED;
+    }
+    note_move(r, q0);
+    free(q0);
+    watch_condition(r, o->t0, &rep);
+    state(ctx, o->t0, r->q, r->qd, r->qdd);
+    r->res->states++;
+
+    double t = o->t0;
+    for (int i = 1; i <= o->steps; i++) {
+        double tn = time_at(o, i);
+        double c0 = pipeline_now();
+        st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, t, tn - t, r->work, r->lwork,
+                         &rep);
+        r->res->step_seconds += pipeline_now() - c0;
+        r->res->newton_iterations += rep.iterations;
+        if (st != MECHRT_OK) {
+            bool newton = rep.step < 0 || st == MECHRT_EMAXITER || rep.residual > o->mechrt.tol_phi
+                          || rep.step > o->mechrt.tol_dq;
+            fail(r, st, tn, r->q, &rep, newton ? "position analysis (Newton)"
+                                               : "velocity and acceleration analysis");
+            return RUN_FAILED;
+        }
+        r->res->steps_done++;
+        watch_condition(r, tn, &rep);
+        t = tn;
+        state(ctx, t, r->q, r->qd, r->qdd);
+        r->res->states++;
+    }
+    return RUN_OK;
+}
+
+/* Velocity-level rows: integrate the positions between output times. */
+static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
+{
+    const RunOptions *o = r->o;
+    MechrtReport rep;
+    RunStatus status = RUN_OK;
+    MechrtHost *host = mechrt_host_new(r->k);
+    if (!host) {
+        snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
+        r->res->status = RUN_FAILED;
+        r->res->cause = MECHRT_EINVAL;
+        r->res->t_fail = o->t0;
+        return RUN_FAILED;
+    }
+    r->res->integrated = true;
+    double *q0 = xmalloc((size_t)r->nq * sizeof *q0);
+    memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
+    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
+    r->res->assembly_iterations = rep.iterations;
+    if (st != MECHRT_OK) {
+        fail(r, st, o->t0, r->q, &rep, "assembly (minimum-norm Newton)");
+        status = RUN_FAILED;
+        goto out;
+    }
+    note_move(r, q0);
+    st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, o->t0, r->qd, r->qdd, r->work,
+                                      r->lwork, &rep);
+    if (st != MECHRT_OK) {
+        fail(r, st, o->t0, r->q, &rep, "velocity and acceleration analysis");
+        status = RUN_FAILED;
+        goto out;
+    }
+    watch_condition(r, o->t0, &rep);
+    state(ctx, o->t0, r->q, r->qd, r->qdd);
+    r->res->states++;
+
+    double t = o->t0, hstep = (o->t1 - o->t0) / o->steps;
+    for (int i = 1; i <= o->steps; i++) {
+        double tn = time_at(o, i), c0 = pipeline_now();
+        long it0 = mechrt_host_stats(host)->project_iterations;
+        st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep, &rep);
+        r->res->newton_iterations += mechrt_host_stats(host)->project_iterations - it0;
+        if (st != MECHRT_OK) {
+            double tf;
+            const double *qf = mechrt_host_failure(host, &tf);
+            bool proj = st == MECHRT_EMAXITER
+                        || (st == MECHRT_ENOTFINITE && rep.worst_row >= 0);
+            fail(r, st, tf, qf, &rep, proj ? "projection" : "integration (velocity analysis)");
+            status = RUN_FAILED;
+            goto out;
+        }
+        st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
+                                          r->lwork, &rep);
+        r->res->step_seconds += pipeline_now() - c0;
+        if (st != MECHRT_OK) {
+            fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
+            status = RUN_FAILED;
+            goto out;
+        }
+        r->res->steps_done++;
+        watch_condition(r, tn, &rep);
+        t = tn;
+        state(ctx, t, r->q, r->qd, r->qdd);
+        r->res->states++;
+    }
+out:
+    r->res->host = *mechrt_host_stats(host);
+    mechrt_host_free(host);
+    free(q0);
+    return status;
+}
+
+static RunStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static RunStatus bad_input(RunResult *res, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(res->message, sizeof res->message, fmt, ap);
+    va_end(ap);
+    res->status = RUN_BAD_INPUT;
+    res->cause = MECHRT_EINVAL;
+    return RUN_BAD_INPUT;
+}
+
+RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                       RunStateFn state, void *state_ctx, RunResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    if (!(isfinite(o->t0) && isfinite(o->t1)) || o->t0 == o->t1)
+        return bad_input(res, "the time interval must be finite and not empty (t0 = %g, t1 = %g)",
+                         o->t0, o->t1);
+    if (o->steps < 1)
+        return bad_input(res, "the number of steps must be at least 1, not %d", o->steps);
+    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
+        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
+                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
+    if (m->nr < m->nq) {
+        int dof = m->nq - m->nr;
+        return bad_input(res, "%d degree%s of freedom %s not driven (%d coordinates, %d %s): "
+                         "add %s%s", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are", m->nq,
+                         m->nr, plural(m->nr, "row", "rows"), dof == 1 ? "a driver" : "drivers",
+                         dof == 1 ? "" : " (one per degree of freedom)");
+    }
+    if (m->nr > m->nq) {
+        int extra = m->nr - m->nq;
+        return bad_input(res, "the mechanism has %d more %s than coordinates (%d rows, %d "
+                         "coordinates): run needs exactly one row per coordinate; remove "
+                         "redundant rows or drivers", extra, plural(extra, "row", "rows"),
+                         m->nr, m->nq);
+    }
+
+    Run r = {0};
+    r.m = m;
+    r.k = k;
+    r.o = o;
+    r.res = res;
+    r.nq = m->nq;
+    r.nr = m->nr;
+    size_t nq = (size_t)m->nq;
+    r.q = xcalloc(nq, sizeof *r.q);
+    r.qd = xcalloc(nq, sizeof *r.qd);
+    r.qdd = xcalloc(nq, sizeof *r.qdd);
+    r.lwork = mechrt_workspace_size(m->nq, m->nr);
+    r.work = xcalloc(r.lwork, sizeof *r.work);
+    memcpy(r.q, m->q0, nq * sizeof *r.q);
+
+    RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
+                                  : run_integrated(&r, state, state_ctx);
+    if (status == RUN_OK && r.episode)
+        notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
+              "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
+    res->status = status;
+    free(r.q), free(r.qd), free(r.qdd), free(r.work);
+    return status;
+}
+
+double run_time_all(const MechrtKernels *k, const double *q, const double *qd, double t,
+                    double min_seconds)
+{
+    size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
+    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(nr * nq + 1, sizeof *jac);
+    double *nu = xcalloc(nr + 1, sizeof *nu), *gamma = xcalloc(nr + 1, sizeof *gamma);
+    long calls = 0, batch = 64;
+    double t0 = pipeline_now(), elapsed;
+    do {
+        for (long i = 0; i < batch; i++) {
+            if (k->all) {
+                k->all(k->ctx, q, qd, t, phi, jac, nu, gamma);
+            } else {
+                k->phi(k->ctx, q, t, phi);
+                k->jac(k->ctx, q, t, jac);
+                k->nu(k->ctx, q, t, nu);
+                k->gamma(k->ctx, q, qd, t, gamma);
+            }
+        }
+        calls += batch;
+        batch *= 2;
+        elapsed = pipeline_now() - t0;
+    } while (elapsed < min_seconds);
+    free(phi), free(jac), free(nu), free(gamma);
+    return 1e9 * elapsed / (double)calls;
+}

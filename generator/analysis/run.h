@@ -1,0 +1,83 @@
+/* run.h - kinematic analysis over time, the machinery of `mechc run`, as a library.
+ *
+ * run_analysis assembles a mechanism at t0 from its file's initial values
+ * and walks it over `steps` equal intervals to t1, handing every state
+ * (t, q, qd, qdd) to a callback as soon as it is known. It never prints
+ * an error and never exits: a failure is a RunStatus with a one-line
+ * message naming `t = VALUE`, the cause and the rows and coordinates
+ * involved; notes and warnings (assembly moved q, nearly singular
+ * stretches) go to RunOptions.notes when that is not NULL.
+ */
+#ifndef MECHC_RUN_H
+#define MECHC_RUN_H
+
+#include <stdio.h>
+
+#include "../../runtime/mechrt.h"
+#include "../../runtime/host/mechrt_host.h"
+#include "../engine/engine.h"
+#include "../model/model.h"
+
+/* What a run does; fill with run_default_options(), then change fields. */
+typedef struct RunOptions {
+    double t0, t1;           /* time interval, t1 != t0 (t1 < t0 runs backwards); 0, 1 */
+    int steps;               /* equal intervals, >= 1: steps + 1 states; 100 */
+    MechrtOptions mechrt;    /* Newton tolerances and cap, pivot and condition
+                                thresholds: mechrt_default_options() */
+    MechrtOdeOptions ode;    /* integrator for velocity-level rows: rk8pd, 1e-10 */
+    /* a note when assembly moves q by more than move_note * ||q0||_inf
+       (dimensionless); default 1e-3 */
+    double move_note;
+    FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
+} RunOptions;
+
+RunOptions run_default_options(void);
+
+/* Statuses double as mechc's exit codes (spec section 3). */
+typedef enum RunStatus {
+    RUN_OK = 0,              /* every state computed */
+    RUN_FAILED = 1,          /* the analysis failed at t_fail: exit 1 */
+    RUN_BAD_INPUT = 2        /* not runnable as given (row count, options): exit 2 */
+} RunStatus;
+
+enum { RUN_MESSAGE_MAX = 1024 };
+
+typedef struct RunResult {
+    RunStatus status;
+    MechrtStatus cause;          /* the runtime's status behind RUN_FAILED */
+    double t_fail;               /* when RUN_FAILED: the time that failed */
+    char message[RUN_MESSAGE_MAX]; /* RUN_FAILED, RUN_BAD_INPUT: "t = 0.25: ..." */
+    int states;                  /* states handed to the callback */
+    int warnings;                /* nearly singular episodes warned about */
+    double assembly_move;        /* ||q(t0) - q0||_inf */
+    int assembly_iterations;     /* Newton (or Gauss-Newton) iterations at t0 */
+    /* per-step statistics, over the steps after t0 */
+    int steps_done;
+    long newton_iterations;      /* Newton iterations (velocity rows: projection
+                                    iterations) */
+    double step_seconds;         /* wall time inside the analysis of those steps */
+    double max_cond;             /* largest condition estimate seen (0: off) */
+    bool integrated;             /* positions came from the integrator */
+    MechrtHostStats host;        /* integrator counters when integrated */
+} RunResult;
+
+/* Receives each state as soon as it is computed. */
+typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *qd,
+                           const double *qdd);
+
+/* The runtime's view of an open engine: every kernel calls engine_* with
+   the Engine as its context. The engine must outlive the kernels. */
+MechrtKernels run_engine_kernels(const Engine *engine);
+
+/* The run. m gives sizes, names and initial values; k evaluates m's rows.
+   Needs k->nh + k->nv == k->nq, otherwise RUN_BAD_INPUT saying how many
+   degrees of freedom are not driven (or how many rows are too many). */
+RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                       RunStateFn state, void *state_ctx, RunResult *res);
+
+/* Nanoseconds per call of the fused `all` kernel (or phi + jac + nu + gamma
+   when there is none) at (q, qd, t), timed over at least min_seconds. */
+double run_time_all(const MechrtKernels *k, const double *q, const double *qd, double t,
+                    double min_seconds);
+
+#endif

@@ -1,0 +1,39 @@
+/* aot.h - generated C built by the system compiler into a cached shared library and loaded with dlopen. */
+#ifndef MECHC_AOT_H
+#define MECHC_AOT_H
+
+#include "../base/diag.h"
+#include "../jit/jit.h"
+
+#include <stdbool.h>
+
+/* The compiler command ($CC split at blanks, default "cc") and the flags
+   every library is built with. */
+#define AOT_FLAGS "-O2 -fPIC -shared"
+
+typedef struct AotResult {
+    void *handle;           /* dlopen handle: aot_unload it */
+    double seconds;         /* compile (or cache lookup) plus load time */
+    bool cached;            /* the library came from the cache */
+    char path[1200];        /* the library's file */
+} AotResult;
+
+/* Builds source (double kernels emitted without declare_math, symbols
+   starting with prefix) into $XDG_CACHE_HOME/mechc/HASH.so (~/.cache/mechc
+   without XDG_CACHE_HOME), HASH being that of the source, compiler and
+   flags; reuses the file when it exists, unless fresh. The library is
+   written under a temporary name and renamed, so concurrent runs never see
+   half a file. Fills k from dlsym. Returns false with diag filled when no
+   compiler is found, it fails, or the library cannot be loaded. */
+bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
+              AotResult *out, Diag *diag);
+void aot_unload(void *handle);
+
+/* The cache folder, created (mode 0700) when missing; false with diag
+   filled when there is none. */
+bool aot_cache_dir(char *dir, size_t size, Diag *diag);
+
+/* Whether the compiler can be started at all (for tests and bench). */
+bool aot_compiler_available(void);
+
+#endif

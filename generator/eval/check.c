@@ -1,0 +1,607 @@
+/* check.c - compares the generated derivatives with finite differences and the engines with each other.
+ *
+ * The engine under test is the JIT (the generated C). At sampled states
+ * around the assembled configuration (Newton from the initial values at
+ * t = 0 when the holonomic rows are square, the initial values otherwise)
+ * it compares, for every row:
+ *
+ *   jac     position rows: dPhi/dq_j by gsl_deriv_central on Phi;
+ *           velocity rows: dPsi/dqd_j on Psi (from the generic evaluator,
+ *           the only place Psi exists before it is split into a and b);
+ *   nu      position rows: -dPhi/dt (gsl_deriv_central);
+ *           velocity rows: -Psi(q, 0, t);
+ *   gamma   position rows: -(d/dtau)^2 Phi(q + qd tau, t + tau) at tau = 0,
+ *           the second total derivative with qdd = 0, by a central second
+ *           difference with one Richardson step (error O(h^4));
+ *           velocity rows: -d/dtau Psi(q + qd tau, qd, t + tau) at 0;
+ *
+ * and every pair of engines (jit, generic, aot) on phi, jac, nu, gamma.
+ * Errors are |value - reference| / (1 + |reference|). Where the worst
+ * error passes its tolerance, the two numbers are examined for the
+ * classic textbook slips: a ratio of -1 or 2, a missing term, and for
+ * gamma a decomposition of the finite difference into its -(Phi_q qd)_q qd,
+ * -2 Phi_qt qd and -Phi_tt parts to name the one that was dropped.
+ */
+#include "check.h"
+
+#include "../../runtime/mechrt.h"
+#include "../base/arena.h"
+#include "aot.h"
+#include "generic.h"
+
+#include <gsl/gsl_deriv.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+CheckOptions check_default_options(void)
+{
+    return (CheckOptions){
+        .samples = 20, .seed = 1, .tol = 1e-6, .tol_engines = 1e-10,
+        .spread_q = 0.05, .spread_qd = 1.0, .fd_step = 1e-4, .fd_step2 = 2e-3,
+        .use_aot = true, .fault = {.kind = CHECK_FAULT_NONE},
+    };
+}
+
+enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT, PAIR_COUNT = 3, FD_CACHE = 8 };
+
+static const char *const fd_names[3] = {"jac", "nu", "gamma"};
+static const char *const pair_names[PAIR_COUNT * QTY_COUNT] = {
+    "phi jit/generic", "jac jit/generic", "nu jit/generic", "gamma jit/generic",
+    "phi jit/aot",     "jac jit/aot",     "nu jit/aot",     "gamma jit/aot",
+    "phi generic/aot", "jac generic/aot", "nu generic/aot", "gamma generic/aot",
+};
+static const EngineKind pair_engines[PAIR_COUNT][2] = {
+    {ENGINE_JIT, ENGINE_GENERIC}, {ENGINE_JIT, ENGINE_AOT}, {ENGINE_GENERIC, ENGINE_AOT},
+};
+
+/* The state of one check run. */
+typedef struct Checker {
+    const Model *m;
+    const CheckOptions *opt;
+    CheckReport *rep;
+    int nq, nh, nv, nr;
+    Engine eng[ENGINE_KIND_COUNT];
+    bool open[ENGINE_KIND_COUNT];
+    double *out[ENGINE_KIND_COUNT][QTY_COUNT];  /* each engine's results at the sample */
+    double *q, *qd, t;                          /* the sample */
+    int sample;
+    double *qw, *qdw;                           /* perturbed copies */
+    double *gamma0;                             /* fault hook scratch */
+    double *save_q[3], *save_qd[3];             /* state of each FD item's worst */
+    double *d2[5];                              /* second-difference points */
+} Checker;
+
+/* ---- the engine under test, with the optional planted fault ---- */
+
+static void under_test(Checker *c)
+{
+    const Engine *e = &c->eng[ENGINE_JIT];
+    double **o = c->out[ENGINE_JIT];
+    engine_phi(e, c->q, c->t, o[QTY_PHI]);
+    engine_jac(e, c->q, c->t, o[QTY_JAC]);
+    engine_nu(e, c->q, c->t, o[QTY_NU]);
+    engine_gamma(e, c->q, c->qd, c->t, o[QTY_GAMMA]);
+    const CheckFault *f = &c->opt->fault;
+    if (f->kind == CHECK_FAULT_NONE || f->row < 0 || f->row >= c->nr)
+        return;
+    switch (f->kind) {
+    case CHECK_FAULT_NONE:
+        break;
+    case CHECK_FAULT_JAC_SCALE:
+        if (f->col >= 0 && f->col < c->nq)
+            o[QTY_JAC][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
+        break;
+    case CHECK_FAULT_NU_SCALE:
+        o[QTY_NU][f->row] *= f->factor;
+        break;
+    case CHECK_FAULT_GAMMA_ZERO:
+        o[QTY_GAMMA][f->row] = 0.0;
+        break;
+    case CHECK_FAULT_GAMMA_DROP_TT:
+    case CHECK_FAULT_GAMMA_DROP_QD:
+        /* with qd = 0 only -Phi_tt is left of gamma */
+        memset(c->qdw, 0, (size_t)c->nq * sizeof *c->qdw);
+        engine_gamma(e, c->q, c->qdw, c->t, c->gamma0);
+        if (f->kind == CHECK_FAULT_GAMMA_DROP_TT)
+            o[QTY_GAMMA][f->row] -= c->gamma0[f->row];
+        else
+            o[QTY_GAMMA][f->row] = c->gamma0[f->row];
+        break;
+    }
+}
+
+/* ---- recording errors ---- */
+
+static double rel_error(double value, double ref)
+{
+    if (isnan(value) && isnan(ref))
+        return 0.0;
+    if (!isfinite(value) || !isfinite(ref))
+        return value == ref ? 0.0 : INFINITY;
+    return fabs(value - ref) / (1.0 + fabs(ref));
+}
+
+static void record(Checker *c, int what, int row, int col, double value, double ref)
+{
+    CheckItem *it = &c->rep->items[what];
+    double err = rel_error(value, ref);
+    if (it->checked && !(err > it->error))
+        return;
+    it->checked = true;
+    it->error = err;
+    it->row = row;
+    it->col = col;
+    it->value = value;
+    it->reference = ref;
+    it->sample = c->sample;
+    it->t = c->t;
+    if (what < CHECK_PAIR_FIRST) {
+        memcpy(c->save_q[what], c->q, (size_t)c->nq * sizeof *c->q);
+        memcpy(c->save_qd[what], c->qd, (size_t)c->nq * sizeof *c->qd);
+    }
+}
+
+/* ---- finite differences ---- */
+
+/* A vector function of one scalar x, its values cached for the few x
+   gsl_deriv_central asks for, so the rows of one column share them. */
+typedef enum FdKind {
+    FD_PHI_Q,       /* Phi(q with q_col = x, t) */
+    FD_PHI_PATH,    /* Phi(q + qd x [path_q], t + x [path_t]) */
+    FD_PSI_QD,      /* Psi(q, qd with qd_col = x, t) */
+    FD_PSI_PATH,    /* Psi(q + qd x [path_q], qd, t + x [path_t]) */
+} FdKind;
+
+typedef struct VecFn {
+    Checker *c;
+    FdKind kind;
+    int col;
+    bool path_q, path_t;
+    int comp;               /* the component gsl asks about */
+    double x[FD_CACHE];
+    double *val[FD_CACHE];
+    int count, next;
+} VecFn;
+
+static void vecfn_eval(VecFn *f, double x, double *out)
+{
+    Checker *c = f->c;
+    int nq = c->nq;
+    switch (f->kind) {
+    case FD_PHI_Q:
+        memcpy(c->qw, c->q, (size_t)nq * sizeof *c->qw);
+        c->qw[f->col] = x;
+        engine_phi(&c->eng[ENGINE_JIT], c->qw, c->t, out);
+        return;
+    case FD_PHI_PATH:
+        for (int i = 0; i < nq; i++)
+            c->qw[i] = c->q[i] + (f->path_q ? c->qd[i] * x : 0.0);
+        engine_phi(&c->eng[ENGINE_JIT], c->qw, c->t + (f->path_t ? x : 0.0), out);
+        return;
+    case FD_PSI_QD:
+        memcpy(c->qdw, c->qd, (size_t)nq * sizeof *c->qdw);
+        c->qdw[f->col] = x;
+        generic_psi(c->eng[ENGINE_GENERIC].generic, c->q, c->qdw, c->t, out);
+        return;
+    case FD_PSI_PATH:
+        for (int i = 0; i < nq; i++)
+            c->qw[i] = c->q[i] + (f->path_q ? c->qd[i] * x : 0.0);
+        generic_psi(c->eng[ENGINE_GENERIC].generic, c->qw, c->qd, c->t + (f->path_t ? x : 0.0), out);
+        return;
+    }
+}
+
+static void vecfn_init(VecFn *f, Checker *c, FdKind kind, int col, bool path_q, bool path_t, double *store)
+{
+    *f = (VecFn){.c = c, .kind = kind, .col = col, .path_q = path_q, .path_t = path_t};
+    int n = (c->nh > c->nv ? c->nh : c->nv) + 1;
+    for (int k = 0; k < FD_CACHE; k++)
+        f->val[k] = store + (size_t)k * (size_t)n;
+}
+
+static double vecfn_component(double x, void *params)
+{
+    VecFn *f = params;
+    for (int k = 0; k < f->count; k++)
+        if (f->x[k] == x)
+            return f->val[k][f->comp];
+    int slot = f->next;
+    f->next = (f->next + 1) % FD_CACHE;
+    if (f->count < FD_CACHE)
+        f->count++;
+    f->x[slot] = x;
+    vecfn_eval(f, x, f->val[slot]);
+    return f->val[slot][f->comp];
+}
+
+/* d f_comp / dx at x0 by GSL's adaptive five-point central difference. */
+static double fd_first(VecFn *f, int comp, double x0, double h)
+{
+    gsl_function fn = {vecfn_component, f};
+    double result, abserr;
+    f->comp = comp;
+    gsl_deriv_central(&fn, x0, h * fmax(1.0, fabs(x0)), &result, &abserr);
+    return result;
+}
+
+/* d2 f/dx2 at 0 for every component into out: central second differences
+   D(h) = (f(h) - 2 f(0) + f(-h))/h^2 at h and h/2, then Richardson
+   (4 D(h/2) - D(h))/3, which cancels the h^2 error term. */
+static void fd_second(VecFn *f, int n, double h, double *out)
+{
+    Checker *c = f->c;
+    const double xs[5] = {-h, -0.5 * h, 0.0, 0.5 * h, h};
+    for (int k = 0; k < 5; k++)
+        vecfn_eval(f, xs[k], c->d2[k]);
+    for (int i = 0; i < n; i++) {
+        double f0 = c->d2[2][i];
+        double dh = (c->d2[4][i] - 2.0 * f0 + c->d2[0][i]) / (h * h);
+        double dh2 = (c->d2[3][i] - 2.0 * f0 + c->d2[1][i]) / (0.25 * h * h);
+        out[i] = (4.0 * dh2 - dh) / 3.0;
+    }
+}
+
+static void check_fd(Checker *c, double *scratch, double *vec)
+{
+    const CheckOptions *o = c->opt;
+    double **u = c->out[ENGINE_JIT];
+    int nq = c->nq, nh = c->nh, nv = c->nv;
+    VecFn f;
+    /* jac */
+    for (int j = 0; j < nq; j++) {
+        if (nh > 0) {
+            vecfn_init(&f, c, FD_PHI_Q, j, false, false, scratch);
+            for (int i = 0; i < nh; i++)
+                record(c, CHECK_JAC_FD, i, j, u[QTY_JAC][(size_t)i * nq + j], fd_first(&f, i, c->q[j], o->fd_step));
+        }
+        if (nv > 0) {
+            vecfn_init(&f, c, FD_PSI_QD, j, false, false, scratch);
+            for (int i = 0; i < nv; i++)
+                record(c, CHECK_JAC_FD, nh + i, j, u[QTY_JAC][(size_t)(nh + i) * nq + j],
+                       fd_first(&f, i, c->qd[j], o->fd_step));
+        }
+    }
+    /* nu */
+    if (nh > 0) {
+        vecfn_init(&f, c, FD_PHI_PATH, -1, false, true, scratch);
+        for (int i = 0; i < nh; i++)
+            record(c, CHECK_NU_FD, i, -1, u[QTY_NU][i], -fd_first(&f, i, 0.0, o->fd_step));
+    }
+    if (nv > 0) {
+        memset(c->qdw, 0, (size_t)nq * sizeof *c->qdw);
+        generic_psi(c->eng[ENGINE_GENERIC].generic, c->q, c->qdw, c->t, vec);
+        for (int i = 0; i < nv; i++)
+            record(c, CHECK_NU_FD, nh + i, -1, u[QTY_NU][nh + i], -vec[i]);
+    }
+    /* gamma */
+    if (nh > 0) {
+        vecfn_init(&f, c, FD_PHI_PATH, -1, true, true, scratch);
+        fd_second(&f, nh, o->fd_step2, vec);
+        for (int i = 0; i < nh; i++)
+            record(c, CHECK_GAMMA_FD, i, -1, u[QTY_GAMMA][i], -vec[i]);
+    }
+    if (nv > 0) {
+        vecfn_init(&f, c, FD_PSI_PATH, -1, true, true, scratch);
+        for (int i = 0; i < nv; i++)
+            record(c, CHECK_GAMMA_FD, nh + i, -1, u[QTY_GAMMA][nh + i], -fd_first(&f, i, 0.0, o->fd_step));
+    }
+}
+
+/* ---- engines against each other ---- */
+
+static void eval_engine(Checker *c, EngineKind k)
+{
+    double **o = c->out[k];
+    engine_phi(&c->eng[k], c->q, c->t, o[QTY_PHI]);
+    engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
+    engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
+    engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
+}
+
+static void compare_pair(Checker *c, int pair)
+{
+    EngineKind a = pair_engines[pair][0], b = pair_engines[pair][1];
+    int nq = c->nq;
+    for (int qty = 0; qty < QTY_COUNT; qty++) {
+        int what = CHECK_PAIR_FIRST + pair * QTY_COUNT + qty;
+        int n = qty == QTY_PHI ? c->nh : qty == QTY_JAC ? c->nr * nq : c->nr;
+        for (int i = 0; i < n; i++) {
+            int row = qty == QTY_JAC ? i / nq : i, col = qty == QTY_JAC ? i % nq : -1;
+            record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i]);
+        }
+        if (n == 0)
+            c->rep->items[what].checked = true;
+    }
+}
+
+/* ---- diagnosis ---- */
+
+static bool near(double a, double b, double tol)
+{
+    return fabs(a - b) <= tol * (1.0 + fabs(b));
+}
+
+/* The ratio patterns between value and reference. */
+typedef enum Ratio { RATIO_NONE, RATIO_NEG, RATIO_TWO, RATIO_HALF } Ratio;
+
+static Ratio ratio_of(double v, double r, double tol)
+{
+    if (r == 0.0)
+        return RATIO_NONE;
+    if (near(v, -r, 10 * tol))
+        return RATIO_NEG;
+    if (near(v, 2.0 * r, 10 * tol))
+        return RATIO_TWO;
+    if (near(v, 0.5 * r, 10 * tol))
+        return RATIO_HALF;
+    return RATIO_NONE;
+}
+
+static void hint_jac(const Checker *c, CheckItem *it)
+{
+    double tol = c->opt->tol;
+    bool velocity = it->row >= c->nh;
+    switch (ratio_of(it->value, it->reference, tol)) {
+    case RATIO_NEG:
+        snprintf(it->hint, sizeof it->hint, "the sign is wrong (value = -reference): e.g. d(P_A - P_B)/dq "
+                 "written for P_B - P_A, or B = dA/dphi taken with the wrong sign");
+        return;
+    case RATIO_TWO:
+        snprintf(it->hint, sizeof it->hint, "a factor 2 too many (value = 2 x reference): e.g. a term "
+                 "added twice, or d(d.d)/dq taken as 4 d.d_q");
+        return;
+    case RATIO_HALF:
+        snprintf(it->hint, sizeof it->hint, "a factor 2 missing (value = reference / 2): e.g. "
+                 "d(d.d)/dq = 2 d.d_q with the 2 dropped");
+        return;
+    case RATIO_NONE:
+        break;
+    }
+    if (it->value == 0.0)
+        snprintf(it->hint, sizeof it->hint, "a Jacobian term is missing%s",
+                 velocity ? " (a der() coefficient left out)"
+                          : " (e.g. the B s column of a body-fixed point)");
+    else if (fabs(it->reference) <= tol)
+        snprintf(it->hint, sizeof it->hint,
+                 "a spurious entry: the row does not change with this coordinate");
+    else
+        snprintf(it->hint, sizeof it->hint, "no classic pattern: compare the row's formula term by term");
+}
+
+static void hint_nu(const Checker *c, CheckItem *it)
+{
+    switch (ratio_of(it->value, it->reference, c->opt->tol)) {
+    case RATIO_NEG:
+        snprintf(it->hint, sizeof it->hint, "the sign is wrong: nu = -Phi_t (Phi_q qd = nu), not +Phi_t");
+        return;
+    case RATIO_TWO:
+        snprintf(it->hint, sizeof it->hint, "a factor 2 too many (value = 2 x reference)");
+        return;
+    case RATIO_HALF:
+        snprintf(it->hint, sizeof it->hint, "a factor 2 missing (value = reference / 2)");
+        return;
+    case RATIO_NONE:
+        break;
+    }
+    if (it->value == 0.0)
+        snprintf(it->hint, sizeof it->hint,
+                 "Phi_t is missing: a time-dependent driver, length or angle treated as constant");
+    else
+        snprintf(it->hint, sizeof it->hint, "no classic pattern: check the row's time dependence");
+}
+
+/* -(d/dtau)^2 of one position row (or -d/dtau of one velocity row) along
+   the path with only q moving, or only t. */
+static double gamma_part(Checker *c, int row, bool path_q, bool path_t, double *scratch, double *vec)
+{
+    VecFn f;
+    if (row < c->nh) {
+        vecfn_init(&f, c, FD_PHI_PATH, -1, path_q, path_t, scratch);
+        fd_second(&f, c->nh, c->opt->fd_step2, vec);
+        return -vec[row];
+    }
+    vecfn_init(&f, c, FD_PSI_PATH, -1, path_q, path_t, scratch);
+    return -fd_first(&f, row - c->nh, 0.0, c->opt->fd_step);
+}
+
+static void hint_gamma(Checker *c, CheckItem *it, double *scratch, double *vec)
+{
+    double tol = 10 * c->opt->tol, v = it->value, r = it->reference;
+    /* back to the worst state to split the reference into its parts */
+    memcpy(c->q, c->save_q[CHECK_GAMMA_FD], (size_t)c->nq * sizeof *c->q);
+    memcpy(c->qd, c->save_qd[CHECK_GAMMA_FD], (size_t)c->nq * sizeof *c->qd);
+    c->t = it->t;
+    double gq = gamma_part(c, it->row, true, false, scratch, vec);   /* -(Phi_q qd)_q qd */
+    double gt = gamma_part(c, it->row, false, true, scratch, vec);   /* -Phi_tt */
+    double gx = r - gq - gt;                                         /* -2 Phi_qt qd */
+    bool velocity = it->row >= c->nh;
+    struct { double value; const char *text; } cand[] = {
+        {-r, velocity ? "the sign is wrong: gamma = -(Psi_q qd + Psi_t)"
+                      : "the sign is wrong: Phi_q qdd = gamma = -(Phi_q qd)_q qd - 2 Phi_qt qd - Phi_tt"},
+        {r - gt, velocity ? "the term -Psi_t is missing (the time derivative of a der() coefficient or right side)"
+                          : "the term -Phi_tt is missing (the second time derivative of a driver, length or angle)"},
+        {r - gq, velocity ? "the term -Psi_q qd is missing (the coefficients' change along the motion)"
+                          : "the quadratic velocity term -(Phi_q qd)_q qd is missing (e.g. A s phi'^2 of a revolute)"},
+        {r - gx, "the mixed term -2 Phi_qt qd is missing"},
+        {r - 0.5 * gx, "the mixed term is counted once: -Phi_qt qd instead of -2 Phi_qt qd"},
+        {r - 2.0 * gq, "the quadratic velocity term has the wrong sign"},
+        {2.0 * r, "a factor 2 too many (value = 2 x reference)"},
+        {0.5 * r, "a factor 2 missing (value = reference / 2)"},
+    };
+    for (size_t k = 0; k < sizeof cand / sizeof *cand; k++) {
+        if (!near(cand[k].value, r, tol) && near(v, cand[k].value, tol)) {
+            snprintf(it->hint, sizeof it->hint, "%s", cand[k].text);
+            return;
+        }
+    }
+    if (v == 0.0)
+        snprintf(it->hint, sizeof it->hint, "gamma of this row is missing altogether");
+    else
+        snprintf(it->hint, sizeof it->hint, "no classic pattern: compare the row's gamma term by term");
+}
+
+static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
+{
+    int fd = qty == QTY_JAC ? CHECK_JAC_FD : qty == QTY_NU ? CHECK_NU_FD : qty == QTY_GAMMA ? CHECK_GAMMA_FD : -1;
+    const CheckItem *f = fd >= 0 ? &c->rep->items[fd] : NULL;
+    const char *kind = joint_info[c->m->rows[it->row].kind].keyword;
+    if (pair == 1)
+        snprintf(it->hint, sizeof it->hint,
+                 "the same C differs under libtcc and cc: suspect a compiler or math library difference");
+    else if (f && f->checked && !(f->error <= f->tol))
+        snprintf(it->hint, sizeof it->hint,
+                 "the generated code fails against finite differences too (see above)");
+    else if (f)
+        snprintf(it->hint, sizeof it->hint, "the generated code agrees with finite differences: "
+                 "suspect the generic evaluator's %s formula", kind);
+    else
+        snprintf(it->hint, sizeof it->hint, "suspect the generic evaluator's %s formula, "
+                 "or the row's lowering in generator/model/joints.c", kind);
+}
+
+/* ---- the run ---- */
+
+static void k_phi(void *ctx, const double *q, double t, double *o) { engine_phi(ctx, q, t, o); }
+static void k_jac(void *ctx, const double *q, double t, double *o) { engine_jac(ctx, q, t, o); }
+static void k_nu(void *ctx, const double *q, double t, double *o) { engine_nu(ctx, q, t, o); }
+static void k_gamma(void *ctx, const double *q, const double *qd, double t, double *o)
+{
+    engine_gamma(ctx, q, qd, t, o);
+}
+
+/* The base state: Newton from the initial values at t = 0 when the
+   holonomic rows are square, else the initial values. */
+static bool assemble(Checker *c, double *q)
+{
+    memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
+    if (c->nh != c->nq)
+        return false;
+    MechrtKernels k = {.nq = c->nq, .nh = c->nh, .nv = c->nv, .ctx = &c->eng[ENGINE_JIT],
+                       .phi = k_phi, .jac = k_jac, .nu = k_nu, .gamma = k_gamma};
+    size_t lwork = mechrt_workspace_size(c->nq, c->nr);
+    double *work = xmalloc(lwork * sizeof *work);
+    MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
+    free(work);
+    if (st != MECHRT_OK)
+        memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
+    return st == MECHRT_OK;
+}
+
+/* splitmix64: a small, fully determined generator. */
+static double uniform(uint64_t *s, double lo, double hi)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
+}
+
+bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep, Diag *diag)
+{
+    CheckOptions defaults = check_default_options();
+    if (!opt)
+        opt = &defaults;
+    memset(rep, 0, sizeof *rep);
+    Checker c = {.m = mech->model, .opt = opt, .rep = rep};
+    const Model *m = mech->model;
+    c.nq = m->nq, c.nh = m->nh, c.nv = m->nv, c.nr = m->nr;
+    for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
+        CheckItem *it = &rep->items[w];
+        it->what = w < CHECK_PAIR_FIRST ? fd_names[w] : pair_names[w - CHECK_PAIR_FIRST];
+        it->tol = w < CHECK_PAIR_FIRST ? opt->tol : opt->tol_engines;
+        it->row = it->col = -1;
+    }
+
+    bool ok = true;
+    for (int k = 0; k < ENGINE_KIND_COUNT && ok; k++) {
+        if (k == ENGINE_AOT && !opt->use_aot) {
+            snprintf(rep->note, sizeof rep->note, "aot not compared (not asked for)");
+            continue;
+        }
+        if (k == ENGINE_AOT && !aot_compiler_available()) {
+            snprintf(rep->note, sizeof rep->note, "aot not compared: no C compiler found (set CC)");
+            continue;
+        }
+        c.open[k] = engine_open(&c.eng[k], (EngineKind)k, mech, diag);
+        ok = c.open[k];
+        rep->engine_used[k] = c.open[k];
+    }
+
+    size_t nq = (size_t)c.nq, nr = (size_t)c.nr, nvec = (size_t)(c.nh > c.nv ? c.nh : c.nv) + 1;
+    double *mem = NULL;
+    if (ok) {
+        size_t total = ENGINE_KIND_COUNT * (2 * nr + nr * nq + nvec) + 12 * nq + nr + 6 * nvec
+                       + FD_CACHE * nvec + 2 * nq;
+        mem = xcalloc(total, sizeof *mem);
+        double *p = mem;
+        for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
+            c.out[k][QTY_PHI] = p, p += nvec;
+            c.out[k][QTY_JAC] = p, p += nr * nq;
+            c.out[k][QTY_NU] = p, p += nr;
+            c.out[k][QTY_GAMMA] = p, p += nr;
+        }
+        double *base = p;
+        p += nq;
+        c.q = p, p += nq;
+        c.qd = p, p += nq;
+        c.qw = p, p += nq;
+        c.qdw = p, p += nq;
+        for (int k = 0; k < 3; k++) {
+            c.save_q[k] = p, p += nq;
+            c.save_qd[k] = p, p += nq;
+        }
+        c.gamma0 = p, p += nr;
+        for (int k = 0; k < 5; k++)
+            c.d2[k] = p, p += nvec;
+        double *vec = p;
+        p += nvec;
+        double *scratch = p;
+
+        rep->assembled = assemble(&c, base);
+        uint64_t rng = (uint64_t)opt->seed * 0x2545f4914f6cdd1dull + 1;
+        for (int s = 0; s < opt->samples; s++) {
+            c.sample = s;
+            for (size_t i = 0; i < nq; i++) {
+                c.q[i] = base[i] + (s == 0 ? 0.0 : uniform(&rng, -opt->spread_q, opt->spread_q));
+                c.qd[i] = uniform(&rng, -opt->spread_qd, opt->spread_qd);
+            }
+            c.t = s == 0 ? 0.0 : uniform(&rng, 0.0, 1.0);
+            under_test(&c);
+            for (int k = 1; k < ENGINE_KIND_COUNT; k++)
+                if (c.open[k])
+                    eval_engine(&c, (EngineKind)k);
+            for (int pair = 0; pair < PAIR_COUNT; pair++)
+                if (c.open[pair_engines[pair][0]] && c.open[pair_engines[pair][1]])
+                    compare_pair(&c, pair);
+            check_fd(&c, scratch, vec);
+        }
+        rep->samples = opt->samples;
+        rep->ok = true;
+        for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
+            CheckItem *it = &rep->items[w];
+            if (!it->checked || it->error <= it->tol)
+                continue;
+            rep->ok = false;
+            if (w == CHECK_JAC_FD)
+                hint_jac(&c, it);
+            else if (w == CHECK_NU_FD)
+                hint_nu(&c, it);
+            else if (w == CHECK_GAMMA_FD)
+                hint_gamma(&c, it, scratch, vec);
+        }
+        for (int w = CHECK_PAIR_FIRST; w < CHECK_WHAT_COUNT; w++) {
+            CheckItem *it = &rep->items[w];
+            if (it->checked && !(it->error <= it->tol))
+                hint_pair(&c, it, (w - CHECK_PAIR_FIRST) / QTY_COUNT, (w - CHECK_PAIR_FIRST) % QTY_COUNT);
+        }
+    }
+    free(mem);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        if (c.open[k])
+            engine_close(&c.eng[k]);
+    return ok;
+}

@@ -1,0 +1,74 @@
+/* check.h - mechc check as a library: derivatives against finite differences, engines against each other. */
+#ifndef MECHC_CHECK_H
+#define MECHC_CHECK_H
+
+#include "../engine/engine.h"
+
+/* A deliberate mistake planted in the engine under test (the JIT kernels),
+   so tests can prove that check catches what it is meant to catch. */
+typedef enum CheckFaultKind {
+    CHECK_FAULT_NONE,
+    CHECK_FAULT_JAC_SCALE,      /* Phi_q[row][col] *= factor (-1: sign, 2: factor 2) */
+    CHECK_FAULT_NU_SCALE,       /* nu[row] *= factor */
+    CHECK_FAULT_GAMMA_ZERO,     /* gamma[row] = 0 */
+    CHECK_FAULT_GAMMA_DROP_TT,  /* gamma[row] loses its -Phi_tt term */
+    CHECK_FAULT_GAMMA_DROP_QD,  /* gamma[row] keeps only -Phi_tt (the qd terms dropped) */
+} CheckFaultKind;
+
+typedef struct CheckFault {
+    CheckFaultKind kind;
+    int row, col;
+    double factor;
+} CheckFault;
+
+/* Defaults from check_default_options(). */
+typedef struct CheckOptions {
+    int samples;            /* states sampled (default 20) */
+    unsigned long seed;     /* random states are a function of it (default 1) */
+    /* error = |value - reference| / (1 + |reference|), dimensionless */
+    double tol;             /* against finite differences (default 1e-6) */
+    double tol_engines;     /* between engines (default 1e-10) */
+    double spread_q;        /* q = q_assembled + U(-s, s), coordinate units (default 0.05) */
+    double spread_qd;       /* qd = U(-s, s) (default 1) */
+    double fd_step;         /* first step of gsl_deriv_central (default 1e-4) */
+    double fd_step2;        /* step of the second difference for gamma (default 2e-3) */
+    bool use_aot;           /* compare the aot engine too when a compiler exists (default true) */
+    CheckFault fault;       /* tests only (default none) */
+} CheckOptions;
+
+CheckOptions check_default_options(void);
+
+/* The checks, in report order. FD: the engine under test (jit) against
+   finite differences; then every pair of engines on every quantity. */
+typedef enum CheckWhat {
+    CHECK_JAC_FD, CHECK_NU_FD, CHECK_GAMMA_FD,
+    CHECK_PAIR_FIRST,
+    CHECK_WHAT_COUNT = CHECK_PAIR_FIRST + 12
+} CheckWhat;
+
+typedef struct CheckItem {
+    const char *what;       /* "jac", "nu", "gamma", "phi jit/generic", ... */
+    bool checked;           /* something was compared */
+    double error;           /* worst error seen (+inf for a NaN on one side) */
+    double tol;
+    int row, col;           /* where (col: Jacobian column, else -1) */
+    double value, reference;/* the two numbers at the worst place */
+    int sample;
+    double t;               /* time of the worst sample */
+    char hint[240];         /* when above tolerance: what mistake it looks like */
+} CheckItem;
+
+typedef struct CheckReport {
+    bool ok;
+    int samples;
+    bool assembled;         /* the base state came from Newton (else initial values) */
+    bool engine_used[ENGINE_KIND_COUNT];
+    char note[300];         /* e.g. why aot was not compared */
+    CheckItem items[CHECK_WHAT_COUNT];
+} CheckReport;
+
+/* Runs the checks. Returns false with diag filled when it cannot run (an
+   engine failed to build); otherwise rep->ok tells the verdict. */
+bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep, Diag *diag);
+
+#endif

@@ -1,0 +1,266 @@
+/* generic.c - the generic evaluator's state, its interpreted rows and options, and its entry points.
+ *
+ * generic_open turns the model's joint list into plans: standard joints
+ * keep their attachments and axis for the formulas of generic_joints.c;
+ * `constraint`, `driver` and `velocity` rows and non-constant options
+ * (length, angle, radius) are compiled to instruction lists (interp.h).
+ * A call computes cos and sin of every body angle the formulas need
+ * once, then runs each plan, which writes its own rows. For an
+ * interpreted row:
+ *
+ *   position row Phi:   Jacobian dPhi/dq_j by one dual pass per column in
+ *                       the row's support; nu = -dPhi/dt (dual in t);
+ *                       gamma = -D(D(Phi)), a second-order jet along
+ *                       (q, t) -> (qd, 1), i.e. qdd = 0;
+ *   velocity row Psi:   Psi = a(q,t) . qd + b(q,t): a_j = dPsi/dqd_j (dual
+ *                       per column), nu = -Psi(qd = 0) = -b,
+ *                       gamma = -D(Psi), a first-order jet along (qd, 0, 1).
+ */
+#include "generic_impl.h"
+
+#include "../base/arena.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- options ---- */
+
+double option_value(const Call *c, const Option *o)
+{
+    if (o->constant)
+        return o->value;
+    return tape_value(&c->g->progs[o->prog], c->q, NULL, c->t, c->g->vreg);
+}
+
+double option_dt(const Call *c, const Option *o)
+{
+    if (o->constant || !c->g->progs[o->prog].has_t)
+        return 0.0;
+    Seed s = {.q = c->q, .t = c->t, .col_q = -1, .col_qd = -1, .dt = 1.0};
+    return tape_jet(&c->g->progs[o->prog], &s, 1, c->g->jreg).d;
+}
+
+Jet option_along(const Call *c, const Option *o, int order)
+{
+    if (o->constant)
+        return (Jet){o->value, 0.0, 0.0};
+    Seed s = {.q = c->q, .t = c->t, .dq = c->qd, .col_q = -1, .col_qd = -1, .dt = 1.0};
+    return tape_jet(&c->g->progs[o->prog], &s, order, c->g->jreg);
+}
+
+void option_jac(const Call *c, const Option *o, double coef, double *row)
+{
+    if (o->constant)
+        return;
+    const Tape *p = &c->g->progs[o->prog];
+    for (int k = 0; k < p->nqcols; k++) {
+        Seed s = {.q = c->q, .t = c->t, .col_q = p->qcols[k], .col_qd = -1};
+        row[p->qcols[k]] += coef * tape_jet(p, &s, 1, c->g->jreg).d;
+    }
+}
+
+/* ---- interpreted rows ---- */
+
+/* constraint or driver: Phi(q, t) = lhs - rhs. */
+static void position_row(const Call *c, const Tape *p, int r)
+{
+    Generic *g = c->g;
+    if (c->phi)
+        c->phi[r] = tape_value(p, c->q, NULL, c->t, g->vreg);
+    if (c->jac) {
+        double *row = c->jac + (size_t)r * (size_t)g->nq;
+        for (int k = 0; k < p->nqcols; k++) {
+            Seed s = {.q = c->q, .t = c->t, .col_q = p->qcols[k], .col_qd = -1};
+            row[p->qcols[k]] += tape_jet(p, &s, 1, g->jreg).d;
+        }
+    }
+    if (c->nu) {
+        Seed s = {.q = c->q, .t = c->t, .col_q = -1, .col_qd = -1, .dt = 1.0};
+        c->nu[r] = p->has_t ? -tape_jet(p, &s, 1, g->jreg).d : 0.0;
+    }
+    if (c->gamma) {
+        Seed s = {.q = c->q, .t = c->t, .dq = c->qd, .col_q = -1, .col_qd = -1, .dt = 1.0};
+        c->gamma[r] = -tape_jet(p, &s, 2, g->jreg).dd;
+    }
+}
+
+/* velocity or velocity-level driver: Psi(q, qd, t) = lhs - rhs. */
+static void velocity_row(const Call *c, const Tape *p, int r)
+{
+    Generic *g = c->g;
+    if (c->psi)
+        c->psi[r - g->nh] = tape_value(p, c->q, c->qd, c->t, g->vreg);
+    if (c->jac) {
+        double *row = c->jac + (size_t)r * (size_t)g->nq;
+        for (int k = 0; k < p->nqdcols; k++) {
+            Seed s = {.q = c->q, .t = c->t, .col_q = -1, .col_qd = p->qdcols[k]};
+            row[p->qdcols[k]] += tape_jet(p, &s, 1, g->jreg).d;
+        }
+    }
+    if (c->nu)
+        c->nu[r] = -tape_value(p, c->q, NULL, c->t, g->vreg);
+    if (c->gamma) {
+        Seed s = {.q = c->q, .qd = c->qd, .t = c->t, .dq = c->qd, .col_q = -1, .col_qd = -1, .dt = 1.0};
+        c->gamma[r] = -tape_jet(p, &s, 1, g->jreg).d;
+    }
+}
+
+/* ---- a call ---- */
+
+static void run(Call *c)
+{
+    Generic *g = c->g;
+    /* nu of the standard joints never rotates anything, phi only for
+       position-level joints */
+    int nangles = c->jac || c->gamma || c->psi ? g->nangles : c->phi ? g->nangles_pos : 0;
+    for (int k = 0; k < nangles; k++) {
+        double phi = c->q[g->angles[k]];
+        g->cosq[g->angles[k]] = cos(phi);
+        g->sinq[g->angles[k]] = sin(phi);
+    }
+    if (c->jac)
+        memset(c->jac, 0, (size_t)g->nr * (size_t)g->nq * sizeof *c->jac);
+    for (int i = 0; i < g->nplans; i++) {
+        const Plan *p = &g->plans[i];
+        if (p->prog < 0)
+            generic_joint_rows(c, p);
+        else if (p->j->velocity)
+            velocity_row(c, &g->progs[p->prog], p->row);
+        else
+            position_row(c, &g->progs[p->prog], p->row);
+    }
+}
+
+void generic_phi(Generic *g, const double *q, double t, double *phi)
+{
+    run(&(Call){.g = g, .q = q, .t = t, .phi = phi});
+}
+
+void generic_jac(Generic *g, const double *q, double t, double *jac)
+{
+    run(&(Call){.g = g, .q = q, .t = t, .jac = jac});
+}
+
+void generic_nu(Generic *g, const double *q, double t, double *nu)
+{
+    run(&(Call){.g = g, .q = q, .t = t, .nu = nu});
+}
+
+void generic_gamma(Generic *g, const double *q, const double *qd, double t, double *gamma)
+{
+    run(&(Call){.g = g, .q = q, .qd = qd, .t = t, .gamma = gamma});
+}
+
+void generic_all(Generic *g, const double *q, const double *qd, double t,
+                 double *phi, double *jac, double *nu, double *gamma)
+{
+    run(&(Call){.g = g, .q = q, .qd = qd, .t = t, .phi = phi, .jac = jac, .nu = nu, .gamma = gamma});
+}
+
+void generic_psi(Generic *g, const double *q, const double *qd, double t, double *psi)
+{
+    run(&(Call){.g = g, .q = q, .qd = qd, .t = t, .psi = psi});
+}
+
+/* ---- set-up ---- */
+
+static int add_tape(Generic *g, const Model *m, NodeId root, CompileScratch *cs)
+{
+    tape_compile(&g->progs[g->nprogs], &m->dag, root, cs);
+    return g->nprogs++;
+}
+
+/* The formulas rotate s or the axis by A(phi) for these attachments:
+   need[phi] = 1 for velocity-level joints, 2 for position-level ones. */
+static void need_angle(char *need, const Attach *at, bool normal, bool velocity)
+{
+    if (at->q >= 0 && at->has_phi && (normal || at->sx != 0.0 || at->sy != 0.0)) {
+        char level = velocity ? 1 : 2;
+        if (need[at->q + 2] < level)
+            need[at->q + 2] = level;
+    }
+}
+
+Generic *generic_open(const Model *m)
+{
+    Generic *g = xcalloc(1, sizeof *g);
+    g->m = m;
+    g->nq = m->nq;
+    g->nh = m->nh;
+    g->nv = m->nv;
+    g->nr = m->nr;
+    g->nplans = m->njoints;
+    g->plans = xcalloc((size_t)m->njoints + 1, sizeof *g->plans);
+    g->progs = xcalloc(2 * (size_t)m->njoints + 1, sizeof *g->progs);
+    g->cosq = xcalloc((size_t)m->nq, sizeof *g->cosq);
+    g->sinq = xcalloc((size_t)m->nq, sizeof *g->sinq);
+    g->angles = xcalloc((size_t)m->nq, sizeof *g->angles);
+    char *need = xcalloc((size_t)m->nq, sizeof *need);
+    CompileScratch cs;
+    compile_scratch_init(&cs, &m->dag);
+    for (int i = 0; i < m->njoints; i++) {
+        const Joint *j = &m->joints[i];
+        Plan *p = &g->plans[i];
+        *p = (Plan){.j = j, .row = j->first_row, .prog = -1, .opt = {.constant = true, .prog = -1}};
+        switch (j->kind) {
+        case JOINT_CONSTRAINT:
+        case JOINT_DRIVER:
+        case JOINT_VELOCITY:
+            p->prog = add_tape(g, m, j->expr, &cs);
+            break;
+        case JOINT_PRISMATIC:
+        case JOINT_POINTLINE:
+        case JOINT_KNIFE:
+            need_angle(need, &j->a, true, j->velocity);
+            need_angle(need, &j->b, false, j->velocity);
+            break;
+        case JOINT_REVOLUTE:
+        case JOINT_DISTANCE:
+        case JOINT_WELD:
+        case JOINT_ROLLING:
+            need_angle(need, &j->a, false, j->velocity);
+            need_angle(need, &j->b, false, j->velocity);
+            break;
+        case JOINT_KIND_COUNT:
+            break;
+        }
+        if (joint_info[j->kind].option != OPTION_NONE
+            && !dag_is_const(&m->dag, j->option, &p->opt.value)) {
+            p->opt.constant = false;
+            p->opt.prog = add_tape(g, m, j->option, &cs);
+        }
+    }
+    compile_scratch_free(&cs);
+    for (int level = 2; level >= 1; level--) {
+        for (int k = 0; k < m->nq; k++)
+            if (need[k] == level)
+                g->angles[g->nangles++] = k;
+        if (level == 2)
+            g->nangles_pos = g->nangles;
+    }
+    free(need);
+    int regs = 1;
+    for (int k = 0; k < g->nprogs; k++)
+        if (g->progs[k].n > regs)
+            regs = g->progs[k].n;
+    g->jreg = xcalloc((size_t)regs, sizeof *g->jreg);
+    g->vreg = xcalloc((size_t)regs, sizeof *g->vreg);
+    return g;
+}
+
+void generic_free(Generic *g)
+{
+    if (!g)
+        return;
+    for (int k = 0; k < g->nprogs; k++)
+        tape_free(&g->progs[k]);
+    free(g->progs);
+    free(g->plans);
+    free(g->cosq);
+    free(g->sinq);
+    free(g->angles);
+    free(g->jreg);
+    free(g->vreg);
+    free(g);
+}

@@ -1,0 +1,63 @@
+/* generic_impl.h - what generic.c and generic_joints.c share: the evaluator's state and one call's outputs. */
+#ifndef MECHC_GENERIC_IMPL_H
+#define MECHC_GENERIC_IMPL_H
+
+#include "generic.h"
+#include "interp.h"
+
+/* A joint's length, angle or radius: a constant, or a program of (q, t). */
+typedef struct Option {
+    bool constant;
+    double value;       /* when constant */
+    int prog;           /* index into Generic.progs, -1 when constant */
+} Option;
+
+/* One joint, ready to evaluate. */
+typedef struct Plan {
+    const Joint *j;
+    int row;            /* its first row */
+    int prog;           /* constraint, driver, velocity: the row's program; else -1 */
+    Option opt;
+} Plan;
+
+struct Generic {
+    const Model *m;
+    int nq, nh, nv, nr;
+    Plan *plans;
+    int nplans;
+    Tape *progs;
+    int nprogs;
+    int *angles;        /* body angles whose rotation A(phi) the joint formulas use: */
+    int nangles;        /* all of them, */
+    int nangles_pos;    /* of which the first nangles_pos serve position-level joints */
+    double *cosq, *sinq;    /* per coordinate; valid for angles[] during a call */
+    Jet *jreg;          /* registers for the longest program */
+    double *vreg;
+};
+
+/* One evaluation: the state and where each requested quantity goes (NULL:
+   not requested). jac is zero-filled by the caller; formulas add to it. */
+typedef struct Call {
+    Generic *g;
+    const double *q, *qd;   /* qd NULL unless gamma or psi is requested */
+    double t;
+    double *phi;        /* nh */
+    double *jac;        /* nr*nq */
+    double *nu;         /* nr */
+    double *gamma;      /* nr */
+    double *psi;        /* nv, indexed by row - nh */
+} Call;
+
+/* Options (generic.c). */
+double option_value(const Call *c, const Option *o);
+/* d option/dt at fixed q. */
+double option_dt(const Call *c, const Option *o);
+/* The option along (qd, 1): value, D and D(D) with qdd = 0. */
+Jet option_along(const Call *c, const Option *o, int order);
+/* row[j] += coef * d option/dq_j for every coordinate the option reads. */
+void option_jac(const Call *c, const Option *o, double coef, double *row);
+
+/* The rows of one standard joint (generic_joints.c). */
+void generic_joint_rows(const Call *c, const Plan *p);
+
+#endif

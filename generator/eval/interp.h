@@ -1,0 +1,77 @@
+/* interp.h - one expression of the graph compiled to an instruction list, run with forward-mode derivatives.
+ *
+ * The generic evaluator's own arithmetic for `constraint`, `driver` and
+ * `velocity` rows and for joint options (length, angle, radius): it never
+ * builds derivative nodes, it carries derivatives along while it runs
+ * (dual numbers, and second-order jets for gamma).
+ */
+#ifndef MECHC_INTERP_H
+#define MECHC_INTERP_H
+
+#include "../dag/dag.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* One instruction: register k (its index in the program) = op(reg a, reg b).
+   Leaves: VAR / VARD read q[a] / qd[a], TIME reads t, CONST holds value. */
+typedef struct Instr {
+    uint8_t op;         /* DagOp */
+    int32_t a, b;       /* operand registers (unary: b = a); leaves: coordinate index */
+    double value;       /* CONST */
+} Instr;
+
+/* The reachable nodes of one root, in topological (node id) order; the
+   last instruction is the root. */
+typedef struct Tape {
+    Instr *code;
+    int n;
+    int *qcols;         /* coordinates it reads (OP_VAR), ascending */
+    int nqcols;
+    int *qdcols;        /* velocities it reads (OP_VARD), ascending */
+    int nqdcols;
+    bool has_t;         /* reads t */
+} Tape;
+
+/* A truncated Taylor expansion along one direction s of (q, qd, t):
+   v = f, d = df/ds, dd = d2f/ds2. With the direction (qd, 0, 1) these are
+   f, its total time derivative D f and D(D f) with qdd = 0. */
+typedef struct Jet {
+    double v, d, dd;
+} Jet;
+
+/* Where a jet pass starts: the point and the direction of each leaf. */
+typedef struct Seed {
+    const double *q, *qd;   /* the point; qd NULL: all velocities zero */
+    double t;
+    const double *dq;       /* direction of q; NULL: unit vector col_q (or none) */
+    int col_q;              /* -1: none */
+    int col_qd;             /* direction of qd: unit vector col_qd, -1: none */
+    double dt;              /* direction of t */
+} Seed;
+
+/* Scratch for compiling: marks the nodes of one root at a time. Sized for
+   the graph as it is when interp_scratch_init is called. */
+typedef struct CompileScratch {
+    uint32_t *mark;
+    uint32_t stamp;
+    NodeId *stack, *nodes;
+    int32_t *slot;
+    int cap;
+} CompileScratch;
+
+void compile_scratch_init(CompileScratch *cs, const Dag *dag);
+void compile_scratch_free(CompileScratch *cs);
+
+/* Compiles the expression rooted at root into p (malloc'ed arrays). */
+void tape_compile(Tape *p, const Dag *dag, NodeId root, CompileScratch *cs);
+void tape_free(Tape *p);
+
+/* The value only. reg holds p->n doubles; qd NULL: velocities zero. */
+double tape_value(const Tape *p, const double *q, const double *qd, double t, double *reg);
+
+/* Value and first derivative along the seed's direction (order 1), or
+   also the second (order 2). reg holds p->n jets. */
+Jet tape_jet(const Tape *p, const Seed *seed, int order, Jet *reg);
+
+#endif

@@ -1,0 +1,54 @@
+/* svg_anim.h - an animated SVG (SMIL, no script) of a mechanism over a run. */
+#ifndef MECHC_SVG_ANIM_H
+#define MECHC_SVG_ANIM_H
+
+#include "../model/model.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+/* A point whose path is drawn: P = r + A(phi) s of a body (has_phi), or a
+   particle (has_phi false, sx = sy = 0). q is the index of the x coordinate. */
+typedef struct SvgTrace {
+    int q;
+    bool has_phi;
+    double sx, sy;
+    const char *label;      /* legend text (escaped on output); NULL: none */
+} SvgTrace;
+
+/* Tunables with their defaults (svg_anim_default_options). */
+typedef struct SvgAnimOptions {
+    int max_frames;         /* frames kept after subsampling; default 200 */
+    double min_duration;    /* seconds of playback at least (a run shorter
+                               than this is slowed down); default 2 */
+    double max_duration;    /* seconds of playback at most (a longer run is
+                               sped up); default 60 */
+    int width, height;      /* largest drawing area in px; default 760 x 520 */
+} SvgAnimOptions;
+
+SvgAnimOptions svg_anim_default_options(void);
+
+/* Writes the animation of nframes frames: t[k] (non-decreasing, finite) and
+   q[k*nq + i] (the model's coordinates). The static attributes show the
+   first frame, so viewers that do not animate show the start of the run;
+   SMIL <animate> elements play the run in a loop. Frames are subsampled to
+   at most 200. traces may be NULL when ntraces is 0; title may be NULL (the
+   mechanism name is used). Returns false, writing nothing, when the input is
+   unusable (no frame, decreasing time, a non-finite coordinate; errno =
+   EINVAL) or when writing fails (errno from stdio). */
+bool svg_write_animation(FILE *out, const Model *m, const double *t, const double *q,
+                         int nframes, const SvgTrace *traces, int ntraces, const char *title);
+/* The same with options (NULL: defaults). */
+bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const double *q,
+                             int nframes, const SvgTrace *traces, int ntraces,
+                             const char *title, const SvgAnimOptions *opt);
+
+/* Parses a --trace argument: `BODY(sx, sy)`, `BODY` (its reference point) or
+   `POINT` (a particle), sx and sy numbers (optionally signed, `pi` allowed,
+   e.g. `-0.15`, `pi/4` is not: numbers only). On success fills *out (label =
+   text, so text must outlive the trace) and returns true; otherwise writes a
+   one-line reason into err (errlen bytes) and returns false. */
+bool svg_parse_trace(const Model *m, const char *text, SvgTrace *out, char *err, size_t errlen);
+
+#endif

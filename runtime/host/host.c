@@ -1,0 +1,440 @@
+/* host.c - minimum-norm Gauss-Newton, position integration and singular directions, on GSL.
+ *
+ * A mechanism with velocity-level rows (rolling, knife edges, velocity
+ * drivers) has nh holonomic rows Phi(q, t) = 0 and nv Pfaffian rows
+ * A(q, t) qd = b, nh + nv = nq. Its velocities come from the square system
+ * [Phi_q; A] qd = nu, its positions only by integrating q' = qd(q, t)
+ * (Haug, Computer-Aided Kinematics and Dynamics of Mechanical Systems, 1989,
+ * ch. 7; the velocity rows need not be integrable). The integrator keeps
+ * Phi constant only to its tolerance, so after every accepted step q is
+ * projected back onto Phi = 0 (coordinate projection: Hairer & Wanner,
+ * Solving ODEs II, section VII.2; Eich, SIAM J. Numer. Anal. 30, 1993).
+ * With nh < nq that projection is underdetermined; each Gauss-Newton step
+ * takes the minimum-norm correction, which moves q least (Ben-Israel's
+ * Newton method for underdetermined systems).
+ *
+ * Workspaces are allocated once in mechrt_host_new; the calls per step
+ * allocate nothing. GSL's error handler (abort by default) is switched off
+ * around every GSL call and restored afterwards: failures come back as
+ * statuses, never as an abort.
+ */
+#include "mechrt_host.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_vector.h>
+
+struct MechrtHost {
+    const MechrtKernels *k;
+    int nq, nh, nr;
+    double *work;               /* the core runtime's workspace */
+    size_t lwork;
+    double *phi;                /* nh (at least 1) */
+    double *jac;                /* nr * nq */
+    double *dq, *y;             /* nq each */
+    gsl_matrix *at;             /* nq x nh: Phi_q^T, then U of its SVD */
+    gsl_matrix *v;              /* nh x nh */
+    gsl_vector *s, *svwork;     /* nh */
+    /* integration */
+    gsl_odeiv2_step *step;
+    MechrtOdeMethod step_method;
+    gsl_odeiv2_control *control;
+    gsl_odeiv2_evolve *evolve;
+    MechrtOptions rhs_opts;     /* the caller's, condition estimate off */
+    MechrtStatus fail_status;   /* set by the right-hand side on failure */
+    double fail_t;
+    double *fail_q;             /* nq */
+    MechrtHostStats stats;
+};
+
+MechrtOdeOptions mechrt_ode_default_options(void)
+{
+    MechrtOdeOptions o = {MECHRT_ODE_RK8PD, 1e-10};
+    return o;
+}
+
+const char *mechrt_ode_method_name(MechrtOdeMethod m)
+{
+    switch (m) {
+    case MECHRT_ODE_RK8PD: return "rk8pd";
+    case MECHRT_ODE_RKF45: return "rkf45";
+    }
+    return NULL;
+}
+
+bool mechrt_ode_method_from_name(const char *name, MechrtOdeMethod *out)
+{
+    if (strcmp(name, "rk8pd") == 0)
+        *out = MECHRT_ODE_RK8PD;
+    else if (strcmp(name, "rkf45") == 0)
+        *out = MECHRT_ODE_RKF45;
+    else
+        return false;
+    return true;
+}
+
+static const gsl_odeiv2_step_type *ode_type(MechrtOdeMethod m)
+{
+    switch (m) {
+    case MECHRT_ODE_RK8PD: return gsl_odeiv2_step_rk8pd;
+    case MECHRT_ODE_RKF45: return gsl_odeiv2_step_rkf45;
+    }
+    return gsl_odeiv2_step_rk8pd;
+}
+
+void mechrt_host_free(MechrtHost *h)
+{
+    if (!h)
+        return;
+    free(h->work);
+    free(h->phi);
+    free(h->jac);
+    free(h->dq);
+    free(h->y);
+    free(h->fail_q);
+    if (h->at)
+        gsl_matrix_free(h->at);
+    if (h->v)
+        gsl_matrix_free(h->v);
+    if (h->s)
+        gsl_vector_free(h->s);
+    if (h->svwork)
+        gsl_vector_free(h->svwork);
+    if (h->step)
+        gsl_odeiv2_step_free(h->step);
+    if (h->control)
+        gsl_odeiv2_control_free(h->control);
+    if (h->evolve)
+        gsl_odeiv2_evolve_free(h->evolve);
+    free(h);
+}
+
+MechrtHost *mechrt_host_new(const MechrtKernels *k)
+{
+    if (!k || k->nq < 1 || k->nh < 0 || k->nv < 0 || k->nh > k->nq)
+        return NULL;
+    MechrtHost *h = calloc(1, sizeof *h);
+    if (!h)
+        return NULL;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    size_t nq = (size_t)k->nq, nh = (size_t)k->nh;
+    h->k = k;
+    h->nq = k->nq;
+    h->nh = k->nh;
+    h->nr = k->nh + k->nv;
+    h->lwork = mechrt_workspace_size(k->nq, h->nr > k->nq ? h->nr : k->nq);
+    h->work = h->lwork ? malloc(h->lwork * sizeof *h->work) : NULL;
+    h->phi = malloc((nh + 1) * sizeof *h->phi);
+    h->jac = malloc((size_t)h->nr * nq * sizeof *h->jac + 1);
+    h->dq = malloc(nq * sizeof *h->dq);
+    h->y = malloc(nq * sizeof *h->y);
+    h->fail_q = calloc(nq, sizeof *h->fail_q);
+    bool ok = h->work && h->phi && h->jac && h->dq && h->y && h->fail_q;
+    if (ok && nh > 0) {
+        h->at = gsl_matrix_alloc(nq, nh);
+        h->v = gsl_matrix_alloc(nh, nh);
+        h->s = gsl_vector_alloc(nh);
+        h->svwork = gsl_vector_alloc(nh);
+        ok = h->at && h->v && h->s && h->svwork;
+    }
+    if (ok) {
+        h->evolve = gsl_odeiv2_evolve_alloc(nq);
+        h->control = gsl_odeiv2_control_y_new(1e-10, 1e-10);
+        ok = h->evolve && h->control;
+    }
+    gsl_set_error_handler(old);
+    if (!ok) {
+        mechrt_host_free(h);
+        return NULL;
+    }
+    return h;
+}
+
+const MechrtHostStats *mechrt_host_stats(const MechrtHost *h) { return &h->stats; }
+
+const double *mechrt_host_failure(const MechrtHost *h, double *t)
+{
+    if (t)
+        *t = h->fail_t;
+    return h->fail_q;
+}
+
+/* ||Phi(q, t)||_inf over the holonomic rows, with the worst row. */
+static MechrtStatus eval_phi(MechrtHost *h, const double *q, double t, double *residual,
+                             int *worst)
+{
+    const MechrtKernels *k = h->k;
+    k->phi(k->ctx, q, t, h->phi);
+    *residual = 0;
+    *worst = h->nh > 0 ? 0 : -1;
+    for (int i = 0; i < h->nh; i++) {
+        double a = fabs(h->phi[i]);
+        if (!isfinite(a)) {
+            *residual = a;
+            *worst = i;
+            return MECHRT_ENOTFINITE;
+        }
+        if (a > *residual) {
+            *residual = a;
+            *worst = i;
+        }
+    }
+    return MECHRT_OK;
+}
+
+/* One minimum-norm Gauss-Newton step for Phi_q dq = -Phi (nh x nq, nh <= nq).
+ * With the thin SVD Phi_q^T = U S V^T (U nq x nh, Golub-Reinsch in GSL),
+ * Phi_q = V S U^T and the minimum-norm least-squares solution is
+ *   dq = -U S^+ V^T Phi,
+ * S^+ inverting only the singular values above pivot_tol * sigma_max
+ * (Golub & Van Loan, 4th ed., section 5.5.4). h->phi holds Phi at q. */
+static MechrtStatus min_norm_step(MechrtHost *h, const MechrtOptions *o, const double *q,
+                                  double t)
+{
+    const MechrtKernels *k = h->k;
+    int nq = h->nq, nh = h->nh;
+    k->jac(k->ctx, q, t, h->jac);
+    for (int i = 0; i < nh; i++)
+        for (int j = 0; j < nq; j++) {
+            double a = h->jac[(size_t)i * (size_t)nq + (size_t)j];
+            if (!isfinite(a))
+                return MECHRT_ENOTFINITE;
+            gsl_matrix_set(h->at, (size_t)j, (size_t)i, a);
+        }
+    if (gsl_linalg_SV_decomp(h->at, h->v, h->s, h->svwork) != GSL_SUCCESS)
+        return MECHRT_ENOTFINITE;
+    double smax = gsl_vector_get(h->s, 0), cut = o->pivot_tol * smax;
+    if (!(smax > 0))
+        return MECHRT_ESING;   /* Phi_q = 0: no direction to move in */
+    for (int j = 0; j < nq; j++)
+        h->dq[j] = 0;
+    for (int c = 0; c < nh; c++) {
+        double sc = gsl_vector_get(h->s, (size_t)c), y = 0;
+        if (sc <= cut)
+            break;             /* singular values come sorted, largest first */
+        for (int i = 0; i < nh; i++)
+            y -= gsl_matrix_get(h->v, (size_t)i, (size_t)c) * h->phi[i];
+        y /= sc;
+        for (int j = 0; j < nq; j++)
+            h->dq[j] += gsl_matrix_get(h->at, (size_t)j, (size_t)c) * y;
+    }
+    return MECHRT_OK;
+}
+
+static MechrtStatus project(MechrtHost *h, const MechrtOptions *o, double *q, double t,
+                            MechrtReport *r)
+{
+    MechrtReport rep = {0, 0, -1, -1, -1, 0, false};
+    MechrtStatus st;
+    h->stats.projections++;
+    if (h->nh == 0) {
+        if (r)
+            *r = rep;
+        return MECHRT_OK;
+    }
+    for (;;) {
+        st = eval_phi(h, q, t, &rep.residual, &rep.worst_row);
+        if (st != MECHRT_OK)
+            break;
+        if (rep.step >= 0 && rep.residual <= o->tol_phi && rep.step <= o->tol_dq)
+            break;
+        if (rep.iterations >= o->max_iter) {
+            st = MECHRT_EMAXITER;
+            break;
+        }
+        st = min_norm_step(h, o, q, t);
+        if (st != MECHRT_OK)
+            break;
+        double step = 0;
+        for (int j = 0; j < h->nq; j++) {
+            if (!isfinite(h->dq[j])) {
+                st = MECHRT_ENOTFINITE;
+                break;
+            }
+            q[j] += h->dq[j];
+            if (fabs(h->dq[j]) > step)
+                step = fabs(h->dq[j]);
+        }
+        if (st != MECHRT_OK)
+            break;
+        rep.step = step;
+        rep.iterations++;
+        h->stats.project_iterations++;
+    }
+    if (r)
+        *r = rep;
+    return st;
+}
+
+MechrtStatus mechrt_host_project(MechrtHost *h, const MechrtOptions *o, double *q, double t,
+                                 MechrtReport *report)
+{
+    MechrtOptions def = mechrt_default_options();
+    if (!h || !q)
+        return MECHRT_EINVAL;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    MechrtStatus st = project(h, o ? o : &def, q, t, report);
+    gsl_set_error_handler(old);
+    return st;
+}
+
+/* q' = qd(q, t) for GSL: the velocity solve of the square system. A failure
+   (singular [Phi_q; A], NaN) is kept with its time and state, and reported
+   as GSL_EBADFUNC, which stops the integrator at once. */
+static int ode_rhs(double t, const double y[], double dydt[], void *params)
+{
+    MechrtHost *h = params;
+    h->stats.rhs_calls++;
+    MechrtReport rep;
+    MechrtStatus st = mechrt_velocity(h->k, &h->rhs_opts, y, t, dydt, h->work, h->lwork, &rep);
+    if (st == MECHRT_OK)
+        return GSL_SUCCESS;
+    if (h->fail_status == MECHRT_OK) {
+        h->fail_status = st;
+        h->fail_t = t;
+        memcpy(h->fail_q, y, (size_t)h->nq * sizeof *y);
+    }
+    return GSL_EBADFUNC;
+}
+
+MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
+                                   const MechrtOdeOptions *oo, double *q, double *t,
+                                   double t_end, double *hstep, MechrtReport *report)
+{
+    MechrtOptions def = mechrt_default_options();
+    MechrtOdeOptions odef = mechrt_ode_default_options();
+    if (!h || !q || !t || !hstep || !isfinite(*t) || !isfinite(t_end))
+        return MECHRT_EINVAL;
+    if (h->nr != h->nq)
+        return MECHRT_ENOTSQUARE;
+    o = o ? o : &def;
+    oo = oo ? oo : &odef;
+    if (!(oo->tol > 0))
+        return MECHRT_EINVAL;
+    if (report)
+        *report = (MechrtReport){0, 0, -1, -1, -1, 0, false};
+    if (*t == t_end)
+        return MECHRT_OK;
+
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    MechrtStatus st = MECHRT_OK;
+    if (!h->step || h->step_method != oo->method) {
+        if (h->step)
+            gsl_odeiv2_step_free(h->step);
+        h->step = gsl_odeiv2_step_alloc(ode_type(oo->method), (size_t)h->nq);
+        h->step_method = oo->method;
+        if (!h->step)
+            st = MECHRT_EINVAL;
+    }
+    if (st == MECHRT_OK) {
+        gsl_odeiv2_control_init(h->control, oo->tol, oo->tol, 1.0, 0.0);
+        gsl_odeiv2_evolve_reset(h->evolve);
+        gsl_odeiv2_step_reset(h->step);
+    }
+    h->rhs_opts = *o;
+    h->rhs_opts.cond_warn = 0;   /* estimates are for the output times */
+    h->fail_status = MECHRT_OK;
+
+    double dir = t_end > *t ? 1.0 : -1.0, hh = *hstep;
+    if (!(hh * dir > 0) || !isfinite(hh) || fabs(hh) > fabs(t_end - *t))
+        hh = t_end - *t;
+    gsl_odeiv2_system sys = {ode_rhs, NULL, (size_t)h->nq, h};
+    while (st == MECHRT_OK && *t * dir < t_end * dir) {
+        int gs = gsl_odeiv2_evolve_apply(h->evolve, h->control, h->step, &sys, t, t_end, &hh, q);
+        if (gs != GSL_SUCCESS) {
+            if (h->fail_status != MECHRT_OK) {
+                st = h->fail_status;
+            } else {
+                /* step size underflow: keep where the integrator gave up */
+                st = MECHRT_ESTEP;
+                h->fail_t = *t;
+                memcpy(h->fail_q, q, (size_t)h->nq * sizeof *q);
+            }
+            break;
+        }
+        h->stats.ode_steps++;
+        MechrtReport pr;
+        memcpy(h->y, q, (size_t)h->nq * sizeof *q);
+        st = project(h, o, h->y, *t, &pr);
+        if (report && pr.iterations > report->iterations)
+            *report = pr;   /* the hardest projection of the call */
+        if (st != MECHRT_OK) {
+            h->fail_status = st;
+            h->fail_t = *t;
+            memcpy(h->fail_q, h->y, (size_t)h->nq * sizeof *q);
+            if (report)
+                *report = pr;
+            break;
+        }
+        memcpy(q, h->y, (size_t)h->nq * sizeof *q);
+    }
+    h->stats.ode_rejected += (long)h->evolve->failed_steps;
+    *hstep = hh;
+    if (st != MECHRT_OK)
+        *t = h->fail_t;
+    gsl_set_error_handler(old);
+    return st;
+}
+
+double mechrt_host_singular_direction(int m, int n, const double *a, double *row_w,
+                                      double *col_w)
+{
+    if (m < 1 || n < 1 || !a)
+        return -1;
+    /* GSL's SVD wants rows >= columns: decompose a or its transpose */
+    bool tr = m < n;
+    size_t rows = (size_t)(tr ? n : m), cols = (size_t)(tr ? m : n);
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    gsl_matrix *u = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
+    gsl_vector *s = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
+    double ratio = -1;
+    if (u && v && s && w) {
+        bool finite = true;
+        for (int i = 0; i < m; i++)
+            for (int j = 0; j < n; j++) {
+                double x = a[(size_t)i * (size_t)n + (size_t)j];
+                finite = finite && isfinite(x);
+                if (tr)
+                    gsl_matrix_set(u, (size_t)j, (size_t)i, x);
+                else
+                    gsl_matrix_set(u, (size_t)i, (size_t)j, x);
+            }
+        if (finite && gsl_linalg_SV_decomp(u, v, s, w) == GSL_SUCCESS) {
+            /* a = U S V^T (or a^T = U S V^T): the last column of U and of V
+               belong to the smallest singular value */
+            size_t c = cols - 1;
+            double smax = gsl_vector_get(s, 0), smin = gsl_vector_get(s, c);
+            ratio = smax > 0 ? smin / smax : 0;
+            for (size_t i = 0; i < rows; i++) {
+                double x = fabs(gsl_matrix_get(u, i, c));
+                if (tr)
+                    col_w[i] = x;
+                else
+                    row_w[i] = x;
+            }
+            for (size_t i = 0; i < cols; i++) {
+                double x = fabs(gsl_matrix_get(v, i, c));
+                if (tr)
+                    row_w[i] = x;
+                else
+                    col_w[i] = x;
+            }
+        }
+    }
+    if (u)
+        gsl_matrix_free(u);
+    if (v)
+        gsl_matrix_free(v);
+    if (s)
+        gsl_vector_free(s);
+    if (w)
+        gsl_vector_free(w);
+    gsl_set_error_handler(old);
+    return ratio;
+}

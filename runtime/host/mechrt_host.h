@@ -1,0 +1,134 @@
+/* mechrt_host.h - host-side companions of the runtime: GSL numerics and output formats.
+ *
+ * What a firmware build does not need and a host tool does: minimum-norm
+ * Gauss-Newton projection onto Phi = 0 when there are fewer holonomic rows
+ * than coordinates, adaptive integration of the positions of mechanisms with
+ * velocity-level rows (GSL's odeiv2), the singular direction of a Jacobian
+ * for error messages (GSL's SVD), and the CSV and JSON writers of `mechc run`.
+ * Compiled into the tool only (double reals, C11, links GSL); the
+ * freestanding core in runtime/ stays free of all of it.
+ *
+ * Ownership follows the core: a MechrtHost holds every workspace for one
+ * mechanism size, allocated once by mechrt_host_new, so the per-step calls
+ * allocate nothing (GSL's SVD and odeiv2 steppers work in place).
+ */
+#ifndef MECHRT_HOST_H
+#define MECHRT_HOST_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "../mechrt.h"
+
+/* ---- Integrator options ------------------------------------------------ */
+
+typedef enum MechrtOdeMethod {
+    MECHRT_ODE_RK8PD,   /* Runge-Kutta Prince-Dormand (8, 9): few steps at tight tolerances */
+    MECHRT_ODE_RKF45    /* Runge-Kutta-Fehlberg (4, 5): cheaper steps, more of them */
+} MechrtOdeMethod;
+
+typedef struct MechrtOdeOptions {
+    MechrtOdeMethod method;  /* default MECHRT_ODE_RK8PD */
+    /* Local error allowed per step, absolute and relative at once:
+       |err_i| <= tol (1 + |q_i|) (coordinate units). default 1e-10 */
+    double tol;
+} MechrtOdeOptions;
+
+MechrtOdeOptions mechrt_ode_default_options(void);
+/* "rk8pd" / "rkf45"; NULL for an unknown name */
+const char *mechrt_ode_method_name(MechrtOdeMethod m);
+/* Parses a method name; false when unknown. */
+bool mechrt_ode_method_from_name(const char *name, MechrtOdeMethod *out);
+
+/* Counters of the host-side work, accumulated over calls. */
+typedef struct MechrtHostStats {
+    long ode_steps;          /* accepted integrator steps */
+    long ode_rejected;       /* integrator steps retried with a smaller h */
+    long rhs_calls;          /* velocity solves for the integrator */
+    long projections;        /* calls of mechrt_host_project */
+    long project_iterations; /* Gauss-Newton iterations in them */
+} MechrtHostStats;
+
+/* ---- The host object (host.c) ------------------------------------------ */
+
+typedef struct MechrtHost MechrtHost;
+
+/* Workspaces for the mechanism of k (which must outlive the host).
+   NULL when out of memory or k is malformed. */
+MechrtHost *mechrt_host_new(const MechrtKernels *k);
+void mechrt_host_free(MechrtHost *h);
+const MechrtHostStats *mechrt_host_stats(const MechrtHost *h);
+
+/* Gauss-Newton on the nh holonomic rows, any nh <= nq (nh == 0: nothing
+ * to do), each step the minimum-norm solution of Phi_q dq = -Phi from the SVD
+ * of Phi_q (singular values below pivot_tol * sigma_max dropped, so
+ * consistent redundant rows are harmless). Stops like Newton (newton.c):
+ * ||Phi||_inf <= tol_phi and ||dq||_inf <= tol_dq, at most max_iter
+ * iterations. q is updated in place; report (may be NULL) gets iterations,
+ * residual, step and worst_row. MECHRT_EMAXITER, MECHRT_ENOTFINITE. */
+MechrtStatus mechrt_host_project(MechrtHost *h, const MechrtOptions *o, double *q, double t,
+                                 MechrtReport *report);
+
+/* Integrates the positions of a mechanism with velocity-level rows,
+ *   q' = qd(q, t),  [Phi_q; A](q, t) qd = nu(q, t)   (square: nh + nv == nq),
+ * from *t to t_end with GSL's adaptive embedded Runge-Kutta pair (odeiv2
+ * evolve + standard step control), projecting q back onto Phi = 0 with
+ * mechrt_host_project after every accepted step (the drift of the holonomic
+ * rows, which the velocity equations alone only keep constant).
+ * *hstep is the step size to try first and, on return, the one to use next.
+ * On success *t == t_end exactly. On failure *t is the time of the failing
+ * velocity solve or projection, and mechrt_host_failure() gives the state;
+ * q holds the last accepted state. */
+MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
+                                   const MechrtOdeOptions *oo, double *q, double *t,
+                                   double t_end, double *hstep, MechrtReport *report);
+
+/* After a failed mechrt_host_integrate: the state and time where it failed. */
+const double *mechrt_host_failure(const MechrtHost *h, double *t);
+
+/* ---- Singular directions (host.c) --------------------------------------- */
+
+/* The direction in which the m x n row-major matrix a is closest to
+ * singular, from its SVD: row_w[m] and col_w[n] receive |u_i| and |v_j| of
+ * the singular vectors of the smallest singular value (the rows and the
+ * coordinates of the dependency, each of unit 2-norm). Returns
+ * sigma_min / sigma_max (0 for an exactly singular or zero matrix), or -1
+ * when m or n is < 1 or memory runs out. Allocates: for error paths. */
+double mechrt_host_singular_direction(int m, int n, const double *a, double *row_w,
+                                      double *col_w);
+
+/* ---- Output (output.c) ---------------------------------------------------- */
+
+/* v as text: with digits == 0 the shortest of %.15g, %.16g, %.17g that
+   reads back as v (0.3 stays "0.3"), else %.<digits>g. NaN and infinities
+   are "nan", "inf", "-inf". Returns the length written. */
+int mechrt_format_real(char *buf, size_t size, double v, int digits);
+
+/* CSV (RFC 4180, no quoting needed: coordinate names are identifiers with
+   dots). Header: t, the coordinate names, d(NAME) for each velocity,
+   dd(NAME) for each acceleration; one row per time, 1 + 3 nq columns. */
+void mechrt_csv_header(FILE *out, int nq, const char *const *names);
+void mechrt_csv_row(FILE *out, int nq, double t, const double *q, const double *qd,
+                    const double *qdd, int digits);
+
+/* The rows of a run kept for JSON (which cannot be streamed key by key):
+   each row is t, q[nq], qd[nq], qdd[nq]. */
+typedef struct MechrtTrace {
+    int nq;
+    size_t rows, cap;
+    double *data;
+} MechrtTrace;
+
+void mechrt_trace_init(MechrtTrace *tr, int nq);
+/* false when out of memory (the row is not kept) */
+bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double *qd,
+                       const double *qdd);
+void mechrt_trace_free(MechrtTrace *tr);
+
+/* {"coords": [...], "t": [...], "q": [[...]...], "qd": [...], "qdd": [...],
+    "ok": true|false, "error": {"t": T, "message": "..."}} - error only when
+   error_message is not NULL. Non-finite numbers are null. */
+void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *names, int digits,
+                       const char *error_message, double error_t);
+
+#endif

@@ -1,0 +1,172 @@
+/* output.c - the CSV and JSON of `mechc run`, and numbers printed to round-trip.
+ *
+ * CSV streams: a header row, then one row per time as the analysis
+ * produces it, so a failed run still leaves every row computed before the
+ * failure (the caller flushes). JSON keeps one array per key (spec section
+ * 3: "t", "q", "qd", "qdd"), so the rows are collected in a MechrtTrace and
+ * written at the end, also after a failure, with "ok": false and the error.
+ */
+#include "mechrt_host.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int mechrt_format_real(char *buf, size_t size, double v, int digits)
+{
+    if (isnan(v))
+        return snprintf(buf, size, "nan");
+    if (isinf(v))
+        return snprintf(buf, size, v > 0 ? "inf" : "-inf");
+    if (digits > 0)
+        return snprintf(buf, size, "%.*g", digits, v);
+    /* 17 significant digits always round-trip a double; fewer usually do
+       and read better (0.3, not 0.29999999999999999) */
+    int n = 0;
+    for (int d = 15; d <= 17; d++) {
+        n = snprintf(buf, size, "%.*g", d, v);
+        if (d == 17 || strtod(buf, NULL) == v)
+            break;
+    }
+    return n;
+}
+
+static void put_real(FILE *out, double v, int digits)
+{
+    char buf[40];
+    mechrt_format_real(buf, sizeof buf, v, digits);
+    fputs(buf, out);
+}
+
+void mechrt_csv_header(FILE *out, int nq, const char *const *names)
+{
+    fputs("t", out);
+    for (int i = 0; i < nq; i++)
+        fprintf(out, ",%s", names[i]);
+    for (int i = 0; i < nq; i++)
+        fprintf(out, ",d(%s)", names[i]);
+    for (int i = 0; i < nq; i++)
+        fprintf(out, ",dd(%s)", names[i]);
+    fputc('\n', out);
+}
+
+void mechrt_csv_row(FILE *out, int nq, double t, const double *q, const double *qd,
+                    const double *qdd, int digits)
+{
+    put_real(out, t, digits);
+    const double *v[3] = {q, qd, qdd};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < nq; i++) {
+            fputc(',', out);
+            put_real(out, v[k][i], digits);
+        }
+    fputc('\n', out);
+}
+
+void mechrt_trace_init(MechrtTrace *tr, int nq)
+{
+    tr->nq = nq;
+    tr->rows = tr->cap = 0;
+    tr->data = NULL;
+}
+
+bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double *qd,
+                       const double *qdd)
+{
+    size_t w = 1 + 3 * (size_t)tr->nq;
+    if (tr->rows == tr->cap) {
+        size_t cap = tr->cap ? 2 * tr->cap : 64;
+        if (cap > ((size_t)-1 / sizeof(double)) / w)
+            return false;
+        double *p = realloc(tr->data, cap * w * sizeof *p);
+        if (!p)
+            return false;
+        tr->data = p;
+        tr->cap = cap;
+    }
+    double *row = tr->data + tr->rows * w;
+    size_t n = (size_t)tr->nq;
+    row[0] = t;
+    memcpy(row + 1, q, n * sizeof *q);
+    memcpy(row + 1 + n, qd, n * sizeof *qd);
+    memcpy(row + 1 + 2 * n, qdd, n * sizeof *qdd);
+    tr->rows++;
+    return true;
+}
+
+void mechrt_trace_free(MechrtTrace *tr)
+{
+    free(tr->data);
+    tr->data = NULL;
+    tr->rows = tr->cap = 0;
+}
+
+/* A JSON string: quotes, backslashes and control characters escaped
+   (RFC 8259 section 7); other bytes (UTF-8) pass through. */
+static void json_str(FILE *out, const char *s)
+{
+    fputc('"', out);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        switch (*p) {
+        case '"':  fputs("\\\"", out); break;
+        case '\\': fputs("\\\\", out); break;
+        case '\n': fputs("\\n", out); break;
+        case '\t': fputs("\\t", out); break;
+        case '\r': fputs("\\r", out); break;
+        default:
+            if (*p < 0x20)
+                fprintf(out, "\\u%04x", *p);
+            else
+                fputc(*p, out);
+        }
+    }
+    fputc('"', out);
+}
+
+static void json_num(FILE *out, double v, int digits)
+{
+    if (isfinite(v))
+        put_real(out, v, digits);
+    else
+        fputs("null", out);
+}
+
+void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *names, int digits,
+                       const char *error_message, double error_t)
+{
+    size_t n = (size_t)tr->nq, w = 1 + 3 * n;
+    fputs("{\"coords\": [", out);
+    for (size_t i = 0; i < n; i++) {
+        fputs(i ? ", " : "", out);
+        json_str(out, names[i]);
+    }
+    fputs("],\n \"t\": [", out);
+    for (size_t r = 0; r < tr->rows; r++) {
+        fputs(r ? ", " : "", out);
+        json_num(out, tr->data[r * w], digits);
+    }
+    fputs("]", out);
+    static const char *const keys[3] = {"q", "qd", "qdd"};
+    for (size_t k = 0; k < 3; k++) {
+        fprintf(out, ",\n \"%s\": [", keys[k]);
+        for (size_t r = 0; r < tr->rows; r++) {
+            const double *v = tr->data + r * w + 1 + k * n;
+            fputs(r ? ",\n   [" : "[", out);
+            for (size_t i = 0; i < n; i++) {
+                fputs(i ? ", " : "", out);
+                json_num(out, v[i], digits);
+            }
+            fputs("]", out);
+        }
+        fputs("]", out);
+    }
+    fprintf(out, ",\n \"ok\": %s", error_message ? "false" : "true");
+    if (error_message) {
+        fputs(",\n \"error\": {\"t\": ", out);
+        json_num(out, error_t, 0);
+        fputs(", \"message\": ", out);
+        json_str(out, error_message);
+        fputs("}", out);
+    }
+    fputs("}\n", out);
+}

@@ -1,0 +1,189 @@
+#!/bin/sh
+# tests/info_cli.sh MECHC - `mechc info` from the outside: exit statuses, the
+# JSON keys of spec section 3, and the verdicts on the examples (redundant
+# row, nonholonomic knife, integrable rolling disk, singular toggle).
+#
+#   sh tests/info_cli.sh build/mechc
+#
+# The last line is "info_cli: N passed, M failed"; the exit status is
+# non-zero on any failure. The JSON parse checks need python3 and are
+# skipped (and say so) without it.
+set -u
+
+mechc=${1:-build/mechc}
+case $mechc in
+    /*) ;;
+    *) mechc=$(pwd)/$mechc ;;
+esac
+if [ ! -x "$mechc" ]; then
+    echo "info_cli: $mechc is not an executable" >&2
+    exit 2
+fi
+root=$(cd "$(dirname "$0")/.." && pwd)
+ex=$root/examples
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_info.XXXXXX") || exit 2
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 2' INT TERM HUP
+
+pass=0
+fail=0
+have_python=0
+command -v python3 > /dev/null 2>&1 && have_python=1
+
+check() {
+    desc=$1
+    shift
+    if "$@"; then
+        pass=$((pass + 1))
+    else
+        fail=$((fail + 1))
+        echo "FAIL: $desc" >&2
+        if [ -s "$tmp/err" ]; then
+            echo "  stderr was:" >&2
+            sed -n '1,6s/^/    /p' "$tmp/err" >&2
+        fi
+    fi
+}
+
+skip() { echo "skip: $1" >&2; }
+
+run() {
+    "$mechc" "$@" > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+}
+rc_is() { [ "$rc" = "$1" ]; }
+out_has() { grep -F -q -- "$1" "$tmp/out"; }
+err_has() { grep -F -q -- "$1" "$tmp/err"; }
+err_empty() { [ ! -s "$tmp/err" ]; }
+
+# ---- usage and bad input: exit 2 ----
+
+run info --help
+check "info --help exits 0" rc_is 0
+check "info --help shows the usage" out_has "usage: mechc info"
+run info
+check "info without a file exits 2" rc_is 2
+check "info without a file says so" err_has "no input file"
+run info "$ex/four_bar.mech" --frobnicate
+check "info with an unknown option exits 2" rc_is 2
+run info "$ex/four_bar.mech" --rank-tol
+check "info --rank-tol without a value exits 2" rc_is 2
+run info "$ex/four_bar.mech" --rank-tol -1
+check "info --rank-tol -1 exits 2" rc_is 2
+run info "$ex/four_bar.mech" --rank-tol abc
+check "info --rank-tol abc exits 2" rc_is 2
+run info "$tmp/does_not_exist.mech"
+check "info on a missing file exits 2" rc_is 2
+printf 'body b x = 0\nrevolute J: ground crnk\n' > "$tmp/bad.mech"
+run info "$tmp/bad.mech"
+check "info on bad input exits 2" rc_is 2
+check "info on bad input reports FILE:LINE:COL: error:" err_has "bad.mech:2:20: error:"
+
+# ---- the analysis cannot assemble: exit 1, the report still printed ----
+
+printf 'point m x = 0.5 y = 0.1\ndistance a: ground(0, 0) m length = 1\ndistance b: ground(5, 0) m length = 1\n' \
+    > "$tmp/impossible.mech"
+run info "$tmp/impossible.mech"
+check "info on an impossible mechanism exits 1" rc_is 1
+check "info on an impossible mechanism names t = 0" err_has "t = 0"
+check "info on an impossible mechanism says the assembly failed" err_has "did not converge"
+check "info on an impossible mechanism still prints the report" out_has "verdict:"
+
+# ---- every example runs ----
+
+for f in "$ex"/*.mech; do
+    run info "$f"
+    check "info $(basename "$f") exits 0" rc_is 0
+    run info "$f" --json
+    check "info --json $(basename "$f") exits 0" rc_is 0
+done
+
+# ---- parallelogram: rank 11 of 12, A2.y redundant ----
+
+run info "$ex/parallelogram_redundant.mech"
+check "parallelogram: text verdict" \
+    out_has "the count says 0 DOF; the Jacobian has rank 11 of 12: the mechanism moves with 1 DOF, row A2.y is redundant"
+check "parallelogram: nothing on stderr" err_empty
+run info "$ex/parallelogram_redundant.mech" --json
+for key in '"coords": [' '"rows": [' '"nq": 12' '"nh": 12' '"nv": 0' '"dof": 0' '"rank": 11' \
+           '"redundant": ["A2.y"]' '"joint": "A2"' '"level": "position"' '"kind": "revolute"'; do
+    check "parallelogram --json has $key" out_has "$key"
+done
+cp "$tmp/out" "$tmp/parallelogram.json"
+run info "$ex/parallelogram_redundant.mech" --json --rank-tol 1e-30
+check "parallelogram --rank-tol 1e-30: rank 12" out_has '"rank": 12'
+run info "$ex/parallelogram_redundant.mech" --json --rank-tol=10
+check "parallelogram --rank-tol=10: rank 0" out_has '"rank": 0'
+
+# ---- knife: nonholonomic; rolling disk: integrable with its law ----
+
+run info "$ex/knife_cart.mech" --json
+cp "$tmp/out" "$tmp/knife.json"
+check "knife_cart --json: blade not integrable" \
+    grep -q '"name": "blade".*"integrable": false' "$tmp/knife.json"
+run info "$ex/knife_cart.mech"
+check "knife_cart text: nonholonomic" out_has "not integrable (nonholonomic)"
+check "knife_cart text: says the verdict is per row" out_has "the verdict is per row"
+
+run info "$ex/rolling_disk_velocity.mech" --json
+cp "$tmp/out" "$tmp/disk.json"
+check "rolling_disk_velocity --json: roll integrable with its law" \
+    grep -q '"name": "roll".*"integrable": true, "law": "disk.x + 0.5\*disk.phi = const"' "$tmp/disk.json"
+run info "$ex/rolling_wheel.mech"
+check "rolling_wheel text: law" out_has "wheel.x + 0.5*wheel.phi = const"
+run info "$ex/skate_velocity.mech" --json
+check "skate_velocity --json: side not integrable" \
+    grep -q '"name": "side".*"integrable": false' "$tmp/out"
+
+# ---- the toggle position of slider_crank_toggle.mech ----
+
+run info "$ex/slider_crank_toggle.mech" --t 0.25
+check "slider_crank_toggle --t 0.25 exits 0" rc_is 0
+check "slider_crank_toggle --t 0.25: near-singular" out_has "near-singular"
+run info "$ex/slider_crank_toggle.mech"
+check "slider_crank_toggle at t = 0: regular" out_has "configuration: regular"
+
+# ---- the JSON parses and has the spec's shape ----
+
+if [ "$have_python" = 1 ]; then
+    check "info --json parses with the spec's keys (parallelogram)" python3 - "$tmp/parallelogram.json" <<'EOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+for k in ("coords", "rows", "nq", "nh", "nv", "dof", "rank", "redundant"):
+    assert k in d, k
+assert d["dof"] == d["nq"] - d["nh"] - d["nv"]
+assert len(d["coords"]) == d["nq"] and len(d["rows"]) == d["nh"] + d["nv"]
+for r in d["rows"]:
+    assert set(("name", "kind", "level", "joint")) <= set(r), r
+    assert r["level"] in ("position", "velocity")
+assert d["redundant"] == ["A2.y"] and d["rank"] == 11
+assert d["cond"] is None or d["cond"] > 1e14
+EOF
+    check "info --json parses: velocity rows carry integrable and law (rolling disk)" \
+        python3 - "$tmp/disk.json" <<'EOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+vel = [r for r in d["rows"] if r["level"] == "velocity"]
+assert len(vel) == d["nv"] == 2
+for r in vel:
+    assert isinstance(r["integrable"], bool)
+    if r["integrable"]:
+        assert isinstance(r["law"], str) and r["law"]
+roll = [r for r in vel if r["name"] == "roll"][0]
+assert roll["integrable"] and "disk.x + 0.5*disk.phi" in roll["law"]
+for r in d["rows"]:
+    if r["level"] == "position":
+        assert "integrable" not in r
+EOF
+    check "info --json parses: knife blade nonholonomic, no law" python3 - "$tmp/knife.json" <<'EOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+blade = [r for r in d["rows"] if r["name"] == "blade"][0]
+assert blade["integrable"] is False and "law" not in blade
+EOF
+else
+    skip "python3 not found: JSON parse checks"
+fi
+
+echo "info_cli: $pass passed, $fail failed"
+[ "$fail" = 0 ]

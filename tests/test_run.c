@@ -1,0 +1,760 @@
+/* test_run.c - kinematic analysis over time (generator/analysis/run.c, runtime/host/).
+ *
+ * Drives run_analysis on the examples and checks the states it delivers
+ * against closed forms: the slider-crank's slider position, velocity and
+ * acceleration over a full turn, the four-bar's Freudenstein equation, the
+ * knife-edge cart's circle and the rolling wheel's line; then the ways a
+ * run must fail (toggle, out of reach, undriven, overdriven) with the time
+ * in the message, the warnings of nearly singular stretches, the host's
+ * minimum-norm projection and output formats, and finally the firmware
+ * path: `gen --real float` kernels built by the system compiler, run by the
+ * runtime compiled as float, against the double run.
+ * Runs from the repository root (examples/ relative), like `make check`.
+ */
+#include "testutil.h"
+
+#include <dlfcn.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../generator/analysis/run.h"
+#include "../generator/base/arena.h"
+#include "../generator/pipeline/pipeline.h"
+#include "../runtime/host/mechrt_host.h"
+
+/* ---- helpers ----------------------------------------------------------- */
+
+/* Every state of a run, and how it ended. */
+typedef struct Collected {
+    MechrtTrace trace;
+    RunResult res;
+    RunStatus status;
+    char notes[8192];
+} Collected;
+
+static void collect(void *ctx, double t, const double *q, const double *qd, const double *qdd)
+{
+    Collected *c = ctx;
+    assert_true(mechrt_trace_push(&c->trace, t, q, qd, qdd));
+}
+
+static const double *state_at(const Collected *c, size_t i)
+{
+    return c->trace.data + i * (1 + 3 * (size_t)c->trace.nq);
+}
+
+static int coord_index(const Model *m, const char *name)
+{
+    for (int i = 0; i < m->nq; i++)
+        if (strcmp(m->coord_names[i], name) == 0)
+            return i;
+    fail_msg("no coordinate %s", name);
+    return -1;
+}
+
+static Mech *load_file(const char *path)
+{
+    static Diag diag;   /* must outlive the Mech on failure paths only */
+    MechLimits limits = mech_default_limits();
+    Mech *m = pipeline_load(path, &limits, &diag);
+    if (!m)
+        fail_msg("%s: %s", path, diag.message);
+    return m;
+}
+
+static Mech *load_text(const char *text, const char *name)
+{
+    static Diag diag;
+    MechLimits limits = mech_default_limits();
+    Mech *m = pipeline_load_text(text, name, &limits, &diag);
+    if (!m)
+        fail_msg("%s: %s", name, diag.message);
+    return m;
+}
+
+/* Runs mech with engine kind and options o (notes captured); c must be freed
+   with collected_free. Returns false (and leaves c empty) when the engine is
+   not available in this build. */
+static bool run_with(Mech *mech, EngineKind kind, RunOptions o, Collected *c)
+{
+    Engine e;
+    Diag diag;
+    memset(c, 0, sizeof *c);
+    mechrt_trace_init(&c->trace, mech->model->nq);
+    if (!engine_open(&e, kind, mech, &diag)) {
+        if (kind == ENGINE_JIT)
+            fail_msg("jit engine: %s", diag.message);
+        return false;
+    }
+    MechrtKernels k = run_engine_kernels(&e);
+    FILE *notes = fmemopen(c->notes, sizeof c->notes - 1, "w");
+    assert_non_null(notes);
+    o.notes = notes;
+    c->status = run_analysis(mech->model, &k, &o, collect, c, &c->res);
+    fclose(notes);
+    engine_close(&e);
+    assert_int_equal(c->status, c->res.status);
+    return true;
+}
+
+static void collected_free(Collected *c)
+{
+    mechrt_trace_free(&c->trace);
+}
+
+static void expect_ok(const Collected *c, int steps)
+{
+    if (c->status != RUN_OK)
+        fail_msg("run failed: %s", c->res.message);
+    assert_int_equal((int)c->trace.rows, steps + 1);
+    assert_int_equal(c->res.states, steps + 1);
+}
+
+/* ---- closed forms ------------------------------------------------------ */
+
+/* slider_crank.mech: r = 0.1, l = 0.3, theta = omega t, omega = 2 pi.
+ *   x    = r c + D,                 D = sqrt(l^2 - r^2 s^2)
+ *   xd   = -r w s - r^2 w s c / D
+ *   xdd  = -r w^2 c - r^2 w^2 (c^2 - s^2) / D - r^4 w^2 s^2 c^2 / D^3
+ *   rod.phi = -asin(r s / l)
+ */
+static void test_slider_crank_closed_form(void **state)
+{
+    (void)state;
+    const double r = 0.1, l = 0.3, w = 2 * M_PI;
+    const int steps = 720;
+    Mech *mech = load_file("examples/slider_crank.mech");
+    RunOptions o = run_default_options();
+    o.steps = steps;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, steps);
+    const Model *m = mech->model;
+    int ix = coord_index(m, "slider.x"), iphi = coord_index(m, "rod.phi");
+    int iy = coord_index(m, "slider.y"), nq = m->nq;
+    for (int i = 0; i <= steps; i++) {
+        const double *st = state_at(&c, (size_t)i);
+        double t = st[0], th = w * t, s = sin(th), co = cos(th);
+        double D = sqrt(l * l - r * r * s * s);
+        double x = r * co + D;
+        double xd = -r * w * s - r * r * w * s * co / D;
+        double xdd = -r * w * w * co - r * r * w * w * (co * co - s * s) / D
+                     - r * r * r * r * w * w * s * s * co * co / (D * D * D);
+        assert_near(t, (double)i / steps, 0, 1e-15);
+        assert_near(st[1 + ix], x, 1e-9, 1e-9);
+        assert_near(st[1 + nq + ix], xd, 1e-9, 1e-9);
+        assert_near(st[1 + 2 * nq + ix], xdd, 1e-9, 1e-9);
+        assert_near(st[1 + iphi], -asin(r * s / l), 1e-9, 1e-9);
+        assert_near(st[1 + iy], 0, 0, 1e-12);
+    }
+    assert_near(state_at(&c, (size_t)steps)[0], 1.0, 0, 0);   /* t1 exactly */
+    /* the predictor keeps Newton to about one iteration per step */
+    assert_true(c.res.newton_iterations <= 2 * steps);
+    assert_int_equal(c.res.warnings, 0);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* four_bar.mech: Freudenstein's equation between the crank angle theta2
+ * and the rocker angle theta4, a = 1, b = 3, c = 2.5, d = 3:
+ *   K1 cos(theta4) - K2 cos(theta2) + K3 = cos(theta2 - theta4)
+ *   K1 = d/a, K2 = d/c, K3 = (a^2 - b^2 + c^2 + d^2) / (2 a c)
+ * and its time derivative for the rocker's angular velocity:
+ *   (K1 sin th4 + sin(th2 - th4)) th4' = (K2 sin th2 + sin(th2 - th4)) th2'
+ */
+static void test_four_bar_freudenstein(void **state)
+{
+    (void)state;
+    const double a = 1, b = 3, cc = 2.5, d = 3, w = 2 * M_PI;
+    const double K1 = d / a, K2 = d / cc, K3 = (a * a - b * b + cc * cc + d * d) / (2 * a * cc);
+    const int steps = 400;
+    Mech *mech = load_file("examples/four_bar.mech");
+    RunOptions o = run_default_options();
+    o.steps = steps;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, steps);
+    const Model *m = mech->model;
+    int i2 = coord_index(m, "crank.phi"), i4 = coord_index(m, "rocker.phi"), nq = m->nq;
+    double lo = 10, hi = -10;
+    for (int i = 0; i <= steps; i++) {
+        const double *st = state_at(&c, (size_t)i);
+        double th2 = st[1 + i2], th4 = st[1 + i4];
+        double w2 = st[1 + nq + i2], w4 = st[1 + nq + i4];
+        assert_near(th2, w * st[0], 1e-12, 1e-12);
+        assert_near(K1 * cos(th4) - K2 * cos(th2) + K3, cos(th2 - th4), 0, 1e-9);
+        assert_near((K1 * sin(th4) + sin(th2 - th4)) * w4, (K2 * sin(th2) + sin(th2 - th4)) * w2,
+                    0, 1e-8);
+        lo = fmin(lo, th4);
+        hi = fmax(hi, th4);
+        if (i == steps / 4)
+            assert_near(th4, 1.725386, 0, 1e-6);   /* the file's header */
+    }
+    assert_near(lo, 1.5208, 0, 2e-4);   /* the rocker's swing, from the header */
+    assert_near(hi, 2.4189, 0, 2e-4);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* knife_cart.mech: v = w = pi from (1, 0, pi/2): the circle of radius v/w = 1
+   about the origin, cart.x = cos(w t), cart.y = sin(w t), phi = pi/2 + w t,
+   centripetal acceleration v w = pi^2. */
+static void test_knife_cart_circle(void **state)
+{
+    (void)state;
+    const double v = M_PI, w = M_PI, x0 = 1, y0 = 0, phi0 = M_PI / 2;
+    const double R = v / w, cx = x0 - R * sin(phi0), cy = y0 + R * cos(phi0);
+    const int steps = 50;
+    Mech *mech = load_file("examples/knife_cart.mech");
+    RunOptions o = run_default_options();
+    o.steps = steps;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, steps);
+    assert_true(c.res.integrated);
+    for (int i = 0; i <= steps; i++) {
+        const double *st = state_at(&c, (size_t)i);
+        double t = st[0], x = st[1], y = st[2], phi = st[3];
+        assert_near(hypot(x - cx, y - cy), R, 0, 1e-8);
+        assert_near(x, cx + R * sin(phi0 + w * t), 0, 1e-8);
+        assert_near(y, cy - R * cos(phi0 + w * t), 0, 1e-8);
+        assert_near(phi, phi0 + w * t, 0, 1e-8);
+        assert_near(hypot(st[4], st[5]), v, 1e-12, 0);
+        assert_near(st[6], w, 1e-12, 0);
+        assert_near(hypot(st[7], st[8]), v * w, 1e-9, 0);
+    }
+    /* the same cart written by hand (skate_velocity.mech) runs the same */
+    Mech *skate = load_file("examples/skate_velocity.mech");
+    Collected c2;
+    run_with(skate, ENGINE_JIT, o, &c2);
+    expect_ok(&c2, steps);
+    for (size_t i = 0; i < c.trace.rows * (1 + 9); i++)
+        assert_near(c2.trace.data[i], c.trace.data[i], 1e-8, 1e-8);
+    collected_free(&c2);
+    pipeline_free(skate);
+    /* rkf45 and a looser tolerance: still on the circle, to that tolerance */
+    o.ode.method = MECHRT_ODE_RKF45;
+    o.ode.tol = 1e-8;
+    Collected c3;
+    run_with(mech, ENGINE_JIT, o, &c3);
+    expect_ok(&c3, steps);
+    for (int i = 0; i <= steps; i++) {
+        const double *st = state_at(&c3, (size_t)i);
+        assert_near(hypot(st[1] - cx, st[2] - cy), R, 0, 1e-6);
+    }
+    collected_free(&c3);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* rolling_wheel.mech: x = 1 + pi t, y = 0.5, phi = -2 pi t; the holonomic
+   rows (height, spin) are kept by projection while x is integrated. The
+   hand-written rolling_disk_velocity.mech gives the same motion. */
+static void test_rolling_wheel(void **state)
+{
+    (void)state;
+    const char *files[2] = {"examples/rolling_wheel.mech", "examples/rolling_disk_velocity.mech"};
+    for (int f = 0; f < 2; f++) {
+        Mech *mech = load_file(files[f]);
+        RunOptions o = run_default_options();
+        o.steps = 20;
+        Collected c;
+        run_with(mech, ENGINE_JIT, o, &c);
+        expect_ok(&c, 20);
+        for (int i = 0; i <= 20; i++) {
+            const double *st = state_at(&c, (size_t)i);
+            double t = st[0];
+            assert_near(st[1], 1 + M_PI * t, 0, 1e-9);
+            assert_near(st[2], 0.5, 0, 1e-12);
+            assert_near(st[3], -2 * M_PI * t, 0, 1e-9);
+            assert_near(st[4], M_PI, 1e-12, 1e-12);
+            assert_near(st[6], -2 * M_PI, 1e-12, 1e-12);
+            for (int j = 7; j < 10; j++)
+                assert_near(st[j], 0, 0, 1e-9);
+        }
+        collected_free(&c);
+        pipeline_free(mech);
+    }
+}
+
+/* Every other runnable example runs to the end. */
+static void test_examples_run(void **state)
+{
+    (void)state;
+    const char *files[] = {"examples/five_bar.mech", "examples/elliptical_trammel.mech",
+                           "examples/pendulum_driven.mech", "examples/point_on_line.mech",
+                           "examples/all_statements.mech"};
+    for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
+        Mech *mech = load_file(files[f]);
+        Collected c;
+        run_with(mech, ENGINE_JIT, run_default_options(), &c);
+        if (c.status != RUN_OK)
+            fail_msg("%s: %s", files[f], c.res.message);
+        expect_ok(&c, 100);
+        collected_free(&c);
+        pipeline_free(mech);
+    }
+    /* pendulum_driven.mech's closed form at t = 1: m = (2, 0), m.yd = pi,
+       m.xdd = -L omega^2 = -pi^2/2 */
+    Mech *mech = load_file("examples/pendulum_driven.mech");
+    Collected c;
+    run_with(mech, ENGINE_JIT, run_default_options(), &c);
+    const double *st = state_at(&c, 100);
+    int ix = coord_index(mech->model, "m.x"), iy = coord_index(mech->model, "m.y");
+    int nq = mech->model->nq;
+    assert_near(st[1 + ix], 2, 0, 1e-12);
+    assert_near(st[1 + iy], 0, 0, 1e-12);
+    assert_near(st[1 + nq + iy], M_PI, 1e-12, 1e-12);
+    assert_near(st[1 + 2 * nq + ix], -M_PI * M_PI / 2, 1e-12, 1e-12);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* ---- failures ---------------------------------------------------------- */
+
+/* slider_crank_toggle.mech (r = l) reaches its toggle at t = 0.25: the run
+   stops there with exit status 1, the 25 states before it delivered. */
+static void test_toggle(void **state)
+{
+    (void)state;
+    Mech *mech = load_file("examples/slider_crank_toggle.mech");
+    Collected c;
+    run_with(mech, ENGINE_JIT, run_default_options(), &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_near(c.res.t_fail, 0.25, 0, 0);
+    assert_int_equal(c.res.states, 25);
+    assert_int_equal((int)c.trace.rows, 25);
+    assert_non_null(strstr(c.res.message, "t = 0.25:"));
+    assert_true(c.res.cause == MECHRT_ESING || c.res.cause == MECHRT_EMAXITER);
+    if (c.res.cause == MECHRT_ESING)
+        assert_non_null(strstr(c.res.message, "singular"));
+    /* the dependency names the slider and the rod */
+    assert_non_null(strstr(c.res.message, "slider.x"));
+    assert_non_null(strstr(c.res.message, "rod.phi"));
+    collected_free(&c);
+
+    /* clear of the toggle, it runs */
+    RunOptions o = run_default_options();
+    o.t1 = 0.2;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, 100);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* A point on the unit circle pulled along x past the circle: from t = 0.45
+   there is no solution, and the first sample beyond is t = 0.5. */
+static const char reach_text[] =
+    "point p x = 0.55 y = 0.8\n"
+    "constraint circle: p.x^2 + p.y^2 = 1\n"
+    "driver pull: p.x = 0.55 + t\n";
+
+static void test_out_of_reach(void **state)
+{
+    (void)state;
+    Mech *mech = load_text(reach_text, "reach.mech");
+    RunOptions o = run_default_options();
+    o.steps = 10;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_near(c.res.t_fail, 0.5, 0, 1e-15);
+    assert_int_equal(c.res.states, 5);
+    assert_non_null(strstr(c.res.message, "t = 0.5:"));
+    assert_int_equal(c.res.cause, MECHRT_EMAXITER);
+    assert_non_null(strstr(c.res.message, "no convergence"));
+    assert_non_null(strstr(c.res.message, "row circle"));
+    /* the initial y was rough: assembly moved it and said so */
+    assert_non_null(strstr(c.notes, "note: assembly at t = 0 moved"));
+    assert_non_null(strstr(c.notes, "p.y"));
+    assert_near(c.res.assembly_move, sqrt(1 - 0.55 * 0.55) - 0.8, 1e-9, 0);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* Assembly that cannot succeed names t0; a NaN names its row. */
+static void test_assembly_and_nan(void **state)
+{
+    (void)state;
+    Mech *mech = load_text("point p x = 3 y = 0\n"
+                           "constraint circle: p.x^2 + p.y^2 = 1\n"
+                           "driver pull: p.x = 2 + t\n", "far.mech");
+    RunOptions o = run_default_options();
+    o.t0 = 0.125;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.res.states, 0);
+    assert_non_null(strstr(c.res.message, "t = 0.125: assembly"));
+    collected_free(&c);
+    pipeline_free(mech);
+
+    /* sqrt of a negative number after t = 0.5 */
+    mech = load_text("point p x = 1 y = 0\n"
+                     "constraint c: p.y = 0\n"
+                     "driver d: p.x = sqrt(0.5 - t)\n", "nan.mech");
+    o = run_default_options();
+    o.steps = 4;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    /* at t = 0.5 the position is still defined, its time derivative not */
+    assert_near(c.res.t_fail, 0.5, 0, 0);
+    assert_int_equal(c.res.cause, MECHRT_ENOTFINITE);
+    assert_non_null(strstr(c.res.message, "t = 0.5:"));
+    assert_non_null(strstr(c.res.message, "nu of row d"));
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* Not as many rows as coordinates: RUN_BAD_INPUT, nothing run, the count
+   in plain words. */
+static void test_row_count(void **state)
+{
+    (void)state;
+    Mech *mech = load_file("examples/pendulum_distance.mech");
+    Collected c;
+    run_with(mech, ENGINE_JIT, run_default_options(), &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.res.states, 0);
+    assert_string_equal(c.res.message, "1 degree of freedom is not driven (2 coordinates, 1 row): "
+                                       "add a driver");
+    collected_free(&c);
+    pipeline_free(mech);
+
+    mech = load_text("body b x = 0 y = 0 phi = 0\nconstraint c: b.x = 0\n", "free.mech");
+    run_with(mech, ENGINE_JIT, run_default_options(), &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_non_null(strstr(c.res.message, "2 degrees of freedom are not driven"));
+    collected_free(&c);
+    pipeline_free(mech);
+
+    mech = load_text("point p x = 0 y = 0\nconstraint a: p.x = 0\nconstraint b: p.y = 0\n"
+                     "driver c: p.x = t\ndriver d: p.y = t\n", "over.mech");
+    run_with(mech, ENGINE_JIT, run_default_options(), &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_non_null(strstr(c.res.message, "the mechanism has 2 more rows than coordinates"));
+    collected_free(&c);
+
+    /* bad options are bad input too */
+    RunOptions o = run_default_options();
+    o.steps = 0;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* Near a singular position: one warning per stretch, with its time. The
+   toggle mechanism with 50 steps passes t = 0.25 and 0.75 between samples;
+   with a low threshold both neighbourhoods warn once each. */
+static void test_condition_episodes(void **state)
+{
+    (void)state;
+    Mech *mech = load_file("examples/slider_crank_toggle.mech");
+    RunOptions o = run_default_options();
+    o.steps = 50;
+    o.mechrt.cond_warn = 100;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, 50);
+    assert_int_equal(c.res.warnings, 2);
+    assert_non_null(strstr(c.notes, "warning: t = 0.2"));
+    assert_non_null(strstr(c.notes, "warning: t = 0.7"));
+    assert_non_null(strstr(c.notes, "note: nearly singular from t = "));
+    /* one warning line per stretch, not one per step */
+    int lines = 0;
+    for (const char *p = c.notes; (p = strstr(p, ": warning: ")); p++)
+        lines++;
+    assert_int_equal(lines, 2);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* The generic engine (when this build has it) runs the same trajectory. */
+static void test_engines_agree(void **state)
+{
+    (void)state;
+    const char *files[2] = {"examples/four_bar.mech", "examples/all_statements.mech"};
+    for (int f = 0; f < 2; f++) {
+        Mech *mech = load_file(files[f]);
+        RunOptions o = run_default_options();
+        o.steps = 40;
+        Collected a, b;
+        run_with(mech, ENGINE_JIT, o, &a);
+        expect_ok(&a, 40);
+        if (!run_with(mech, ENGINE_GENERIC, o, &b)) {
+            collected_free(&a);
+            collected_free(&b);
+            pipeline_free(mech);
+            skip();
+        }
+        expect_ok(&b, 40);
+        for (size_t i = 0; i < a.trace.rows * (1 + 3 * (size_t)a.trace.nq); i++)
+            assert_near(b.trace.data[i], a.trace.data[i], 1e-9, 1e-9);
+        collected_free(&a);
+        collected_free(&b);
+        pipeline_free(mech);
+    }
+}
+
+/* ---- host pieces ------------------------------------------------------- */
+
+/* mechrt_host_project with fewer rows than coordinates moves q the least:
+   onto x + y = 1 from (1, 1) the minimum-norm move is to (0.5, 0.5). */
+static void lin_phi(void *ctx, const double *q, double t, double *phi)
+{
+    (void)ctx;
+    (void)t;
+    phi[0] = q[0] + q[1] - 1;
+}
+
+static void lin_jac(void *ctx, const double *q, double t, double *jac)
+{
+    (void)ctx;
+    (void)q;
+    (void)t;
+    jac[0] = 1;   /* Phi = x + y - 1 */
+    jac[1] = 1;
+    jac[2] = 1;   /* a velocity row: xd - yd = 2 */
+    jac[3] = -1;
+}
+
+static void lin_nu(void *ctx, const double *q, double t, double *nu)
+{
+    (void)ctx;
+    (void)q;
+    (void)t;
+    nu[0] = 0;
+    nu[1] = 2;
+}
+
+static void lin_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
+{
+    (void)ctx;
+    (void)q;
+    (void)qd;
+    (void)t;
+    g[0] = g[1] = 0;
+}
+
+static void test_host_projection(void **state)
+{
+    (void)state;
+    MechrtKernels k = {2, 1, 1, NULL, lin_phi, lin_jac, lin_nu, lin_gamma, NULL};
+    MechrtHost *h = mechrt_host_new(&k);
+    assert_non_null(h);
+    double q[2] = {1, 1};
+    MechrtReport rep;
+    assert_int_equal(mechrt_host_project(h, NULL, q, 0, &rep), MECHRT_OK);
+    assert_near(q[0], 0.5, 0, 1e-15);
+    assert_near(q[1], 0.5, 0, 1e-15);
+    assert_int_equal(rep.iterations, 2);   /* the second step confirms: |dq| ~ 0 */
+    /* integrate: xd - yd = 2 with xd + yd = 0: (1, -1) per unit time */
+    double t = 0, hs = 0.1;
+    assert_int_equal(mechrt_host_integrate(h, NULL, NULL, q, &t, 0.5, &hs, &rep), MECHRT_OK);
+    assert_near(t, 0.5, 0, 0);
+    assert_near(q[0], 1.0, 0, 1e-12);
+    assert_near(q[1], 0.0, 0, 1e-12);
+    assert_true(mechrt_host_stats(h)->ode_steps >= 1);
+    mechrt_host_free(h);
+
+    /* singular directions: rows 0 and 2 of this matrix are equal */
+    const double a[9] = {1, 2, 0, 0, 1, 1, 1, 2, 0};
+    double rw[3], cw[3];
+    double ratio = mechrt_host_singular_direction(3, 3, a, rw, cw);
+    assert_true(ratio >= 0 && ratio < 1e-15);
+    assert_near(rw[0], sqrt(0.5), 0, 1e-12);
+    assert_near(rw[1], 0, 0, 1e-12);
+    assert_near(rw[2], sqrt(0.5), 0, 1e-12);
+    /* a wide matrix (fewer rows than columns) works through its transpose */
+    const double b[6] = {1, 0, 0, 2, 0, 0};
+    ratio = mechrt_host_singular_direction(2, 3, b, rw, cw);
+    assert_true(ratio >= 0 && ratio < 1e-15);
+    assert_near(rw[0] * sqrt(5), 2, 0, 1e-12);
+    assert_near(rw[1] * sqrt(5), 1, 0, 1e-12);
+}
+
+static void test_output_formats(void **state)
+{
+    (void)state;
+    char buf[64];
+    mechrt_format_real(buf, sizeof buf, 0.3, 0);
+    assert_string_equal(buf, "0.3");
+    mechrt_format_real(buf, sizeof buf, 0.1 + 0.2, 0);
+    assert_string_equal(buf, "0.30000000000000004");
+    mechrt_format_real(buf, sizeof buf, M_PI, 6);
+    assert_string_equal(buf, "3.14159");
+    mechrt_format_real(buf, sizeof buf, -INFINITY, 0);
+    assert_string_equal(buf, "-inf");
+
+    char text[1024];
+    FILE *f = fmemopen(text, sizeof text, "w");
+    const char *names[2] = {"p.x", "theta"};
+    double q[2] = {1, 0.5}, qd[2] = {-2, 0}, qdd[2] = {0.25, NAN};
+    mechrt_csv_header(f, 2, names);
+    mechrt_csv_row(f, 2, 0.1, q, qd, qdd, 0);
+    MechrtTrace tr;
+    mechrt_trace_init(&tr, 2);
+    assert_true(mechrt_trace_push(&tr, 0.1, q, qd, qdd));
+    mechrt_json_write(f, &tr, names, 0, "t = 0.2: \"bad\"", 0.2);
+    mechrt_trace_free(&tr);
+    fclose(f);
+    assert_string_equal(text,
+        "t,p.x,theta,d(p.x),d(theta),dd(p.x),dd(theta)\n"
+        "0.1,1,0.5,-2,0,0.25,nan\n"
+        "{\"coords\": [\"p.x\", \"theta\"],\n"
+        " \"t\": [0.1],\n"
+        " \"q\": [[1, 0.5]],\n"
+        " \"qd\": [[-2, 0]],\n"
+        " \"qdd\": [[0.25, null]],\n"
+        " \"ok\": false,\n"
+        " \"error\": {\"t\": 0.2, \"message\": \"t = 0.2: \\\"bad\\\"\"}}\n");
+}
+
+/* ---- the firmware path: float kernels and the float runtime ------------ */
+
+/* The runtime compiled again as float (its names become mechrtf_*), as
+   firmware built with -DMECHRT_REAL_FLOAT would have it. */
+#define MECHRT_REAL_FLOAT
+#include "../runtime/lu.c"
+#include "../runtime/newton.c"
+#include "../runtime/analysis.c"
+
+typedef struct FloatLib {
+    void (*phi)(const float *, float, float *);
+    void (*jac)(const float *, float, float *);
+    void (*nu)(const float *, float, float *);
+    void (*gamma)(const float *, const float *, float, float *);
+    void (*all)(const float *, const float *, float, float *, float *, float *, float *);
+} FloatLib;
+
+static void fl_phi(void *ctx, const float *q, float t, float *o)
+{
+    ((FloatLib *)ctx)->phi(q, t, o);
+}
+
+static void fl_jac(void *ctx, const float *q, float t, float *o)
+{
+    ((FloatLib *)ctx)->jac(q, t, o);
+}
+
+static void fl_nu(void *ctx, const float *q, float t, float *o)
+{
+    ((FloatLib *)ctx)->nu(q, t, o);
+}
+
+static void fl_gamma(void *ctx, const float *q, const float *qd, float t, float *o)
+{
+    ((FloatLib *)ctx)->gamma(q, qd, t, o);
+}
+
+static void fl_all(void *ctx, const float *q, const float *qd, float t, float *phi, float *jac,
+                   float *nu, float *gamma)
+{
+    ((FloatLib *)ctx)->all(q, qd, t, phi, jac, nu, gamma);
+}
+
+static void test_float_kernels(void **state)
+{
+    (void)state;
+    if (system("cc --version >/dev/null 2>&1") != 0)
+        skip();
+    Mech *mech = load_file("examples/slider_crank.mech");
+    const Model *m = mech->model;
+    EmitOptions eo = emit_default_options();
+    eo.real_float = true;
+    eo.prefix = "fsc";
+    EmitResult er;
+    Diag diag;
+    if (!emit_mechanism(&mech->kin, &eo, &er, &diag))
+        fail_msg("emit: %s", diag.message);
+
+    char dir[] = "/tmp/mechc-test-run-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char src[256], lib[256], cmd[1024];
+    snprintf(src, sizeof src, "%s/fsc.c", dir);
+    snprintf(lib, sizeof lib, "%s/fsc.so", dir);
+    FILE *f = fopen(src, "w");
+    assert_non_null(f);
+    fputs(er.c_text, f);
+    fclose(f);
+    emit_result_free(&er);
+    snprintf(cmd, sizeof cmd, "cc -std=c99 -pedantic -Wall -Wextra -Werror -O2 -fPIC -shared "
+             "-o %s %s -lm", lib, src);
+    assert_int_equal(system(cmd), 0);
+    void *h = dlopen(lib, RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        fail_msg("dlopen: %s", dlerror());
+    FloatLib fl;
+    *(void **)&fl.phi = dlsym(h, "fsc_phi");
+    *(void **)&fl.jac = dlsym(h, "fsc_jac");
+    *(void **)&fl.nu = dlsym(h, "fsc_nu");
+    *(void **)&fl.gamma = dlsym(h, "fsc_gamma");
+    *(void **)&fl.all = dlsym(h, "fsc_all");
+    assert_true(fl.phi && fl.jac && fl.nu && fl.gamma && fl.all);
+
+    /* the double run through run_analysis */
+    const int steps = 100;
+    RunOptions o = run_default_options();
+    o.steps = steps;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, steps);
+
+    /* the float run, stepped like firmware would step it */
+    enum { NQ = 9 };
+    assert_int_equal(m->nq, NQ);
+    MechrtKernels k = {NQ, NQ, 0, &fl, fl_phi, fl_jac, fl_nu, fl_gamma, fl_all};
+    float q[NQ], qd[NQ] = {0}, qdd[NQ] = {0}, work[MECHRT_WORKSPACE_LEN(NQ, NQ)];
+    for (int i = 0; i < NQ; i++)
+        q[i] = (float)m->q0[i];
+    MechrtReport rep;
+    float t = 0;
+    double worst = 0;
+    for (int s = 0; s <= steps; s++) {
+        float tn = (float)s / (float)steps;
+        MechrtStatus st = mechrt_step(&k, NULL, q, qd, qdd, t, s == 0 ? 0.0f : tn - t, work,
+                                      sizeof work / sizeof *work, &rep);
+        if (st != MECHRT_OK)
+            fail_msg("float run, t = %g: %s", (double)tn, mechrt_strerror(st));
+        t = tn;
+        const double *ds = state_at(&c, (size_t)s);
+        for (int i = 0; i < NQ; i++) {
+            /* positions and velocities to 1e-4; accelerations (up to 40
+               m/s^2 and rad/s^2 here) to 1e-4 relative */
+            assert_near(q[i], ds[1 + i], 0, 1e-4);
+            assert_near(qd[i], ds[1 + NQ + i], 1e-4, 1e-4);
+            assert_near(qdd[i], ds[1 + 2 * NQ + i], 1e-4, 1e-4);
+            worst = fmax(worst, fabs(q[i] - ds[1 + i]));
+        }
+    }
+    print_message("float kernels + float runtime vs double: worst |dq| %.3g\n", worst);
+    collected_free(&c);
+    dlclose(h);
+    unlink(src);
+    unlink(lib);
+    rmdir(dir);
+    pipeline_free(mech);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_slider_crank_closed_form),
+        cmocka_unit_test(test_four_bar_freudenstein),
+        cmocka_unit_test(test_knife_cart_circle),
+        cmocka_unit_test(test_rolling_wheel),
+        cmocka_unit_test(test_examples_run),
+        cmocka_unit_test(test_toggle),
+        cmocka_unit_test(test_out_of_reach),
+        cmocka_unit_test(test_assembly_and_nan),
+        cmocka_unit_test(test_row_count),
+        cmocka_unit_test(test_condition_episodes),
+        cmocka_unit_test(test_engines_agree),
+        cmocka_unit_test(test_host_projection),
+        cmocka_unit_test(test_output_formats),
+        cmocka_unit_test(test_float_kernels),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
