@@ -105,6 +105,22 @@ check-valgrind: deps $(TESTS)
 	$(Q)sh .ci/deps valgrind
 	$(Q)sh tests/run_valgrind $(BUILD)
 
+# An example's animated SVG rendered in headless Chromium at two instants
+# (tests/browser/run); installs Debian's chromium first when missing.
+.PHONY: check-browser
+check-browser: deps
+	$(Q)sh .ci/deps-browser
+	$(Q)$(MAKE) --no-print-directory $(BUILD)/tests/browser/animate $(BUILD)/tests/browser/pngdiff
+	$(Q)sh tests/browser/run $(BUILD)
+
+$(BUILD)/tests/browser/animate: tests/browser/animate.c $(LIB)
+	@mkdir -p $(dir $@)
+	$(Q)$(CC) $(CFLAGS_TOOL) $(LDFLAGS_TOOL) $< $(LIB) $(LDLIBS_TOOL) -o $@
+
+$(BUILD)/tests/browser/pngdiff: tests/browser/pngdiff.c
+	@mkdir -p $(dir $@)
+	$(Q)$(CC) $(CFLAGS_TOOL) $< -lz -o $@
+
 # libFuzzer over the whole front end (tests/fuzz/README.md). New inputs go
 # to $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.
 FUZZ_SECONDS ?= 60

@@ -123,7 +123,14 @@ check "knife_cart --json: blade not integrable" \
     grep -q '"name": "blade".*"integrable": false' "$tmp/knife.json"
 run info "$ex/knife_cart.mech"
 check "knife_cart text: nonholonomic" out_has "not integrable (nonholonomic)"
-check "knife_cart text: says the verdict is per row" out_has "the verdict is per row"
+check "knife_cart text: says the verdicts are per row" out_has "the verdicts above are per row"
+check "knife_cart text: nonholonomic as a system too" out_has "nonholonomic: d omega of row blade"
+run info "$ex/knife_cart.mech" --json
+check "knife_cart --json: system_integrable false" out_has '"system_integrable": false'
+run info "$ex/rolling_wheel.mech" --json
+check "rolling_wheel --json: system_integrable true" out_has '"system_integrable": true'
+run info "$ex/four_bar.mech" --json
+check "four_bar --json: system_integrable null (no velocity rows)" out_has '"system_integrable": null'
 
 run info "$ex/rolling_disk_velocity.mech" --json
 cp "$tmp/out" "$tmp/disk.json"

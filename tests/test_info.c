@@ -454,6 +454,105 @@ static void test_assembly_failure_reported(void **state)
     unload(l);
 }
 
+/* ---- the sparse path (beyond the dense limit) ---- */
+
+static Loaded *load_opts(const char *text, const AnalysisOptions *o)
+{
+    Loaded *l = calloc(1, sizeof *l);
+    MechLimits limits = mech_default_limits();
+    l->mech = pipeline_load_text(text, "test.mech", &limits, &l->diag);
+    if (!l->mech) {
+        diag_print(&l->diag, stderr);
+        fail_msg("fixture does not load");
+    }
+    if (!info_analyse(l->mech, 0.0, o, &l->rep, &l->diag))
+        fail_msg("info_analyse failed: %s", l->diag.message);
+    return l;
+}
+
+/* A chain of n unit parallelograms (examples/chain.sh) with a third, middle
+   crank in every loop: n redundant rows; rod0 driven. */
+static char *ladder(int n, double shift)
+{
+    size_t cap = 400 + (size_t)n * 400;
+    char *t = malloc(cap);
+    size_t k = 0;
+    for (int i = 0; i <= n; i++)
+        k += (size_t)snprintf(t + k, cap - k, "body rod%d x = %g y = 0.5 phi = pi/2\n", i, i + shift);
+    for (int i = 0; i < n; i++)
+        k += (size_t)snprintf(t + k, cap - k,
+                              "body cpl%d x = %g y = 1 phi = 0\nbody mid%d x = %g y = 0.5 phi = pi/2\n",
+                              i, i + 0.5 + shift, i, i + 0.5);
+    for (int i = 0; i <= n; i++)
+        k += (size_t)snprintf(t + k, cap - k, "revolute G%d: ground(%d, 0) rod%d(-0.5, 0)\n", i, i, i);
+    for (int i = 0; i < n; i++)
+        k += (size_t)snprintf(t + k, cap - k,
+                              "revolute L%d: rod%d(0.5, 0) cpl%d(-0.5, 0)\n"
+                              "revolute R%d: rod%d(0.5, 0) cpl%d(0.5, 0)\n"
+                              "revolute M%d: ground(%g, 0) mid%d(-0.5, 0)\n"
+                              "revolute T%d: mid%d(0.5, 0) cpl%d(0, 0)\n",
+                              i, i, i, i, i + 1, i, i, i + 0.5, i, i, i, i);
+    snprintf(t + k, cap - k, "driver D: rod0.phi = pi/2\n");
+    return t;
+}
+
+static void test_sparse_path_agrees_with_dense(void **state)
+{
+    (void)state;
+    const char *fixtures[] = {parallelogram, toggle, dead_centre, four_bar_free, trammel, twice,
+                              knife_cart, NULL};
+    char *lad = ladder(3, 0.0);
+    for (int f = 0; f <= 7; f++) {
+        const char *text = f < 7 ? fixtures[f] : lad;
+        AnalysisOptions o = analysis_default_options();
+        Loaded *d = load_opts(text, &o);
+        o.max_dense = 0;
+        Loaded *s = load_opts(text, &o);
+        assert_true(d->rep.dense);
+        assert_false(s->rep.dense);
+        assert_int_equal(s->rep.assembled, d->rep.assembled);
+        assert_int_equal(s->rep.rank, d->rep.rank);
+        assert_int_equal(s->rep.rank_all, d->rep.rank_all);
+        assert_int_equal(s->rep.rank_undriven, d->rep.rank_undriven);
+        for (int r = 0; r < d->rep.nr; r++)
+            if (s->rep.rows[r].redundant != d->rep.rows[r].redundant)
+                fail_msg("fixture %d row %s: sparse %d, dense %d", f, d->mech->model->rows[r].name,
+                         s->rep.rows[r].redundant, d->rep.rows[r].redundant);
+        for (int i = 0; i < d->rep.nq; i++)         /* the same minimum-norm configuration */
+            assert_near(s->rep.q[i], d->rep.q[i], 1e-9, 1e-9);
+        assert_true(isnan(s->rep.cond));
+        unload(d);
+        unload(s);
+    }
+    free(lad);
+}
+
+static void test_sparse_large_ladder(void **state)
+{
+    (void)state;
+    /* 301 rods, 300 couplers, 300 middle cranks: 2703 coordinates, 3003 rows,
+       beyond the dense limit; started 0.01 off so the sparse Newton works too */
+    int n = 300;
+    char *text = ladder(n, 0.01);
+    AnalysisOptions o = analysis_default_options();
+    Loaded *l = load_opts(text, &o);
+    const InfoReport *rep = &l->rep;
+    assert_false(rep->dense);
+    assert_int_equal(rep->nq, 9 * n + 3);
+    assert_int_equal(rep->nh, 10 * n + 3);
+    assert_int_equal(rep->dof, -n);
+    assert_true(rep->assembled);
+    assert_true(rep->assembly.iterations > 0);
+    assert_int_equal(rep->rank, 9 * n + 3);
+    assert_int_equal(rep->nredundant, n);
+    assert_int_equal(rep->dof_rank, 0);
+    for (int r = 0; r < rep->nr; r++)       /* the redundant row of each loop is its middle crank's */
+        if (rep->rows[r].redundant && strncmp(l->mech->model->rows[r].name, "T", 1) != 0)
+            fail_msg("unexpected redundant row %s", l->mech->model->rows[r].name);
+    unload(l);
+    free(text);
+}
+
 /* ---- integrability ---- */
 
 static void test_knife_is_nonholonomic(void **state)
@@ -548,6 +647,41 @@ static void test_integrability_cases(void **state)
     unload(l);
 }
 
+static void test_system_of_rows(void **state)
+{
+    (void)state;
+    static const char fixed[] =         /* heading held by a holonomic row */
+        "body cart x = 1  y = 0  phi = 0.3\n"
+        "knife  blade: cart axis(1, 0)\n"
+        "constraint head: cart.phi = 0.3\n";
+    static const char turning[] =       /* heading turned by a time-dependent row */
+        "body cart x = 1  y = 0  phi = 0.3\n"
+        "knife  blade: cart axis(1, 0)\n"
+        "constraint head: cart.phi = 0.3 + t\n";
+    Loaded *l = load(knife_cart);       /* drivers left out: the blade alone */
+    assert_true(l->rep.system.tested);
+    assert_false(l->rep.system.involutive);
+    assert_contains(l->rep.system.note, "row blade");
+    unload(l);
+    l = load(fixed);
+    assert_false(integ(l, "blade")->integrable);     /* alone, on all of (q, t) */
+    assert_true(l->rep.system.tested);
+    assert_true(l->rep.system.involutive);           /* on the manifold phi = 0.3 */
+    assert_true(l->rep.system.points > 1);
+    unload(l);
+    l = load(turning);
+    assert_true(l->rep.system.tested);
+    assert_false(l->rep.system.involutive);
+    unload(l);
+    l = load(rolling_wheel);
+    assert_true(l->rep.system.tested);
+    assert_true(l->rep.system.involutive);
+    unload(l);
+    l = load(parallelogram);
+    assert_false(l->rep.system.tested);
+    unload(l);
+}
+
 static void test_format_shortest_numbers(void **state)
 {
     (void)state;
@@ -611,10 +745,13 @@ int main(void)
         cmocka_unit_test(test_driver_at_dead_centre),
         cmocka_unit_test(test_min_norm_newton_four_bar),
         cmocka_unit_test(test_assembly_failure_reported),
+        cmocka_unit_test(test_sparse_path_agrees_with_dense),
+        cmocka_unit_test(test_sparse_large_ladder),
         cmocka_unit_test(test_knife_is_nonholonomic),
         cmocka_unit_test(test_rolling_disk_is_integrable),
         cmocka_unit_test(test_rolling_statement_is_integrable),
         cmocka_unit_test(test_integrability_cases),
+        cmocka_unit_test(test_system_of_rows),
         cmocka_unit_test(test_format_shortest_numbers),
         cmocka_unit_test(test_textbook_table_and_counts),
     };

@@ -585,6 +585,8 @@ static void test_output_formats(void **state)
     assert_string_equal(buf, "0.30000000000000004");
     mechrt_format_real(buf, sizeof buf, M_PI, 6);
     assert_string_equal(buf, "3.14159");
+    mechrt_format_real(buf, sizeof buf, -0.0, 0);
+    assert_string_equal(buf, "0");
     mechrt_format_real(buf, sizeof buf, -INFINITY, 0);
     assert_string_equal(buf, "-inf");
 

@@ -1,7 +1,7 @@
 /* analysis.h - what `mechc info` computes: singular values and rank, redundant
    rows, minimum-norm assembly, integrability of velocity rows, mobility.
 
-   Host-side only (GSL). Three layers, usable separately:
+   Host-side only (GSL). Layers, usable separately:
      svd.c           dense SVD of a row-major matrix: singular values, numerical
                      rank, condition number, pseudo-inverse solve, redundant rows
                      by incremental rank. `run` may use it to warn near
@@ -10,6 +10,9 @@
                      minimum-norm Newton on any subset of the holonomic rows.
      integrability.c Frobenius test of one velocity-level row and the search
                      for its position law.
+     involutive.c    the velocity rows together with the holonomic rows.
+     sparse.c        rank, redundant rows and assembly beyond the dense limit
+                     (row-wise Givens QR).
      mobility.c      the whole `info` report for a loaded mechanism.
 */
 #ifndef MECHC_ANALYSIS_H
@@ -87,6 +90,10 @@ bool analysis_svd(SvdWork *w, const double *a, int m, int n, int lda, double tol
    solution. b has m entries, x has n. */
 void svd_pinv_solve(const SvdWork *w, const double *b, double *x);
 
+/* Component j (< n) of the l-th (< rank) orthonormal basis vector of the
+   row space of the last matrix decomposed (its right singular vectors). */
+double svd_row_basis(const SvdWork *w, int j, int l);
+
 /* Redundant rows: row i (i >= first) is redundant when the rank of rows
    0..i equals the rank of rows 0..i-1, every rank taken with the absolute
    tolerance tol (singular values only grow when rows are added, so the
@@ -98,10 +105,28 @@ void svd_pinv_solve(const SvdWork *w, const double *b, double *x);
 int svd_redundant_rows(SvdWork *w, const double *a, int m, int n, int lda, double tol,
                        int first, int rank, bool *redundant);
 
+/* ---- large sparse Jacobians (sparse.c) ------------------------------------ */
+
+/* Rank and redundant rows beyond the dense limit: rows are added one at a
+   time to a row-wise Givens QR; a row eliminated down to entries at or
+   below tol is redundant. fill_max bounds the stored R entries. */
+typedef struct SparseRank SparseRank;
+
+SparseRank *sparse_rank_new(int nq, double tol, size_t fill_max);
+void sparse_rank_free(SparseRank *s);
+/* Adds a row given by its nonzeros: 1 it raised the rank, 0 it is
+   redundant, -1 NaN or Inf, -2 the fill limit was reached. */
+int sparse_rank_add(SparseRank *s, const int *cols, const double *vals, int n);
+int sparse_rank_of(const SparseRank *s);
+/* Largest singular value of the listed rows (power iteration);
+   vals[e] is the value of kin->jac[e]. */
+double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *rows, int nrows,
+                        unsigned seed);
+
 /* ---- evaluation and assembly (assemble.c) ------------------------------ */
 
 /* Values of chosen graph nodes at a state (q, qd, t), by one pass over the
-   reachable nodes in id order. Nodes created after analysis_eval_new are
+   reachable nodes in id order. Nodes created after node_eval_new are
    not known to it. */
 typedef struct NodeEval NodeEval;
 
@@ -121,6 +146,9 @@ void mech_eval_init(MechEval *me, const Kinematics *kin);
 void mech_eval_free(MechEval *me);
 /* phi: nh values (may be NULL); jac: nr x nq row-major (may be NULL). */
 void mech_eval(MechEval *me, const double *q, double t, double *phi, double *jac);
+/* The same with the Jacobian as its structural nonzeros: vals[e] is entry
+   kin->jac[e] (row-major, kin->row_start per row). */
+void mech_eval_nz(MechEval *me, const double *q, double t, double *phi, double *vals);
 
 typedef struct AssembleResult {
     bool converged;
@@ -139,6 +167,13 @@ typedef struct AssembleResult {
    dropped). w must hold nrows x nq. */
 bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, double *q,
                        const AnalysisOptions *opt, SvdWork *w, AssembleResult *res);
+
+/* The same beyond the dense limit, on the first nrows holonomic rows, with
+   the sparse QR of Phi_q^T (sparse.c): dq = Phi_q^T y, Phi_q Phi_q^T y = -Phi
+   by the seminormal equations; rows that depend on earlier ones are left
+   out of the step. */
+bool analysis_assemble_sparse(MechEval *me, int nrows, double t, double *q,
+                              const AnalysisOptions *opt, AssembleResult *res);
 
 /* ---- integrability (integrability.c) ------------------------------------ */
 
@@ -165,6 +200,25 @@ typedef struct Integrability {
 bool analysis_integrability(Model *m, int row, const double *q_center,
                             const AnalysisOptions *opt, Integrability *out, Diag *diag);
 void integrability_free(Integrability *it);
+
+/* The velocity-level rows together: the distribution D on (q, t) space
+   annihilated by the rows' forms (velocity rows a^T dq + b dt, holonomic
+   rows dPhi = Phi_q dq + Phi_t dt) is integrable iff it is involutive,
+   i.e. d omega_k(X, Y) = 0 for X, Y in D and every velocity row k (Frobenius;
+   the holonomic forms are exact). Tested numerically at the given points
+   (configurations on the holonomic rows) by projecting each d omega_k onto D. */
+typedef struct Involutivity {
+    bool tested;            /* false: no velocity rows, or no point evaluated */
+    bool involutive;
+    int points;             /* points evaluated */
+    char *note;             /* malloc'd */
+} Involutivity;
+
+/* rows: model rows to include (holonomic first, then velocity-level);
+   points: npoints configurations (npoints x nq) with their times. */
+bool analysis_involutivity(Model *m, const int *rows, int nrows, const double *points,
+                           const double *times, int npoints, Involutivity *out, Diag *diag);
+void involutivity_free(Involutivity *inv);
 
 /* Formats a node as infix text with the shortest round-trip numbers
    (0.3, not 0.29999999999999999), for laws and messages. malloc'd. */
@@ -219,6 +273,7 @@ typedef struct InfoReport {
     int mobility_rank;      /* nq - rank_undriven: DOF without drivers, by rank */
     Singularity singularity;
     InfoRow *rows;          /* nr */
+    Involutivity system;    /* the velocity rows without drivers, with the holonomic ones */
     char *verdict;          /* plain words (malloc'd) */
     char *singular;         /* about the configuration's singularity (malloc'd) */
 } InfoReport;

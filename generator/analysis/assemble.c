@@ -143,6 +143,18 @@ void mech_eval(MechEval *me, const double *q, double t, double *phi, double *jac
     }
 }
 
+void mech_eval_nz(MechEval *me, const double *q, double t, double *phi, double *vals)
+{
+    const Kinematics *kin = me->kin;
+    node_eval_run(me->ev, q, NULL, t);
+    if (phi)
+        for (int i = 0; i < me->nh; i++)
+            phi[i] = node_eval_value(me->ev, kin->phi[i]);
+    if (vals)
+        for (int e = 0; e < kin->nnz; e++)
+            vals[e] = node_eval_value(me->ev, kin->jac[e].value);
+}
+
 /* ---- minimum-norm Newton ---- */
 
 /* Phi and Phi_q of the selected rows at q; returns ||f||_2 (NaN if not finite). */

@@ -62,6 +62,22 @@ static int rank_of(SvdWork *w, const double *a, int m, int nq, double tol)
     return analysis_svd(w, a, m, nq, nq, tol, &r) ? r.rank : -1;
 }
 
+/* A random configuration near q: each coordinate moved by up to 20 % of its
+   size (at least 2 % of the largest), so angles and lengths both move. */
+static void perturb(const double *q, int nq, uint64_t *state, double *qs)
+{
+    double size = 0.0;
+    for (int i = 0; i < nq; i++)
+        size = fmax(size, fabs(q[i]));
+    if (size == 0.0)
+        size = 1.0;
+    for (int i = 0; i < nq; i++) {
+        *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+        double u = (double)(*state >> 11) * 0x1.0p-52 - 1.0;
+        qs[i] = q[i] + 0.2 * u * fmax(fabs(q[i]), 0.1 * size);
+    }
+}
+
 /* Rank of the undriven holonomic rows at configurations assembled from random
    perturbations of q; -1 when none assembled. */
 static int generic_rank(MechEval *me, const int *rows, int nrows, const double *q, double t,
@@ -71,18 +87,9 @@ static int generic_rank(MechEval *me, const int *rows, int nrows, const double *
     double *qs = xmalloc((size_t)nq * sizeof *qs);
     double *jac = xmalloc((size_t)me->nr * (size_t)nq * sizeof *jac + 1);
     double *sub = xmalloc((size_t)nrows * (size_t)nq * sizeof *sub + 1);
-    double size = 0.0;
-    for (int i = 0; i < nq; i++)
-        size = fmax(size, fabs(q[i]));
-    if (size == 0.0)
-        size = 1.0;
     uint64_t state = opt->seed * 2654435761u + 1;
     for (int s = 0; s < opt->generic_samples; s++) {
-        for (int i = 0; i < nq; i++) {
-            state = state * 6364136223846793005ull + 1442695040888963407ull;
-            double u = (double)(state >> 11) * 0x1.0p-52 - 1.0;
-            qs[i] = q[i] + 0.2 * u * fmax(fabs(q[i]), 0.1 * size);
-        }
+        perturb(q, nq, &state, qs);
         AssembleResult ar;
         if (!analysis_assemble(me, rows, nrows, t, qs, opt, w, &ar))
             continue;
@@ -94,6 +101,39 @@ static int generic_rank(MechEval *me, const int *rows, int nrows, const double *
     }
     free(qs), free(jac), free(sub);
     return best;
+}
+
+/* The velocity rows without drivers, together with the holonomic rows
+   without drivers, at the configuration and at a few others assembled on
+   those holonomic rows at nearby times. */
+static bool system_test(Model *m, MechEval *me, InfoReport *rep, const int *undriven, int nu,
+                        int nuh, const AnalysisOptions *opt, SvdWork *w, Diag *diag)
+{
+    int nq = m->nq;
+    if (nu == nuh) {
+        rep->system.note = strdup(m->nv ? "every velocity-level row is a driver" : "no velocity-level rows");
+        return true;
+    }
+    int cap = 1 + opt->generic_samples, np = 0;
+    double *points = xmalloc((size_t)cap * (size_t)nq * sizeof *points);
+    double *times = xmalloc((size_t)cap * sizeof *times);
+    if (rep->assembled) {
+        memcpy(points, rep->q, (size_t)nq * sizeof *points);
+        times[np++] = rep->t;
+    }
+    uint64_t state = opt->seed * 40503u + 3;
+    for (int s = 0; w && s < opt->generic_samples; s++) {
+        double *qs = points + (size_t)np * (size_t)nq;
+        perturb(rep->q, nq, &state, qs);
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        double ts = rep->t + 0.5 * ((double)(state >> 11) * 0x1.0p-52 - 1.0);
+        AssembleResult ar;
+        if (analysis_assemble(me, undriven, nuh, ts, qs, opt, w, &ar))
+            times[np++] = ts;
+    }
+    bool ok = analysis_involutivity(m, undriven, nu, points, times, np, &rep->system, diag);
+    free(points), free(times);
+    return ok;
 }
 
 static void list_rows(StrBuf *sb, const InfoReport *rep, bool redundant_only)
@@ -122,7 +162,7 @@ static char *make_verdict(const InfoReport *rep)
         sb_printf(&sb, " (%d coordinates - %d holonomic - %d velocity-level rows)",
                   rep->nq, rep->nh, rep->nv);
     if (rep->rank < 0) {
-        sb_puts(&sb, "; the rank was not computed (the Jacobian is beyond the dense-SVD limit)");
+        sb_puts(&sb, "; the rank was not computed");
         return sb_take(&sb);
     }
     const char *what = rep->nv > 0 ? "the holonomic rows of the Jacobian have" : "the Jacobian has";
@@ -165,6 +205,10 @@ static char *make_singular(const InfoReport *rep, int nuh)
         sb_puts(&sb, "no holonomic rows: nothing to be singular");
         return sb_take(&sb);
     }
+    if (rep->rank == rep->nh && !rep->dense) {
+        sb_puts(&sb, "full row rank (the condition number is not computed beyond the dense limit)");
+        return sb_take(&sb);
+    }
     if (rep->rank == rep->nh) {
         if (rep->cond > NEAR_SINGULAR_COND)
             sb_printf(&sb, "near-singular (condition number %.3g: close to a dead-centre, toggle "
@@ -187,6 +231,66 @@ static char *make_singular(const InfoReport *rep, int nuh)
     return sb_take(&sb);
 }
 
+/* Beyond the dense limit: ranks and redundant rows by sparse Givens QR of
+   the structural nonzeros, one tolerance for all rows (from sigma_max of
+   all rows); no smallest singular value. */
+static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, const int *undriven,
+                         int nu, int nuh, const AnalysisOptions *opt, bool *red)
+{
+    int nq = rep->nq, nh = rep->nh, nr = rep->nr;
+    double *vals = xmalloc(((size_t)kin->nnz + 1) * sizeof *vals);
+    int *cols = xmalloc(((size_t)kin->nnz + 1) * sizeof *cols);
+    int *all = xmalloc(((size_t)nr + 1) * sizeof *all);
+    for (int e = 0; e < kin->nnz; e++)
+        cols[e] = kin->jac[e].col;
+    for (int r = 0; r < nr; r++)
+        all[r] = r;
+    mech_eval_nz(me, rep->q, rep->t, NULL, vals);
+    double smax = sparse_sigma_max(kin, vals, all, nr, opt->seed);
+    double tol = opt->rank_tol >= 0 ? opt->rank_tol : svd_default_tol(nr, nq, smax);
+    rep->sigma_max = smax;
+    rep->sigma_min = rep->cond = NAN;
+    rep->rank_tol = tol;
+    const size_t fill_max = 50u * 1000u * 1000u;      /* 400 MB of R */
+    for (int pass = 0; pass < 2; pass++) {
+        /* pass 0: all rows in order; pass 1: the rows without drivers */
+        const int *rows = pass ? undriven : all;
+        int n = pass ? nu : nr, nhold = pass ? nuh : nh;
+        SparseRank *s = sparse_rank_new(nq, tol, fill_max);
+        int rank_h = nhold ? -1 : 0, st = 0;
+        for (int k = 0; k < n && st >= 0; k++) {
+            int r = rows[k];
+            st = sparse_rank_add(s, cols + kin->row_start[r], vals + kin->row_start[r],
+                                 kin->row_start[r + 1] - kin->row_start[r]);
+            if (!pass)
+                red[r] = st == 0;
+            if (k + 1 == nhold)
+                rank_h = sparse_rank_of(s);
+        }
+        int rank = sparse_rank_of(s);
+        sparse_rank_free(s);
+        if (st < 0) {
+            rep->rank = rep->rank_all = -1;
+            break;
+        }
+        if (!pass) {
+            rep->rank = rank_h;
+            rep->rank_all = rank;
+            for (int r = 0; r < nr; r++)
+                *(r < nh ? &rep->nredundant : &rep->nredundant_velocity) += red[r];
+            if (rank == nr) {               /* independent rows: so is every subset */
+                rep->rank_undriven_h = nuh;
+                rep->rank_undriven = nu;
+                break;
+            }
+        } else {
+            rep->rank_undriven_h = rank_h;
+            rep->rank_undriven = rank;
+        }
+    }
+    free(vals), free(cols), free(all);
+}
+
 bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
 {
     Model *m = mech->model;
@@ -203,7 +307,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
         bool driver = m->rows[r].kind == JOINT_DRIVER;
         rep->rows[r].driver = driver;
         if (driver)
-            (r < nh ? rep->nh_drivers++ : rep->nv_drivers++);
+            *(r < nh ? &rep->nh_drivers : &rep->nv_drivers) += 1;
         else {
             undriven[nu++] = r;
             nuh += r < nh;
@@ -222,8 +326,9 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     MechEval me;
     mech_eval_init(&me, &mech->kin);
     SvdWork *w = rep->dense ? svd_work_new(nr, nq) : NULL;
-    double *jac = xcalloc((size_t)nr * (size_t)nq + 1, sizeof *jac);
-    double *sub = xcalloc((size_t)nr * (size_t)nq + 1, sizeof *sub);
+    size_t dense_len = w ? (size_t)nr * (size_t)nq : 0;
+    double *jac = xcalloc(dense_len + 1, sizeof *jac);
+    double *sub = xcalloc(dense_len + 1, sizeof *sub);
     bool *red = xcalloc((size_t)nr + 1, sizeof *red);
 
     /* assembly at t */
@@ -232,22 +337,13 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
         rep->assembled = analysis_assemble(&me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
-    } else {            /* too large to factor densely: accept the file's values if they fit */
-        double *phi = xcalloc((size_t)nh, sizeof *phi);
-        mech_eval(&me, rep->q, t, phi, NULL);
-        double res = 0.0;
-        int worst = -1;
-        for (int i = 0; i < nh; i++)
-            if (!(fabs(phi[i]) <= res)) {
-                res = fabs(phi[i]);
-                worst = i;
-            }
-        free(phi);
-        rep->assembly = (AssembleResult){.converged = res <= opt->tol_phi, .residual = res,
-                                         .step = -1, .worst_row = worst, .rank = -1};
-        rep->assembled = rep->assembly.converged;
+    } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
+        rep->assembled = analysis_assemble_sparse(&me, nh, t, rep->q, opt, &rep->assembly);
     }
-    mech_eval(&me, rep->q, t, NULL, jac);
+    if (w)
+        mech_eval(&me, rep->q, t, NULL, jac);
+    else
+        sparse_ranks(&mech->kin, &me, rep, undriven, nu, nuh, opt, red);
 
     if (w) {
         /* holonomic rows */
@@ -275,12 +371,15 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
                 }
             }
         }
-        if (rep->rank < 0 || rep->rank_all < 0) {   /* NaN or Inf in the Jacobian */
-            rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
-            rep->nredundant = rep->nredundant_velocity = 0;
-        }
-        for (int r = 0; r < nr; r++)
-            rep->rows[r].redundant = red[r];
+    }
+    if (rep->rank < 0 || rep->rank_all < 0) {       /* NaN or Inf in the Jacobian */
+        rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
+        rep->nredundant = rep->nredundant_velocity = 0;
+        memset(red, 0, (size_t)nr * sizeof *red);
+    }
+    for (int r = 0; r < nr; r++)
+        rep->rows[r].redundant = red[r];
+    if (w) {
         if (rep->rank >= 0 && rep->rank_undriven_h >= 0 && opt->generic_samples > 0
             && (rep->rank < nh || rep->rank_undriven_h < nuh))
             rep->generic_rank = generic_rank(&me, undriven, nuh, rep->q, t, opt, w);
@@ -304,10 +403,13 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     rep->verdict = make_verdict(rep);
     rep->singular = make_singular(rep, nuh);
 
-    /* integrability of every velocity-level row, around the configuration */
+    /* integrability of every velocity-level row, around the configuration,
+       then of the rows without drivers together */
     bool ok = true;
     for (int r = nh; r < nr && ok; r++)
         ok = analysis_integrability(m, r, rep->q, opt, &rep->rows[r].integ, diag);
+    if (ok)
+        ok = system_test(m, &me, rep, undriven, nu, nuh, opt, w, diag);
 
     mech_eval_free(&me);
     svd_work_free(w);
@@ -323,6 +425,7 @@ void info_report_free(InfoReport *rep)
         for (int r = 0; r < rep->nr; r++)
             integrability_free(&rep->rows[r].integ);
     free(rep->rows);
+    involutivity_free(&rep->system);
     free(rep->q);
     free(rep->verdict);
     free(rep->singular);

@@ -33,6 +33,9 @@
 /* Components of a singular vector at least this fraction of its largest are named. */
 #define RUN_NAME_SHARE 0.2
 #define RUN_NAME_MAX 6
+/* Above this many coordinates the dense SVD of a failure message (O(n^3))
+   would take longer than the user should wait for an error: left out. */
+#define RUN_SVD_MAX_NQ 400
 
 RunOptions run_default_options(void)
 {
@@ -157,6 +160,8 @@ static void name_list(Run *r, const char *const *names, const double *w, int n)
    Returns sigma_min / sigma_max, or -1 when it could not be computed. */
 static double describe_dependency(Run *r, const double *q, double t, int rows, bool always)
 {
+    if (r->nq > RUN_SVD_MAX_NQ)
+        return -1;
     size_t nq = (size_t)r->nq;
     double *jac = xcalloc((size_t)r->nr * nq + 1, sizeof *jac);
     double *roww = xcalloc((size_t)r->nr + 1, sizeof *roww);

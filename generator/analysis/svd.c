@@ -148,7 +148,7 @@ bool analysis_svd(SvdWork *w, const double *a, int m, int n, int lda, double tol
    "left" is the factor b is multiplied with, "right" the one x is built from. */
 void svd_pinv_solve(const SvdWork *w, const double *b, double *x)
 {
-    int k = w->k, r = w->rank;
+    int r = w->rank;
     const gsl_matrix *left = w->transposed ? w->v : w->a;
     const gsl_matrix *right = w->transposed ? w->a : w->v;
     int m = w->m, n = w->n;
@@ -164,7 +164,13 @@ void svd_pinv_solve(const SvdWork *w, const double *b, double *x)
             sum += gsl_matrix_get(right, (size_t)j, (size_t)l) * w->tmp[l];
         x[j] = sum;
     }
-    (void)k;
+}
+
+double svd_row_basis(const SvdWork *w, int j, int l)
+{
+    /* not transposed: A = U S V^T, the row space is V's columns;
+       transposed: A = V S U^T (U in w->a), the row space is U's columns */
+    return gsl_matrix_get(w->transposed ? w->a : w->v, (size_t)j, (size_t)l);
 }
 
 /* Deficiency of the first k rows: k - rank, -1 on NaN/Inf. */

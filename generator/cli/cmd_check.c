@@ -191,7 +191,7 @@ int cmd_check(int argc, char **argv)
                     fprintf(stderr, "%s: error: %s of row %s%s%s is off by %.3g (tolerance %.3g) at t = %.17g%s%s\n",
                             a.file, it->what, row_name(mech->model, it->row),
                             it->col >= 0 ? ", column " : "", it->col >= 0 ? mech->model->coord_names[it->col] : "",
-                            it->error, it->tol, it->t, it->hint[0] ? ": looks like " : "", it->hint);
+                            it->error, it->tol, it->t, it->hint[0] ? ": " : "", it->hint);
                     break;
                 }
             }

@@ -56,6 +56,16 @@ static bool write_file(const char *path, const char *text)
     return ok;
 }
 
+/* A user's value inside a one-line message: control bytes shown as '?'. */
+static const char *shown(const char *value, char *buf, size_t size)
+{
+    size_t n = 0;
+    for (; value[n] && n + 1 < size; n++)
+        buf[n] = (unsigned char)value[n] < 0x20 || value[n] == 0x7f ? '?' : value[n];
+    buf[n] = '\0';
+    return buf;
+}
+
 int cmd_gen(int argc, char **argv)
 {
     Args a;
@@ -104,15 +114,18 @@ int cmd_gen(int argc, char **argv)
         return EXIT_USAGE;
     /* Names that reach the C text are checked before any work. */
     const char *why;
+    char buf[256];
     if (opt.prefix && (why = emit_check_prefix(opt.prefix))) {
-        fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n", opt.prefix, why);
+        fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n",
+                shown(opt.prefix, buf, sizeof buf), why);
         return EXIT_USAGE;
     }
     if (header_path) {
         const char *base = strrchr(header_path, '/');
         opt.header_name = base ? base + 1 : header_path;
         if ((why = emit_check_header_name(opt.header_name))) {
-            fprintf(stderr, "mechc gen: error: --header '%s' cannot be used: %s\n", header_path, why);
+            fprintf(stderr, "mechc gen: error: --header '%s' cannot be used: %s\n",
+                    shown(header_path, buf, sizeof buf), why);
             return EXIT_USAGE;
         }
     }

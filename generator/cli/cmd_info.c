@@ -10,6 +10,7 @@
 
 static const char usage[] =
     "usage: mechc info FILE.mech [--json] [--rank-tol T] [--t T] [--samples N]\n"
+    "                  [--max-dense N]\n"
     "\n"
     "Reports the coordinates, every row with its joint, kind and level, the rows\n"
     "per joint against the textbook table and the mobility count (coordinates -\n"
@@ -26,6 +27,9 @@ static const char usage[] =
     "                 (default max(rows, coords) * eps * largest singular value)\n"
     "  --t T          analyse at time T instead of 0 (drivers move with t)\n"
     "  --samples N    random states for the numerical integrability check (default 8)\n"
+    "  --max-dense N  rows x coordinates up to which the rank comes from a dense SVD\n"
+    "                 (default 500000); larger Jacobians use a sparse QR, which gives\n"
+    "                 the rank and the redundant rows but no condition number\n"
     "\n"
     "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
     "printed, at the last iterate), 2 bad usage or bad input.\n";
@@ -129,6 +133,7 @@ static void print_json(const InfoReport *rep)
     json_int_or_null("rank_all", rep->rank_all);
     json_names("redundant_velocity", rep, true);
     json_int_or_null("generic_rank", rep->generic_rank);
+    printf(",\n \"dense\": %s", rep->dense ? "true" : "false");
     if (rep->rank >= 0) {
         json_num("rank_tol", rep->rank_tol);
         json_num("sigma_max", rep->sigma_max);
@@ -144,7 +149,11 @@ static void print_json(const InfoReport *rep)
         printf(i ? ", " : "");
         json_number(stdout, rep->q[i]);
     }
-    printf("],\n \"singularity\": \"%s\"", singularity_names[rep->singularity]);
+    printf("],\n \"system_integrable\": %s",
+           !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
+    printf(",\n \"system_note\": ");
+    json_string(stdout, rep->system.note ? rep->system.note : "");
+    printf(",\n \"singularity\": \"%s\"", singularity_names[rep->singularity]);
     printf(",\n \"singular\": ");
     json_string(stdout, rep->singular);
     printf(",\n \"verdict\": ");
@@ -203,15 +212,10 @@ static void print_text(const InfoReport *rep)
            rep->nq, rep->nh, rep->nv, rep->dof);
     printf("  without the %d driver%s: %d DOF\n", drivers, drivers == 1 ? "" : "s", rep->mobility);
 
-    printf("\nassembly at t = %g (minimum-norm Newton on the holonomic rows):\n  ", rep->t);
+    printf("\nassembly at t = %g (minimum-norm Newton on the holonomic rows%s):\n  ", rep->t,
+           rep->dense ? "" : ", sparse QR");
     if (rep->nh == 0)
         printf("nothing to assemble (no holonomic rows)\n");
-    else if (!rep->dense && rep->assembled)
-        printf("the initial values fit (residual %.3g); not iterated (beyond the dense limit)\n",
-               rep->assembly.residual);
-    else if (!rep->dense)
-        printf("NOT ASSEMBLED: residual %.3g and the Jacobian is beyond the dense limit\n",
-               rep->assembly.residual);
     else
         printf("%s after %d iteration%s, residual %.3g%s%s\n",
                rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
@@ -220,17 +224,21 @@ static void print_text(const InfoReport *rep)
                rep->assembly.worst_row >= 0 && !rep->assembled
                    ? m->rows[rep->assembly.worst_row].name : "");
 
-    printf("\nrank (SVD at the assembled configuration):\n");
+    printf("\nrank (%s at the assembled configuration):\n", rep->dense ? "SVD" : "sparse QR");
     if (rep->rank < 0) {
         printf("  not computed (%s)\n", rep->dense ? "NaN or Inf in the Jacobian"
-                                                   : "the Jacobian is beyond the dense-SVD limit");
+                                                   : "NaN or Inf, or too much fill in the sparse QR");
     } else {
         printf("  holonomic rows: rank %d of %d (tolerance %.3g)\n", rep->rank, rep->nh, rep->rank_tol);
         if (rep->nv)
             printf("  all rows:       rank %d of %d\n", rep->rank_all, rep->nr);
-        if (rep->nh)
+        if (rep->nh && rep->dense)
             printf("  singular values: largest %.6g, smallest %.6g, condition number %.6g\n",
                    rep->sigma_max, rep->sigma_min, rep->cond);
+        else if (rep->nh)
+            printf("  sparse QR (%d x %d is beyond the dense-SVD limit): largest singular value "
+                   "%.6g,\n  smallest and condition number not computed\n",
+                   rep->nr, rep->nq, rep->sigma_max);
         printf("  configuration: %s\n", rep->singular);
         printf("  redundant rows: ");
         int n = 0;
@@ -257,9 +265,9 @@ static void print_text(const InfoReport *rep)
                 printf("not integrable (nonholonomic)\n");
             printf("  %-*s  %s\n", rw, "", it->note);
         }
-        if (m->nv > 1)
-            printf("  (the verdict is per row: rows that are nonholonomic alone may still\n"
-                   "  combine with the others; the test does not use the holonomic rows)\n");
+        printf("  (the verdicts above are per row, on all of (q, t) space)\n");
+        printf("\nvelocity-level rows together with the holonomic rows, drivers left out:\n  %s\n",
+               rep->system.note ? rep->system.note : "not tested");
     }
 
     printf("\nverdict: %s\n", rep->verdict);
@@ -286,6 +294,11 @@ int cmd_info(int argc, char **argv)
             }
         } else if (strcmp(opt, "--t") == 0) {
             args_double(&a, opt, &t);
+        } else if (strcmp(opt, "--max-dense") == 0) {
+            if (args_double(&a, opt, &o.max_dense) && o.max_dense < 0) {
+                fprintf(stderr, "mechc info: error: --max-dense needs a number >= 0\n");
+                a.failed = true;
+            }
         } else if (strcmp(opt, "--samples") == 0) {
             args_int(&a, opt, 1, 1000, &o.samples);
         } else {
@@ -318,7 +331,7 @@ int cmd_info(int argc, char **argv)
                 t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
-        fprintf(stderr, ")%s\n", rep.dense ? "" : "; the Jacobian is too large to iterate on densely");
+        fprintf(stderr, ")\n");
         status = EXIT_ANALYSIS;
     }
     info_report_free(&rep);

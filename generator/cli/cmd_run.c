@@ -223,9 +223,11 @@ int cmd_run(int argc, char **argv)
     Output out = {.csv = NULL, .json = json, .digits = digits, .nq = m->nq};
     mechrt_trace_init(&out.trace, m->nq);
     int status = EXIT_OK;
+    /* a mechanism that cannot run (row count) leaves no output file behind */
+    bool runnable = m->nr == m->nq;
     if (csv_stdout) {
         out.csv = stdout;
-    } else if (csv_path) {
+    } else if (csv_path && runnable) {
         out.csv = fopen(csv_path, "w");
         if (!out.csv) {
             fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", csv_path, strerror(errno));
@@ -240,7 +242,7 @@ int cmd_run(int argc, char **argv)
     MechrtKernels k = run_engine_kernels(&e);
     RunResult res;
     ro.notes = stderr;
-    if (out.csv && m->nr == m->nq)
+    if (out.csv && runnable)
         mechrt_csv_header(out.csv, m->nq, m->coord_names);
     LastState last = {&out, ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};

@@ -228,14 +228,14 @@ NodeId dag_neg(Dag *dag, NodeId a)
         return DAG_ZERO;
     if (try_fold(dag, OP_NEG, a, DAG_NONE, &r))
         return r;
-    const DagNode *n = &dag->nodes[a];
+    const DagNode n = dag->nodes[a];     /* a copy: the array may move below */
     double c;
-    if (n->op == OP_NEG)
-        return n->a;
-    if (n->op == OP_SUB)
-        return dag_sub(dag, n->b, n->a);
-    if (n->op == OP_MUL && dag_is_const(dag, n->a, &c))
-        return scale(dag, -c, n->b);
+    if (n.op == OP_NEG)
+        return n.a;
+    if (n.op == OP_SUB)
+        return dag_sub(dag, n.b, n.a);
+    if (n.op == OP_MUL && dag_is_const(dag, n.a, &c))
+        return scale(dag, -c, n.b);
     return intern(dag, OP_NEG, a, -1, 0.0);
 }
 
@@ -259,6 +259,8 @@ static bool merge_terms(Dag *dag, NodeId a, NodeId b, double sign, NodeId *out)
     if (ta == DAG_NONE || ta != tb)
         return false;
     double c = ca + sign * cb;
+    if (!isfinite(c))           /* 1e308 x + 1e308 x stays a sum */
+        return false;
     *out = c == 0.0 ? DAG_ZERO : scale(dag, c, ta);
     return true;
 }
@@ -290,10 +292,10 @@ NodeId dag_add(Dag *dag, NodeId a, NodeId b)
     order_commutative(dag, &a, &b);
     /* c1 + (c2 + y) = (c1 + c2) + y: keeps constants together. */
     double c1, c2;
-    const DagNode *nb = &dag->nodes[b];
-    if (dag_is_const(dag, a, &c1) && nb->op == OP_ADD && dag_is_const(dag, nb->a, &c2)
+    const DagNode nb = dag->nodes[b];    /* a copy: the array may move below */
+    if (dag_is_const(dag, a, &c1) && nb.op == OP_ADD && dag_is_const(dag, nb.a, &c2)
         && isfinite(c1 + c2))
-        return dag_add(dag, dag_const(dag, c1 + c2), nb->b);
+        return dag_add(dag, dag_const(dag, c1 + c2), nb.b);
     return intern(dag, OP_ADD, a, b, 0.0);
 }
 
@@ -333,27 +335,29 @@ NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
         return b;
     if (is_value(dag, a, -1.0))
         return dag_neg(dag, b);
-    const DagNode *na = &dag->nodes[a], *nb = &dag->nodes[b];
-    if (na->op == OP_NEG)
-        return dag_neg(dag, dag_mul(dag, na->a, b));
-    if (nb->op == OP_NEG)
-        return dag_neg(dag, dag_mul(dag, a, nb->a));
+    /* copies: nested calls may grow (move) the node array */
+    const DagNode na = dag->nodes[a], nb = dag->nodes[b];
+    if (na.op == OP_NEG)
+        return dag_neg(dag, dag_mul(dag, na.a, b));
+    if (nb.op == OP_NEG)
+        return dag_neg(dag, dag_mul(dag, a, nb.a));
     double c1, c2;
     bool a_const = dag_is_const(dag, a, &c1);
-    if (nb->op == OP_MUL && dag_is_const(dag, nb->a, &c2)) {
+    if (nb.op == OP_MUL && dag_is_const(dag, nb.a, &c2)) {
         if (a_const && isfinite(c1 * c2))       /* c1 (c2 y) = (c1 c2) y */
-            return dag_mul(dag, dag_const(dag, c1 * c2), nb->b);
+            return dag_mul(dag, dag_const(dag, c1 * c2), nb.b);
         if (!a_const)                           /* x (c y) = c (x y) */
-            return dag_mul(dag, nb->a, dag_mul(dag, a, nb->b));
+            return dag_mul(dag, nb.a, dag_mul(dag, a, nb.b));
     }
-    if (!a_const && na->op == OP_MUL && dag_is_const(dag, na->a, &c1))
-        return dag_mul(dag, na->a, dag_mul(dag, na->b, b));
+    if (!a_const && na.op == OP_MUL && dag_is_const(dag, na.a, &c1))
+        return dag_mul(dag, na.a, dag_mul(dag, na.b, b));
     /* (x y) y = x (y y): squares of velocities become one shared node
-       (the chain rule builds (cos(phi) phid) phid). */
-    if (nb->op == OP_MUL && nb->a != nb->b && (nb->a == a || nb->b == a))
-        return dag_mul(dag, nb->a == a ? nb->b : nb->a, dag_mul(dag, a, a));
-    if (na->op == OP_MUL && na->a != na->b && (na->a == b || na->b == b))
-        return dag_mul(dag, na->a == b ? na->b : na->a, dag_mul(dag, b, b));
+       (the chain rule builds (cos(phi) phid) phid). Not for a constant y:
+       c (c x) with c c overflowing would turn back into c (c x) forever. */
+    if (!a_const && nb.op == OP_MUL && nb.a != nb.b && (nb.a == a || nb.b == a))
+        return dag_mul(dag, nb.a == a ? nb.b : nb.a, dag_mul(dag, a, a));
+    if (!a_const && na.op == OP_MUL && na.a != na.b && (na.a == b || na.b == b))
+        return dag_mul(dag, na.a == b ? na.b : na.a, dag_mul(dag, b, b));
     return intern(dag, OP_MUL, a, b, 0.0);
 }
 
@@ -371,18 +375,20 @@ NodeId dag_div(Dag *dag, NodeId a, NodeId b)
         return DAG_ZERO;
     if (a == b)
         return DAG_ONE;
-    const DagNode *na = &dag->nodes[a], *nb = &dag->nodes[b];
-    if (na->op == OP_NEG)
-        return dag_neg(dag, dag_div(dag, na->a, b));
-    if (nb->op == OP_NEG)
-        return dag_neg(dag, dag_div(dag, a, nb->a));
+    /* copies: nested calls may grow (move) the node array */
+    const DagNode na = dag->nodes[a], nb = dag->nodes[b];
+    if (na.op == OP_NEG)
+        return dag_neg(dag, dag_div(dag, na.a, b));
+    if (nb.op == OP_NEG)
+        return dag_neg(dag, dag_div(dag, a, nb.a));
     /* Division by a power of two is an exact multiplication. */
     int e;
-    if (dag_is_const(dag, b, &c) && isfinite(c) && frexp(c, &e) == 0.5 * copysign(1.0, c))
+    if (dag_is_const(dag, b, &c) && isfinite(c) && frexp(c, &e) == 0.5 * copysign(1.0, c)
+        && isfinite(1.0 / c))   /* 1/2^-1074 overflows */
         return dag_mul(dag, dag_const(dag, 1.0 / c), a);
     double ca;
-    if (na->op == OP_MUL && dag_is_const(dag, na->a, &ca))  /* (c x)/y = c (x/y) */
-        return dag_mul(dag, na->a, dag_div(dag, na->b, b));
+    if (na.op == OP_MUL && dag_is_const(dag, na.a, &ca))  /* (c x)/y = c (x/y) */
+        return dag_mul(dag, na.a, dag_div(dag, na.b, b));
     return intern(dag, OP_DIV, a, b, 0.0);
 }
 

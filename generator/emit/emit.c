@@ -94,7 +94,8 @@ static void sanitize_prefix(const char *name, char *out, size_t size)
     for (const char *c = name; *c && n + 1 < size && n < 64; c++)
         out[n++] = isalnum((unsigned char)*c) ? *c : '_';
     out[n] = '\0';
-    if (emit_check_prefix(out) != NULL) {
+    /* a leading '_' is legal but reserved at file scope (C11 7.1.3) */
+    if (emit_check_prefix(out) != NULL || out[0] == '_') {
         memmove(out + 2, out, strlen(out) + 1 < size - 2 ? strlen(out) + 1 : size - 2);
         out[size - 1] = '\0';
         out[0] = 'm';

@@ -181,9 +181,6 @@ static Token scan(Lexer *lx)
             int end = start;
             while (end < lx->len && is_ident_char(s[end]))
                 end++;
-            if (end - start > lx->limits->max_name_length)
-                diag_fail(lx->diag, at(start), "name longer than the limit of %d characters",
-                          lx->limits->max_name_length);
             lx->cur = end;
             return make(TOK_IDENT, s, start, end - start);
         }

@@ -97,6 +97,10 @@ static const char *declared_name(Parser *p, const char *after, SrcPos *pos)
     if (is_reserved(&p->tok))
         diag_fail(p->diag, p->tok.pos, "'%.*s' is a reserved name and cannot be declared",
                   p->tok.len, p->tok.start);
+    /* names become C string literals (row and coordinate names) */
+    if (p->tok.len > p->limits->max_name_length)
+        diag_fail(p->diag, p->tok.pos, "name longer than the limit of %d characters",
+                  p->limits->max_name_length);
     *pos = p->tok.pos;
     const char *name = token_text(p, &p->tok);
     advance(p);

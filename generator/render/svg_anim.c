@@ -10,14 +10,15 @@
  * strokes and marks keep their pixel size whatever the scale.
  *
  * What is drawn (spec section 2 for the joints):
- *   body          the convex hull of its joints' local points and its
- *                 reference point: a line (2 points), a polygon (3+), a mark (1)
+ *   body          the convex hull of its joints' local points, its reference
+ *                 point and its traced points: a line (2 points), a polygon
+ *                 (3+), a mark (1)
  *   point         a dot
  *   revolute      a pin (circle); a ground pivot (triangle, hatching) when
  *                 one side is ground
  *   prismatic     a guide along the axis on body A covering the slide, and a
  *                 block at P_B along that axis
- *   pointline     the line on body A and a dot at P_B
+ *   pointline     the line (a slot) on body A and a dot at P_B
  *   distance      a thin dashed line between the two points
  *   weld          a dot
  *   rolling       a disk of radius R with a spoke, on a hatched ground line
@@ -55,6 +56,7 @@ SvgAnimOptions svg_anim_default_options(void)
         .max_duration = 60,
         .width = 760,
         .height = 520,
+        .max_bytes = 4000000,
     };
     return o;
 }
@@ -97,6 +99,8 @@ typedef struct Scene {
     const Model *m;
     const double *t, *q;
     int n;                  /* frames given */
+    const SvgTrace *traces;
+    int ntraces;
     int *frames, nf;        /* kept frames (indices into t) */
     Vtx *v;
     int nv, vcap;
@@ -107,6 +111,10 @@ typedef struct Scene {
     bool *driven;           /* per coordinate */
     const char **colour;    /* per body or point (at its x coordinate) */
     double L;               /* characteristic size of the motion */
+    double px;              /* model units per pixel, estimated before
+                               symbols are sized (the final scale is a
+                               little smaller: symbols come out a little
+                               smaller than asked) */
     /* pixel mapping: X = ox + s (x - xmin), Y = oy + s (ymax - y) */
     double s, xmin, ymax, ox, oy;
     int width, height;
@@ -287,7 +295,7 @@ static bool body_has_symbol(const Scene *sc, int q)
 {
     for (int j = 0; j < sc->m->njoints; j++) {
         const Joint *jt = &sc->m->joints[j];
-        if ((jt->kind == JOINT_PRISMATIC && (jt->b.q == q || jt->a.q == q)) ||
+        if ((jt->kind == JOINT_PRISMATIC && jt->b.q == q) ||
             (jt->kind == JOINT_ROLLING && jt->a.q == q))
             return true;
     }
@@ -373,11 +381,15 @@ static void add_pin(Scene *sc, Attach a, const char *cls, double r, const char *
     end_shape(sc, s);
 }
 
-/* The local points of body q: its joints' attachments and the reference point. */
+/* The local points of body q: its joints' attachments, the reference point
+   and the traced points on it (a coupler point makes the coupler a triangle). */
 static int body_points(const Scene *sc, int q, P2 *pts)
 {
     int n = 0;
     pts[n++] = (P2){0, 0};
+    for (int i = 0; i < sc->ntraces; i++)
+        if (sc->traces[i].q == q && sc->traces[i].has_phi)
+            pts[n++] = (P2){sc->traces[i].sx, sc->traces[i].sy};
     for (int j = 0; j < sc->m->njoints; j++) {
         const Joint *jt = &sc->m->joints[j];
         const Attach *at[2] = {&jt->a, &jt->b};
@@ -393,8 +405,9 @@ static int body_points(const Scene *sc, int q, P2 *pts)
 static void build_bodies(Scene *sc)
 {
     const Model *m = sc->m;
-    P2 *pts = xmalloc(((size_t)2 * m->njoints + 2) * sizeof *pts);
-    P2 *hull = xmalloc(((size_t)2 * m->njoints + 3) * sizeof *hull);
+    size_t cap = (size_t)2 * m->njoints + (size_t)sc->ntraces + 3;
+    P2 *pts = xmalloc(cap * sizeof *pts);
+    P2 *hull = xmalloc((cap + 1) * sizeof *hull);
     for (int i = 0; i < m->nq; i++) {
         if (sc->base[i] != i || sc->owner[i] == OWNER_SCALAR)
             continue;
@@ -491,8 +504,8 @@ static void add_ground(GroundList *gl, Ground g)
 static void build_joints(Scene *sc, GroundList *gl)
 {
     const Model *m = sc->m;
-    double L = sc->L;
-    double block_len = 0.09 * L, block_h = 0.055 * L;
+    double px = sc->px;
+    double block_len = 52 * px, block_h = 30 * px;
     /* guides and blocks first, pins on top (second pass) */
     for (int j = 0; j < m->njoints; j++) {
         const Joint *jt = &m->joints[j];
@@ -519,15 +532,10 @@ static void build_joints(Scene *sc, GroundList *gl)
             end_shape(sc, s);
             break;
         }
-        case JOINT_POINTLINE: {
-            Shape *g = add_guide(sc, jt, 0.1 * L);
-            if (jt->a.q < 0) {
-                const Vtx *v0 = &sc->v[g->v0], *v1 = &sc->v[g->v0 + 1];
-                add_ground(gl, (Ground){GROUND_LINE, v0->sx + v0->ox, v0->sy + v0->oy,
-                                        v1->sx + v1->ox, v1->sy + v1->oy, 0});
-            }
+        case JOINT_POINTLINE:
+            /* a slot, not a support: no hatching even on ground */
+            add_guide(sc, jt, 24 * px);
             break;
-        }
         case JOINT_DISTANCE: {
             Shape *s = add_shape(sc, SHAPE_POLYLINE, "distance");
             add_vtx(sc, vtx_at(jt->a));
@@ -565,7 +573,7 @@ static void build_joints(Scene *sc, GroundList *gl)
             break;
         }
         case JOINT_KNIFE: {
-            double ulen = hypot(jt->ux, jt->uy), h = 0.06 * L;
+            double ulen = hypot(jt->ux, jt->uy), h = 24 * px;
             double ex = jt->ux / ulen * h, ey = jt->uy / ulen * h;
             Shape *s = add_shape(sc, SHAPE_POLYLINE, "knife");
             add_vtx(sc, vtx_off(jt->a, jt->a, -ex, -ey));
@@ -646,12 +654,12 @@ static void build_drive_arrows(Scene *sc)
             else if (jt->b.q < 0 && jt->a.q == i)
                 centre = jt->a;
         }
-        double rho = 0.05 * sc->L;
+        double rho = 26 * sc->px;
         /* the arrow points the way the angle goes over the run */
         double turn = frame_q(sc, sc->frames[sc->nf - 1])[i + 2] - frame_q(sc, sc->frames[0])[i + 2];
         Shape *s = add_shape(sc, SHAPE_POLYLINE, "drive");
         for (int k = 0; k <= 16; k++) {
-            double a = (turn >= 0 ? 40.0 + 240.0 * k / 16 : 140.0 - 240.0 * k / 16) * M_PI / 180;
+            double a = (turn >= 0 ? 40.0 + 240.0 * k / 16 : 140.0 - 240.0 * k / 16) * (3.14159265358979323846 / 180);
             add_vtx(sc, vtx_off(centre, centre, rho * cos(a), rho * sin(a)));
         }
         s->extra = "marker-end=\"url(#arrow)\"";
@@ -1192,8 +1200,11 @@ static void write_scene(FILE *out, Scene *sc, const SvgTrace *tr, int ntr, const
     free(w.kt);
 }
 
-/* Frames kept: all when at most max, else max evenly spaced indices
-   including the first and the last. */
+/* Frames kept: all when at most max, else about max indices including the
+   first and the last. An exact stride is preferred when it keeps at least
+   60 % of max (1001 frames: every 8th, 126 frames): evenly spaced frames of
+   an evenly stepped run need no keyTimes lists, which saves a third of the
+   file. */
 static int pick_frames(int n, int max, int *out)
 {
     if (max < 2)
@@ -1202,6 +1213,14 @@ static int pick_frames(int n, int max, int *out)
         for (int k = 0; k < n; k++)
             out[k] = k;
         return n;
+    }
+    for (int f = max; f >= 2 && 10 * f >= 6 * max; f--) {
+        if ((n - 1) % (f - 1) == 0) {
+            int stride = (n - 1) / (f - 1);
+            for (int j = 0; j < f; j++)
+                out[j] = j * stride;
+            return f;
+        }
     }
     for (int j = 0; j < max; j++)
         out[j] = (int)((double)j * (n - 1) / (max - 1) + 0.5);
@@ -1244,6 +1263,8 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
     sc.t = t;
     sc.q = q;
     sc.n = nframes;
+    sc.traces = traces;
+    sc.ntraces = ntraces;
     sc.frames = xmalloc((size_t)(o.max_frames > 2 ? o.max_frames : 2) * sizeof *sc.frames);
     sc.nf = pick_frames(nframes, o.max_frames, sc.frames);
     map_coords(&sc);
@@ -1254,12 +1275,23 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
     sc.L = fmax(b.x1 - b.x0, b.y1 - b.y0);
     if (!(sc.L > 0))
         sc.L = 1;
+    set_mapping(&sc, b, &o, 0);
+    sc.px = 1 / sc.s;
     GroundList gl = {0};
     build_joints(&sc, &gl);
     build_bodies(&sc);
     build_drive_arrows(&sc);
     build_pins(&sc, &gl);
     build_trace_dots(&sc, traces, ntraces);
+
+    /* each moving vertex costs about 15 bytes per frame ("123.4,567.8 ", and
+       the elements around) */
+    long moving = 0;
+    for (int i = 0; i < sc.nv; i++)
+        moving += sc.v[i].q >= 0;
+    long budget = moving > 0 ? o.max_bytes / (15 * moving) : o.max_frames;
+    if (budget < sc.nf)
+        sc.nf = pick_frames(nframes, budget < 10 ? 10 : (int)budget, sc.frames);
 
     Box all = scene_box(&sc, true, traces, ntraces, &gl);
     Box first = scene_box(&sc, false, traces, ntraces, NULL);

@@ -25,6 +25,8 @@ typedef struct SvgAnimOptions {
     double max_duration;    /* seconds of playback at most (a longer run is
                                sped up); default 60 */
     int width, height;      /* largest drawing area in px; default 760 x 520 */
+    long max_bytes;         /* about the largest file: a big mechanism keeps
+                               fewer frames (10 at least); default 4000000 */
 } SvgAnimOptions;
 
 SvgAnimOptions svg_anim_default_options(void);
@@ -33,7 +35,7 @@ SvgAnimOptions svg_anim_default_options(void);
    q[k*nq + i] (the model's coordinates). The static attributes show the
    first frame, so viewers that do not animate show the start of the run;
    SMIL <animate> elements play the run in a loop. Frames are subsampled to
-   at most 200. traces may be NULL when ntraces is 0; title may be NULL (the
+   at most 200, fewer for big mechanisms (the file stays under about 4 MB). traces may be NULL when ntraces is 0; title may be NULL (the
    mechanism name is used). Returns false, writing nothing, when the input is
    unusable (no frame, decreasing time, a non-finite coordinate; errno =
    EINVAL) or when writing fails (errno from stdio). */
@@ -44,11 +46,13 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
                              int nframes, const SvgTrace *traces, int ntraces,
                              const char *title, const SvgAnimOptions *opt);
 
-/* Parses a --trace argument: `BODY(sx, sy)`, `BODY` (its reference point) or
-   `POINT` (a particle), sx and sy numbers (optionally signed, `pi` allowed,
-   e.g. `-0.15`, `pi/4` is not: numbers only). On success fills *out (label =
-   text, so text must outlive the trace) and returns true; otherwise writes a
-   one-line reason into err (errlen bytes) and returns false. */
+/* Parses a --trace argument: `BODY(sx, sy)` (a point fixed to the body, in
+   its local frame), `BODY` (its reference point) or `POINT` (a particle);
+   sx and sy are decimal numbers, signed or not (`-0.15`, `2e-3`; no
+   expressions or params). Blanks are allowed between the parts. On success
+   fills *out (label = text, so text must outlive the trace) and returns
+   true; otherwise writes a one-line reason starting "--trace 'TEXT': " into
+   err (errlen bytes) and returns false. */
 bool svg_parse_trace(const Model *m, const char *text, SvgTrace *out, char *err, size_t errlen);
 
 #endif

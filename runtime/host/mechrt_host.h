@@ -100,8 +100,8 @@ double mechrt_host_singular_direction(int m, int n, const double *a, double *row
 /* ---- Output (output.c) ---------------------------------------------------- */
 
 /* v as text: with digits == 0 the shortest of %.15g, %.16g, %.17g that
-   reads back as v (0.3 stays "0.3"), else %.<digits>g. NaN and infinities
-   are "nan", "inf", "-inf". Returns the length written. */
+   reads back as v (0.3 stays "0.3"), else %.<digits>g. -0 is "0"; NaN
+   and infinities are "nan", "inf", "-inf". Returns the length written. */
 int mechrt_format_real(char *buf, size_t size, double v, int digits);
 
 /* CSV (RFC 4180, no quoting needed: coordinate names are identifiers with

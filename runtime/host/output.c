@@ -18,6 +18,8 @@ int mechrt_format_real(char *buf, size_t size, double v, int digits)
         return snprintf(buf, size, "nan");
     if (isinf(v))
         return snprintf(buf, size, v > 0 ? "inf" : "-inf");
+    if (v == 0)
+        v = 0;   /* -0 prints as 0: a sign on zero is noise to a reader */
     if (digits > 0)
         return snprintf(buf, size, "%.*g", digits, v);
     /* 17 significant digits always round-trip a double; fewer usually do

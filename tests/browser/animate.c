@@ -8,9 +8,9 @@
  * step starting from the last two solutions extrapolated, and hands the
  * trajectory to svg_write_animation. Only NH = NQ and NV = 0 mechanisms.
  */
-#include "generator/engine/engine.h"
-#include "generator/pipeline/pipeline.h"
-#include "generator/render/svg_anim.h"
+#include "../../generator/engine/engine.h"
+#include "../../generator/pipeline/pipeline.h"
+#include "../../generator/render/svg_anim.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,0 +1,54 @@
+/* svg_plot.h - line charts of coordinates, velocities or accelerations against time, as SVG. */
+#ifndef MECHC_SVG_PLOT_H
+#define MECHC_SVG_PLOT_H
+
+#include "../model/model.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+/* One curve: n values values[k * stride] (stride 0 means 1), k = 0 .. n-1.
+   NaN and infinite values leave a gap. name is escaped on output. */
+typedef struct SvgSeries {
+    const char *name;
+    const double *values;
+    int stride;
+} SvgSeries;
+
+typedef struct SvgPlotOptions {
+    int width, height;      /* the plot area in px; default 640 x 400 */
+    const char *xlabel;     /* default "t" */
+    const char *ylabel;     /* default none */
+} SvgPlotOptions;
+
+SvgPlotOptions svg_plot_default_options(void);
+
+/* Writes an SVG line chart of the series against t[0..n-1] (finite,
+   non-decreasing): axes, 1-2-5 ticks with labels, grid, legend. Curves with
+   more points than the plot has pixels are reduced to each pixel column's
+   first, lowest, highest and last value, so peaks survive. Returns false,
+   writing nothing, on unusable input (errno = EINVAL) or when writing fails. */
+bool svg_write_plot(FILE *out, const char *title, const double *t, int n,
+                    const SvgSeries *series, int nseries);
+bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
+                        const SvgSeries *series, int nseries, const SvgPlotOptions *opt);
+
+/* A quantity to plot: coordinate coord, derivative order 0 (q), 1 (qd) or 2 (qdd). */
+typedef struct SvgPlotVar {
+    int coord;
+    int order;
+} SvgPlotVar;
+
+/* Parses a --plot-vars list: comma-separated NAME (a coordinate), d(NAME)
+   (its velocity) or dd(NAME) (its acceleration), blanks allowed around
+   items. Fills out[0..max) and returns the count; on error returns -1 with
+   a one-line reason in err (an unknown name is reported with the
+   coordinates that exist). */
+int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
+                     char *err, size_t errlen);
+
+/* The display name of a variable: "crank.phi", "d(crank.phi)", "dd(crank.phi)". */
+void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len);
+
+#endif

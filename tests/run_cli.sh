@@ -1,0 +1,317 @@
+#!/bin/sh
+# tests/run_cli.sh MECHC - `mechc run` from the outside: exit statuses, the
+# CSV header and rows, JSON keys (also after a failure), the failure
+# messages with their times, every example running (or failing the way its
+# header says), engines agreeing, and the firmware path: `mechc gen` output
+# with MECHRT_DEFINE_KERNELS and the runtime built by cc -std=c99 -pedantic,
+# double and float.
+#
+#   sh tests/run_cli.sh build/mechc
+#
+# The last line is "run_cli: N passed, M failed"; the exit status is
+# non-zero on any failure. Checks needing cc or python3 are skipped (and say
+# so) when those are missing.
+set -u
+
+mechc=${1:-build/mechc}
+case $mechc in
+    /*) ;;
+    *) mechc=$(pwd)/$mechc ;;
+esac
+if [ ! -x "$mechc" ]; then
+    echo "run_cli: $mechc is not an executable" >&2
+    exit 2
+fi
+root=$(cd "$(dirname "$0")/.." && pwd)
+ex=$root/examples
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_run_cli.XXXXXX") || exit 2
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 2' INT TERM HUP
+
+pass=0
+fail=0
+have_cc=0
+command -v cc > /dev/null 2>&1 && have_cc=1
+have_python=0
+command -v python3 > /dev/null 2>&1 && have_python=1
+
+# check DESCRIPTION COMMAND...: runs COMMAND, counts the outcome.
+check() {
+    desc=$1
+    shift
+    if "$@"; then
+        pass=$((pass + 1))
+    else
+        fail=$((fail + 1))
+        echo "FAIL: $desc" >&2
+        if [ -s "$tmp/err" ]; then
+            echo "  stderr was:" >&2
+            sed -n '1,6s/^/    /p' "$tmp/err" >&2
+        fi
+    fi
+}
+
+skip() {
+    echo "skip: $1" >&2
+}
+
+# run ARGS...: runs mechc run, stdout to $tmp/out, stderr to $tmp/err, status in $rc.
+run() {
+    "$mechc" run "$@" > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+}
+
+status_is() { [ "$rc" = "$1" ]; }
+err_has() { grep -q -- "$1" "$tmp/err"; }
+out_lines() { [ "$(wc -l < "$tmp/out")" = "$1" ]; }
+out_empty() { [ ! -s "$tmp/out" ]; }
+
+# column NAME FILE: the 1-based index of a CSV column.
+column() {
+    head -1 "$2" | tr ',' '\n' | grep -n -x -F -- "$1" | cut -d: -f1
+}
+
+# value_at T NAME FILE: the value of column NAME in the row whose t is T.
+value_at() {
+    c=$(column "$2" "$3")
+    awk -F, -v t="$1" -v c="$c" 'NR > 1 && $1 == t { print $c }' "$3"
+}
+
+# near A B TOL: |A - B| <= TOL
+near() {
+    awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= tol) }'
+}
+
+# ---- help and usage ------------------------------------------------------
+run --help
+check "run --help exits 0" status_is 0
+check "run --help documents the CSV columns" grep -q "d(crank.x)" "$tmp/out"
+run "$ex/slider_crank.mech" --svg out.svg
+check "--svg: exit 2" status_is 2
+check "--svg: says not implemented" err_has "not implemented"
+run "$ex/slider_crank.mech" --steps 0
+check "--steps 0: exit 2" status_is 2
+run "$ex/slider_crank.mech" --engine warp
+check "--engine warp: exit 2" status_is 2
+run "$ex/slider_crank.mech" --t0 1 --t1 1
+check "empty interval: exit 2" status_is 2
+run "$ex/slider_crank.mech" --ode euler
+check "--ode euler: exit 2" status_is 2
+run "$ex/slider_crank.mech" --tol -1
+check "--tol -1: exit 2" status_is 2
+run "$ex/slider_crank.mech" --csv - --json
+check "--csv - with --json: exit 2" status_is 2
+run "$tmp/missing.mech"
+check "missing file: exit 2" status_is 2
+
+# ---- the slider-crank: CSV -----------------------------------------------
+run "$ex/slider_crank.mech" --steps 8
+check "slider_crank: exit 0" status_is 0
+check "slider_crank: header + 9 rows" out_lines 10
+check "slider_crank: header starts with t and the coordinates" \
+    grep -q '^t,crank\.x,crank\.y,crank\.phi,rod\.x' "$tmp/out"
+check "slider_crank: velocity and acceleration columns" \
+    grep -q ',d(crank\.x),.*,dd(slider\.phi)$' "$tmp/out"
+check "slider_crank: 28 columns" \
+    awk -F, '{ if (NF != 28) exit 1 }' "$tmp/out"
+cp "$tmp/out" "$tmp/sc.csv"
+check "slider_crank: slider.x(0.25) = sqrt(0.08)" \
+    near "$(value_at 0.25 slider.x "$tmp/sc.csv")" 0.28284271247461906 1e-12
+check "slider_crank: slider.x(0.5) = 0.2" \
+    near "$(value_at 0.5 slider.x "$tmp/sc.csv")" 0.2 1e-12
+check "slider_crank: d(slider.x)(0.25) = -omega r" \
+    near "$(value_at 0.25 'd(slider.x)' "$tmp/sc.csv")" -0.62831853071795865 1e-12
+check "slider_crank: last t is exactly 1" \
+    near "$(tail -1 "$tmp/sc.csv" | cut -d, -f1)" 1 0
+check "slider_crank: nothing on stderr" [ ! -s "$tmp/err" ]
+
+run "$ex/slider_crank.mech" --steps 8 --csv "$tmp/file.csv"
+check "--csv FILE: exit 0, stdout empty" out_empty
+check "--csv FILE: same content as stdout" cmp -s "$tmp/file.csv" "$tmp/sc.csv"
+
+run "$ex/slider_crank.mech" --steps 8 --digits 6
+check "--digits 6: 0.282843" [ "$(value_at 0.25 slider.x "$tmp/out")" = "0.282843" ]
+
+run "$ex/slider_crank.mech" --steps 1000 --stats --csv /dev/null
+check "--stats: exit 0" status_is 0
+check "--stats: Newton iterations per step" err_has "Newton iterations per step"
+check "--stats: ns per step" err_has "ns per step"
+check "--stats: cost in all-kernel calls" err_has "a step costs"
+
+# ---- JSON ------------------------------------------------------------------
+run "$ex/slider_crank.mech" --steps 4 --json
+check "--json: exit 0" status_is 0
+if [ "$have_python" = 1 ]; then
+    check "--json: keys and sizes" python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert list(d)[:5] == ["coords", "t", "q", "qd", "qdd"], list(d)
+assert len(d["coords"]) == 9 and d["coords"][6] == "slider.x"
+assert d["t"] == [0, 0.25, 0.5, 0.75, 1]
+assert all(len(d[k]) == 5 and all(len(r) == 9 for r in d[k]) for k in ("q", "qd", "qdd"))
+assert abs(d["q"][2][6] - 0.2) < 1e-12 and d["ok"] is True and "error" not in d
+' "$tmp/out"
+else
+    skip "python3 missing: JSON checks"
+fi
+
+# ---- failures ------------------------------------------------------------
+run "$ex/slider_crank_toggle.mech"
+check "toggle: exit 1" status_is 1
+check "toggle: the message names t = 0.25" err_has "error: t = 0\.25: "
+check "toggle: singular, or no convergence" err_has "singular\|no convergence"
+check "toggle: names slider.x" err_has "slider\.x"
+check "toggle: the 25 states before are written (header + 25)" out_lines 26
+check "toggle: the last row written is t = 0.24" \
+    [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.24" ]
+run "$ex/slider_crank_toggle.mech" --json
+check "toggle --json: exit 1" status_is 1
+if [ "$have_python" = 1 ]; then
+    check "toggle --json: valid, 25 states, ok false, the error's time" python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert len(d["t"]) == 25 and len(d["q"]) == 25 and d["t"][-1] == 0.24
+assert d["ok"] is False and d["error"]["t"] == 0.25
+assert d["error"]["message"].startswith("t = 0.25: ")
+' "$tmp/out"
+fi
+run "$ex/slider_crank_toggle.mech" --t1 0.2
+check "toggle, t1 = 0.2: exit 0" status_is 0
+
+cat > "$tmp/reach.mech" <<'EOF'
+# a point on the unit circle pulled along x past its reach (x = 1 at t = 0.45)
+point p x = 0.55 y = 0.8
+constraint circle: p.x^2 + p.y^2 = 1
+driver pull: p.x = 0.55 + t
+EOF
+run "$tmp/reach.mech" --steps 10
+check "out of reach: exit 1" status_is 1
+check "out of reach: t = 0.5, no convergence" err_has "error: t = 0\.5: .*no convergence"
+check "out of reach: names the row" err_has "row circle"
+check "out of reach: assembly moved the rough initial values: a note" \
+    err_has "note: assembly at t = 0 moved"
+check "out of reach: 5 states written" out_lines 6
+
+run "$ex/parallelogram_redundant.mech"
+check "redundant parallelogram: exit 1 at t = 0, singular" \
+    sh -c '[ "$1" = 1 ] && grep -q "t = 0: .*singular" "$2"' - "$rc" "$tmp/err"
+
+for f in pendulum_distance pendulum_constraint; do
+    run "$ex/$f.mech"
+    check "$f: exit 2" status_is 2
+    check "$f: 1 degree of freedom is not driven" err_has "$f.mech: error: 1 degree of freedom is not driven"
+    check "$f: no output" out_empty
+done
+cat > "$tmp/over.mech" <<'EOF'
+point p x = 0 y = 0
+constraint a: p.x = 0
+constraint b: p.y = 0
+driver c: p.x = t
+EOF
+run "$tmp/over.mech"
+check "one row too many: exit 2" status_is 2
+check "one row too many: says so" err_has "1 more row than coordinates"
+
+# ---- every example runs, or fails as its header says -----------------------
+for f in "$ex"/*.mech; do
+    name=$(basename "$f" .mech)
+    case $name in
+        pendulum_distance|pendulum_constraint) want=2 ;;
+        parallelogram_redundant|slider_crank_toggle) want=1 ;;
+        *) want=0 ;;
+    esac
+    run "$f" --csv /dev/null
+    check "example $name: exit $want" status_is "$want"
+done
+
+# ---- velocity-level rows: integrated positions ----------------------------
+run "$ex/knife_cart.mech" --steps 20
+check "knife_cart: exit 0" status_is 0
+check "knife_cart: (x, y)(0.5) = (0, 1)" sh -c '
+    x=$(awk -F, "NR > 1 && \$1 == 0.5 { print \$2 }" "$1")
+    y=$(awk -F, "NR > 1 && \$1 == 0.5 { print \$3 }" "$1")
+    awk -v x="$x" -v y="$y" "BEGIN { exit !(x*x < 1e-16 && (y-1)*(y-1) < 1e-16) }"' - "$tmp/out"
+check "knife_cart: ends at (-1, 0)" \
+    near "$(value_at 1 cart.x "$tmp/out")" -1 1e-8
+run "$ex/rolling_wheel.mech" --steps 4 --ode rkf45 --ode-tol 1e-9
+check "rolling_wheel (rkf45): x(1) = 1 + pi" \
+    near "$(value_at 1 wheel.x "$tmp/out")" 4.14159265358979 1e-8
+
+# ---- engines agree ---------------------------------------------------------
+"$mechc" run "$ex/four_bar.mech" --steps 20 > "$tmp/jit.csv" 2> "$tmp/err"
+for engine in generic aot; do
+    "$mechc" run "$ex/four_bar.mech" --steps 20 --engine $engine > "$tmp/$engine.csv" 2> "$tmp/err"
+    rc=$?
+    if [ $rc = 2 ] && grep -q "error: .*not available\|error: .*compiler" "$tmp/err"; then
+        skip "--engine $engine not available: $(head -1 "$tmp/err")"
+        continue
+    fi
+    check "four_bar --engine $engine: exit 0" status_is 0
+    check "four_bar: $engine agrees with jit (1e-9)" awk -F, '
+        NR == FNR { for (i = 1; i <= NF; i++) a[FNR, i] = $i; next }
+        FNR == 1 { next }
+        { for (i = 1; i <= NF; i++) { d = $i - a[FNR, i]; if (d < 0) d = -d; if (d > 1e-9) exit 1 } }
+        END { if (FNR != 22) exit 1 }
+    ' "$tmp/jit.csv" "$tmp/$engine.csv"
+done
+
+# ---- firmware: generated C + MECHRT_DEFINE_KERNELS + the runtime ----------
+if [ "$have_cc" = 1 ]; then
+    cat > "$tmp/fw.c" <<'EOF'
+/* what firmware writes: the generated kernels and the runtime, no heap */
+#include <stdio.h>
+#include "fb.h"
+#include "mechrt.h"
+
+MECHRT_DEFINE_KERNELS(fb, FB);
+
+int main(void)
+{
+    static mechrt_real ws[MECHRT_WORKSPACE_LEN(FB_NQ, FB_NR)];
+    mechrt_real q[FB_NQ], qd[FB_NQ] = {0}, qdd[FB_NQ] = {0}, t = 0;
+    MechrtOptions o = mechrt_default_options();
+    MechrtReport r;
+    int i;
+    for (i = 0; i < FB_NQ; i++)
+        q[i] = fb_q0[i];
+    for (i = 0; i <= 100; i++) {
+        mechrt_real tn = (mechrt_real)i / 100;
+        MechrtStatus st = mechrt_step(&fb_kernels, &o, q, qd, qdd, t, i ? tn - t : 0, ws,
+                                      sizeof ws / sizeof *ws, &r);
+        if (st != MECHRT_OK) {
+            printf("t = %g: %s\n", (double)tn, mechrt_strerror(st));
+            return 1;
+        }
+        t = tn;
+        if (i == 25)
+            printf("%.9f %.9f\n", (double)q[6], (double)qd[6]);
+    }
+    return 0;
+}
+EOF
+    for real in double float; do
+        def=""
+        [ $real = float ] && def="-DMECHRT_REAL_FLOAT"
+        if "$mechc" gen "$ex/slider_crank.mech" --prefix fb --real $real \
+                -o "$tmp/fb.c" --header "$tmp/fb.h" 2> "$tmp/err" \
+           && cc -std=c99 -pedantic -Wall -Wextra -Werror -O2 $def -I"$tmp" -I"$root/runtime" \
+                "$tmp/fw.c" "$tmp/fb.c" "$root"/runtime/*.c -lm -o "$tmp/fw_$real" 2> "$tmp/err"; then
+            pass=$((pass + 1))
+            "$tmp/fw_$real" > "$tmp/fw.out" 2> "$tmp/err"
+            set -- $(cat "$tmp/fw.out") "" ""
+            tol=1e-12
+            [ $real = float ] && tol=1e-4
+            check "firmware ($real): slider.x(0.25) = sqrt(0.08)" near "$1" 0.282842712 $tol
+            check "firmware ($real): d(slider.x)(0.25) = -0.2 pi" near "$2" -0.628318531 $tol
+        else
+            fail=$((fail + 1))
+            echo "FAIL: firmware ($real): gen + cc -std=c99 -pedantic -Werror" >&2
+            sed -n '1,10s/^/    /p' "$tmp/err" >&2
+        fi
+    done
+else
+    skip "cc missing: firmware build"
+fi
+
+echo "run_cli: $pass passed, $fail failed"
+[ "$fail" = 0 ]
