@@ -467,7 +467,7 @@ static void test_format(void **state)
     NodeId yy = dag_mul(d, f->y, f->y);
     NodeId e = dag_sub(d, dag_add(d, yy, xx), K(f, 4.0));
     dag_format(d, e, names, &sb);
-    assert_string_equal(sb.data, "m.x * m.x + m.y * m.y - 4");
+    assert_string_equal(sb.data, "m.x*m.x + m.y*m.y - 4");
     sb_clear(&sb);
     dag_format(d, dag_sub(d, f->x, dag_sub(d, f->y, dag_time(d))), NULL, &sb);
     assert_string_equal(sb.data, "q[0] - (q[1] - t)");
@@ -475,7 +475,7 @@ static void test_format(void **state)
     NodeId at = dag_call(d, OP_ATAN2, f->y, f->x);     /* built first: the smaller id */
     NodeId yd = dag_vard(d, 1);
     dag_format(d, dag_mul(d, yd, at), names, &sb);
-    assert_string_equal(sb.data, "atan2(m.y, m.x) * der(m.y)");
+    assert_string_equal(sb.data, "atan2(m.y, m.x)*der(m.y)");
     sb_clear(&sb);
     dag_format(d, dag_neg(d, dag_pow(d, f->x, K(f, 2.5))), names, &sb);
     assert_string_equal(sb.data, "-m.x^2.5");

@@ -72,86 +72,13 @@ static double sample_state(uint64_t *s, const double *center, int nq, double *q)
     return rng_uniform(s);
 }
 
-/* ---- formatting with shortest round-trip numbers ---- */
-
-static void format_number(StrBuf *out, double v)
-{
-    char buf[40];
-    for (int prec = 1; prec <= 17; prec++) {
-        snprintf(buf, sizeof buf, "%.*g", prec, v);
-        if (strtod(buf, NULL) == v)
-            break;
-    }
-    if (v < 0)
-        sb_printf(out, "(%s)", buf);
-    else
-        sb_puts(out, buf);
-}
-
-static int precedence(DagOp op)
-{
-    switch (op) {
-    case OP_ADD: case OP_SUB: return 1;
-    case OP_MUL: case OP_DIV: return 2;
-    case OP_NEG: return 3;
-    case OP_POW: return 4;
-    default: return 5;
-    }
-}
-
-static void format_node(const Dag *dag, NodeId id, const char *const *names, StrBuf *out, int depth)
-{
-    const DagNode *n = dag_node(dag, id);
-    DagOp op = (DagOp)n->op;
-    if (depth > 200) {
-        sb_puts(out, "...");
-        return;
-    }
-    switch (op) {
-    case OP_CONST: format_number(out, n->value); return;
-    case OP_VAR:   sb_puts(out, names[n->a]); return;
-    case OP_VARD:  sb_printf(out, "der(%s)", names[n->a]); return;
-    case OP_TIME:  sb_putc(out, 't'); return;
-    case OP_NEG: {
-        bool paren = precedence(dag_op(dag, n->a)) <= precedence(op);
-        sb_puts(out, paren ? "-(" : "-");
-        format_node(dag, n->a, names, out, depth + 1);
-        if (paren)
-            sb_putc(out, ')');
-        return;
-    }
-    case OP_ADD: case OP_SUB: case OP_MUL: case OP_DIV: case OP_POW: {
-        int p = precedence(op);
-        int pl = precedence(dag_op(dag, n->a)), pr = precedence(dag_op(dag, n->b));
-        bool paren_l = op == OP_POW ? pl <= p : pl < p;
-        bool paren_r = op == OP_POW ? pr < p : (op == OP_SUB || op == OP_DIV) ? pr <= p : pr < p;
-        if (paren_l) sb_putc(out, '(');
-        format_node(dag, n->a, names, out, depth + 1);
-        if (paren_l) sb_putc(out, ')');
-        sb_printf(out, op == OP_POW ? "%s" : op == OP_MUL || op == OP_DIV ? "%s" : " %s ",
-                  dag_op_info[op].spelling);
-        if (paren_r) sb_putc(out, '(');
-        format_node(dag, n->b, names, out, depth + 1);
-        if (paren_r) sb_putc(out, ')');
-        return;
-    }
-    default:
-        sb_printf(out, "%s(", dag_op_info[op].spelling);
-        format_node(dag, n->a, names, out, depth + 1);
-        if (dag_op_info[op].arity == 2) {
-            sb_puts(out, ", ");
-            format_node(dag, n->b, names, out, depth + 1);
-        }
-        sb_putc(out, ')');
-        return;
-    }
-}
+/* ---- formatting ---- */
 
 char *analysis_format(const Dag *dag, NodeId id, const char *const *coord_names)
 {
     StrBuf sb;
     sb_init(&sb);
-    format_node(dag, id, coord_names, &sb, 0);
+    dag_format(dag, id, coord_names, &sb);
     return sb_take(&sb);
 }
 

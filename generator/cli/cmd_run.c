@@ -10,6 +10,9 @@
 
 #include "../analysis/run.h"
 #include "../base/arena.h"
+#include "../render/progress.h"
+#include "../render/svg_anim.h"
+#include "../render/svg_plot.h"
 
 #include <errno.h>
 #include <math.h>
@@ -46,7 +49,13 @@ static const char usage[] =
     "  --ode-tol X      its error per step, absolute and relative (default 1e-10)\n"
     "  --stats          print time per step, Newton iterations per step and the\n"
     "                   step's cost in evaluations of the fused `all` kernel\n"
-    "  --svg FILE       (not implemented yet)\n"
+    "  --svg FILE       write an animated SVG of the motion (plays in any browser)\n"
+    "  --trace B(sx,sy) draw the path of the point (sx, sy) of body B in the\n"
+    "                   animation (repeatable; a point particle: --trace m)\n"
+    "  --plot FILE      write an SVG chart of variables against time\n"
+    "  --plot-vars LIST what --plot shows: coordinate names, d(NAME) for a\n"
+    "                   velocity, dd(NAME) for an acceleration (default: every\n"
+    "                   coordinate)\n"
     "\n"
     "CSV columns: t, then every coordinate by name (crank.x, ...), then the\n"
     "velocities d(crank.x), ..., then the accelerations dd(crank.x), ...\n"
@@ -58,8 +67,10 @@ static const char usage[] =
 /* Where the states go. */
 typedef struct Output {
     FILE *csv;              /* NULL: no CSV */
-    MechrtTrace trace;      /* JSON rows, when json */
+    MechrtTrace trace;      /* kept rows, for JSON and pictures */
     bool json, trace_full;
+    Progress progress;
+    double t0, t1;
     int digits;
     int nq;
 } Output;
@@ -71,6 +82,57 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
         mechrt_csv_row(out->csv, out->nq, t, q, qd, qdd, out->digits);
     if (out->json && !mechrt_trace_push(&out->trace, t, q, qd, qdd))
         out->trace_full = true;
+    if (out->t1 != out->t0)
+        progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
+}
+
+enum { MAX_TRACES = 16, MAX_PLOT_VARS = 64 };
+
+/* The animation and the chart, from the kept rows [t, q, qd, qdd]. */
+static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *svg_path,
+                           const SvgTrace *traces, int ntraces, const char *plot_path,
+                           const SvgPlotVar *vars, int nvars)
+{
+    size_t n = tr->rows, nq = (size_t)m->nq, w = 1 + 3 * nq;
+    bool ok = true;
+    if (n == 0)
+        return true;
+    double *t = xcalloc(n, sizeof *t), *q = xcalloc(n * nq, sizeof *q);
+    for (size_t k = 0; k < n; k++) {
+        t[k] = tr->data[k * w];
+        memcpy(q + k * nq, tr->data + k * w + 1, nq * sizeof *q);
+    }
+    const char *paths[2] = {svg_path, plot_path};
+    for (int which = 0; which < 2; which++) {
+        if (!paths[which])
+            continue;
+        FILE *f = fopen(paths[which], "w");
+        if (!f) {
+            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", paths[which], strerror(errno));
+            ok = false;
+            continue;
+        }
+        bool wrote;
+        if (which == 0) {
+            wrote = svg_write_animation(f, m, t, q, (int)n, traces, ntraces, m->name);
+        } else {
+            SvgSeries series[MAX_PLOT_VARS];
+            char names[MAX_PLOT_VARS][96];
+            for (int i = 0; i < nvars; i++) {
+                svg_plot_var_name(m, vars[i], names[i], sizeof names[i]);
+                series[i] = (SvgSeries){names[i], tr->data + 1 + (size_t)vars[i].order * nq
+                                                  + (size_t)vars[i].coord, (int)w};
+            }
+            wrote = svg_write_plot(f, m->name, t, (int)n, series, nvars);
+        }
+        if (fclose(f) != 0 || !wrote) {
+            fprintf(stderr, "mechc run: error: writing '%s' failed\n", paths[which]);
+            ok = false;
+        }
+    }
+    free(t);
+    free(q);
+    return ok;
 }
 
 static bool positive_option(Args *a, const char *opt, double *out, bool allow_zero)
@@ -135,7 +197,9 @@ int cmd_run(int argc, char **argv)
     Args a;
     args_init(&a, "run", argc, argv);
     RunOptions ro = run_default_options();
-    const char *csv_path = NULL, *opt;
+    const char *csv_path = NULL, *svg_path = NULL, *plot_path = NULL, *plot_list = NULL, *opt;
+    const char *trace_text[MAX_TRACES];
+    int ntraces = 0;
     bool json = false, stats = false;
     int engine = ENGINE_JIT, digits = 0;
     double x;
@@ -164,8 +228,19 @@ int cmd_run(int argc, char **argv)
         } else if (strcmp(opt, "--json") == 0) {
             json = true;
         } else if (strcmp(opt, "--svg") == 0) {
-            fprintf(stderr, "mechc run: error: --svg is not implemented yet; use --csv or --json\n");
-            a.failed = true;
+            svg_path = args_value(&a, opt);
+        } else if (strcmp(opt, "--trace") == 0) {
+            const char *v = args_value(&a, opt);
+            if (v && ntraces == MAX_TRACES) {
+                fprintf(stderr, "mechc run: error: at most %d --trace points\n", MAX_TRACES);
+                a.failed = true;
+            } else if (v) {
+                trace_text[ntraces++] = v;
+            }
+        } else if (strcmp(opt, "--plot") == 0) {
+            plot_path = args_value(&a, opt);
+        } else if (strcmp(opt, "--plot-vars") == 0) {
+            plot_list = args_value(&a, opt);
         } else if (strcmp(opt, "--digits") == 0) {
             args_int(&a, opt, 1, 17, &digits);
         } else if (strcmp(opt, "--tol") == 0) {
@@ -200,7 +275,13 @@ int cmd_run(int argc, char **argv)
         fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", ro.t0);
         return EXIT_USAGE;
     }
-    bool csv_stdout = csv_path ? strcmp(csv_path, "-") == 0 : !json;
+    if ((ntraces > 0 && !svg_path) || (plot_list && !plot_path)) {
+        fprintf(stderr, "mechc run: error: %s goes with %s\n", ntraces ? "--trace" : "--plot-vars",
+                ntraces ? "--svg FILE" : "--plot FILE");
+        return EXIT_USAGE;
+    }
+    bool pictures = svg_path || plot_path;
+    bool csv_stdout = csv_path ? strcmp(csv_path, "-") == 0 : !json && !pictures;
     if (csv_stdout && json) {
         fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
         return EXIT_USAGE;
@@ -213,6 +294,28 @@ int cmd_run(int argc, char **argv)
         return EXIT_USAGE;
     }
     const Model *m = mech->model;
+    SvgTrace traces[MAX_TRACES];
+    SvgPlotVar vars[MAX_PLOT_VARS];
+    int nvars = 0;
+    char err[256];
+    for (int i = 0; i < ntraces; i++) {
+        if (!svg_parse_trace(m, trace_text[i], &traces[i], err, sizeof err)) {
+            fprintf(stderr, "mechc run: error: %s\n", err);
+            pipeline_free(mech);
+            return EXIT_USAGE;
+        }
+    }
+    if (plot_path && plot_list) {
+        nvars = svg_plot_resolve(m, plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
+        if (nvars <= 0) {
+            fprintf(stderr, "mechc run: error: %s\n", err);
+            pipeline_free(mech);
+            return EXIT_USAGE;
+        }
+    } else if (plot_path) {
+        for (int i = 0; i < m->nq && nvars < MAX_PLOT_VARS; i++)
+            vars[nvars++] = (SvgPlotVar){i, 0};
+    }
     Engine e;
     if (!engine_open(&e, (EngineKind)engine, mech, &diag)) {
         fprintf(stderr, "mechc run: error: %s\n", diag.message);
@@ -220,7 +323,8 @@ int cmd_run(int argc, char **argv)
         return EXIT_USAGE;
     }
 
-    Output out = {.csv = NULL, .json = json, .digits = digits, .nq = m->nq};
+    Output out = {.csv = NULL, .json = json || pictures, .digits = digits, .nq = m->nq,
+                  .t0 = ro.t0, .t1 = ro.t1};
     mechrt_trace_init(&out.trace, m->nq);
     int status = EXIT_OK;
     /* a mechanism that cannot run (row count) leaves no output file behind */
@@ -247,12 +351,17 @@ int cmd_run(int argc, char **argv)
     LastState last = {&out, ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
+    progress_start(&out.progress, "run", 1000);
     RunStatus rs = run_analysis(m, &k, &ro, on_state_keep, &last, &res);
+    progress_finish(&out.progress);
 
     if (rs == RUN_BAD_INPUT) {
         fprintf(stderr, "%s: error: %s\n", m->file, res.message);
         status = EXIT_USAGE;
     } else {
+        if (pictures && !write_pictures(m, &out.trace, svg_path, traces, ntraces, plot_path,
+                                        vars, nvars))
+            status = EXIT_USAGE;
         if (json)
             mechrt_json_write(stdout, &out.trace, m->coord_names, digits,
                               rs == RUN_FAILED ? res.message : NULL, res.t_fail);

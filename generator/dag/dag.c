@@ -13,6 +13,7 @@
 #include "../base/strbuf.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -503,12 +504,16 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
         return;
     }
     switch (op) {
-    case OP_CONST:
-        if (n->value < 0)
-            sb_printf(out, "(%.17g)", n->value);
-        else
-            sb_printf(out, "%.17g", n->value);
+    case OP_CONST: {
+        char buf[40];               /* the fewest digits that read back exactly */
+        for (int prec = 1; prec <= 17; prec++) {
+            snprintf(buf, sizeof buf, "%.*g", prec, n->value);
+            if (strtod(buf, NULL) == n->value)
+                break;
+        }
+        sb_printf(out, n->value < 0 ? "(%s)" : "%s", buf);
         return;
+    }
     case OP_VAR:
         if (names)
             sb_puts(out, names[n->a]);
@@ -543,7 +548,8 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
         if (paren_l) sb_putc(out, '(');
         format_node(dag, n->a, names, out, depth + 1);
         if (paren_l) sb_putc(out, ')');
-        sb_printf(out, op == OP_POW ? "%s" : " %s ", dag_op_info[op].spelling);
+        /* x*y and x/y tight, x + y spaced: reads like the .mech file */
+        sb_printf(out, op == OP_ADD || op == OP_SUB ? " %s " : "%s", dag_op_info[op].spelling);
         if (paren_r) sb_putc(out, '(');
         format_node(dag, n->b, names, out, depth + 1);
         if (paren_r) sb_putc(out, ')');
