@@ -109,13 +109,9 @@ check-valgrind: deps $(TESTS)
 # (tests/browser/run); installs Debian's chromium first when missing.
 .PHONY: check-browser
 check-browser: deps
-	$(Q)sh .ci/deps-browser
-	$(Q)$(MAKE) --no-print-directory $(BUILD)/tests/browser/animate $(BUILD)/tests/browser/pngdiff
+	$(Q)sh .ci/deps browser
+	$(Q)$(MAKE) --no-print-directory $(MECHC) $(BUILD)/tests/browser/pngdiff
 	$(Q)sh tests/browser/run $(BUILD)
-
-$(BUILD)/tests/browser/animate: tests/browser/animate.c $(LIB)
-	@mkdir -p $(dir $@)
-	$(Q)$(CC) $(CFLAGS_TOOL) $(LDFLAGS_TOOL) $< $(LIB) $(LDLIBS_TOOL) -o $@
 
 $(BUILD)/tests/browser/pngdiff: tests/browser/pngdiff.c
 	@mkdir -p $(dir $@)

@@ -86,9 +86,19 @@ near() {
 run --help
 check "run --help exits 0" status_is 0
 check "run --help documents the CSV columns" grep -q "d(crank.x)" "$tmp/out"
-run "$ex/slider_crank.mech" --svg out.svg
-check "--svg: exit 2" status_is 2
-check "--svg: says not implemented" err_has "not implemented"
+run "$ex/slider_crank.mech" --svg "$tmp/anim.svg" --trace 'rod(0, 0)' --plot "$tmp/plot.svg" --plot-vars 'slider.x,d(slider.x)'
+check "--svg: exit 0" status_is 0
+check "--svg: no CSV on stdout when only pictures are asked for" out_empty
+check "--svg: an animated SVG" grep -q "<animate" "$tmp/anim.svg"
+check "--svg --trace: the path is drawn" grep -q "path of rod(0, 0)" "$tmp/anim.svg"
+check "--plot: a chart with the legend entry" grep -q "d(slider.x)" "$tmp/plot.svg"
+run "$ex/slider_crank.mech" --trace 'rod(0, 0)'
+check "--trace without --svg: exit 2" status_is 2
+run "$ex/slider_crank.mech" --plot "$tmp/p2.svg" --plot-vars 'nothing.x'
+check "--plot-vars with an unknown name: exit 2" status_is 2
+check "--plot-vars with an unknown name: names it" err_has "nothing"
+run "$ex/slider_crank.mech" --svg "$tmp/a2.svg" --trace 'ghost(0,0)'
+check "--trace of an unknown body: exit 2" status_is 2
 run "$ex/slider_crank.mech" --steps 0
 check "--steps 0: exit 2" status_is 2
 run "$ex/slider_crank.mech" --engine warp
