@@ -244,6 +244,8 @@ static void fd_second(VecFn *f, int n, double h, double *out)
     }
 }
 
+static double second_step(const Checker *c);
+
 static void check_fd(Checker *c, double *scratch, double *vec)
 {
     const CheckOptions *o = c->opt;
@@ -279,7 +281,7 @@ static void check_fd(Checker *c, double *scratch, double *vec)
     /* gamma */
     if (nh > 0) {
         vecfn_init(&f, c, FD_PHI_PATH, -1, true, true, scratch);
-        fd_second(&f, nh, o->fd_step2, vec);
+        fd_second(&f, nh, second_step(c), vec);
         for (int i = 0; i < nh; i++)
             record(c, CHECK_GAMMA_FD, i, -1, u[QTY_GAMMA][i], -vec[i]);
     }
@@ -393,6 +395,17 @@ static void hint_nu(const Checker *c, CheckItem *it)
         snprintf(it->hint, sizeof it->hint, "no classic pattern: check the row's time dependence");
 }
 
+/* The second difference's step: its rounding error grows like
+   eps |q| / h^2 (rows are differences of coordinates of size |q|), its
+   truncation error like h^4, so the best h grows like |q|^(1/6). */
+static double second_step(const Checker *c)
+{
+    double qmax = 1.0;
+    for (int i = 0; i < c->nq; i++)
+        qmax = fmax(qmax, fabs(c->q[i]));
+    return c->opt->fd_step2 * pow(qmax, 1.0 / 6.0);
+}
+
 /* -(d/dtau)^2 of one position row (or -d/dtau of one velocity row) along
    the path with only q moving, or only t. */
 static double gamma_part(Checker *c, int row, bool path_q, bool path_t, double *scratch, double *vec)
@@ -400,7 +413,7 @@ static double gamma_part(Checker *c, int row, bool path_q, bool path_t, double *
     VecFn f;
     if (row < c->nh) {
         vecfn_init(&f, c, FD_PHI_PATH, -1, path_q, path_t, scratch);
-        fd_second(&f, c->nh, c->opt->fd_step2, vec);
+        fd_second(&f, c->nh, second_step(c), vec);
         return -vec[row];
     }
     vecfn_init(&f, c, FD_PSI_PATH, -1, path_q, path_t, scratch);

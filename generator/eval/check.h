@@ -31,7 +31,8 @@ typedef struct CheckOptions {
     double spread_q;        /* q = q_assembled + U(-s, s), coordinate units (default 0.05) */
     double spread_qd;       /* qd = U(-s, s) (default 1) */
     double fd_step;         /* first step of gsl_deriv_central (default 1e-4) */
-    double fd_step2;        /* step of the second difference for gamma (default 2e-3) */
+    double fd_step2;        /* step of the second difference for gamma, times
+                               max(1, |q|)^(1/6) (default 2e-3) */
     bool use_aot;           /* compare the aot engine too when a compiler exists (default true) */
     CheckFault fault;       /* tests only (default none) */
 } CheckOptions;

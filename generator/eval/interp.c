@@ -193,19 +193,26 @@ Jet tape_jet(const Tape *p, const Seed *s, int order, Jet *reg)
 {
     for (int k = 0; k < p->n; k++) {
         const Instr *in = &p->code[k];
+        switch ((DagOp)in->op) {    /* leaves: a is a coordinate, not a register */
+        case OP_CONST:
+            reg[k] = (Jet){in->value, 0.0, 0.0};
+            continue;
+        case OP_VAR:
+            reg[k] = (Jet){s->q[in->a], s->dq ? s->dq[in->a] : (in->a == s->col_q ? 1.0 : 0.0), 0.0};
+            continue;
+        case OP_VARD:
+            reg[k] = (Jet){s->qd ? s->qd[in->a] : 0.0, in->a == s->col_qd ? 1.0 : 0.0, 0.0};
+            continue;
+        case OP_TIME:
+            reg[k] = (Jet){s->t, s->dt, 0.0};
+            continue;
+        default:
+            break;
+        }
         Jet a = reg[in->a], b = reg[in->b], r;
         switch ((DagOp)in->op) {
-        case OP_CONST:
-            r = (Jet){in->value, 0.0, 0.0};
-            break;
-        case OP_VAR:
-            r = (Jet){s->q[in->a], s->dq ? s->dq[in->a] : (in->a == s->col_q ? 1.0 : 0.0), 0.0};
-            break;
-        case OP_VARD:
-            r = (Jet){s->qd ? s->qd[in->a] : 0.0, in->a == s->col_qd ? 1.0 : 0.0, 0.0};
-            break;
-        case OP_TIME:
-            r = (Jet){s->t, s->dt, 0.0};
+        case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME:
+            r = a;      /* handled above */
             break;
         case OP_NEG:
             r = (Jet){-a.v, -a.d, -a.dd};
