@@ -106,6 +106,17 @@ static NodeId intern(Dag *dag, DagOp op, int32_t a, int32_t b, double value)
     return id;
 }
 
+NodeId dag_find(const Dag *dag, DagOp op, NodeId a, NodeId b)
+{
+    if (!dag->table_cap)
+        return DAG_NONE;
+    uint32_t mask = dag->table_cap - 1;
+    for (uint32_t h = hash_key(op, a, b, 0.0) & mask; dag->table[h] >= 0; h = (h + 1) & mask)
+        if (same_key(&dag->nodes[dag->table[h]], op, a, b, 0.0))
+            return dag->table[h];
+    return DAG_NONE;
+}
+
 void dag_init(Dag *dag, int32_t max_nodes, Diag *diag)
 {
     memset(dag, 0, sizeof *dag);

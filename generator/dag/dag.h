@@ -57,6 +57,9 @@ NodeId dag_mul(Dag *dag, NodeId a, NodeId b);
 NodeId dag_div(Dag *dag, NodeId a, NodeId b);
 NodeId dag_pow(Dag *dag, NodeId a, NodeId b);   /* small integer powers become products */
 NodeId dag_call(Dag *dag, DagOp fn, NodeId a, NodeId b);  /* b = DAG_NONE for unary */
+/* The node (op, a, b) when it exists, else DAG_NONE; never creates one. */
+NodeId dag_find(const Dag *dag, DagOp op, NodeId a, NodeId b);
+
 /* Any operator or function by op (what the AST lowering uses). */
 NodeId dag_apply(Dag *dag, DagOp op, NodeId a, NodeId b);
 

@@ -203,6 +203,19 @@ static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top)
     }
 }
 
+/* For the JIT: the cos node of a sin node (or the reverse) when both have
+   a temporary in this chunk, so one sincos call computes the pair (libtcc
+   calls what is written; gcc merges such pairs itself, and sincos is not
+   C99, so file output never uses it). */
+static NodeId sincos_partner(const Emitter *e, NodeId id)
+{
+    DagOp op = dag_op(e->dag, id);
+    if (!e->opt->declare_math || e->opt->real_float || (op != OP_SIN && op != OP_COS))
+        return DAG_NONE;
+    NodeId other = dag_find(e->dag, op == OP_SIN ? OP_COS : OP_SIN, dag_node(e->dag, id)->a, -1);
+    return other != DAG_NONE && e->sched.temp[other] >= 0 ? other : DAG_NONE;
+}
+
 /* The statements of one chunk: temporaries in id order, then the stores. */
 static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
                       EmitFunction which)
@@ -227,6 +240,17 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         NodeId id = c->nodes[i];
         if (e->sched.temp[id] < 0)
             continue;
+        NodeId partner = sincos_partner(e, id);
+        if (partner != DAG_NONE && partner < id)
+            continue;                       /* written with its partner */
+        if (partner != DAG_NONE) {
+            bool is_sin = dag_op(e->dag, id) == OP_SIN;
+            int ts = e->sched.temp[is_sin ? id : partner], tc = e->sched.temp[is_sin ? partner : id];
+            sb_printf(sb, "    %s_real u%d, u%d;\n    sincos(", e->prefix, ts, tc);
+            put_expr(e, sb, dag_node(e->dag, id)->a, false);
+            sb_printf(sb, ", &u%d, &u%d);\n", ts, tc);
+            continue;
+        }
         sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
         put_expr(e, sb, id, true);
         sb_puts(sb, ";\n");
@@ -237,6 +261,8 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         put_expr(e, sb, o->value, false);
         sb_puts(sb, ";\n");
     }
+    for (int i = 0; i < c->nnodes; i++)     /* temporaries end with their chunk */
+        e->sched.temp[c->nodes[i]] = -1;
 }
 
 /* "q, qd, t, gamma" -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
@@ -298,7 +324,7 @@ static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutp
             add_output(outs, n, "phi", r, kin->phi[r]);
         for (int k = kin->row_start[r]; k < kin->row_start[r + 1]; k++) {
             const JacEntry *j = &kin->jac[k];
-            if (all)
+            if (all || which == EMIT_JAC)
                 add_output(outs, n, "jac", j->row * m->nq + j->col, j->value);
             else if (which == EMIT_JAC_NZ)
                 add_output(outs, n, "vals", k, j->value);
@@ -381,7 +407,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
-        if (f == EMIT_JAC || too_big)   /* the template builds jac on jac_nz */
+        if ((f == EMIT_JAC && !opt->direct_jac) || too_big)  /* jac_spread.tmpl: on jac_nz */
             continue;
         SchedOutput *outs;
         int n;
@@ -406,11 +432,14 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
                          "the limit (see --max-code-ops)", opt->max_ops);
         return false;
     }
-    out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
-    out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
+    if (!opt->direct_jac) {
+        out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
+        out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
+    }
 
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface;
-    StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface};
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac;
+    StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
+                          &zero, &jac};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
@@ -436,8 +465,15 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         for (int op = OP_POW; op < OP_COUNT; op++)
             sb_printf(&math, "double %s(double%s);\n", dag_op_info[op].c_double,
                       dag_op_info[op].arity == 2 ? ", double" : "");
+        sb_puts(&math, "void sincos(double, double *, double *);\n");
+        sb_puts(&math, "void *memset(void *, int, unsigned long);\n");
+        /* libtcc compiles loops as written: a library zero-fill is faster */
+        sb_printf(&zero, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", out->prefix,
+                  upper, upper);
     } else {
         sb_puts(&math, "#include <math.h>\n");
+        sb_printf(&zero, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;",
+                  upper, upper);
     }
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
@@ -459,10 +495,16 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         {"NU_PARTS", parts[EMIT_NU].data}, {"NU_BODY", bodies[EMIT_NU].data},
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
+        {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
+        {"ZERO_JAC", zero.data}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     const char *bad = template_render(&iface, template_interface, vars, nvars);
     vars[11].value = iface.data;                    /* INTERFACE */
+    if (!bad)
+        bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
+                              vars, nvars);
+    vars[nvars - 1].value = jac.data;               /* JAC */
     StrBuf header, source;
     sb_init(&header);
     sb_init(&source);

@@ -13,6 +13,9 @@ typedef struct EmitOptions {
     bool real_float;            /* float kernels (sinf, 1.5f, ...) */
     const char *header_name;    /* non-NULL: the .c includes this header
                                    instead of carrying the interface */
+    bool direct_jac;            /* dense jac with its own stores (fast
+                                   under libtcc) rather than spread from
+                                   jac_nz (half the code for gcc -O2) */
     bool declare_math;          /* declare libm functions instead of
                                    #include <math.h> (the in-process JIT
                                    needs no system headers) */

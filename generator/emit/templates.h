@@ -3,6 +3,8 @@
 #define MECHC_TEMPLATES_H
 
 extern const char template_interface[];
+extern const char template_jac_direct[];
+extern const char template_jac_spread[];
 extern const char template_mech_c[];
 extern const char template_mech_h[];
 

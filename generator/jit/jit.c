@@ -4,6 +4,7 @@
  * including <math.h>, and is compiled with -nostdlib: nothing is read
  * from the file system, and every external symbol is one we add here.
  */
+#define _GNU_SOURCE 1     /* sincos */
 #include "jit.h"
 
 #include "../base/arena.h"
@@ -38,6 +39,8 @@ static void add_libm(TCCState *s)
         tcc_add_symbol(s, unary_names[i], (const void *)unary[i]);
     tcc_add_symbol(s, "pow", (const void *)pow);
     tcc_add_symbol(s, "atan2", (const void *)atan2);
+    tcc_add_symbol(s, "memset", (const void *)memset);
+    tcc_add_symbol(s, "sincos", (const void *)sincos);
 }
 
 /* Keeps the source of a failed compile for the bug report. */
