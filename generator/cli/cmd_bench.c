@@ -8,6 +8,8 @@
  */
 #include "cli.h"
 
+#include "../render/progress.h"
+
 #include "../base/arena.h"
 #include "../engine/engine.h"
 #include "../eval/aot.h"
@@ -90,7 +92,9 @@ static void measure(Bench *b, int repeat)
             b->batch[k][fn] = n;
         }
     }
-    for (int r = 0; r < repeat; r++)
+    Progress progress;
+    progress_start(&progress, "bench", repeat);
+    for (int r = 0; r < repeat; r++, progress_update(&progress, r))
         for (int i = 0; i < ENGINE_KIND_COUNT; i++) {
             EngineKind k = order[i];
             if (!b->open[k])
@@ -99,6 +103,7 @@ static void measure(Bench *b, int repeat)
                 if (has_fn(b, k, fn))
                     b->ns[k][fn][r] = 1e9 * time_batch(b, k, fn, b->batch[k][fn]) / (double)b->batch[k][fn];
         }
+    progress_finish(&progress);
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         for (int fn = 0; fn < FN_COUNT && b->open[k]; fn++) {
             if (!has_fn(b, k, fn))
