@@ -23,7 +23,9 @@ static const char usage[] =
     "  --chunk N         most operations per C function before it is split into\n"
     "                    static parts, counting operations and stores (default 150;\n"
     "                    keeps optimizing compilers fast)\n"
-    "  --stats           print the operation count of each function to stderr\n"
+    "  --stats           print to stderr the operation count of each function and\n"
+    "                    the time of each stage, including an in-process libtcc\n"
+    "                    compile of the kernels (what eval and run do)\n"
     "  --dump rows       print each row as an expression of q[i], qd[i] and t\n"
     "                    (Phi, or Psi for velocity rows) instead of C\n";
 
@@ -167,6 +169,17 @@ int cmd_gen(int argc, char **argv)
             fprintf(stderr, " %s %d%s", emit_function_names[f], res.ops[f], f + 1 < EMIT_FUNCTION_COUNT ? "," : "\n");
         fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
                 (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
+        EmitResult jit_src;
+        double jit_emit = 0, jit_tcc = 0;
+        Jit *jit = pipeline_jit(mech, &jit_src, &jit_emit, &jit_tcc, &diag);
+        if (jit)
+            fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
+                    "file to machine code %.3f s\n", jit_emit, jit_tcc,
+                    mech->load_seconds + mech->diff_seconds + jit_emit + jit_tcc);
+        else
+            fprintf(stderr, "mechc gen: %s\n", diag.message);
+        jit_free(jit);
+        emit_result_free(&jit_src);
     }
     emit_result_free(&res);
     pipeline_free(mech);
