@@ -47,6 +47,7 @@ help:
 	@echo "make check-asan the same tests under AddressSanitizer and UBSan"
 	@echo "make check-valgrind  the cmocka suites under valgrind memcheck"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
+	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
 	@echo "make bench      time the engines side by side (bench/run)"
 	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
 
@@ -116,6 +117,17 @@ check-browser: deps
 $(BUILD)/tests/browser/pngdiff: tests/browser/pngdiff.c
 	@mkdir -p $(dir $@)
 	$(Q)$(CC) $(CFLAGS_TOOL) $< -lz -o $@
+
+# The firmware example (examples/firmware/README.md): the Cortex-M4F and
+# Cortex-M3 images run under QEMU's MPS2 boards and compared with the host
+# run, then tests/firmware_rules.sh with the Cortex-M builds. Installs the
+# cross toolchain and QEMU first when missing (.ci/deps firmware).
+.PHONY: firmware-check
+firmware-check: deps $(MECHC)
+	$(Q)sh .ci/deps firmware
+	$(Q)$(MAKE) --no-print-directory -C examples/firmware check \
+	  MECHC=$(abspath $(MECHC)) OUT=$(abspath $(BUILD))/firmware
+	$(Q)sh tests/firmware_rules.sh $(MECHC)
 
 # libFuzzer over the whole front end (tests/fuzz/README.md). New inputs go
 # to $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.

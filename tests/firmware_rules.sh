@@ -1,0 +1,451 @@
+#!/bin/sh
+# tests/firmware_rules.sh MECHC - checks the promise of spec section 4 on the
+# compiled objects, not only on the text: generated kernels and the runtime
+# core build as freestanding C99 and need nothing but <math.h>.
+#
+#   sh tests/firmware_rules.sh build/mechc
+#
+# For every examples/*.mech (and a synthetic mechanism that uses every
+# function of the file format) in double and float:
+#   - `mechc gen` output compiles with cc -std=c99 -O2 -ffreestanding
+#     -Wall -Wextra -Wpedantic -Wconversion -Wdouble-promotion -Wvla -Werror
+#     (float code: float literals and sinf/cosf..., no promotion to double;
+#     no variable-length arrays);
+#   - the source includes only <math.h> and its own header, and names no
+#     allocation, stdio or other library call; `static` appears only as
+#     `static const` data or in the PART macro of helper functions;
+#   - nm: every undefined symbol is a <math.h> function of the right
+#     precision, or memset/memcpy/memmove/memcmp, which GCC documents that
+#     every freestanding environment must provide and may call for zeroing
+#     or copying loops (GCC 12 emits none here under -ffreestanding; hosted
+#     -O2 builds do call memset for the Jacobian's zero fill, and glibc
+#     hosts merge sin/cos into sincos, which newlib also has);
+#   - no writable data: no D/d/B/b/C/G/g/S/s symbols, empty .data and .bss
+#     (objects built -fno-pie: position-independent code would move the
+#     name tables' pointers to .data.rel.ro);
+#   - every defined symbol starts with the prefix (several mechanisms link
+#     into one image);
+#   - call graph (objdump -dr): no indirect call, every call goes to the
+#     object's own functions (the _partN helpers, fb_jac -> fb_jac_nz) or
+#     to an allowed libm function, and the graph has no cycle: no recursion.
+# The runtime core (runtime/*.c, not runtime/host/) in double and float:
+# the same flags, no undefined symbol but mechrt's own and mem*, no writable
+# data, an acyclic direct-call graph (its indirect calls are the kernels,
+# by design), exported names mechrt_* (double) or mechrtf_* (float).
+# Linking: slider_crank (prefix sc) + four_bar (prefix fb) + the runtime in
+# one program, run and checked against known values; and the same two in
+# double with four_bar as fbf in float and both runtime builds (mechrt_*,
+# mechrtf_*) in one program.
+# With arm-none-eabi-gcc installed (.ci/deps firmware), the kernels and the
+# runtime are also compiled for a Cortex-M4F (float, hard-float ABI) and a
+# Cortex-M3 (double, software floating point) and checked the same way;
+# there the compiler's floating-point helpers (__aeabi_*) are allowed too.
+#
+# The last line is "firmware_rules: N passed, M failed"; the exit status is
+# non-zero on any failure. POSIX sh, awk, cc, nm, size, objdump.
+# Flag lists ($FLAGS, $arch ...) are split into words on purpose.
+# shellcheck disable=SC2086,SC2046
+set -u
+
+mechc=${1:-build/mechc}
+case $mechc in
+    /*) ;;
+    *) mechc=$(pwd)/$mechc ;;
+esac
+if [ ! -x "$mechc" ]; then
+    echo "firmware_rules: $mechc is not an executable" >&2
+    exit 2
+fi
+root=$(cd "$(dirname "$0")/.." && pwd)
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_firmware_rules.XXXXXX") || exit 2
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 2' INT TERM HUP
+
+pass=0
+fail=0
+CC=${CC:-cc}
+FLAGS="-std=c99 -O2 -ffreestanding -Wall -Wextra -Wpedantic -Wconversion -Wdouble-promotion -Wvla -Werror"
+LIBM='sin|cos|tan|asin|acos|atan|atan2|sqrt|exp|log|sinh|cosh|tanh|pow|fabs'
+MEM='memset|memcpy|memmove|memcmp'
+
+# check DESCRIPTION COMMAND...: runs COMMAND (its output to $tmp/why),
+# counts the outcome, prints the output of a failure.
+check() {
+    desc=$1
+    shift
+    if "$@" > "$tmp/why" 2>&1; then
+        pass=$((pass + 1))
+    else
+        fail=$((fail + 1))
+        echo "FAIL: $desc" >&2
+        sed -n '1,12s/^/    /p' "$tmp/why" >&2
+    fi
+}
+
+for tool in "$CC" nm size objdump; do
+    if ! command -v "$tool" > /dev/null 2>&1; then
+        echo "firmware_rules: $tool is missing" >&2
+        echo "firmware_rules: 0 passed, 1 failed"
+        exit 1
+    fi
+done
+
+# ---- helpers over objects ---------------------------------------------------
+
+# undefined_only OBJ NM REGEX: every undefined symbol matches REGEX.
+undefined_only() {
+    "$2" -u "$1" | awk -v re="$3" '{ s = $NF } s !~ re { print "undefined: " s; bad = 1 } END { exit bad }'
+}
+
+# no_writable_data OBJ NM SIZE: no data/bss symbols, empty .data and .bss.
+no_writable_data() {
+    "$2" "$1" | awk 'NF == 3 && $2 ~ /^[DdBbCGgSs]$/ { print "writable: " $0; bad = 1 } END { exit bad }' &&
+    "$3" -A "$1" | awk '$1 ~ /^\.(data|bss)/ && $2 != 0 { print "section " $1 " has " $2 " bytes"; bad = 1 } END { exit bad }'
+}
+
+# defined_prefixed OBJ NM REGEX: every defined symbol matches REGEX.
+defined_prefixed() {
+    "$2" --defined-only "$1" | awk -v re="$3" 'NF == 3 && $2 ~ /^[TtRrDdBb]$/ && $3 !~ /^[.$]/ && $3 !~ re {
+        print "foreign name: " $3; bad = 1 } END { exit bad }'
+}
+
+# The call graph of one object from `objdump -dr --no-show-raw-insn`, x86-64
+# or Arm Thumb. A branch's target is the symbol of the relocation that
+# follows it (calls to other objects and to libm), else the <name> that the
+# assembler resolved (calls inside the section); a target inside the
+# current function is a local jump. Checks: no indirect branch unless
+# allow_indirect, every target a function of this object or matching the
+# regex ext, no cycle (nodes are removed while they call no remaining node;
+# what is left lies on a cycle).
+cat > "$tmp/callgraph.awk" <<'EOF'
+function base(s) { sub(/[+-]0x[0-9a-f]+$/, "", s); return s }
+# A branch to another function, or a call (not a jump) to this one's entry.
+function flush() {
+    if (pending && target != "" && (target != fn || is_call)) edge(fn, target)
+    pending = 0; target = ""
+}
+function edge(a, b) {
+    if (!((a, b) in seen)) { seen[a, b] = 1; from[++ne] = a; to[ne] = b }
+}
+/^[0-9a-f]+ <[^>]+>:$/ {
+    flush()
+    fn = $2; gsub(/[<>:]/, "", fn); defined[fn] = 1
+    next
+}
+/^[ \t]+[0-9a-f]+:[ \t]+R_/ {
+    if (pending) { target = base($NF); flush() }
+    next
+}
+/^[ \t]+[0-9a-f]+:\t/ {
+    flush()
+    insn = $0; sub(/^[^\t]*\t/, "", insn)
+    mnem = insn; sub(/[ \t].*/, "", mnem)
+    ops = insn; sub(/^[^ \t]+[ \t]*/, "", ops)
+    if (mnem ~ /^(call|jmp|j[a-z]+)/ || (mnem ~ /^(b[a-z]*(\.[nw])?|cbn?z)$/ && mnem !~ /^(bic|bics|bfi|bfc|bkpt)/)) {
+        if (ops ~ /^\*/ || mnem ~ /^(blx|bx)/ && ops ~ /^(r[0-9]+|ip|sl|fp)$/) {
+            if (!allow_indirect) { print fn ": indirect branch: " insn; bad = 1 }
+            next
+        }
+        pending = 1
+        is_call = mnem ~ /^(call|bl|blx)$/
+        if (match(ops, /<[^>]+>/)) {
+            target = substr(ops, RSTART + 1, RLENGTH - 2)
+            # a jump or call into the middle of this function is local
+            if (base(target) == fn && target != fn) target = ""
+            else target = base(target)
+        }
+    } else if (mnem ~ /^(tbb|tbh)/ && !allow_indirect) {
+        print fn ": table branch: " insn; bad = 1
+    }
+    next
+}
+END {
+    flush()
+    for (i = 1; i <= ne; i++) {
+        if (to[i] in defined) { out[from[i]]++; continue }
+        if (to[i] ~ /^\./) { print from[i] ": section-relative branch to " to[i]; bad = 1 }
+        else if (to[i] !~ ext) { print from[i] ": calls " to[i]; bad = 1 }
+    }
+    do {
+        changed = 0
+        for (f in defined) if (!(f in gone) && !out[f]) {
+            gone[f] = 1; changed = 1
+            for (i = 1; i <= ne; i++) if (to[i] == f) out[from[i]]--
+        }
+    } while (changed)
+    for (f in defined) if (!(f in gone)) { print "on a call cycle: " f; bad = 1 }
+    exit bad
+}
+EOF
+
+# call_graph OBJ OBJDUMP EXT_REGEX ALLOW_INDIRECT
+call_graph() {
+    "$2" -dr --no-show-raw-insn "$1" > "$tmp/dis" &&
+    awk -v ext="$3" -v allow_indirect="$4" -f "$tmp/callgraph.awk" "$tmp/dis"
+}
+
+# code_of FILE: the C text of FILE without comments and with every string
+# and character literal emptied (names from the .mech file live in those);
+# lines and directives kept. Fails on an empty result.
+code_of() {
+    awk '
+    {
+        out = ""; i = 1; n = length($0)
+        while (i <= n) {
+            c = substr($0, i, 1); d = substr($0, i, 2)
+            if (incomment) {
+                if (d == "*/") { incomment = 0; i += 2 } else i++
+            } else if (d == "/*") { incomment = 1; i += 2; out = out " "
+            } else if (d == "//") { break
+            } else if (c == "\"" || c == "'\''") {
+                # a literal: skip to its closing quote, past escapes
+                for (j = i + 1; j <= n && substr($0, j, 1) != c; j++)
+                    if (substr($0, j, 1) == "\\") j++
+                out = out c c; i = j + 1
+            } else { out = out c; i++ }
+        }
+        print out
+    }
+    # an #include names its file in quotes: keep those lines whole
+    ' "$1" | awk -v f="$1" '
+        BEGIN { while ((getline l < f) > 0) raw[++nr] = l }
+        { print (raw[NR] ~ /^[ \t]*#[ \t]*include/ ? raw[NR] : $0); n++ }
+        END { exit n == 0 }'
+}
+
+FORBIDDEN='\b(malloc|calloc|realloc|free|alloca|printf|fprintf|sprintf|snprintf|puts|putchar|fopen|FILE|stdio|stdlib|setjmp|longjmp|exit|abort|errno)\b'
+
+# source_rules C H: includes, forbidden names, static.
+source_rules() {
+    for f in "$1" "$2"; do
+        code_of "$f" > "$tmp/code" || return 1
+        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|"[A-Za-z0-9_]+\.h")$/ {
+            print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
+        ! grep -n -E "$FORBIDDEN" "$tmp/code" &&
+        ! grep -n -w static "$tmp/code" | grep -v -E 'static const|#define [A-Z0-9_]+_PART static' ||
+        return 1
+    done
+}
+
+# ---- the toolchains ---------------------------------------------------------
+# name|compiler|arch flags|nm|size|objdump|reals|extra allowed symbols
+toolchains="host|$CC|-fno-pie|nm|size|objdump|double float|"
+if command -v arm-none-eabi-gcc > /dev/null 2>&1; then
+    a=arm-none-eabi-
+    toolchains="$toolchains
+m4f|${a}gcc|-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard|${a}nm|${a}size|${a}objdump|float|__aeabi_[a-z0-9]+
+m3|${a}gcc|-mcpu=cortex-m3 -mthumb -mfloat-abi=soft|${a}nm|${a}size|${a}objdump|double|__aeabi_[a-z0-9]+"
+else
+    echo "skip: arm-none-eabi-gcc missing: Cortex-M builds (sh .ci/deps firmware installs it)" >&2
+fi
+
+# A mechanism using every function and operator of the file format, for
+# the float spellings (sinf, atan2f, powf ...) and float literals. It need
+# not assemble: only its code is compiled.
+cat > "$tmp/every_function.mech" <<'EOF'
+mechanism every_function
+param a = 0.5
+body b x = 0.3 y = 0.4 phi = 0.2
+coord s = 0.7
+point m x = 1 y = 1
+constraint c1: sin(b.x) + cos(b.y) + tan(b.phi) + asin(b.x) + acos(b.y) + atan(b.phi) = 3*t + a
+constraint c2: atan2(b.x, b.y) + sqrt(m.x) + exp(m.y) + log(m.x) + sinh(s) + cosh(s) + tanh(s) = t^2
+constraint c3: m.x^3 + m.y^0.5 + m.x^m.y + (-s)^2 - 1e-3/s = 1/(1 + t)
+driver d1: b.phi = 0.2 + t
+distance L: b(0.1, 0) m length = 1 + 0.1*t
+velocity v: der(m.x) + b.x*der(m.y) = sin(t)
+EOF
+
+# ---- generated kernels --------------------------------------------------------
+for mech in "$root"/examples/*.mech "$tmp/every_function.mech"; do
+    name=$(basename "$mech" .mech)
+    prefix=$(echo "$name" | tr -c 'A-Za-z0-9_\n' '_')
+    for real in double float; do
+        d=$tmp/$name-$real
+        mkdir -p "$d"
+        if ! "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
+                -o "$d/$prefix.c" --header "$d/$prefix.h" > "$tmp/why" 2>&1; then
+            fail=$((fail + 1))
+            echo "FAIL: $name ($real): mechc gen" >&2
+            sed -n '1,5s/^/    /p' "$tmp/why" >&2
+            continue
+        fi
+        pass=$((pass + 1))
+        check "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
+        if [ "$real" = float ]; then f=f; else f=; fi
+        echo "$toolchains" | while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+            case " $reals " in *" $real "*) ;; *) continue ;; esac
+            allowed="^(($LIBM)$f|$MEM${extra:+|$extra})\$"
+            o=$d/$prefix-$tc.o
+            if $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" > "$tmp/why" 2>&1; then
+                echo pass
+            else
+                echo "FAIL: $name ($real, $tc): $cc $FLAGS $arch" >&2
+                sed -n '1,10s/^/    /p' "$tmp/why" >&2
+                echo fail
+                continue
+            fi
+            for rule in "undefined_only $o $nm_ $allowed" \
+                        "no_writable_data $o $nm_ $size_" \
+                        "defined_prefixed $o $nm_ ^${prefix}_" \
+                        "call_graph $o $objdump_ $allowed 0"; do
+                if $rule > "$tmp/why" 2>&1; then
+                    echo pass
+                else
+                    echo "FAIL: $name ($real, $tc): ${rule%% *}" >&2
+                    sed -n '1,10s/^/    /p' "$tmp/why" >&2
+                    echo fail
+                fi
+            done
+        done > "$tmp/counts"
+        pass=$((pass + $(grep -c '^pass$' "$tmp/counts")))
+        fail=$((fail + $(grep -c '^fail$' "$tmp/counts")))
+    done
+done
+
+# ---- the runtime core -----------------------------------------------------------
+rt_sources=$(ls "$root"/runtime/*.c)
+rt_src_rules() {
+    for f in "$@"; do
+        code_of "$f" > "$tmp/code" || return 1
+        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|<stddef\.h>|<stdbool\.h>|"mechrt\.h")$/ {
+            print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
+        ! grep -n -E "$FORBIDDEN" "$tmp/code" || return 1
+    done
+}
+check "runtime: includes and forbidden names" rt_src_rules $rt_sources "$root/runtime/mechrt.h"
+echo "$toolchains" | while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+    for real in $reals; do
+        d=$tmp/runtime-$real-$tc
+        mkdir -p "$d"
+        def=""
+        exported='^mechrt_'
+        if [ "$real" = float ]; then def=-DMECHRT_REAL_FLOAT; exported='^mechrtf_'; fi
+        ok=1
+        for src in $rt_sources; do
+            if ! $cc $FLAGS $arch $def -I"$root/runtime" -c "$src" \
+                    -o "$d/$(basename "$src" .c).o" > "$tmp/why" 2>&1; then
+                echo "FAIL: runtime ($real, $tc): $cc $FLAGS $arch $def $(basename "$src")" >&2
+                sed -n '1,10s/^/    /p' "$tmp/why" >&2
+                ok=0
+            fi
+        done
+        if [ $ok = 0 ] || ! $cc $arch -r -nostdlib "$d"/*.o -o "$d/core.o" > "$tmp/why" 2>&1; then
+            echo fail
+            continue
+        fi
+        echo pass
+        allowed="^($MEM${extra:+|$extra})\$"
+        for rule in "undefined_only $d/core.o $nm_ $allowed" \
+                    "no_writable_data $d/core.o $nm_ $size_" \
+                    "call_graph $d/core.o $objdump_ $allowed 1"; do
+            if $rule > "$tmp/why" 2>&1; then echo pass; else
+                echo "FAIL: runtime ($real, $tc): ${rule%% *}" >&2
+                sed -n '1,10s/^/    /p' "$tmp/why" >&2
+                echo fail
+            fi
+        done
+        if $nm_ -g --defined-only "$d/core.o" | awk -v re="$exported" 'NF == 3 && $3 !~ re { print "exported: " $3; bad = 1 } END { exit bad }' > "$tmp/why"; then
+            echo pass
+        else
+            echo "FAIL: runtime ($real, $tc): exported names" >&2
+            sed -n '1,10s/^/    /p' "$tmp/why" >&2
+            echo fail
+        fi
+    done
+done > "$tmp/counts"
+pass=$((pass + $(grep -c '^pass$' "$tmp/counts")))
+fail=$((fail + $(grep -c '^fail$' "$tmp/counts")))
+
+# ---- two mechanisms and the runtime in one program ---------------------------
+# run_P.c steps mechanism P from t = 0 to t_end through the runtime, with
+# static memory as firmware would, and returns one coordinate. Three units:
+# slider_crank as sc and four_bar as fb in double, four_bar as fbf in float.
+link=$tmp/link
+mkdir -p "$link"
+LINKFLAGS="-std=c99 -O2 -Wall -Wextra -Wpedantic -Wdouble-promotion -Werror -I$link -I$root/runtime"
+units="sc:SC:double:slider_crank:slider.x fb:FB:double:four_bar:rocker.phi fbf:FBF:float:four_bar:rocker.phi"
+make_unit() {
+    p=$1 P=$2 real=$3 mech=$4 coord=$5
+    def=""
+    [ "$real" = float ] && def="#define MECHRT_REAL_FLOAT"
+    "$mechc" gen "$root/examples/$mech.mech" --prefix "$p" --real "$real" \
+        -o "$link/$p.c" --header "$link/$p.h" || return 1
+    cat > "$link/run_$p.c" <<EOF
+$def
+#include "$p.h"
+#include "mechrt.h"
+double run_$p(double t_end, int steps);
+MECHRT_DEFINE_KERNELS($p, $P);
+static mechrt_real ws[MECHRT_WORKSPACE_LEN(${P}_NQ, ${P}_NR)];
+static int same(const char *a, const char *b)
+{
+    while (*a && *a == *b)
+        a++, b++;
+    return *a == *b;
+}
+double run_$p(double t_end, int steps)
+{
+    mechrt_real q[${P}_NQ], qd[${P}_NQ], qdd[${P}_NQ], t = 0;
+    int i, c = -1;
+    for (i = 0; i < ${P}_NQ; i++) {
+        q[i] = ${p}_q0[i];
+        qd[i] = qdd[i] = 0;
+        if (same(${p}_coord_names[i], "$coord"))
+            c = i;
+    }
+    for (i = 0; i <= steps; i++) {
+        mechrt_real tn = (mechrt_real)t_end * (mechrt_real)i / (mechrt_real)steps;
+        if (mechrt_step(&${p}_kernels, NULL, q, qd, qdd, t, tn - t, ws,
+                        sizeof ws / sizeof ws[0], NULL) != MECHRT_OK)
+            return -1000;
+        t = tn;
+    }
+    return c < 0 ? -2000 : (double)q[c];
+}
+EOF
+    $CC $LINKFLAGS -c "$link/run_$p.c" -o "$link/run_$p.o" &&
+    $CC $LINKFLAGS -c "$link/$p.c" -o "$link/$p.o"
+}
+build_units() {
+    for u in $units; do
+        make_unit $(echo "$u" | tr ':' ' ') || return 1
+    done
+    for src in $rt_sources; do
+        b=$(basename "$src" .c)
+        $CC $LINKFLAGS -c "$src" -o "$link/rt_$b.o" &&
+        $CC $LINKFLAGS -DMECHRT_REAL_FLOAT -c "$src" -o "$link/rtf_$b.o" || return 1
+    done
+}
+check "link: generate and compile sc, fb (double), fbf (float), both runtime builds" build_units
+# link_run NAME EXPECTED UNITS...: main calls run_UNIT(0.25, 25) for each
+# unit, links them with both runtime builds and compares with EXPECTED, a
+# list of VALUE:TOLERANCE.
+link_run() {
+    name=$1 expected=$2
+    shift 2
+    {
+        echo '#include <stdio.h>'
+        for u in "$@"; do echo "double run_$u(double t_end, int steps);"; done
+        echo 'int main(void)'
+        echo '{'
+        for u in "$@"; do printf '    printf("%%.12f\\n", run_%s(0.25, 25));\n' "$u"; done
+        echo '    return 0;'
+        echo '}'
+    } > "$link/$name.c"
+    objs=""
+    for u in "$@"; do objs="$objs $link/run_$u.o $link/$u.o"; done
+    $CC $LINKFLAGS "$link/$name.c" $objs "$link"/rt_*.o "$link"/rtf_*.o -lm -o "$link/$name" &&
+    "$link/$name" > "$link/$name.out" &&
+    echo "got: $(tr '\n' ' ' < "$link/$name.out"), expected: $expected" &&
+    echo "$expected" | tr ' :' '\n ' | paste -d ' ' - "$link/$name.out" |
+        awk '{ d = $1 - $3; if (d < 0) d = -d; if (d > $2) bad = 1; n++ }
+             END { exit bad || n == 0 }'
+}
+check "link: slider_crank (sc) + four_bar (fb) + runtime in one program: slider.x(0.25) = sqrt(0.08), rocker.phi(0.25) = 1.725386" \
+    link_run two "0.282842712475:1e-9 1.725386:1e-6" sc fb
+check "link: sc and fb in double, fbf in float, mechrt_* and mechrtf_* in one program" \
+    link_run mixed "0.282842712475:1e-9 1.725386:1e-6 1.725386:1e-4" sc fb fbf
+
+echo "firmware_rules: $pass passed, $fail failed"
+[ "$fail" = 0 ]
