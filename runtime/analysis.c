@@ -131,6 +131,26 @@ static MechrtStatus an_solve(int n, const mechrt_real *lu, const mechrt_real *pi
     return an_all_finite(n, x) ? MECHRT_OK : MECHRT_ENOTFINITE;
 }
 
+/* The start of every analysis-only call: checks the kernels and the
+   workspace, evaluates the Jacobian and the right side at (q, t) (nu, or
+   gamma when qd is given) and factors the Jacobian. */
+static MechrtStatus an_prepare(const MechrtKernels *k, const MechrtOptions *o,
+                               const mechrt_real *q, const mechrt_real *qd, mechrt_real t,
+                               mechrt_real *work, size_t lwork, AnWork *w,
+                               MechrtReport *report)
+{
+    MechrtStatus st = an_setup(k, work, lwork, w);
+
+    if (st != MECHRT_OK)
+        return st;
+    k->jac(k->ctx, q, t, w->jac);
+    if (qd)
+        k->gamma(k->ctx, q, qd, t, w->rhs);
+    else
+        k->nu(k->ctx, q, t, w->rhs);
+    return an_factor(k->nq, o, w->jac, w->piv, w->cwork, report);
+}
+
 MechrtStatus mechrt_velocity(const MechrtKernels *k, const MechrtOptions *opts,
                              const mechrt_real *q, mechrt_real t, mechrt_real *qd_out,
                              mechrt_real *work, size_t lwork, MechrtReport *report)
@@ -142,12 +162,7 @@ MechrtStatus mechrt_velocity(const MechrtKernels *k, const MechrtOptions *opts,
     an_report_init(report);
     if (!q || !qd_out)
         return MECHRT_EINVAL;
-    st = an_setup(k, work, lwork, &w);
-    if (st != MECHRT_OK)
-        return st;
-    k->jac(k->ctx, q, t, w.jac);
-    k->nu(k->ctx, q, t, w.rhs);
-    st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
+    st = an_prepare(k, &o, q, NULL, t, work, lwork, &w, report);
     if (st != MECHRT_OK)
         return st;
     return an_solve(k->nq, w.jac, w.piv, w.rhs, qd_out);
@@ -165,12 +180,7 @@ MechrtStatus mechrt_acceleration(const MechrtKernels *k, const MechrtOptions *op
     an_report_init(report);
     if (!q || !qd || !qdd_out)
         return MECHRT_EINVAL;
-    st = an_setup(k, work, lwork, &w);
-    if (st != MECHRT_OK)
-        return st;
-    k->jac(k->ctx, q, t, w.jac);
-    k->gamma(k->ctx, q, qd, t, w.rhs);
-    st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
+    st = an_prepare(k, &o, q, qd, t, work, lwork, &w, report);
     if (st != MECHRT_OK)
         return st;
     return an_solve(k->nq, w.jac, w.piv, w.rhs, qdd_out);
@@ -189,12 +199,7 @@ MechrtStatus mechrt_velocity_acceleration(const MechrtKernels *k, const MechrtOp
     an_report_init(report);
     if (!q || !qd_out || !qdd_out)
         return MECHRT_EINVAL;
-    st = an_setup(k, work, lwork, &w);
-    if (st != MECHRT_OK)
-        return st;
-    k->jac(k->ctx, q, t, w.jac);
-    k->nu(k->ctx, q, t, w.rhs);
-    st = an_factor(k->nq, &o, w.jac, w.piv, w.cwork, report);
+    st = an_prepare(k, &o, q, NULL, t, work, lwork, &w, report);
     if (st != MECHRT_OK)
         return st;
     st = an_solve(k->nq, w.jac, w.piv, w.rhs, qd_out);

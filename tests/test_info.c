@@ -202,9 +202,9 @@ static void test_svd_values_rank_cond(void **state)
         for (int j = 0; j < 3; j++)
             for (int k = 0; k < 3; k++)
                 a[i * 3 + j] += u[i][k] * d[k] * v[j][k];
-    SvdWork *w = svd_work_new(3, 3);
-    SvdResult r;
-    assert_true(analysis_svd(w, a, 3, 3, 3, -1.0, &r));
+    MechrtSvd *w = svd_work_new(3, 3);
+    MechrtSvdResult r;
+    assert_true(mechrt_svd(w, a, 3, 3, 3, -1.0, &r));
     assert_int_equal(r.k, 3);
     assert_near(r.sigma[0], 3.0, 1e-14, 0);
     assert_near(r.sigma[1], 2.0, 1e-14, 0);
@@ -214,13 +214,13 @@ static void test_svd_values_rank_cond(void **state)
     assert_true(r.cond > 1e15);
     assert_near(r.tol, 3 * DBL_EPSILON * 3.0, 1e-12, 0);
     /* a user tolerance */
-    assert_true(analysis_svd(w, a, 3, 3, 3, 2.5, &r));
+    assert_true(mechrt_svd(w, a, 3, 3, 3, 2.5, &r));
     assert_int_equal(r.rank, 1);
     /* NaN is refused */
     a[4] = NAN;
-    assert_false(analysis_svd(w, a, 3, 3, 3, -1.0, &r));
+    assert_false(mechrt_svd(w, a, 3, 3, 3, -1.0, &r));
     assert_int_equal(r.rank, -1);
-    svd_work_free(w);
+    mechrt_svd_free(w);
 }
 
 static void test_svd_wide_min_norm(void **state)
@@ -228,17 +228,17 @@ static void test_svd_wide_min_norm(void **state)
     (void)state;
     /* x + y = 2 and z free: the minimum-norm solution is (1, 1, 0) */
     double a[3] = {1, 1, 0}, b[1] = {2}, x[3];
-    SvdWork *w = svd_work_new(1, 3);
-    SvdResult r;
-    assert_true(analysis_svd(w, a, 1, 3, 3, -1.0, &r));
+    MechrtSvd *w = svd_work_new(1, 3);
+    MechrtSvdResult r;
+    assert_true(mechrt_svd(w, a, 1, 3, 3, -1.0, &r));
     assert_int_equal(r.k, 1);
     assert_int_equal(r.rank, 1);
     assert_near(r.sigma_max, sqrt(2.0), 1e-15, 0);
-    svd_pinv_solve(w, b, x);
+    mechrt_svd_pinv_solve(w, b, x);
     assert_near(x[0], 1.0, 1e-15, 1e-15);
     assert_near(x[1], 1.0, 1e-15, 1e-15);
     assert_near(x[2], 0.0, 0, 1e-15);
-    svd_work_free(w);
+    mechrt_svd_free(w);
 }
 
 static void test_svd_tall_least_squares(void **state)
@@ -246,15 +246,15 @@ static void test_svd_tall_least_squares(void **state)
     (void)state;
     /* x = 1, x = 3 (inconsistent): least squares gives 2; a zero column stays 0 */
     double a[4] = {1, 0, 1, 0}, b[2] = {1, 3}, x[2];
-    SvdWork *w = svd_work_new(2, 2);
-    SvdResult r;
-    assert_true(analysis_svd(w, a, 2, 2, 2, -1.0, &r));
+    MechrtSvd *w = svd_work_new(2, 2);
+    MechrtSvdResult r;
+    assert_true(mechrt_svd(w, a, 2, 2, 2, -1.0, &r));
     assert_int_equal(r.rank, 1);
     assert_true(isinf(r.cond));
-    svd_pinv_solve(w, b, x);
+    mechrt_svd_pinv_solve(w, b, x);
     assert_near(x[0], 2.0, 1e-15, 0);
     assert_near(x[1], 0.0, 0, 1e-15);
-    svd_work_free(w);
+    mechrt_svd_free(w);
 }
 
 static void test_redundant_rows_incremental(void **state)
@@ -270,9 +270,9 @@ static void test_redundant_rows_incremental(void **state)
         0, 0, 0, 10,
     };
     bool red[6];
-    SvdWork *w = svd_work_new(6, 4);
-    SvdResult r;
-    assert_true(analysis_svd(w, a, 6, 4, 4, -1.0, &r));
+    MechrtSvd *w = svd_work_new(6, 4);
+    MechrtSvdResult r;
+    assert_true(mechrt_svd(w, a, 6, 4, 4, -1.0, &r));
     assert_int_equal(r.rank, 3);
     assert_int_equal(svd_redundant_rows(w, a, 6, 4, 4, r.tol, 0, -1, red), 3);
     bool want[6] = {false, false, true, true, false, true};
@@ -283,7 +283,45 @@ static void test_redundant_rows_incremental(void **state)
     assert_int_equal(svd_redundant_rows(w, a, 6, 4, 4, r.tol, 4, 3, red), 1);
     assert_false(red[4]);
     assert_true(red[5]);
-    svd_work_free(w);
+    mechrt_svd_free(w);
+}
+
+/* One program for many roots (what `info` evaluates Phi, the Jacobian and
+   its own nodes with): shared nodes, a repeated root and DAG_NONE; each
+   root's value equals its own one-root program's. */
+static void test_node_values_many_roots(void **state)
+{
+    (void)state;
+    Diag diag;
+    memset(&diag, 0, sizeof diag);
+    Dag d;
+    dag_init(&d, 1000, &diag);
+    NodeId x = dag_var(&d, 0), y = dag_var(&d, 1), t = dag_time(&d);
+    NodeId s = dag_call(&d, OP_SIN, dag_mul(&d, x, y), DAG_NONE);     /* shared */
+    NodeId roots[5] = {
+        dag_add(&d, s, t),
+        dag_div(&d, s, dag_add(&d, y, dag_const(&d, 2.0))),
+        DAG_NONE,
+        dag_add(&d, s, t),
+        dag_mul(&d, dag_vard(&d, 1), x),
+    };
+    double q[2] = {0.7371, -0.4213}, qd[2] = {0.3, -0.613}, tt = 0.4137;
+    NodeValues nv;
+    node_values_init(&nv, &d, roots, 5);
+    node_values_run(&nv, q, qd, tt);
+    double sxy = sin(q[0] * q[1]);
+    assert_near(node_values_get(&nv, 0), sxy + tt, 1e-15, 0);
+    assert_near(node_values_get(&nv, 1), sxy / (q[1] + 2.0), 1e-15, 0);
+    assert_true(isnan(node_values_get(&nv, 2)));
+    assert_near(node_values_get(&nv, 3), sxy + tt, 1e-15, 0);
+    assert_near(node_values_get(&nv, 4), qd[1] * q[0], 1e-15, 0);
+    for (int k = 0; k < 5; k++)
+        if (roots[k] != DAG_NONE)
+            assert_near(node_value_at(&d, roots[k], q, qd, tt), node_values_get(&nv, k), 0, 0);
+    node_values_run(&nv, q, NULL, tt);      /* velocities zero */
+    assert_near(node_values_get(&nv, 4), 0.0, 0, 0);
+    node_values_free(&nv);
+    dag_free(&d);
 }
 
 /* ---- rank and redundancy of mechanisms ---- */
@@ -736,6 +774,7 @@ int main(void)
         cmocka_unit_test(test_svd_wide_min_norm),
         cmocka_unit_test(test_svd_tall_least_squares),
         cmocka_unit_test(test_redundant_rows_incremental),
+        cmocka_unit_test(test_node_values_many_roots),
         cmocka_unit_test(test_parallelogram_rank_and_redundant_row),
         cmocka_unit_test(test_rank_tolerance_option),
         cmocka_unit_test(test_full_rank_trammel),

@@ -2,22 +2,24 @@
    rows, minimum-norm assembly, integrability of velocity rows, mobility.
 
    Host-side only (GSL). Layers, usable separately:
-     svd.c           dense SVD of a row-major matrix: singular values, numerical
-                     rank, condition number, pseudo-inverse solve, redundant rows
-                     by incremental rank. `run` may use it to warn near
-                     singular positions.
-     assemble.c      a tree-walking evaluator over the expression graph and
-                     minimum-norm Newton on any subset of the holonomic rows.
+     svd.c           redundant rows by incremental rank, on the dense SVD of
+                     runtime/host/svd.c (singular values, numerical rank,
+                     condition number, pseudo-inverse solve), which `run`
+                     shares for its projection and its failure messages.
+     assemble.c      Phi and Phi_q through the graph interpreter (eval/interp.h)
+                     and minimum-norm Newton on any subset of the holonomic rows.
      integrability.c Frobenius test of one velocity-level row and the search
                      for its position law.
      involutive.c    the velocity rows together with the holonomic rows.
-     sparse.c        rank, redundant rows and assembly beyond the dense limit
-                     (row-wise Givens QR).
+     sparse.c        rank, redundant rows and the assembly step beyond the
+                     dense limit (row-wise Givens QR).
      mobility.c      the whole `info` report for a loaded mechanism.
 */
 #ifndef MECHC_ANALYSIS_H
 #define MECHC_ANALYSIS_H
 
+#include "../../runtime/host/mechrt_host.h"
+#include "../eval/interp.h"
 #include "../pipeline/pipeline.h"
 
 #include <stdbool.h>
@@ -53,46 +55,13 @@ typedef struct AnalysisOptions {
 
 AnalysisOptions analysis_default_options(void);
 
-/* ---- dense SVD (svd.c) ------------------------------------------------- */
+/* ---- dense SVD (runtime/host/svd.c, and svd.c here) ----------------------- */
 
-/* Caller-owned workspace for matrices up to max_m x max_n (GSL's rule: no
-   allocation per call). */
-typedef struct SvdWork SvdWork;
-
-SvdWork *svd_work_new(int max_m, int max_n);
-void svd_work_free(SvdWork *w);
-
-/* Outcome of one decomposition. sigma points into the workspace and stays
-   valid until its next use. */
-typedef struct SvdResult {
-    int m, n;               /* the matrix decomposed */
-    int k;                  /* min(m, n): number of singular values */
-    const double *sigma;    /* k singular values, descending */
-    double sigma_max;       /* sigma[0], 0 when k == 0 */
-    double sigma_min;       /* sigma[k-1], 0 when k == 0 */
-    double cond;            /* sigma_max / sigma_min; INFINITY when sigma_min == 0 */
-    double tol;             /* the rank tolerance used */
-    int rank;               /* singular values > tol */
-} SvdResult;
-
-/* The default rank tolerance max(m, n) * DBL_EPSILON * sigma_max. */
-double svd_default_tol(int m, int n, double sigma_max);
-
-/* Singular values of the m x n row-major matrix a (leading dimension lda)
-   by GSL's Golub-Reinsch SVD (of a^T when m < n). tol < 0 selects the
-   default tolerance. Returns false (out->rank = -1) when a holds NaN or Inf
-   or is larger than the workspace. a is not modified. */
-bool analysis_svd(SvdWork *w, const double *a, int m, int n, int lda, double tol,
-                  SvdResult *out);
-
-/* x = pinv(A) b with the factors of the last analysis_svd, singular values
-   at or below its tolerance dropped: the minimum-norm least-squares
-   solution. b has m entries, x has n. */
-void svd_pinv_solve(const SvdWork *w, const double *b, double *x);
-
-/* Component j (< n) of the l-th (< rank) orthonormal basis vector of the
-   row space of the last matrix decomposed (its right singular vectors). */
-double svd_row_basis(const SvdWork *w, int j, int l);
+/* The dense SVD is the host runtime's (MechrtSvd, mechrt_svd,
+   mechrt_svd_pinv_solve, mechrt_svd_row_basis: runtime/host/mechrt_host.h),
+   the same one `run` projects with. svd_work_new allocates its workspace
+   and aborts when memory runs out, like xmalloc. */
+MechrtSvd *svd_work_new(int max_m, int max_n);
 
 /* Redundant rows: row i (i >= first) is redundant when the rank of rows
    0..i equals the rank of rows 0..i-1, every rank taken with the absolute
@@ -102,7 +71,7 @@ double svd_row_basis(const SvdWork *w, int j, int l);
    rows with tol when already known (saves one decomposition), else -1.
    Sets redundant[i] for i in [first, m); returns their count, -1 on NaN or
    Inf. Uses (and clobbers) the workspace. */
-int svd_redundant_rows(SvdWork *w, const double *a, int m, int n, int lda, double tol,
+int svd_redundant_rows(MechrtSvd *w, const double *a, int m, int n, int lda, double tol,
                        int first, int rank, bool *redundant);
 
 /* ---- large sparse Jacobians (sparse.c) ------------------------------------ */
@@ -118,6 +87,10 @@ void sparse_rank_free(SparseRank *s);
    redundant, -1 NaN or Inf, -2 the fill limit was reached. */
 int sparse_rank_add(SparseRank *s, const int *cols, const double *vals, int n);
 int sparse_rank_of(const SparseRank *s);
+/* Solves R^T R y = b in place with the factor of the rows added so far
+   (m of them; a redundant row gets y = 0): the seminormal equations of the
+   sparse minimum-norm step. */
+void sparse_rank_seminormal_solve(const SparseRank *s, int m, double *b);
 /* Largest singular value of the listed rows (power iteration);
    vals[e] is the value of kin->jac[e]. */
 double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *rows, int nrows,
@@ -125,20 +98,11 @@ double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *ro
 
 /* ---- evaluation and assembly (assemble.c) ------------------------------ */
 
-/* Values of chosen graph nodes at a state (q, qd, t), by one pass over the
-   reachable nodes in id order. Nodes created after node_eval_new are
-   not known to it. */
-typedef struct NodeEval NodeEval;
-
-NodeEval *node_eval_new(const Dag *dag, const NodeId *roots, int nroots);
-void node_eval_free(NodeEval *ev);
-void node_eval_run(NodeEval *ev, const double *q, const double *qd, double t);
-double node_eval_value(const NodeEval *ev, NodeId id);
-
-/* Phi and the dense Jacobian of a loaded mechanism, interpreted from its graph. */
+/* Phi and the Jacobian of a loaded mechanism, interpreted from its graph
+   (generator/eval/interp.h: one program for every row and entry). */
 typedef struct MechEval {
     const Kinematics *kin;
-    NodeEval *ev;
+    NodeValues values;      /* roots: Phi (nh), then the Jacobian's nonzeros (kin->nnz) */
     int nq, nh, nr;
 } MechEval;
 
@@ -166,7 +130,7 @@ typedef struct AssembleResult {
    redundant rows (singular values at or below the rank tolerance are
    dropped). w must hold nrows x nq. */
 bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, double *q,
-                       const AnalysisOptions *opt, SvdWork *w, AssembleResult *res);
+                       const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res);
 
 /* The same beyond the dense limit, on the first nrows holonomic rows, with
    the sparse QR of Phi_q^T (sparse.c): dq = Phi_q^T y, Phi_q Phi_q^T y = -Phi

@@ -1,20 +1,21 @@
-/* assemble.c - graph interpreter and minimum-norm Newton assembly on any set of holonomic rows.
+/* assemble.c - Phi and Phi_q from the graph, and minimum-norm Newton assembly on any set of holonomic rows.
  *
- * The interpreter marks the nodes reachable from its roots once, then each
- * run is one loop over them in id order (operands have smaller ids), using
- * dag_op_eval, the single definition of every operation. It needs no code
- * generation, so `info` also evaluates nodes it builds itself (the
- * integrability test).
+ * Phi and the Jacobian's nonzeros are the roots of one program of the graph
+ * interpreter (generator/eval/interp.h), compiled once: each evaluation is
+ * one loop over the reachable nodes in id order. It needs no code
+ * generation and works on the same graph as the rest of `info` (the
+ * integrability test evaluates nodes it builds itself the same way).
  *
  * Minimum-norm Newton (Gauss-Newton through the pseudo-inverse; Ben-Israel
  * 1966, Deuflhard, Newton Methods for Nonlinear Problems, 4.4):
  *     dq = -pinv(Phi_q(q)) Phi(q),   q <- q + alpha dq
- * pinv from the SVD with singular values at or below the rank tolerance
- * dropped. With fewer rows than coordinates this is the shortest step that
- * zeroes the linearised rows, so the iteration settles on the configuration
- * nearest the start; with redundant rows the dropped singular values are
- * the dependent directions. alpha is halved (at most 12 times) until the
- * residual's 2-norm decreases.
+ * pinv from the SVD (runtime/host/svd.c) with singular values at or below
+ * the rank tolerance dropped, or beyond the dense limit from the sparse QR
+ * of Phi_q^T (sparse.c); one iteration serves both. With fewer rows than
+ * coordinates this is the shortest step that zeroes the linearised rows, so
+ * the iteration settles on the configuration nearest the start; with
+ * redundant rows the dropped singular values are the dependent directions.
+ * alpha is halved (at most 12 times) until the residual's 2-norm decreases.
  */
 #include "analysis.h"
 
@@ -38,71 +39,6 @@ AnalysisOptions analysis_default_options(void)
     };
 }
 
-/* ---- graph interpreter ---- */
-
-struct NodeEval {
-    const Dag *dag;
-    NodeId *order;      /* reachable nodes, ascending ids */
-    int count;
-    double *value;      /* indexed by node id (size dag->count at creation) */
-    int32_t known;      /* dag->count at creation */
-};
-
-NodeEval *node_eval_new(const Dag *dag, const NodeId *roots, int nroots)
-{
-    NodeEval *ev = xcalloc(1, sizeof *ev);
-    ev->dag = dag;
-    ev->known = dag->count;
-    size_t n = (size_t)dag->count;
-    uint32_t *mark = xcalloc(n, sizeof *mark);
-    NodeId *stack = xmalloc(n * sizeof *stack);
-    ev->count = dag_mark_reachable(dag, roots, nroots, mark, 1, stack);
-    ev->order = xmalloc(((size_t)ev->count + 1) * sizeof *ev->order);
-    int k = 0;
-    for (int32_t id = 0; id < dag->count; id++)
-        if (mark[id] == 1)
-            ev->order[k++] = id;
-    ev->count = k;
-    ev->value = xcalloc(n + 1, sizeof *ev->value);
-    free(mark);
-    free(stack);
-    return ev;
-}
-
-void node_eval_free(NodeEval *ev)
-{
-    if (!ev)
-        return;
-    free(ev->order);
-    free(ev->value);
-    free(ev);
-}
-
-void node_eval_run(NodeEval *ev, const double *q, const double *qd, double t)
-{
-    const DagNode *nodes = ev->dag->nodes;
-    double *v = ev->value;
-    for (int k = 0; k < ev->count; k++) {
-        NodeId id = ev->order[k];
-        const DagNode *n = &nodes[id];
-        switch ((DagOp)n->op) {
-        case OP_CONST: v[id] = n->value; break;
-        case OP_VAR:   v[id] = q[n->a]; break;
-        case OP_VARD:  v[id] = qd ? qd[n->a] : 0.0; break;
-        case OP_TIME:  v[id] = t; break;
-        default:
-            v[id] = dag_op_eval((DagOp)n->op, v[n->a],
-                                dag_op_info[n->op].arity == 2 ? v[n->b] : 0.0);
-            break;
-        }
-    }
-}
-
-double node_eval_value(const NodeEval *ev, NodeId id)
-{
-    return id >= 0 && id < ev->known ? ev->value[id] : NAN;
-}
-
 /* ---- Phi and Phi_q of a mechanism ---- */
 
 void mech_eval_init(MechEval *me, const Kinematics *kin)
@@ -118,75 +54,64 @@ void mech_eval_init(MechEval *me, const Kinematics *kin)
         roots[i] = kin->phi[i];
     for (int e = 0; e < kin->nnz; e++)
         roots[m->nh + e] = kin->jac[e].value;
-    me->ev = node_eval_new(&m->dag, roots, nroots);
+    node_values_init(&me->values, &m->dag, roots, nroots);
     free(roots);
 }
 
 void mech_eval_free(MechEval *me)
 {
-    node_eval_free(me->ev);
+    node_values_free(&me->values);
     memset(me, 0, sizeof *me);
+}
+
+/* Runs the program at (q, t) and copies Phi out (phi may be NULL). */
+static void eval_phi(MechEval *me, const double *q, double t, double *phi)
+{
+    node_values_run(&me->values, q, NULL, t);
+    if (phi)
+        for (int i = 0; i < me->nh; i++)
+            phi[i] = node_values_get(&me->values, i);
 }
 
 void mech_eval(MechEval *me, const double *q, double t, double *phi, double *jac)
 {
     const Kinematics *kin = me->kin;
-    node_eval_run(me->ev, q, NULL, t);
-    if (phi)
-        for (int i = 0; i < me->nh; i++)
-            phi[i] = node_eval_value(me->ev, kin->phi[i]);
+    eval_phi(me, q, t, phi);
     if (jac) {
         memset(jac, 0, (size_t)me->nr * (size_t)me->nq * sizeof *jac);
         for (int e = 0; e < kin->nnz; e++)
             jac[(size_t)kin->jac[e].row * (size_t)me->nq + (size_t)kin->jac[e].col] =
-                node_eval_value(me->ev, kin->jac[e].value);
+                node_values_get(&me->values, me->nh + e);
     }
 }
 
 void mech_eval_nz(MechEval *me, const double *q, double t, double *phi, double *vals)
 {
-    const Kinematics *kin = me->kin;
-    node_eval_run(me->ev, q, NULL, t);
-    if (phi)
-        for (int i = 0; i < me->nh; i++)
-            phi[i] = node_eval_value(me->ev, kin->phi[i]);
+    eval_phi(me, q, t, phi);
     if (vals)
-        for (int e = 0; e < kin->nnz; e++)
-            vals[e] = node_eval_value(me->ev, kin->jac[e].value);
+        for (int e = 0; e < me->kin->nnz; e++)
+            vals[e] = node_values_get(&me->values, me->nh + e);
 }
 
 /* ---- minimum-norm Newton ---- */
 
-/* Phi and Phi_q of the selected rows at q; returns ||f||_2 (NaN if not finite). */
-static double rows_eval(MechEval *me, const int *rows, int nrows, const double *q, double t,
-                        double *phi_all, double *jac_all, double *f, double *jac,
-                        double *inf_norm, int *worst)
-{
-    mech_eval(me, q, t, phi_all, jac_all ? jac : NULL);
-    double sum = 0.0, inf = 0.0;
-    int nq = me->nq;
-    *worst = -1;
-    for (int i = 0; i < nrows; i++) {
-        f[i] = phi_all[rows[i]];
-        if (jac_all)
-            memcpy(jac_all + (size_t)i * (size_t)nq, jac + (size_t)rows[i] * (size_t)nq,
-                   (size_t)nq * sizeof *jac);
-        if (!isfinite(f[i]))
-            return NAN;
-        sum += f[i] * f[i];
-        if (fabs(f[i]) > inf || *worst < 0) {
-            inf = fabs(f[i]);
-            *worst = rows[i];
-        }
-    }
-    *inf_norm = inf;
-    return sqrt(sum);
-}
+/* Where the Newton direction comes from: the residual of the rows at a
+   point and dq = -pinv(Phi_q) Phi at the last iterate. */
+typedef struct NewtonPath {
+    /* Phi of the rows at q: returns ||Phi||_2 (NaN or Inf if not finite),
+       sets ||Phi||_inf and the model row where it is largest. iterate: q is
+       the new iterate, whose Jacobian the next direction uses; else a
+       trial point of the step halving. */
+    double (*eval)(void *ctx, const double *q, bool iterate, double *inf, int *worst);
+    /* The step at the last iterate into dq (nq); false when there is none.
+       *rank: the rank of the rows' Jacobian seen by the solve. */
+    bool (*direction)(void *ctx, double *dq, int *rank);
+    void *ctx;
+} NewtonPath;
 
-bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, double *q,
-                       const AnalysisOptions *opt, SvdWork *w, AssembleResult *res)
+static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
+                            const AnalysisOptions *opt, AssembleResult *res)
 {
-    int nq = me->nq;
     memset(res, 0, sizeof *res);
     res->step = -1.0;
     res->worst_row = -1;
@@ -195,16 +120,11 @@ bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, doubl
         res->converged = true;
         return true;
     }
-    double *phi_all = xcalloc((size_t)me->nh + 1, sizeof *phi_all);
-    double *jac = xcalloc((size_t)me->nr * (size_t)nq + 1, sizeof *jac);
-    double *J = xcalloc((size_t)nrows * (size_t)nq, sizeof *J);
-    double *f = xcalloc((size_t)nrows, sizeof *f);
-    double *ftrial = xcalloc((size_t)nrows, sizeof *ftrial);
     double *dq = xcalloc((size_t)nq, sizeof *dq);
     double *trial = xcalloc((size_t)nq, sizeof *trial);
     double inf = 0.0;
     int worst = -1;
-    double norm = rows_eval(me, rows, nrows, q, t, phi_all, J, f, jac, &inf, &worst);
+    double norm = p->eval(p->ctx, q, true, &inf, &worst);
     res->residual = inf;
     res->worst_row = worst;
     bool ok = false;
@@ -213,43 +133,218 @@ bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, doubl
             ok = true;
             break;
         }
-        if (iter >= opt->max_iter)
+        if (iter >= opt->max_iter || !p->direction(p->ctx, dq, &res->rank))
             break;
-        SvdResult sv;
-        if (!analysis_svd(w, J, nrows, nq, nq, opt->rank_tol, &sv))
-            break;
-        res->rank = sv.rank;
-        svd_pinv_solve(w, f, dq);
         double step = 0.0;
-        for (int j = 0; j < nq; j++) {
-            dq[j] = -dq[j];
+        for (int j = 0; j < nq; j++)
             step = fmax(step, fabs(dq[j]));
-        }
         /* step halving until the residual decreases (or is already small) */
         double alpha = 1.0, tnorm = NAN, tinf = 0.0;
         int tworst = -1;
         for (int h = 0; h <= 12; h++) {
             for (int j = 0; j < nq; j++)
                 trial[j] = q[j] + alpha * dq[j];
-            tnorm = rows_eval(me, rows, nrows, trial, t, phi_all, NULL, ftrial, jac, &tinf, &tworst);
+            tnorm = p->eval(p->ctx, trial, false, &tinf, &tworst);
             if (isfinite(tnorm) && (tnorm < norm || tinf <= opt->tol_phi))
                 break;
             alpha *= 0.5;
         }
-        if (!isfinite(tnorm) || !(tnorm < norm || tinf <= opt->tol_phi)) {
-            /* no descent along the Newton direction: take the full step */
-            alpha = 1.0;
-            for (int j = 0; j < nq; j++)
-                trial[j] = q[j] + dq[j];
-        }
-        memcpy(q, trial, (size_t)nq * sizeof *q);
+        if (!isfinite(tnorm) || !(tnorm < norm || tinf <= opt->tol_phi))
+            alpha = 1.0;    /* no descent along the Newton direction: take the full step */
+        for (int j = 0; j < nq; j++)
+            q[j] += alpha * dq[j];
         res->iterations = iter + 1;
         res->step = alpha * step;
-        norm = rows_eval(me, rows, nrows, q, t, phi_all, J, f, jac, &inf, &worst);
+        norm = p->eval(p->ctx, q, true, &inf, &worst);
         res->residual = isfinite(norm) ? inf : NAN;
         res->worst_row = worst;
     }
     res->converged = ok;
-    free(phi_all), free(jac), free(J), free(f), free(ftrial), free(dq), free(trial);
+    free(dq), free(trial);
+    return ok;
+}
+
+/* ---- the dense direction: SVD of the selected rows ---- */
+
+typedef struct DenseRows {
+    MechEval *me;
+    const int *rows;        /* model rows */
+    int nrows;
+    double t, rank_tol;
+    MechrtSvd *w;
+    double *phi_all;        /* nh */
+    double *jac;            /* nr x nq */
+    double *J, *f;          /* the rows' Jacobian (nrows x nq) and Phi at the iterate */
+    double *ftrial;         /* Phi at a trial point */
+} DenseRows;
+
+static double dense_eval(void *ctx, const double *q, bool iterate, double *inf, int *worst)
+{
+    DenseRows *d = ctx;
+    int nq = d->me->nq;
+    double *f = iterate ? d->f : d->ftrial;
+    mech_eval(d->me, q, d->t, d->phi_all, iterate ? d->jac : NULL);
+    double sum = 0.0, big = 0.0;
+    *worst = -1;
+    for (int i = 0; i < d->nrows; i++) {
+        f[i] = d->phi_all[d->rows[i]];
+        if (iterate)
+            memcpy(d->J + (size_t)i * (size_t)nq, d->jac + (size_t)d->rows[i] * (size_t)nq,
+                   (size_t)nq * sizeof *d->J);
+        if (!isfinite(f[i]))
+            return NAN;
+        sum += f[i] * f[i];
+        if (fabs(f[i]) > big || *worst < 0) {
+            big = fabs(f[i]);
+            *worst = d->rows[i];
+        }
+    }
+    *inf = big;
+    return sqrt(sum);
+}
+
+static bool dense_direction(void *ctx, double *dq, int *rank)
+{
+    DenseRows *d = ctx;
+    int nq = d->me->nq;
+    MechrtSvdResult sv;
+    if (!mechrt_svd(d->w, d->J, d->nrows, nq, nq, d->rank_tol, &sv))
+        return false;
+    *rank = sv.rank;
+    mechrt_svd_pinv_solve(d->w, d->f, dq);
+    for (int j = 0; j < nq; j++)
+        dq[j] = -dq[j];
+    return true;
+}
+
+bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, double *q,
+                       const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res)
+{
+    size_t nq = (size_t)me->nq;
+    DenseRows d = {
+        .me = me, .rows = rows, .nrows = nrows, .t = t, .rank_tol = opt->rank_tol, .w = w,
+        .phi_all = xcalloc((size_t)me->nh + 1, sizeof *d.phi_all),
+        .jac = xcalloc((size_t)me->nr * nq + 1, sizeof *d.jac),
+        .J = xcalloc((size_t)nrows * nq + 1, sizeof *d.J),
+        .f = xcalloc((size_t)nrows + 1, sizeof *d.f),
+        .ftrial = xcalloc((size_t)nrows + 1, sizeof *d.ftrial),
+    };
+    NewtonPath path = {dense_eval, dense_direction, &d};
+    bool ok = min_norm_newton(&path, nrows, me->nq, q, opt, res);
+    free(d.phi_all), free(d.jac), free(d.J), free(d.f), free(d.ftrial);
+    return ok;
+}
+
+/* ---- the sparse direction: QR of Phi_q^T ----
+ *
+ * With J^T = Q R (R: m x m upper triangular, from the row-wise QR of J^T,
+ * whose rows are the columns of J), J = R^T Q^T and Q = J^T R^-1, so the
+ * minimum-norm solution of J dq = -f is
+ *     dq = Q R^-T (-f) = J^T y,   R^T R y = -f
+ * (the seminormal equations; Bjoerck 1996, 6.6.5: accurate enough for a
+ * Newton direction, and every iterate's residual is checked anyway).
+ * Rows that depend on the ones before them (entries at or below the rank
+ * tolerance where a pivot would be) are left out of the step.
+ */
+
+typedef struct SparseRows {
+    MechEval *me;
+    int nrows;              /* the first nrows holonomic rows */
+    double t;
+    const AnalysisOptions *opt;
+    int *cstart, *crow, *cidx;  /* the rows' Jacobian by columns (CSC); cidx: entry of kin->jac */
+    double *vals, *cval;    /* every nonzero at the last evaluation; one column's */
+    double *phi, *y;
+    int *all;               /* 0 .. nrows-1 */
+} SparseRows;
+
+static double sparse_eval(void *ctx, const double *q, bool iterate, double *inf, int *worst)
+{
+    SparseRows *s = ctx;
+    (void)iterate;          /* one pass gives Phi and the nonzeros together */
+    mech_eval_nz(s->me, q, s->t, s->phi, s->vals);
+    double sum = 0.0;
+    *inf = 0.0;
+    *worst = -1;
+    for (int i = 0; i < s->nrows; i++) {
+        sum += s->phi[i] * s->phi[i];
+        if (fabs(s->phi[i]) > *inf || *worst < 0) {
+            *inf = fabs(s->phi[i]);
+            *worst = i;
+        }
+    }
+    return sqrt(sum);
+}
+
+static bool sparse_direction(void *ctx, double *dq, int *rank)
+{
+    SparseRows *s = ctx;
+    const Kinematics *kin = s->me->kin;
+    const AnalysisOptions *opt = s->opt;
+    int nq = s->me->nq, nrows = s->nrows;
+    const size_t fill_max = 50u * 1000u * 1000u;
+    /* factor J^T row by row (its rows are J's columns) */
+    double tol = opt->rank_tol >= 0
+                     ? opt->rank_tol
+                     : mechrt_svd_default_tol(nrows, nq,
+                                              sparse_sigma_max(kin, s->vals, s->all, nrows, opt->seed));
+    SparseRank *qr = sparse_rank_new(nrows, tol, fill_max);
+    bool good = true;
+    for (int i = 0; i < nq && good; i++) {
+        int k0 = s->cstart[i], k1 = s->cstart[i + 1];
+        for (int k = k0; k < k1; k++)
+            s->cval[k] = s->vals[s->cidx[k]];
+        good = sparse_rank_add(qr, s->crow + k0, s->cval + k0, k1 - k0) >= 0;
+    }
+    *rank = sparse_rank_of(qr);
+    for (int i = 0; i < nrows; i++)
+        s->y[i] = -s->phi[i];
+    if (good)
+        sparse_rank_seminormal_solve(qr, nrows, s->y);
+    sparse_rank_free(qr);
+    if (!good)
+        return false;
+    for (int i = 0; i < nq; i++) {          /* dq = J^T y */
+        double sum = 0.0;
+        for (int k = s->cstart[i]; k < s->cstart[i + 1]; k++)
+            sum += s->vals[s->cidx[k]] * s->y[s->crow[k]];
+        dq[i] = sum;
+    }
+    return true;
+}
+
+bool analysis_assemble_sparse(MechEval *me, int nrows, double t, double *q,
+                              const AnalysisOptions *opt, AssembleResult *res)
+{
+    const Kinematics *kin = me->kin;
+    int nq = me->nq;
+    /* the columns of the first nrows rows of J (CSC), fixed structure */
+    int nnz = kin->row_start[nrows];
+    SparseRows s = {
+        .me = me, .nrows = nrows, .t = t, .opt = opt,
+        .cstart = xcalloc((size_t)nq + 2, sizeof *s.cstart),
+        .crow = xmalloc(((size_t)nnz + 1) * sizeof *s.crow),
+        .cidx = xmalloc(((size_t)nnz + 1) * sizeof *s.cidx),
+        .vals = xmalloc(((size_t)kin->nnz + 1) * sizeof *s.vals),
+        .cval = xmalloc(((size_t)nnz + 1) * sizeof *s.cval),
+        .phi = xmalloc(((size_t)me->nh + 1) * sizeof *s.phi),
+        .y = xmalloc(((size_t)nrows + 1) * sizeof *s.y),
+        .all = xmalloc(((size_t)nrows + 1) * sizeof *s.all),
+    };
+    for (int e = 0; e < nnz; e++)
+        s.cstart[kin->jac[e].col + 2]++;
+    for (int i = 0; i < nq; i++)
+        s.cstart[i + 2] += s.cstart[i + 1];
+    for (int e = 0; e < nnz; e++) {         /* rows ascending within each column */
+        int k = s.cstart[kin->jac[e].col + 1]++;
+        s.crow[k] = kin->jac[e].row;
+        s.cidx[k] = e;
+    }
+    for (int i = 0; i < nrows; i++)
+        s.all[i] = i;
+    NewtonPath path = {sparse_eval, sparse_direction, &s};
+    bool ok = min_norm_newton(&path, nrows, nq, q, opt, res);
+    free(s.cstart), free(s.crow), free(s.cidx), free(s.vals), free(s.cval), free(s.phi),
+        free(s.y), free(s.all);
     return ok;
 }

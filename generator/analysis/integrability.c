@@ -279,13 +279,13 @@ typedef struct Sampler {
     double *q;
 } Sampler;
 
-/* Evaluates the nodes at one random state; false if any is not finite. */
-static bool sample(Sampler *s, NodeEval *ev, const NodeId *nodes, int n, double *values)
+/* Evaluates the n roots of ev at one random state; false if any is not finite. */
+static bool sample(Sampler *s, NodeValues *ev, int n, double *values)
 {
     double t = sample_state(&s->state, s->center, s->nq, s->q);
-    node_eval_run(ev, s->q, NULL, t);
+    node_values_run(ev, s->q, NULL, t);
     for (int i = 0; i < n; i++) {
-        values[i] = node_eval_value(ev, nodes[i]);
+        values[i] = node_values_get(ev, i);
         if (!isfinite(values[i]))
             return false;
     }
@@ -328,11 +328,12 @@ static NodeId try_law(Form *f, int p, Sampler *smp, int samples, bool *symbolic)
     if (exact) {
         *symbolic = true;
     } else {
-        NodeEval *ev = node_eval_new(d, check, 2 * nv);
+        NodeValues ev;
+        node_values_init(&ev, d, check, 2 * nv);
         int good = 0;
         bool bad = false;
         for (int s = 0; s < samples && !bad; s++) {
-            if (!sample(smp, ev, check, 2 * nv, val))
+            if (!sample(smp, &ev, 2 * nv, val))
                 continue;
             good++;
             for (int k = 0; k < nv; k++) {
@@ -341,7 +342,7 @@ static NodeId try_law(Form *f, int p, Sampler *smp, int samples, bool *symbolic)
                     bad = true;
             }
         }
-        node_eval_free(ev);
+        node_values_free(&ev);
         if (bad || good == 0)
             goto fail;
     }
@@ -473,11 +474,12 @@ static void test_form(Form *f, Sampler *smp, int samples, Integrability *out)
     double *val = xmalloc((size_t)nn * sizeof *val);
     memcpy(nodes, f->coef, (size_t)nv * sizeof *nodes);
     memcpy(nodes + nv, f->d, (size_t)nv * (size_t)nv * sizeof *nodes);
-    NodeEval *ev = node_eval_new(f->dag, nodes, nn);
+    NodeValues ev;
+    node_values_init(&ev, f->dag, nodes, nn);
     double worst = 0.0, worst_value = 0.0;
     int good = 0;
     for (int s = 0; s < samples; s++) {
-        if (!sample(smp, ev, nodes, nn, val))
+        if (!sample(smp, &ev, nn, val))
             continue;
         good++;
         for (int i = 0; i < nv; i++)
@@ -492,7 +494,7 @@ static void test_form(Form *f, Sampler *smp, int samples, Integrability *out)
                     }
                 }
     }
-    node_eval_free(ev);
+    node_values_free(&ev);
     free(nodes);
     free(val);
     out->samples = good;

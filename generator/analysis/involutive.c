@@ -150,29 +150,30 @@ bool analysis_involutivity(Model *m, const int *rows, int nrows, const double *p
             roots[e] = coef->e[e].node;
         for (int e = 0; e < part->n; e++)
             roots[coef->n + e] = part->e[e].node;
-        NodeEval *ev = node_eval_new(dag, roots, nroots);
+        NodeValues ev;          /* value e: coef->e[e], value coef->n + e: part->e[e] */
+        node_values_init(&ev, dag, roots, nroots);
         free(roots);
         size_t nn = (size_t)n * (size_t)n;
         double *C = xmalloc((size_t)nrows * (size_t)n * sizeof *C);
         double *B = xmalloc((size_t)n * (size_t)n * sizeof *B);
         double *W = xmalloc(nn * sizeof *W), *M = xmalloc(nn * sizeof *M);
         double *scratch = xmalloc(2 * nn * sizeof *scratch);
-        SvdWork *w = svd_work_new(nrows, n);
+        MechrtSvd *w = svd_work_new(nrows, n);
         double worst = 0.0;
         int worst_row = -1, worst_point = -1;
         for (int p = 0; p < npoints; p++) {
-            node_eval_run(ev, points + (size_t)p * (size_t)nq, NULL, times[p]);
+            node_values_run(&ev, points + (size_t)p * (size_t)nq, NULL, times[p]);
             memset(C, 0, (size_t)nrows * (size_t)n * sizeof *C);
             for (int e = 0; e < coef->n; e++)
                 C[(size_t)coef->e[e].k * (size_t)n + (size_t)coef->e[e].j] =
-                    node_eval_value(ev, coef->e[e].node);
-            SvdResult sv;
-            if (!analysis_svd(w, C, nrows, n, n, -1.0, &sv))
+                    node_values_get(&ev, e);
+            MechrtSvdResult sv;
+            if (!mechrt_svd(w, C, nrows, n, n, -1.0, &sv))
                 continue;               /* NaN or Inf here: skip the point */
             int r = sv.rank;
             for (int j = 0; j < n; j++)
                 for (int c = 0; c < r; c++)
-                    B[j * r + c] = svd_row_basis(w, j, c);
+                    B[j * r + c] = mechrt_svd_row_basis(w, j, c);
             bool finite = true;
             for (int v = 0; v < nvel && finite; v++) {
                 memset(W, 0, nn * sizeof *W);
@@ -180,7 +181,7 @@ bool analysis_involutivity(Model *m, const int *rows, int nrows, const double *p
                 for (int e = 0; e < part->n; e++) {
                     if (part->e[e].k != vel[v])
                         continue;
-                    double x = node_eval_value(ev, part->e[e].node);   /* d_l a_j */
+                    double x = node_values_get(&ev, coef->n + e);   /* d_l a_j */
                     int j = part->e[e].j, l = part->e[e].l;
                     W[l * n + j] += x;
                     W[j * n + l] -= x;
@@ -203,8 +204,8 @@ bool analysis_involutivity(Model *m, const int *rows, int nrows, const double *p
             if (finite)
                 out->points++;
         }
-        svd_work_free(w);
-        node_eval_free(ev);
+        mechrt_svd_free(w);
+        node_values_free(&ev);
         free(C), free(B), free(W), free(M), free(scratch);
         StrBuf sb;
         sb_init(&sb);

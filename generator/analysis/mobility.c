@@ -56,10 +56,10 @@ static void pick_rows(const double *jac, int nq, const int *rows, int n, double 
                (size_t)nq * sizeof *out);
 }
 
-static int rank_of(SvdWork *w, const double *a, int m, int nq, double tol)
+static int rank_of(MechrtSvd *w, const double *a, int m, int nq, double tol)
 {
-    SvdResult r;
-    return analysis_svd(w, a, m, nq, nq, tol, &r) ? r.rank : -1;
+    MechrtSvdResult r;
+    return mechrt_svd(w, a, m, nq, nq, tol, &r) ? r.rank : -1;
 }
 
 /* A random configuration near q: each coordinate moved by up to 20 % of its
@@ -81,7 +81,7 @@ static void perturb(const double *q, int nq, uint64_t *state, double *qs)
 /* Rank of the undriven holonomic rows at configurations assembled from random
    perturbations of q; -1 when none assembled. */
 static int generic_rank(MechEval *me, const int *rows, int nrows, const double *q, double t,
-                        const AnalysisOptions *opt, SvdWork *w)
+                        const AnalysisOptions *opt, MechrtSvd *w)
 {
     int nq = me->nq, best = -1;
     double *qs = xmalloc((size_t)nq * sizeof *qs);
@@ -107,7 +107,7 @@ static int generic_rank(MechEval *me, const int *rows, int nrows, const double *
    without drivers, at the configuration and at a few others assembled on
    those holonomic rows at nearby times. */
 static bool system_test(Model *m, MechEval *me, InfoReport *rep, const int *undriven, int nu,
-                        int nuh, const AnalysisOptions *opt, SvdWork *w, Diag *diag)
+                        int nuh, const AnalysisOptions *opt, MechrtSvd *w, Diag *diag)
 {
     int nq = m->nq;
     if (nu == nuh) {
@@ -247,7 +247,7 @@ static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, c
         all[r] = r;
     mech_eval_nz(me, rep->q, rep->t, NULL, vals);
     double smax = sparse_sigma_max(kin, vals, all, nr, opt->seed);
-    double tol = opt->rank_tol >= 0 ? opt->rank_tol : svd_default_tol(nr, nq, smax);
+    double tol = opt->rank_tol >= 0 ? opt->rank_tol : mechrt_svd_default_tol(nr, nq, smax);
     rep->sigma_max = smax;
     rep->sigma_min = rep->cond = NAN;
     rep->rank_tol = tol;
@@ -325,7 +325,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
 
     MechEval me;
     mech_eval_init(&me, &mech->kin);
-    SvdWork *w = rep->dense ? svd_work_new(nr, nq) : NULL;
+    MechrtSvd *w = rep->dense ? svd_work_new(nr, nq) : NULL;
     size_t dense_len = w ? (size_t)nr * (size_t)nq : 0;
     double *jac = xcalloc(dense_len + 1, sizeof *jac);
     double *sub = xcalloc(dense_len + 1, sizeof *sub);
@@ -347,8 +347,8 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
 
     if (w) {
         /* holonomic rows */
-        SvdResult sv;
-        if (analysis_svd(w, jac, nh, nq, nq, opt->rank_tol, &sv)) {
+        MechrtSvdResult sv;
+        if (mechrt_svd(w, jac, nh, nq, nq, opt->rank_tol, &sv)) {
             rep->rank = sv.rank;
             rep->rank_tol = sv.tol;
             rep->sigma_max = sv.sigma_max;
@@ -356,8 +356,8 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
             rep->cond = nh ? sv.cond : 0.0;
             rep->nredundant = svd_redundant_rows(w, jac, nh, nq, nq, sv.tol, 0, sv.rank, red);
             /* all rows, velocity level included (the same matrix when nv == 0) */
-            SvdResult sa = sv;
-            if (m->nv == 0 || analysis_svd(w, jac, nr, nq, nq, opt->rank_tol, &sa)) {
+            MechrtSvdResult sa = sv;
+            if (m->nv == 0 || mechrt_svd(w, jac, nr, nq, nq, opt->rank_tol, &sa)) {
                 rep->rank_all = sa.rank;
                 rep->nredundant_velocity =
                     svd_redundant_rows(w, jac, nr, nq, nq, sa.tol, nh, sa.rank, red);
@@ -412,7 +412,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
         ok = system_test(m, &me, rep, undriven, nu, nuh, opt, w, diag);
 
     mech_eval_free(&me);
-    svd_work_free(w);
+    mechrt_svd_free(w);
     free(jac), free(sub), free(red), free(undriven), free(hrows);
     if (!ok)
         info_report_free(rep);

@@ -320,6 +320,15 @@ static void watch_condition(Run *r, double t, const MechrtReport *rep)
     }
 }
 
+/* A state computed at t (in r->q, r->qd, r->qdd): the condition watch,
+   then out to the caller. */
+static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
+{
+    watch_condition(r, t, rep);
+    state(ctx, t, r->q, r->qd, r->qdd);
+    r->res->states++;
+}
+
 static double time_at(const RunOptions *o, int i)
 {
     if (i == o->steps)
@@ -344,9 +353,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     }
     note_move(r, q0);
     free(q0);
-    watch_condition(r, o->t0, &rep);
-    state(ctx, o->t0, r->q, r->qd, r->qdd);
-    r->res->states++;
+    put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0;
     for (int i = 1; i <= o->steps; i++) {
@@ -364,10 +371,8 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
             return RUN_FAILED;
         }
         r->res->steps_done++;
-        watch_condition(r, tn, &rep);
         t = tn;
-        state(ctx, t, r->q, r->qd, r->qdd);
-        r->res->states++;
+        put_state(r, t, &rep, state, ctx);
     }
     return RUN_OK;
 }
@@ -404,9 +409,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         status = RUN_FAILED;
         goto out;
     }
-    watch_condition(r, o->t0, &rep);
-    state(ctx, o->t0, r->q, r->qd, r->qdd);
-    r->res->states++;
+    put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0, hstep = (o->t1 - o->t0) / o->steps;
     for (int i = 1; i <= o->steps; i++) {
@@ -432,10 +435,8 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
             goto out;
         }
         r->res->steps_done++;
-        watch_condition(r, tn, &rep);
         t = tn;
-        state(ctx, t, r->q, r->qd, r->qdd);
-        r->res->states++;
+        put_state(r, t, &rep, state, ctx);
     }
 out:
     r->res->host = *mechrt_host_stats(host);

@@ -164,22 +164,11 @@ double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *ro
     return sigma;
 }
 
-/* ---- minimum-norm Newton with the sparse factor ----
- *
- * With J^T = Q R (R: m x m upper triangular, from the row-wise QR of J^T,
- * whose rows are the columns of J), J = R^T Q^T and Q = J^T R^-1, so the
- * minimum-norm solution of J dq = -f is
- *     dq = Q R^-T (-f) = J^T y,   R^T R y = -f
- * (the seminormal equations; Bjoerck 1996, 6.6.5: accurate enough for a
- * Newton direction, and every iterate's residual is checked anyway).
- * Rows that depend on the ones before them (entries at or below the rank
- * tolerance where a pivot would be) are left out of the step.
- */
-
-/* Solves R^T R y = b in place (b becomes y). A row of J that depends on
-   the rows before it has no pivot: it is left out (y_j = 0), which is
-   the factor of J without that row. */
-static void seminormal_solve(const SparseRank *s, int m, double *b)
+/* Solves R^T R y = b in place (b becomes y): the seminormal equations of
+   the minimum-norm step (assemble.c). A row of J that depends on the rows
+   before it has no pivot: it is left out (y_j = 0), which is the factor of
+   J without that row. */
+void sparse_rank_seminormal_solve(const SparseRank *s, int m, double *b)
 {
     for (int j = 0; j < m; j++) {           /* R^T z = b, forward */
         const double *r = s->seg[j];
@@ -200,119 +189,4 @@ static void seminormal_solve(const SparseRank *s, int m, double *b)
             sum -= r[k] * b[j + k];
         b[j] = sum / r[0];
     }
-}
-
-bool analysis_assemble_sparse(MechEval *me, int nrows, double t, double *q,
-                              const AnalysisOptions *opt, AssembleResult *res)
-{
-    const Kinematics *kin = me->kin;
-    int nq = me->nq;
-    memset(res, 0, sizeof *res);
-    res->step = -1.0;
-    res->worst_row = -1;
-    res->rank = -1;
-    if (nrows == 0) {
-        res->converged = true;
-        return true;
-    }
-    /* the columns of the first nrows rows of J (CSC), fixed structure */
-    int nnz = kin->row_start[nrows];
-    int *cstart = xcalloc((size_t)nq + 2, sizeof *cstart);
-    int *crow = xmalloc(((size_t)nnz + 1) * sizeof *crow);
-    int *cidx = xmalloc(((size_t)nnz + 1) * sizeof *cidx);     /* entry e of kin->jac */
-    for (int e = 0; e < nnz; e++)
-        cstart[kin->jac[e].col + 2]++;
-    for (int i = 0; i < nq; i++)
-        cstart[i + 2] += cstart[i + 1];
-    for (int e = 0; e < nnz; e++) {         /* rows ascending within each column */
-        int k = cstart[kin->jac[e].col + 1]++;
-        crow[k] = kin->jac[e].row;
-        cidx[k] = e;
-    }
-    double *vals = xmalloc(((size_t)kin->nnz + 1) * sizeof *vals);
-    double *cval = xmalloc(((size_t)nnz + 1) * sizeof *cval);
-    double *phi = xmalloc(((size_t)me->nh + 1) * sizeof *phi);
-    double *y = xmalloc(((size_t)nrows + 1) * sizeof *y);
-    double *dq = xmalloc((size_t)nq * sizeof *dq), *trial = xmalloc((size_t)nq * sizeof *trial);
-    const size_t fill_max = 50u * 1000u * 1000u;
-    int *all = xmalloc(((size_t)nrows + 1) * sizeof *all);
-    for (int i = 0; i < nrows; i++)
-        all[i] = i;
-
-#define NORMS(x, norm2, inf, worst) do { \
-        mech_eval_nz(me, (x), t, phi, vals); \
-        double s2_ = 0.0; (inf) = 0.0; (worst) = -1; \
-        for (int i_ = 0; i_ < nrows; i_++) { \
-            s2_ += phi[i_] * phi[i_]; \
-            if (fabs(phi[i_]) > (inf) || (worst) < 0) { (inf) = fabs(phi[i_]); (worst) = i_; } \
-        } \
-        (norm2) = sqrt(s2_); \
-    } while (0)
-
-    double norm, inf;
-    int worst;
-    NORMS(q, norm, inf, worst);
-    res->residual = inf;
-    res->worst_row = worst;
-    bool ok = false;
-    for (int iter = 0; isfinite(norm); iter++) {
-        if (inf <= opt->tol_phi && (res->step < 0 || res->step <= opt->tol_dq)) {
-            ok = true;
-            break;
-        }
-        if (iter >= opt->max_iter)
-            break;
-        /* factor J^T row by row (its rows are J's columns) */
-        double tol = opt->rank_tol >= 0
-                         ? opt->rank_tol
-                         : svd_default_tol(nrows, nq, sparse_sigma_max(kin, vals, all, nrows, opt->seed));
-        SparseRank *s = sparse_rank_new(nrows, tol, fill_max);
-        bool good = true;
-        for (int i = 0; i < nq && good; i++) {
-            int k0 = cstart[i], k1 = cstart[i + 1];
-            for (int k = k0; k < k1; k++)
-                cval[k] = vals[cidx[k]];
-            good = sparse_rank_add(s, crow + k0, cval + k0, k1 - k0) >= 0;
-        }
-        res->rank = sparse_rank_of(s);
-        for (int i = 0; i < nrows; i++)
-            y[i] = -phi[i];
-        if (good)
-            seminormal_solve(s, nrows, y);
-        sparse_rank_free(s);
-        if (!good)
-            break;
-        double step = 0.0;
-        for (int i = 0; i < nq; i++) {      /* dq = J^T y */
-            double sum = 0.0;
-            for (int k = cstart[i]; k < cstart[i + 1]; k++)
-                sum += vals[cidx[k]] * y[crow[k]];
-            dq[i] = sum;
-            step = fmax(step, fabs(sum));
-        }
-        double alpha = 1.0, tnorm = NAN, tinf = 0.0;
-        int tworst;
-        for (int h = 0; h <= 12; h++) {
-            for (int i = 0; i < nq; i++)
-                trial[i] = q[i] + alpha * dq[i];
-            NORMS(trial, tnorm, tinf, tworst);
-            if (isfinite(tnorm) && (tnorm < norm || tinf <= opt->tol_phi))
-                break;
-            alpha *= 0.5;
-        }
-        if (!isfinite(tnorm) || !(tnorm < norm || tinf <= opt->tol_phi))
-            alpha = 1.0;
-        for (int i = 0; i < nq; i++)
-            q[i] += alpha * dq[i];
-        res->iterations = iter + 1;
-        res->step = alpha * step;
-        NORMS(q, norm, inf, worst);
-        res->residual = isfinite(norm) ? inf : NAN;
-        res->worst_row = worst;
-    }
-#undef NORMS
-    res->converged = ok;
-    free(cstart), free(crow), free(cidx), free(vals), free(cval), free(phi), free(y), free(dq),
-        free(trial), free(all);
-    return ok;
 }

@@ -142,6 +142,18 @@ bool args_limit(Args *a, const char *option, MechLimits *limits)
     return false;
 }
 
+bool args_engine(Args *a, const char *option, int *engine)
+{
+    if (strcmp(option, "--engine") != 0)
+        return false;
+    const char *v = args_value(a, option);
+    if (v && (*engine = engine_from_name(v)) < 0) {
+        fprintf(stderr, "mechc %s: error: --engine takes jit, generic or aot, not '%s'\n", a->command, v);
+        a->failed = true;
+    }
+    return true;
+}
+
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out)
 {
     int count = 0;
@@ -224,4 +236,14 @@ void json_string(FILE *out, const char *s)
     sb_put_json_string(&sb, s);
     fputs(sb.data, out);
     sb_free(&sb);
+}
+
+void json_string_list(FILE *out, const char *const *s, int n)
+{
+    fputc('[', out);
+    for (int i = 0; i < n; i++) {
+        fputs(i ? ", " : "", out);
+        json_string(out, s[i]);
+    }
+    fputc(']', out);
 }

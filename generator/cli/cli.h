@@ -1,8 +1,9 @@
-/* cli.h - the subcommands and the small argument helpers they share. */
+/* cli.h - the subcommands and the small helpers they share (args.c, common.c). */
 #ifndef MECHC_CLI_H
 #define MECHC_CLI_H
 
 #include "../base/limits.h"
+#include "../engine/engine.h"
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -34,11 +35,27 @@ bool args_int(Args *a, const char *option, int min, int max, int *out);
    (a->failed set on a bad value). args_limits_usage is their --help text. */
 bool args_limit(Args *a, const char *option, MechLimits *limits);
 extern const char args_limits_usage[];
+/* --engine jit|generic|aot: true when option is --engine, its value then
+   parsed into *engine (a->failed set on a bad value). */
+bool args_engine(Args *a, const char *option, int *engine);
 /* A comma-separated list of exactly n finite numbers. */
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out);
 void args_unknown(Args *a, const char *option);
 bool args_need_file(Args *a);
 bool args_is_help(const char *option);
+
+/* ---- after the options (common.c) ---- */
+
+/* Loads a->file (no file: the usage error of args_need_file) with limits
+   (NULL: the defaults). On bad input prints the diagnostic and returns
+   NULL: exit status 2. diag must outlive the Mech (pipeline_load). */
+Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag);
+/* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
+void cli_error(const Args *a, const Diag *diag);
+/* engine_open_with (options NULL: the defaults), the failure reported by
+   cli_error. */
+bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech,
+                     const EngineOptions *options, Diag *diag);
 
 int cmd_gen(int argc, char **argv);
 int cmd_eval(int argc, char **argv);
@@ -50,5 +67,7 @@ int cmd_bench(int argc, char **argv);
 /* JSON number: %.17g, or null for NaN and infinities (JSON has neither). */
 void json_number(FILE *out, double v);
 void json_string(FILE *out, const char *s);
+/* ["s0", "s1", ...] */
+void json_string_list(FILE *out, const char *const *s, int n);
 
 #endif

@@ -11,7 +11,6 @@
 #include "../render/progress.h"
 
 #include "../base/arena.h"
-#include "../engine/engine.h"
 #include "../eval/aot.h"
 
 #include <stdlib.h>
@@ -252,15 +251,10 @@ int cmd_bench(int argc, char **argv)
             args_unknown(&a, o);
         }
     }
-    if (!args_need_file(&a))
-        return EXIT_USAGE;
-    MechLimits limits = mech_default_limits();
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, NULL, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     const Model *m = mech->model;
     Bench *b = xcalloc(1, sizeof *b);
     EngineOptions eo = engine_default_options();
@@ -273,11 +267,9 @@ int cmd_bench(int argc, char **argv)
                 fprintf(stderr, "mechc bench: note: no C compiler found (set CC): aot left out\n");
             continue;
         }
-        b->open[k] = engine_open_with(&b->eng[k], k, mech, &eo, &diag);
-        if (!b->open[k]) {
-            fprintf(stderr, "mechc bench: error: %s\n", diag.message);
+        b->open[k] = cli_engine_open(&a, &b->eng[k], k, mech, &eo, &diag);
+        if (!b->open[k])
             status = EXIT_USAGE;
-        }
     }
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
     if (status == EXIT_OK) {

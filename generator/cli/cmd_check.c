@@ -164,19 +164,14 @@ int cmd_check(int argc, char **argv)
             args_unknown(&a, o);
         }
     }
-    if (!args_need_file(&a))
-        return EXIT_USAGE;
-    MechLimits limits = mech_default_limits();
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, NULL, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     CheckReport rep;
     int status = EXIT_OK;
     if (!check_mechanism(mech, &opt, &rep, &diag)) {
-        fprintf(stderr, "mechc check: error: %s\n", diag.message);
+        cli_error(&a, &diag);
         status = EXIT_USAGE;
     } else {
         if (json)

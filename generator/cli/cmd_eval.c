@@ -2,7 +2,6 @@
 #include "cli.h"
 
 #include "../base/arena.h"
-#include "../engine/engine.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -26,12 +25,9 @@ static const char *row_level(const Row *row) { return row->velocity ? "velocity"
 static void print_json(const Model *m, double t, const double *q, const double *qd, const double *phi,
                        const double *jac, const double *nu, const double *gamma)
 {
-    printf("{\"coords\": [");
-    for (int i = 0; i < m->nq; i++) {
-        printf(i ? ", " : "");
-        json_string(stdout, m->coord_names[i]);
-    }
-    printf("],\n \"rows\": [");
+    printf("{\"coords\": ");
+    json_string_list(stdout, m->coord_names, m->nq);
+    printf(",\n \"rows\": [");
     for (int r = 0; r < m->nr; r++) {
         printf(r ? ",\n          " : "");
         printf("{\"name\": ");
@@ -130,7 +126,7 @@ int cmd_eval(int argc, char **argv)
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);
             return EXIT_OK;
-        } else if (args_limit(&a, opt, &limits)) {
+        } else if (args_limit(&a, opt, &limits) || args_engine(&a, opt, &engine)) {
             continue;
         } else if (strcmp(opt, "--q") == 0) {
             q_text = args_value(&a, opt);
@@ -140,24 +136,14 @@ int cmd_eval(int argc, char **argv)
             args_double(&a, opt, &t);
         } else if (strcmp(opt, "--json") == 0) {
             json = true;
-        } else if (strcmp(opt, "--engine") == 0) {
-            const char *v = args_value(&a, opt);
-            if (v && (engine = engine_from_name(v)) < 0) {
-                fprintf(stderr, "mechc eval: error: --engine takes jit, generic or aot, not '%s'\n", v);
-                a.failed = true;
-            }
         } else {
             args_unknown(&a, opt);
         }
     }
-    if (!args_need_file(&a))
-        return EXIT_USAGE;
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, &limits, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     const Model *m = mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
     double *q = xcalloc(nq, sizeof *q), *qd = xcalloc(nq, sizeof *qd);
@@ -170,8 +156,7 @@ int cmd_eval(int argc, char **argv)
         status = EXIT_USAGE;
     } else {
         Engine e;
-        if (!engine_open(&e, (EngineKind)engine, mech, &diag)) {
-            fprintf(stderr, "mechc eval: error: %s\n", diag.message);
+        if (!cli_engine_open(&a, &e, (EngineKind)engine, mech, NULL, &diag)) {
             status = EXIT_USAGE;
         } else {
             engine_phi(&e, q, t, phi);

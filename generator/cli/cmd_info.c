@@ -80,12 +80,9 @@ static void print_json(const InfoReport *rep)
     const Model *m = rep->model;
     printf("{\"mechanism\": ");
     json_string(stdout, m->name);
-    printf(",\n \"coords\": [");
-    for (int i = 0; i < m->nq; i++) {
-        printf(i ? ", " : "");
-        json_string(stdout, m->coord_names[i]);
-    }
-    printf("],\n \"rows\": [");
+    printf(",\n \"coords\": ");
+    json_string_list(stdout, m->coord_names, m->nq);
+    printf(",\n \"rows\": [");
     for (int r = 0; r < m->nr; r++) {
         const Row *row = &m->rows[r];
         const InfoRow *ir = &rep->rows[r];
@@ -305,18 +302,13 @@ int cmd_info(int argc, char **argv)
             args_unknown(&a, opt);
         }
     }
-    if (!args_need_file(&a))
-        return EXIT_USAGE;
-    MechLimits limits = mech_default_limits();
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, NULL, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     InfoReport rep;
     if (!info_analyse(mech, t, &o, &rep, &diag)) {
-        fprintf(stderr, "mechc info: error: %s\n", diag.message);
+        cli_error(&a, &diag);
         pipeline_free(mech);
         return EXIT_USAGE;
     }

@@ -209,7 +209,7 @@ int cmd_run(int argc, char **argv)
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);
             return EXIT_OK;
-        } else if (args_limit(&a, opt, &limits)) {
+        } else if (args_limit(&a, opt, &limits) || args_engine(&a, opt, &engine)) {
             continue;
         } else if (strcmp(opt, "--t0") == 0) {
             args_double(&a, opt, &ro.t0);
@@ -217,12 +217,6 @@ int cmd_run(int argc, char **argv)
             args_double(&a, opt, &ro.t1);
         } else if (strcmp(opt, "--steps") == 0) {
             args_int(&a, opt, 1, 100000000, &ro.steps);
-        } else if (strcmp(opt, "--engine") == 0) {
-            const char *v = args_value(&a, opt);
-            if (v && (engine = engine_from_name(v)) < 0) {
-                fprintf(stderr, "mechc run: error: --engine takes jit, generic or aot, not '%s'\n", v);
-                a.failed = true;
-            }
         } else if (strcmp(opt, "--csv") == 0) {
             csv_path = args_value(&a, opt);
         } else if (strcmp(opt, "--json") == 0) {
@@ -288,11 +282,9 @@ int cmd_run(int argc, char **argv)
     }
 
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, &limits, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     const Model *m = mech->model;
     SvgTrace traces[MAX_TRACES];
     SvgPlotVar vars[MAX_PLOT_VARS];
@@ -317,8 +309,7 @@ int cmd_run(int argc, char **argv)
             vars[nvars++] = (SvgPlotVar){i, 0};
     }
     Engine e;
-    if (!engine_open(&e, (EngineKind)engine, mech, &diag)) {
-        fprintf(stderr, "mechc run: error: %s\n", diag.message);
+    if (!cli_engine_open(&a, &e, (EngineKind)engine, mech, NULL, &diag)) {
         pipeline_free(mech);
         return EXIT_USAGE;
     }

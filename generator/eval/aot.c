@@ -203,13 +203,6 @@ static bool build(const char *dir, const char *hex, const char *source, const ch
     return ok;
 }
 
-static void *symbol(void *handle, const char *prefix, const char *name)
-{
-    char s[256];
-    snprintf(s, sizeof s, "%s_%s", prefix, name);
-    return dlsym(handle, s);
-}
-
 bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
               AotResult *out, Diag *diag)
 {
@@ -237,16 +230,7 @@ bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
         diag_error_nopos(diag, "the aot engine cannot load %s: %s", out->path, dlerror());
         return false;
     }
-    memset(k, 0, sizeof *k);
-    k->phi = (KernelPhi)symbol(handle, prefix, "phi");
-    k->jac = (KernelPhi)symbol(handle, prefix, "jac");
-    k->jac_nz = (KernelPhi)symbol(handle, prefix, "jac_nz");
-    k->nu = (KernelPhi)symbol(handle, prefix, "nu");
-    k->gamma = (KernelGamma)symbol(handle, prefix, "gamma");
-    k->all = (KernelAll)symbol(handle, prefix, "all");
-    k->jac_row = symbol(handle, prefix, "jac_row");
-    k->jac_col = symbol(handle, prefix, "jac_col");
-    if (!k->phi || !k->jac || !k->jac_nz || !k->nu || !k->gamma || !k->all || !k->jac_row || !k->jac_col) {
+    if (!kernels_bind(k, dlsym, handle, prefix)) {
         diag_error_nopos(diag, "internal error: %s lacks a generated function (remove it and retry)",
                          out->path);
         dlclose(handle);

@@ -1,6 +1,6 @@
-/* interp.c - compiles one expression to an instruction list and runs it, with or without derivatives.
+/* interp.c - compiles expressions to an instruction list and runs it, with or without derivatives.
  *
- * Compiling: the nodes reachable from the root are collected (iterative
+ * Compiling: the nodes reachable from the roots are collected (iterative
  * depth-first walk) and sorted by id, which is a topological order of the
  * graph; node ids become register numbers. Running is one loop over the
  * instructions. Values come from dag_op_eval, the single definition of
@@ -55,7 +55,8 @@ static int compare_ints(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-void tape_compile(Tape *p, const Dag *dag, NodeId root, CompileScratch *cs)
+void tape_compile_roots(Tape *p, const Dag *dag, const NodeId *roots, int nroots,
+                        CompileScratch *cs)
 {
     memset(p, 0, sizeof *p);
     if (++cs->stamp == 0) {
@@ -63,8 +64,11 @@ void tape_compile(Tape *p, const Dag *dag, NodeId root, CompileScratch *cs)
         cs->stamp = 1;
     }
     int top = 0, n = 0;
-    cs->stack[top++] = root;
-    cs->mark[root] = cs->stamp;
+    for (int r = 0; r < nroots; r++)
+        if (roots[r] >= 0 && cs->mark[roots[r]] != cs->stamp) {
+            cs->mark[roots[r]] = cs->stamp;
+            cs->stack[top++] = roots[r];
+        }
     while (top > 0) {
         NodeId id = cs->stack[--top];
         cs->nodes[n++] = id;
@@ -109,17 +113,27 @@ void tape_compile(Tape *p, const Dag *dag, NodeId root, CompileScratch *cs)
     /* hash-consing makes every leaf unique: sorting is all that is needed */
     qsort(p->qcols, (size_t)p->nqcols, sizeof *p->qcols, compare_ints);
     qsort(p->qdcols, (size_t)p->nqdcols, sizeof *p->qdcols, compare_ints);
+    p->nout = nroots;
+    p->out = xmalloc((size_t)nroots * sizeof *p->out);
+    for (int r = 0; r < nroots; r++)
+        p->out[r] = roots[r] >= 0 ? cs->slot[roots[r]] : -1;
+}
+
+void tape_compile(Tape *p, const Dag *dag, NodeId root, CompileScratch *cs)
+{
+    tape_compile_roots(p, dag, &root, 1, cs);
 }
 
 void tape_free(Tape *p)
 {
     free(p->code);
+    free(p->out);
     free(p->qcols);
     free(p->qdcols);
     memset(p, 0, sizeof *p);
 }
 
-double tape_value(const Tape *p, const double *q, const double *qd, double t, double *reg)
+void tape_run(const Tape *p, const double *q, const double *qd, double t, double *reg)
 {
     for (int k = 0; k < p->n; k++) {
         const Instr *in = &p->code[k];
@@ -131,6 +145,11 @@ double tape_value(const Tape *p, const double *q, const double *qd, double t, do
         default:       reg[k] = dag_op_eval((DagOp)in->op, reg[in->a], reg[in->b]); break;
         }
     }
+}
+
+double tape_value(const Tape *p, const double *q, const double *qd, double t, double *reg)
+{
+    tape_run(p, q, qd, t, reg);
     return reg[p->n - 1];
 }
 
@@ -256,4 +275,43 @@ Jet tape_jet(const Tape *p, const Seed *s, int order, Jet *reg)
         reg[k] = r;
     }
     return reg[p->n - 1];
+}
+
+/* ---- many roots, evaluated again and again ---- */
+
+void node_values_init(NodeValues *nv, const Dag *dag, const NodeId *roots, int nroots)
+{
+    CompileScratch cs;
+    compile_scratch_init(&cs, dag);
+    tape_compile_roots(&nv->tape, dag, roots, nroots, &cs);
+    compile_scratch_free(&cs);
+    nv->reg = xcalloc((size_t)nv->tape.n, sizeof *nv->reg);
+}
+
+void node_values_free(NodeValues *nv)
+{
+    tape_free(&nv->tape);
+    free(nv->reg);
+    nv->reg = NULL;
+}
+
+void node_values_run(NodeValues *nv, const double *q, const double *qd, double t)
+{
+    tape_run(&nv->tape, q, qd, t, nv->reg);
+}
+
+double node_values_get(const NodeValues *nv, int k)
+{
+    int r = nv->tape.out[k];
+    return r >= 0 ? nv->reg[r] : NAN;
+}
+
+double node_value_at(const Dag *dag, NodeId id, const double *q, const double *qd, double t)
+{
+    NodeValues nv;
+    node_values_init(&nv, dag, &id, 1);
+    node_values_run(&nv, q, qd, t);
+    double v = node_values_get(&nv, 0);
+    node_values_free(&nv);
+    return v;
 }

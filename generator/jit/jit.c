@@ -62,12 +62,29 @@ static void save_failed_source(const char *source, const char *prefix, char *pat
     }
 }
 
-static void *lookup(TCCState *s, const char *prefix, const char *name)
+static void *kernel(KernelFind find, void *handle, const char *prefix, const char *name)
 {
     char symbol[256];
     snprintf(symbol, sizeof symbol, "%s_%s", prefix, name);
-    return tcc_get_symbol(s, symbol);
+    return find(handle, symbol);
 }
+
+bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
+{
+    memset(k, 0, sizeof *k);
+    k->phi = (KernelPhi)kernel(find, handle, prefix, "phi");
+    k->jac = (KernelPhi)kernel(find, handle, prefix, "jac");
+    k->jac_nz = (KernelPhi)kernel(find, handle, prefix, "jac_nz");
+    k->nu = (KernelPhi)kernel(find, handle, prefix, "nu");
+    k->gamma = (KernelGamma)kernel(find, handle, prefix, "gamma");
+    k->all = (KernelAll)kernel(find, handle, prefix, "all");
+    k->jac_row = kernel(find, handle, prefix, "jac_row");
+    k->jac_col = kernel(find, handle, prefix, "jac_col");
+    return k->phi && k->jac && k->jac_nz && k->nu && k->gamma && k->all && k->jac_row
+           && k->jac_col;
+}
+
+static void *tcc_find(void *s, const char *symbol) { return tcc_get_symbol(s, symbol); }
 
 Jit *jit_compile(const char *source, const char *prefix, Diag *diag)
 {
@@ -100,17 +117,7 @@ Jit *jit_compile(const char *source, const char *prefix, Diag *diag)
     if (rc == 0) {
         jit = xcalloc(1, sizeof *jit);
         jit->state = s;
-        Kernels *k = &jit->kernels;
-        k->phi = (KernelPhi)lookup(s, prefix, "phi");
-        k->jac = (KernelPhi)lookup(s, prefix, "jac");
-        k->jac_nz = (KernelPhi)lookup(s, prefix, "jac_nz");
-        k->nu = (KernelPhi)lookup(s, prefix, "nu");
-        k->gamma = (KernelGamma)lookup(s, prefix, "gamma");
-        k->all = (KernelAll)lookup(s, prefix, "all");
-        k->jac_row = lookup(s, prefix, "jac_row");
-        k->jac_col = lookup(s, prefix, "jac_col");
-        if (!k->phi || !k->jac || !k->jac_nz || !k->nu || !k->gamma || !k->all
-            || !k->jac_row || !k->jac_col) {
+        if (!kernels_bind(&jit->kernels, tcc_find, s, prefix)) {
             sb_puts(&errors, "a generated function is missing after compilation\n");
             rc = -1;
             free(jit);

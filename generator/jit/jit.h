@@ -18,6 +18,13 @@ typedef struct Kernels {
     const int *jac_row, *jac_col;
 } Kernels;
 
+/* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
+typedef void *(*KernelFind)(void *handle, const char *symbol);
+
+/* Fills k with the generated functions PREFIX_phi, PREFIX_jac, ... of
+   handle; false when one is missing. */
+bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix);
+
 typedef struct Jit Jit;
 
 /* Compiles source (double kernels, emitted with declare_math) whose

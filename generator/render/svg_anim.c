@@ -31,6 +31,7 @@
 
 #include "../base/arena.h"
 #include "../diff/kinematics.h"
+#include "../eval/interp.h"
 #include "svg_common.h"
 
 #include <errno.h>
@@ -302,25 +303,6 @@ static bool body_has_symbol(const Scene *sc, int q)
     return false;
 }
 
-/* Evaluates a graph node at (q, t): the rolling radius (usually a constant). */
-static double eval_node(const Dag *dag, NodeId id, const double *q, double t, int depth)
-{
-    if (id < 0 || id >= dag->count || depth > 200)
-        return NAN;
-    const DagNode *n = dag_node(dag, id);
-    switch ((DagOp)n->op) {
-    case OP_CONST: return n->value;
-    case OP_VAR: return q[n->a];
-    case OP_VARD: return 0;
-    case OP_TIME: return t;
-    default: break;
-    }
-    int arity = dag_op_info[n->op].arity;
-    double a = eval_node(dag, n->a, q, t, depth + 1);
-    double b = arity > 1 ? eval_node(dag, n->b, q, t, depth + 1) : 0;
-    return dag_op_eval((DagOp)n->op, a, b);
-}
-
 /* ---- convex hull of a body's local points (Andrew's monotone chain) ---- */
 
 typedef struct P2 { double x, y; } P2;
@@ -546,7 +528,7 @@ static void build_joints(Scene *sc, GroundList *gl)
         }
         case JOINT_ROLLING: {
             const double *q0 = frame_q(sc, sc->frames[0]);
-            double R = fabs(eval_node(&m->dag, jt->option, q0, sc->t[sc->frames[0]], 0));
+            double R = fabs(node_value_at(&m->dag, jt->option, q0, NULL, sc->t[sc->frames[0]]));
             if (!isfinite(R) || R <= 0)
                 break;
             Attach centre = {jt->a.q, true, 0, 0};

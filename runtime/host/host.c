@@ -1,4 +1,4 @@
-/* host.c - minimum-norm Gauss-Newton, position integration and singular directions, on GSL.
+/* host.c - minimum-norm Gauss-Newton projection and position integration, on GSL.
  *
  * A mechanism with velocity-level rows (rolling, knife edges, velocity
  * drivers) has nh holonomic rows Phi(q, t) = 0 and nv Pfaffian rows
@@ -25,10 +25,7 @@
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
-#include <gsl/gsl_linalg.h>
-#include <gsl/gsl_matrix.h>
 #include <gsl/gsl_odeiv2.h>
-#include <gsl/gsl_vector.h>
 
 struct MechrtHost {
     const MechrtKernels *k;
@@ -38,9 +35,7 @@ struct MechrtHost {
     double *phi;                /* nh (at least 1) */
     double *jac;                /* nr * nq */
     double *dq, *y;             /* nq each */
-    gsl_matrix *at;             /* nq x nh: Phi_q^T, then U of its SVD */
-    gsl_matrix *v;              /* nh x nh */
-    gsl_vector *s, *svwork;     /* nh */
+    MechrtSvd *svd;             /* nh x nq (svd.c) */
     /* integration */
     gsl_odeiv2_step *step;
     MechrtOdeMethod step_method;
@@ -98,14 +93,7 @@ void mechrt_host_free(MechrtHost *h)
     free(h->dq);
     free(h->y);
     free(h->fail_q);
-    if (h->at)
-        gsl_matrix_free(h->at);
-    if (h->v)
-        gsl_matrix_free(h->v);
-    if (h->s)
-        gsl_vector_free(h->s);
-    if (h->svwork)
-        gsl_vector_free(h->svwork);
+    mechrt_svd_free(h->svd);
     if (h->step)
         gsl_odeiv2_step_free(h->step);
     if (h->control)
@@ -137,11 +125,8 @@ MechrtHost *mechrt_host_new(const MechrtKernels *k)
     h->fail_q = calloc(nq, sizeof *h->fail_q);
     bool ok = h->work && h->phi && h->jac && h->dq && h->y && h->fail_q;
     if (ok && nh > 0) {
-        h->at = gsl_matrix_alloc(nq, nh);
-        h->v = gsl_matrix_alloc(nh, nh);
-        h->s = gsl_vector_alloc(nh);
-        h->svwork = gsl_vector_alloc(nh);
-        ok = h->at && h->v && h->s && h->svwork;
+        h->svd = mechrt_svd_new(k->nh, k->nq);
+        ok = h->svd != NULL;
     }
     if (ok) {
         h->evolve = gsl_odeiv2_evolve_alloc(nq);
@@ -188,42 +173,24 @@ static MechrtStatus eval_phi(MechrtHost *h, const double *q, double t, double *r
     return MECHRT_OK;
 }
 
-/* One minimum-norm Gauss-Newton step for Phi_q dq = -Phi (nh x nq, nh <= nq).
- * With the thin SVD Phi_q^T = U S V^T (U nq x nh, Golub-Reinsch in GSL),
- * Phi_q = V S U^T and the minimum-norm least-squares solution is
- *   dq = -U S^+ V^T Phi,
- * S^+ inverting only the singular values above pivot_tol * sigma_max
- * (Golub & Van Loan, 4th ed., section 5.5.4). h->phi holds Phi at q. */
+/* One minimum-norm Gauss-Newton step for Phi_q dq = -Phi (nh x nq, nh <= nq):
+ * dq = -pinv(Phi_q) Phi from the SVD (svd.c), the pseudo-inverse inverting
+ * only the singular values above pivot_tol * sigma_max (Golub & Van Loan,
+ * 4th ed., section 5.5.4). h->phi holds Phi at q. */
 static MechrtStatus min_norm_step(MechrtHost *h, const MechrtOptions *o, const double *q,
                                   double t)
 {
     const MechrtKernels *k = h->k;
-    int nq = h->nq, nh = h->nh;
+    MechrtSvdResult sv;
     k->jac(k->ctx, q, t, h->jac);
-    for (int i = 0; i < nh; i++)
-        for (int j = 0; j < nq; j++) {
-            double a = h->jac[(size_t)i * (size_t)nq + (size_t)j];
-            if (!isfinite(a))
-                return MECHRT_ENOTFINITE;
-            gsl_matrix_set(h->at, (size_t)j, (size_t)i, a);
-        }
-    if (gsl_linalg_SV_decomp(h->at, h->v, h->s, h->svwork) != GSL_SUCCESS)
+    if (!mechrt_svd(h->svd, h->jac, h->nh, h->nq, h->nq, -1, &sv))
         return MECHRT_ENOTFINITE;
-    double smax = gsl_vector_get(h->s, 0), cut = o->pivot_tol * smax;
-    if (!(smax > 0))
+    if (!(sv.sigma_max > 0))
         return MECHRT_ESING;   /* Phi_q = 0: no direction to move in */
-    for (int j = 0; j < nq; j++)
-        h->dq[j] = 0;
-    for (int c = 0; c < nh; c++) {
-        double sc = gsl_vector_get(h->s, (size_t)c), y = 0;
-        if (sc <= cut)
-            break;             /* singular values come sorted, largest first */
-        for (int i = 0; i < nh; i++)
-            y -= gsl_matrix_get(h->v, (size_t)i, (size_t)c) * h->phi[i];
-        y /= sc;
-        for (int j = 0; j < nq; j++)
-            h->dq[j] += gsl_matrix_get(h->at, (size_t)j, (size_t)c) * y;
-    }
+    mechrt_svd_truncate(h->svd, o->pivot_tol * sv.sigma_max);
+    mechrt_svd_pinv_solve(h->svd, h->phi, h->dq);
+    for (int j = 0; j < h->nq; j++)
+        h->dq[j] = -h->dq[j];
     return MECHRT_OK;
 }
 
@@ -380,61 +347,4 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
         *t = h->fail_t;
     gsl_set_error_handler(old);
     return st;
-}
-
-double mechrt_host_singular_direction(int m, int n, const double *a, double *row_w,
-                                      double *col_w)
-{
-    if (m < 1 || n < 1 || !a)
-        return -1;
-    /* GSL's SVD wants rows >= columns: decompose a or its transpose */
-    bool tr = m < n;
-    size_t rows = (size_t)(tr ? n : m), cols = (size_t)(tr ? m : n);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
-    gsl_matrix *u = gsl_matrix_alloc(rows, cols), *v = gsl_matrix_alloc(cols, cols);
-    gsl_vector *s = gsl_vector_alloc(cols), *w = gsl_vector_alloc(cols);
-    double ratio = -1;
-    if (u && v && s && w) {
-        bool finite = true;
-        for (int i = 0; i < m; i++)
-            for (int j = 0; j < n; j++) {
-                double x = a[(size_t)i * (size_t)n + (size_t)j];
-                finite = finite && isfinite(x);
-                if (tr)
-                    gsl_matrix_set(u, (size_t)j, (size_t)i, x);
-                else
-                    gsl_matrix_set(u, (size_t)i, (size_t)j, x);
-            }
-        if (finite && gsl_linalg_SV_decomp(u, v, s, w) == GSL_SUCCESS) {
-            /* a = U S V^T (or a^T = U S V^T): the last column of U and of V
-               belong to the smallest singular value */
-            size_t c = cols - 1;
-            double smax = gsl_vector_get(s, 0), smin = gsl_vector_get(s, c);
-            ratio = smax > 0 ? smin / smax : 0;
-            for (size_t i = 0; i < rows; i++) {
-                double x = fabs(gsl_matrix_get(u, i, c));
-                if (tr)
-                    col_w[i] = x;
-                else
-                    row_w[i] = x;
-            }
-            for (size_t i = 0; i < cols; i++) {
-                double x = fabs(gsl_matrix_get(v, i, c));
-                if (tr)
-                    row_w[i] = x;
-                else
-                    col_w[i] = x;
-            }
-        }
-    }
-    if (u)
-        gsl_matrix_free(u);
-    if (v)
-        gsl_matrix_free(v);
-    if (s)
-        gsl_vector_free(s);
-    if (w)
-        gsl_vector_free(w);
-    gsl_set_error_handler(old);
-    return ratio;
 }

@@ -3,8 +3,9 @@
  * What a firmware build does not need and a host tool does: minimum-norm
  * Gauss-Newton projection onto Phi = 0 when there are fewer holonomic rows
  * than coordinates, adaptive integration of the positions of mechanisms with
- * velocity-level rows (GSL's odeiv2), the singular direction of a Jacobian
- * for error messages (GSL's SVD), and the CSV and JSON writers of `mechc run`.
+ * velocity-level rows (GSL's odeiv2), the dense SVD behind both the
+ * projection and `info` (ranks, pseudo-inverse, the singular direction of a
+ * Jacobian for error messages), and the CSV and JSON writers of `mechc run`.
  * Compiled into the tool only (double reals, C11, links GSL); the
  * freestanding core in runtime/ stays free of all of it.
  *
@@ -86,14 +87,63 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
 /* After a failed mechrt_host_integrate: the state and time where it failed. */
 const double *mechrt_host_failure(const MechrtHost *h, double *t);
 
-/* ---- Singular directions (host.c) --------------------------------------- */
+/* ---- Dense SVD and pseudo-inverse (svd.c) ------------------------------ */
 
-/* The direction in which the m x n row-major matrix a is closest to
- * singular, from its SVD: row_w[m] and col_w[n] receive |u_i| and |v_j| of
- * the singular vectors of the smallest singular value (the rows and the
- * coordinates of the dependency, each of unit 2-norm). Returns
- * sigma_min / sigma_max (0 for an exactly singular or zero matrix), or -1
- * when m or n is < 1 or memory runs out. Allocates: for error paths. */
+/* Workspace for matrices up to max_m x max_n, allocated once (GSL's rule:
+   no allocation per call). */
+typedef struct MechrtSvd MechrtSvd;
+
+/* NULL when out of memory. */
+MechrtSvd *mechrt_svd_new(int max_m, int max_n);
+void mechrt_svd_free(MechrtSvd *w);
+
+/* Outcome of one decomposition. sigma points into the workspace and stays
+   valid until its next use. */
+typedef struct MechrtSvdResult {
+    int m, n;               /* the matrix decomposed */
+    int k;                  /* min(m, n): number of singular values */
+    const double *sigma;    /* k singular values, descending */
+    double sigma_max;       /* sigma[0], 0 when k == 0 */
+    double sigma_min;       /* sigma[k-1], 0 when k == 0 */
+    double cond;            /* sigma_max / sigma_min; INFINITY when sigma_min == 0 */
+    double tol;             /* the rank tolerance used */
+    int rank;               /* singular values > tol */
+} MechrtSvdResult;
+
+/* The default rank tolerance max(m, n) * DBL_EPSILON * sigma_max. */
+double mechrt_svd_default_tol(int m, int n, double sigma_max);
+
+/* Singular values of the m x n row-major matrix a (leading dimension lda)
+   by GSL's Golub-Reinsch SVD (of a^T when m < n), and the rank: singular
+   values above the absolute tolerance tol (tol < 0: the default). Returns
+   false (out->rank = -1) when a holds NaN or Inf, is larger than the
+   workspace or the decomposition fails. a is not modified. */
+bool mechrt_svd(MechrtSvd *w, const double *a, int m, int n, int lda, double tol,
+                MechrtSvdResult *out);
+
+/* Sets the tolerance of the last decomposition (the singular values
+   mechrt_svd_pinv_solve keeps: those above tol); returns the rank. */
+int mechrt_svd_truncate(MechrtSvd *w, double tol);
+
+/* x = pinv(A) b with the factors of the last decomposition, singular values
+   at or below its tolerance dropped: the minimum-norm least-squares
+   solution. b has m entries, x has n. */
+void mechrt_svd_pinv_solve(const MechrtSvd *w, const double *b, double *x);
+
+/* Component j (< n) of the l-th (< rank) orthonormal basis vector of the
+   row space of the last matrix decomposed (its right singular vectors). */
+double mechrt_svd_row_basis(const MechrtSvd *w, int j, int l);
+
+/* The direction in which the last matrix decomposed is closest to
+   singular: row_w[m] and col_w[n] receive |u_i| and |v_j| of the singular
+   vectors of the smallest singular value (the rows and the coordinates of
+   the dependency, each of unit 2-norm). Nothing when k == 0. */
+void mechrt_svd_smallest(const MechrtSvd *w, double *row_w, double *col_w);
+
+/* The same for one matrix, without a workspace: mechrt_svd_smallest of the
+ * m x n row-major matrix a. Returns sigma_min / sigma_max (0 for an exactly
+ * singular or zero matrix), or -1 when m or n is < 1, a holds NaN or Inf,
+ * or memory runs out. Allocates: for error paths. */
 double mechrt_host_singular_direction(int m, int n, const double *a, double *row_w,
                                       double *col_w);
 
