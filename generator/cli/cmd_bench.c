@@ -234,13 +234,17 @@ int cmd_bench(int argc, char **argv)
 {
     Args a;
     args_init(&a, "bench", argc, argv);
+    MechLimits limits = mech_default_limits();
     int repeat = 15;
     bool json = false, use_aot = true;
     const char *o;
     while ((o = args_next(&a)) && !a.failed) {
         if (args_is_help(o)) {
             fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
             return EXIT_OK;
+        } else if (args_limit(&a, o, &limits)) {
+            continue;
         } else if (strcmp(o, "--repeat") == 0) {
             args_int(&a, o, 1, 100000, &repeat);
         } else if (strcmp(o, "--no-aot") == 0) {
@@ -252,7 +256,7 @@ int cmd_bench(int argc, char **argv)
         }
     }
     Diag diag;
-    Mech *mech = cli_load(&a, NULL, &diag);
+    Mech *mech = cli_load(&a, &limits, &diag);
     if (!mech)
         return EXIT_USAGE;
     const Model *m = mech->model;

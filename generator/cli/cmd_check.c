@@ -131,13 +131,17 @@ int cmd_check(int argc, char **argv)
 {
     Args a;
     args_init(&a, "check", argc, argv);
+    MechLimits limits = mech_default_limits();
     CheckOptions opt = check_default_options();
     bool json = false;
     const char *o;
     while ((o = args_next(&a)) && !a.failed) {
         if (args_is_help(o)) {
             fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
             return EXIT_OK;
+        } else if (args_limit(&a, o, &limits)) {
+            continue;
         } else if (strcmp(o, "--samples") == 0) {
             args_int(&a, o, 1, 1000000, &opt.samples);
         } else if (strcmp(o, "--seed") == 0) {
@@ -165,7 +169,7 @@ int cmd_check(int argc, char **argv)
         }
     }
     Diag diag;
-    Mech *mech = cli_load(&a, NULL, &diag);
+    Mech *mech = cli_load(&a, &limits, &diag);
     if (!mech)
         return EXIT_USAGE;
     CheckReport rep;

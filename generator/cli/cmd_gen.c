@@ -112,8 +112,6 @@ int cmd_gen(int argc, char **argv)
             args_unknown(&a, opt_name);
         }
     }
-    if (!args_need_file(&a))
-        return EXIT_USAGE;
     /* Names that reach the C text are checked before any work. */
     const char *why;
     char buf[256];
@@ -134,11 +132,9 @@ int cmd_gen(int argc, char **argv)
     opt.max_ops = limits.max_code_ops;
 
     Diag diag;
-    Mech *mech = pipeline_load(a.file, &limits, &diag);
-    if (!mech) {
-        diag_print(&diag, stderr);
+    Mech *mech = cli_load(&a, &limits, &diag);
+    if (!mech)
         return EXIT_USAGE;
-    }
     if (dump) {
         dump_rows(mech);
         pipeline_free(mech);

@@ -274,6 +274,7 @@ int cmd_info(int argc, char **argv)
 {
     Args a;
     args_init(&a, "info", argc, argv);
+    MechLimits limits = mech_default_limits();
     const char *opt;
     bool json = false;
     double t = 0.0;
@@ -281,7 +282,10 @@ int cmd_info(int argc, char **argv)
     while ((opt = args_next(&a)) && !a.failed) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
+            fputs(args_limits_usage, stdout);
             return EXIT_OK;
+        } else if (args_limit(&a, opt, &limits)) {
+            continue;
         } else if (strcmp(opt, "--json") == 0) {
             json = true;
         } else if (strcmp(opt, "--rank-tol") == 0) {
@@ -303,7 +307,7 @@ int cmd_info(int argc, char **argv)
         }
     }
     Diag diag;
-    Mech *mech = cli_load(&a, NULL, &diag);
+    Mech *mech = cli_load(&a, &limits, &diag);
     if (!mech)
         return EXIT_USAGE;
     InfoReport rep;
