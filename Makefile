@@ -155,11 +155,12 @@ install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/bin
 	install -m 755 $(MECHC) $(DESTDIR)$(PREFIX)/bin/mechc
 	install -d $(DESTDIR)$(PREFIX)/include/mechc $(DESTDIR)$(PREFIX)/share/mechc/runtime
+	install -m 644 runtime/mechrt.h $(DESTDIR)$(PREFIX)/include/mechc/
 	install -m 644 runtime/*.h runtime/*.c $(DESTDIR)$(PREFIX)/share/mechc/runtime/
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
-	rm -rf $(DESTDIR)$(PREFIX)/share/mechc
+	rm -rf $(DESTDIR)$(PREFIX)/share/mechc $(DESTDIR)$(PREFIX)/include/mechc
 
 clean:
 	rm -rf build build-asan $(FUZZ_BUILD)
