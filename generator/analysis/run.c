@@ -359,8 +359,25 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
         double c0 = pipeline_now();
+        double hh = tn - t, qp[64], mot[64];
+        for (int j = 0; j < r->nq && j < 64; j++) {
+            qp[j] = r->q[j] + hh * r->qd[j] + 0.5 * hh * hh * r->qdd[j];
+            mot[j] = fabs(hh * r->qd[j]) + 0.5 * hh * hh * fabs(r->qdd[j]);
+        }
         st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, t, tn - t, r->work, r->lwork,
                          &rep);
+        if (getenv("DBGSTEP")) {
+            double cinf = 0, minf = 0, rmax = 0; int jr = -1;
+            for (int j = 0; j < r->nq && j < 64; j++) {
+                double cj = fabs(r->q[j] - qp[j]);
+                if (cj > cinf) cinf = cj;
+                if (mot[j] > minf) minf = mot[j];
+                if (cj / (mot[j] + 1e-300) > rmax) { rmax = cj / (mot[j] + 1e-300); jr = j; }
+            }
+            fprintf(stderr, "t=%.5g it=%d st=%d corr=%.3g mot=%.3g ratio=%.3g maxcomp=%.3g (%s corr %.3g mot %.3g)\n",
+                    tn, rep.iterations, st, cinf, minf, cinf / minf, rmax, jr >= 0 ? r->m->coord_names[jr] : "-",
+                    jr >= 0 ? fabs(r->q[jr] - qp[jr]) : 0, jr >= 0 ? mot[jr] : 0);
+        }
         r->res->step_seconds += pipeline_now() - c0;
         r->res->newton_iterations += rep.iterations;
         if (st != MECHRT_OK) {

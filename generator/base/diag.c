@@ -49,6 +49,8 @@ static void record(Diag *diag, const SrcPos *pos, const char *fmt, va_list ap)
     while (start + n < diag->text_len && diag->text[start + n] != '\n'
            && n < DIAG_LINE_MAX - 1)
         n++;
+    if (n > 0 && diag->text[start + n - 1] == '\r')     /* CRLF files */
+        n--;
     memcpy(diag->source_line, diag->text + start, (size_t)n);
     diag->source_line[n] = '\0';
 }

@@ -12,7 +12,8 @@ typedef struct SrcPos {
     int offset;
 } SrcPos;
 
-enum { DIAG_MESSAGE_MAX = 512, DIAG_LINE_MAX = 512 };
+/* DIAG_LINE_MAX holds the longest line the default limits accept. */
+enum { DIAG_MESSAGE_MAX = 512, DIAG_LINE_MAX = 4100 };
 
 /* The outcome of a front-end or back-end stage. Library code never exits:
    it records the first error here and returns (or longjmps to the one

@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include "../base/strbuf.h"
+#include "../../runtime/host/mechrt_host.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -18,10 +19,19 @@ void args_init(Args *a, const char *command, int argc, char **argv)
 const char *args_next(Args *a)
 {
     char *name = a->name;
-    a->pending = NULL;
+    if (a->pending) {           /* --flag=value on an option that takes none */
+        fprintf(stderr, "mechc %s: error: %s takes no value (given '%s')\n", a->command,
+                a->name, a->pending);
+        a->failed = true;
+        return NULL;
+    }
     while (a->i < a->argc) {
         char *arg = a->argv[a->i++];
-        if (arg[0] == '-' && arg[1] == '-' && arg[2]) {
+        if (strcmp(arg, "--") == 0 && !a->options_done) {
+            a->options_done = true;     /* the rest are file names */
+            continue;
+        }
+        if (arg[0] == '-' && arg[1] == '-' && arg[2] && !a->options_done) {
             const char *eq = strchr(arg, '=');
             if (eq) {
                 size_t n = (size_t)(eq - arg) < sizeof a->name - 1 ? (size_t)(eq - arg) : sizeof a->name - 1;
@@ -32,7 +42,7 @@ const char *args_next(Args *a)
             }
             return arg;
         }
-        if (arg[0] == '-' && arg[1] && arg[1] != '-')
+        if (arg[0] == '-' && arg[1] && arg[1] != '-' && !a->options_done)
             return arg;         /* -o, -h */
         if (a->file) {
             fprintf(stderr, "mechc %s: error: more than one input file ('%s' and '%s')\n",
@@ -62,6 +72,8 @@ const char *args_value(Args *a, const char *option)
 
 static bool parse_double(const char *text, double *out)
 {
+    if (strpbrk(text, "xXpP"))     /* strtod would read hexadecimal floats */
+        return false;
     char *end;
     errno = 0;
     *out = strtod(text, &end);
@@ -221,12 +233,13 @@ bool args_is_help(const char *option)
 
 void json_number(FILE *out, double v)
 {
-    if (v == 0.0)
-        fputs("0", out);            /* not -0 */
-    else if (isfinite(v))
-        fprintf(out, "%.17g", v);
-    else
+    char buf[40];
+    if (!isfinite(v)) {
         fputs("null", out);
+        return;
+    }
+    mechrt_format_real(buf, sizeof buf, v, 0);  /* as run's JSON: 0.3, not 0.29999999999999999 */
+    fputs(buf, out);
 }
 
 void json_string(FILE *out, const char *s)

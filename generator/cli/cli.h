@@ -17,7 +17,8 @@ typedef struct Args {
     char **argv;
     const char *command;
     const char *file;       /* the one positional argument */
-    const char *pending;    /* value given as --opt=value */
+    const char *pending;    /* value given as --opt=value, until consumed */
+    bool options_done;      /* after "--": every argument is a file name */
     char name[64];          /* the option name split off --opt=value */
     bool failed;
 } Args;

@@ -238,7 +238,7 @@ int cmd_bench(int argc, char **argv)
     int repeat = 15;
     bool json = false, use_aot = true;
     const char *o;
-    while ((o = args_next(&a)) && !a.failed) {
+    while (!a.failed && (o = args_next(&a))) {
         if (args_is_help(o)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

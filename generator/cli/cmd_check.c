@@ -135,7 +135,7 @@ int cmd_check(int argc, char **argv)
     CheckOptions opt = check_default_options();
     bool json = false;
     const char *o;
-    while ((o = args_next(&a)) && !a.failed) {
+    while (!a.failed && (o = args_next(&a))) {
         if (args_is_help(o)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

@@ -121,7 +121,7 @@ int cmd_eval(int argc, char **argv)
     bool json = false;
     int engine = ENGINE_JIT;
     MechLimits limits = mech_default_limits();
-    while ((opt = args_next(&a)) && !a.failed) {
+    while (!a.failed && (opt = args_next(&a))) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

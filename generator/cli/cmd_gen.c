@@ -76,7 +76,7 @@ int cmd_gen(int argc, char **argv)
     bool stats = false, dump = false;
     EmitOptions opt = emit_default_options();
     MechLimits limits = mech_default_limits();
-    while ((opt_name = args_next(&a)) && !a.failed) {
+    while (!a.failed && (opt_name = args_next(&a))) {
         if (args_is_help(opt_name)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

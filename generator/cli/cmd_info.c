@@ -41,11 +41,6 @@ static const char *evidence(const Integrability *it)
     return !it->decided ? "undecided" : it->symbolic ? "symbolic" : "numeric";
 }
 
-static const char *law_text(const Integrability *it)
-{
-    return it->law ? it->law : "integrable (law not found in closed form)";
-}
-
 /* ---- JSON ---- */
 
 static void json_names(const char *key, const InfoReport *rep, bool velocity)
@@ -97,8 +92,11 @@ static void print_json(const InfoReport *rep)
             const Integrability *it = &ir->integ;
             printf(", \"integrable\": %s", it->integrable ? "true" : "false");
             if (it->integrable) {
-                printf(", \"law\": ");
-                json_string(stdout, law_text(it));
+                /* "law" is the law itself or absent: never a sentence */
+                if (it->law) {
+                    printf(", \"law\": ");
+                    json_string(stdout, it->law);
+                }
                 printf(", \"law_found\": %s", it->law ? "true" : "false");
             }
             printf(", \"evidence\": \"%s\", \"note\": ", evidence(it));
@@ -176,8 +174,8 @@ static const char *joint_name(const Model *m, int i) { return m->joints[i].name;
 static void print_text(const InfoReport *rep)
 {
     const Model *m = rep->model;
-    printf("mechanism %s: %d coordinates, %d rows (%d holonomic, %d velocity level)\n\n",
-           m->name, m->nq, m->nr, m->nh, m->nv);
+    printf("mechanism %s: %d coordinate%s, %d row%s (%d holonomic, %d velocity level)\n\n",
+           m->name, m->nq, m->nq == 1 ? "" : "s", m->nr, m->nr == 1 ? "" : "s", m->nh, m->nv);
 
     int cw = width(m->nq, coord_name, m, 5);
     printf("coordinates (initial value, assembled at t = %g):\n", rep->t);
@@ -279,7 +277,7 @@ int cmd_info(int argc, char **argv)
     bool json = false;
     double t = 0.0;
     AnalysisOptions o = analysis_default_options();
-    while ((opt = args_next(&a)) && !a.failed) {
+    while (!a.failed && (opt = args_next(&a))) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

@@ -204,7 +204,7 @@ int cmd_run(int argc, char **argv)
     int engine = ENGINE_JIT, digits = 0;
     double x;
     MechLimits limits = mech_default_limits();
-    while ((opt = args_next(&a)) && !a.failed) {
+    while (!a.failed && (opt = args_next(&a))) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);

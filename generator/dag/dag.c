@@ -11,6 +11,7 @@
 
 #include "../base/arena.h"
 #include "../base/strbuf.h"
+#include "../../runtime/host/mechrt_host.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -516,12 +517,8 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
     }
     switch (op) {
     case OP_CONST: {
-        char buf[40];               /* the fewest digits that read back exactly */
-        for (int prec = 1; prec <= 17; prec++) {
-            snprintf(buf, sizeof buf, "%.*g", prec, n->value);
-            if (strtod(buf, NULL) == n->value)
-                break;
-        }
+        char buf[40];
+        mechrt_format_real(buf, sizeof buf, n->value, 0);   /* reads back exactly */
         sb_printf(out, n->value < 0 ? "(%s)" : "%s", buf);
         return;
     }

@@ -109,6 +109,14 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
             kin->gamma[r] = dag_neg(dag, diff_total(&df, diff_total(&df, row->expr)));
         } else {
             ncols = support_collect(&scan, dag, row->expr, OP_VARD, cols);
+            if (ncols == 0) {
+                diag_error(diag, row->pos,
+                           "velocity row '%s' has no der() term left once simplified: it "
+                           "constrains no velocity (write a position row as a 'constraint')",
+                           row->name);
+                ok = false;
+                goto done;
+            }
             kin->nu[r] = dag_neg(dag, diff_without_velocities(&df, row->expr));
             kin->gamma[r] = dag_neg(dag, diff_total(&df, row->expr));
         }

@@ -21,7 +21,8 @@ typedef struct Kinematics {
 } Kinematics;
 
 /* Differentiates every row of the model. Returns false with diag filled
-   when a velocity row is not affine in der(). Arrays live in the model's
+   when a velocity row is not affine in der() or has no der() term left,
+   or when the graph passes its node limit. Arrays live in the model's
    arena; the derivative nodes in its graph. */
 bool kinematics_build(Model *model, Kinematics *kin, Diag *diag);
 

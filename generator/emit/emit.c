@@ -384,6 +384,18 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     } else {
         sanitize_prefix(m->name, out->prefix, sizeof out->prefix);
     }
+    /* A nonzero constant that float rounds to zero would change the
+       equations (x / 1e-50 becoming x / 0): refuse rather than emit it. */
+    if (opt->real_float) {
+        for (NodeId id = 0; id < m->dag.count; id++) {
+            double v;
+            if (dag_is_const(&m->dag, id, &v) && v != 0.0 && (float)v == 0.0f) {
+                diag_error_nopos(diag, "the constant %.17g is too small for float (it would "
+                                 "become 0); use --real double or rescale the mechanism", v);
+                return false;
+            }
+        }
+    }
     if (opt->header_name) {
         const char *why = emit_check_header_name(opt->header_name);
         if (why) {
@@ -398,7 +410,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
 
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
                  .prefix_upper = upper};
-    sched_init(&e.sched, &m->dag, opt->chunk_nodes > 0 ? opt->chunk_nodes : 2000);
+    sched_init(&e.sched, &m->dag,
+               opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
     e.sched.max_ops = opt->max_ops;
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     bool too_big = false;

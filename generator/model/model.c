@@ -96,8 +96,9 @@ static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos
 static void check_jacobian_size(Builder *b, long long nr, long long nq, SrcPos pos)
 {
     if (nr * nq > b->limits->max_jac_entries)
-        diag_fail(b->diag, pos, "the dense Jacobian would have %lld rows x %lld coordinates = %lld "
-                  "entries, more than the limit of %d", nr, nq, nr * nq, b->limits->max_jac_entries);
+        diag_fail(b->diag, pos, "the dense Jacobian would have %lld row%s x %lld coordinate%s = "
+                  "%lld entries, more than the limit of %d", nr, nr == 1 ? "" : "s", nq,
+                  nq == 1 ? "" : "s", nr * nq, b->limits->max_jac_entries);
 }
 
 static int add_coord(Builder *b, const char *owner, const char *suffix, double q0, SrcPos pos)
@@ -121,12 +122,15 @@ static int add_coord(Builder *b, const char *owner, const char *suffix, double q
 
 typedef enum ExprContext {
     EXPR_CONSTANT,      /* params, initial values, offsets, axes */
+    EXPR_TIMED,         /* length, angle, radius: may also use t */
     EXPR_HOLONOMIC,     /* may use coordinates and t */
     EXPR_VELOCITY,      /* may also use der() */
 } ExprContext;
 
 static const char *context_what(ExprContext ctx)
 {
+    if (ctx == EXPR_TIMED)
+        return "a joint's length, angle or radius (numbers, params and t)";
     return ctx == EXPR_CONSTANT ? "a constant expression (numbers, pi and earlier params)"
                                 : "a holonomic row (use a 'velocity' or 'driver' statement for der())";
 }
@@ -174,13 +178,13 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
         Entity *e = lookup(b, ast->name, ast->pos);
         if (e->kind == ENT_PARAM)
             return dag_const(dag, e->value);
-        if (ctx == EXPR_CONSTANT)
+        if (ctx <= EXPR_TIMED)
             diag_fail(b->diag, ast->pos, "'%s' is %s; only params may appear in %s",
                       e->name, entity_word(e->kind), context_what(ctx));
         return dag_var(dag, coordinate_of(b, ast));
     }
     case AST_MEMBER:
-        if (ctx == EXPR_CONSTANT) {
+        if (ctx <= EXPR_TIMED) {
             lookup(b, ast->name, ast->pos);
             diag_fail(b->diag, ast->pos, "coordinate '%s.%s' cannot appear in %s",
                       ast->name, ast->member, context_what(ctx));
@@ -286,8 +290,12 @@ static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
     case ENT_PARAM: case ENT_COORD: case ENT_JOINT:
         break;
     }
-    diag_fail(b->diag, at->pos, "'%s' is %s; %s attaches to bodies, points or ground",
-              e->name, entity_word(e->kind), keyword);
+    static const char *const takes[] = {
+        [ATTACH_ANY] = "bodies, points or ground", [ATTACH_FRAME] = "bodies or ground",
+        [ATTACH_BODY] = "a body", [ATTACH_BODY_ONLY] = "a body", [ATTACH_NONE] = "nothing",
+    };
+    diag_fail(b->diag, at->pos, "'%s' is %s; %s attaches to %s",
+              e->name, entity_word(e->kind), keyword, takes[rule]);
 }
 
 static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
@@ -328,6 +336,13 @@ static void build_joint(Builder *b, const Stmt *s)
         else
             j->b = at;
     }
+    /* A joint between a frame and itself constrains nothing (or is
+       unsatisfiable): always a mistake in the joint list. */
+    if (info->attachments == 2 && j->a.q == j->b.q)
+        diag_fail(b->diag, s->attach[1].pos, j->a.q < 0
+                  ? "%s '%s' joins ground to ground: its rows depend on no coordinate"
+                  : "%s '%s' joins '%s' to itself: its rows depend on no relative motion",
+                  info->keyword, s->name, s->attach[0].name);
     if (info->axis) {
         j->ux = constant_value(b, s->axis[0], "the axis component ux");
         j->uy = constant_value(b, s->axis[1], "the axis component uy");
@@ -335,7 +350,7 @@ static void build_joint(Builder *b, const Stmt *s)
             diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }
     if (s->option) {
-        j->option = lower_expr(b, s->option, EXPR_HOLONOMIC);
+        j->option = lower_expr(b, s->option, EXPR_TIMED);
     }
     switch (info->level) {
     case LEVEL_POSITION: j->velocity = false; break;
@@ -505,10 +520,11 @@ char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag
             break;
     }
     bool bad = ferror(f);
+    int err = errno;
     if (f != stdin)
         fclose(f);
     if (bad) {
-        diag_error_nopos(diag, "cannot read '%s'", path);
+        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(err));
         free(buf);
         return NULL;
     }

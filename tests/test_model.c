@@ -1,0 +1,122 @@
+/* test_model.c - the model builder's input errors (names, attachments, joint sanity, row levels) and option parsing. */
+#include "testutil.h"
+
+#include "../generator/cli/cli.h"
+#include "../generator/pipeline/pipeline.h"
+
+#include <string.h>
+
+typedef struct BadInput {
+    const char *text;
+    int line, col;
+    const char *needle;         /* a part of the message */
+} BadInput;
+
+static const BadInput bad_inputs[] = {
+    /* coordinates in length, angle and radius: the spec allows t only */
+    {"body b\nprismatic J: ground b axis(1,0) angle = b.phi\n", 2, 41, "cannot appear in a joint's length, angle or radius"},
+    {"point a\ndistance J: a ground length = a.x\n", 2, 31, "cannot appear in a joint's length"},
+    {"coord c\nbody b\nrolling R: b radius = 1 + c\n", 3, 27, "only params may appear"},
+    {"body b\nrolling R: b radius = der(b.x)\n", 2, 23, "der() cannot appear in a joint's length"},
+    /* joints between a frame and itself */
+    {"point a\nrevolute RG: ground(1,1) ground(2,2)\n", 2, 26, "joins ground to ground"},
+    {"body a\nrevolute R: a(1,0.5) a(-0.3,0.2)\n", 2, 22, "joins 'a' to itself"},
+    {"point p\ndistance D: p p length = 1\n", 2, 15, "joins 'p' to itself"},
+    /* velocity rows whose der() terms simplify away */
+    {"point a\nvelocity J: 0*der(a.x) + a.y = 0\n", 2, 1, "no der() term left"},
+    {"point a\nvelocity J: der(a.x) = der(a.x)\n", 2, 1, "no der() term left"},
+    /* the attachment kinds each joint takes, named in the message */
+    {"coord c\nrolling R: c radius = 1\n", 2, 12, "rolling attaches to a body"},
+    {"coord c\nbody b\nprismatic P: c b axis(1,0)\n", 3, 14, "prismatic attaches to bodies or ground"},
+    {"param k = 1\nbody b\nrevolute R: k b\n", 3, 13, "revolute attaches to bodies, points or ground"},
+};
+
+static void test_bad_inputs(void **state)
+{
+    (void)state;
+    MechLimits limits = mech_default_limits();
+    for (size_t i = 0; i < sizeof bad_inputs / sizeof *bad_inputs; i++) {
+        const BadInput *b = &bad_inputs[i];
+        Diag diag;
+        Mech *mech = pipeline_load_text(b->text, "bad.mech", &limits, &diag);
+        if (mech) {
+            pipeline_free(mech);
+            fail_msg("case %zu accepted: %s", i, b->text);
+        }
+        if (!diag.has_pos || diag.line != b->line || diag.col != b->col || !strstr(diag.message, b->needle))
+            fail_msg("case %zu: error at %d:%d '%s', expected %d:%d containing '%s'", i, diag.line,
+                     diag.col, diag.message, b->line, b->col, b->needle);
+    }
+}
+
+/* What stays valid: t in options, and joints between different frames. */
+static void test_time_in_options_is_fine(void **state)
+{
+    (void)state;
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load_text("body b\ndistance d: ground b length = 1 + t\n"
+                                    "prismatic p: ground b axis(1,0) angle = 0.1*t\n"
+                                    "body w\nrolling r: w radius = 0.3 + 0.1*t\n",
+                                    "ok.mech", &limits, &diag);
+    if (!mech)
+        fail_msg("rejected: %s", diag.message);
+    assert_int_equal(mech->model->nr, 4);
+    pipeline_free(mech);
+}
+
+/* Runs the option loop the commands use; returns the options seen. */
+static int parse(char **argv, int argc, Args *a, const char **seen, const char **values)
+{
+    args_init(a, "test", argc, argv);
+    const char *opt;
+    int n = 0;
+    while (!a->failed && (opt = args_next(a))) {
+        seen[n] = opt;
+        values[n++] = strcmp(opt, "--t") == 0 ? args_value(a, opt) : NULL;
+    }
+    if (!a->failed)
+        args_next(a);           /* the loop's last call: an unused --flag=value fails here */
+    return n;
+}
+
+static void test_options(void **state)
+{
+    (void)state;
+    Args a;
+    const char *seen[8], *values[8];
+    /* argv strings are writable in C: give them storage */
+    char file[] = "f.mech", t_opt[] = "--t=0.5", json[] = "--json", json1[] = "--json=1";
+    char dd[] = "--", odd[] = "--odd-name.mech";
+    char *ok[] = {file, t_opt, json};
+    assert_int_equal(parse(ok, 3, &a, seen, values), 2);
+    assert_false(a.failed);
+    assert_string_equal(a.file, "f.mech");
+    assert_string_equal(values[0], "0.5");
+
+    char *flag_value[] = {file, json1};                /* a flag takes no value */
+    parse(flag_value, 2, &a, seen, values);
+    assert_true(a.failed);
+
+    char *dashes[] = {dd, odd};                        /* after --, file names only */
+    assert_int_equal(parse(dashes, 2, &a, seen, values), 0);
+    assert_false(a.failed);
+    assert_string_equal(a.file, "--odd-name.mech");
+
+    double v[2];
+    assert_false(args_vector("test", "--q", "0x10,1", 2, v));   /* no hexadecimal */
+    assert_false(args_vector("test", "--q", "nan,1", 2, v));
+    assert_true(args_vector("test", "--q", "1e-3,-2", 2, v));
+    assert_near(v[0], 1e-3, 0, 0);
+    assert_near(v[1], -2.0, 0, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_time_in_options_is_fine),
+        cmocka_unit_test(test_options),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
