@@ -31,6 +31,8 @@
  */
 #include "analysis.h"
 
+#include "../base/rng.h"
+
 #include "../base/arena.h"
 #include "../base/strbuf.h"
 #include "../diff/diff.h"
@@ -49,27 +51,12 @@ enum {
    computing it from evaluated partials is a few eps times its terms). */
 static const double ZERO_RTOL = 1e-9;
 
-/* ---- deterministic random states (splitmix64) ---- */
-
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double rng_uniform(uint64_t *s)      /* in [-1, 1) */
-{
-    return (double)(rng_next(s) >> 11) * 0x1.0p-52 - 1.0;
-}
-
 /* q around the centre (spread grows with the coordinate's size), t in [-1, 1). */
 static double sample_state(uint64_t *s, const double *center, int nq, double *q)
 {
     for (int i = 0; i < nq; i++)
-        q[i] = center[i] + rng_uniform(s) * (0.5 + 0.25 * fabs(center[i]));
-    return rng_uniform(s);
+        q[i] = center[i] + rng_symmetric(s) * (0.5 + 0.25 * fabs(center[i]));
+    return rng_symmetric(s);
 }
 
 /* ---- formatting ---- */

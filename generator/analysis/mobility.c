@@ -17,6 +17,8 @@
  */
 #include "analysis.h"
 
+#include "../base/rng.h"
+
 #include "../base/arena.h"
 #include "../base/strbuf.h"
 
@@ -72,8 +74,7 @@ static void perturb(const double *q, int nq, uint64_t *state, double *qs)
     if (size == 0.0)
         size = 1.0;
     for (int i = 0; i < nq; i++) {
-        *state = *state * 6364136223846793005ull + 1442695040888963407ull;
-        double u = (double)(*state >> 11) * 0x1.0p-52 - 1.0;
+        double u = rng_symmetric(state);
         qs[i] = q[i] + 0.2 * u * fmax(fabs(q[i]), 0.1 * size);
     }
 }
@@ -125,8 +126,7 @@ static bool system_test(Model *m, MechEval *me, InfoReport *rep, const int *undr
     for (int s = 0; w && s < opt->generic_samples; s++) {
         double *qs = points + (size_t)np * (size_t)nq;
         perturb(rep->q, nq, &state, qs);
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        double ts = rep->t + 0.5 * ((double)(state >> 11) * 0x1.0p-52 - 1.0);
+        double ts = rep->t + 0.5 * rng_symmetric(&state);
         AssembleResult ar;
         if (analysis_assemble(me, undriven, nuh, ts, qs, opt, w, &ar))
             times[np++] = ts;

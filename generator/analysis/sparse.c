@@ -15,6 +15,8 @@
  */
 #include "analysis.h"
 
+#include "../base/rng.h"
+
 #include "../base/arena.h"
 
 #include <math.h>
@@ -130,8 +132,7 @@ double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *ro
     double *x = xmalloc((size_t)nq * sizeof *x), *y = xcalloc((size_t)nq, sizeof *y);
     uint64_t st = seed * 2654435761u + 7;
     for (int i = 0; i < nq; i++) {
-        st = st * 6364136223846793005ull + 1442695040888963407ull;
-        x[i] = (double)(st >> 11) * 0x1.0p-53 + 0.5;
+        x[i] = rng_unit(&st) + 0.5;
     }
     double sigma = 0.0;
     for (int it = 0; it < 50; it++) {

@@ -31,6 +31,15 @@ extern char **environ;
 
 enum { AOT_MAX_WORDS = 32 };
 
+/* Splits buf in place at blanks, appending at most max words; returns the new count. */
+static int split_words(char *buf, char **words, int n, int max)
+{
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, " \t", &save); tok && n < max; tok = strtok_r(NULL, " \t", &save))
+        words[n++] = tok;
+    return n;
+}
+
 /* $CC split at blanks into words (stored in buf). */
 static int compiler_words(char *buf, size_t size, char **words)
 {
@@ -38,10 +47,7 @@ static int compiler_words(char *buf, size_t size, char **words)
     if (!cc || !*cc)
         cc = "cc";
     snprintf(buf, size, "%s", cc);
-    int n = 0;
-    for (char *tok = strtok(buf, " \t"); tok && n < AOT_MAX_WORDS; tok = strtok(NULL, " \t"))
-        words[n++] = tok;
-    return n;
+    return split_words(buf, words, 0, AOT_MAX_WORDS);
 }
 
 /* Two FNV-1a 64-bit lanes with different offsets: 32 hex digits. */
@@ -122,7 +128,7 @@ bool aot_compiler_available(void)
     int n = compiler_words(buf, sizeof buf, words);
     if (n == 0)
         return false;
-    static char version[] = "--version";
+    char version[] = "--version";      /* exec wants writable strings */
     words[n++] = version;
     words[n] = NULL;
     int err = 0;
@@ -169,9 +175,8 @@ static bool build(const char *dir, const char *hex, const char *source, const ch
         return false;
     }
     char flags[] = AOT_FLAGS;
-    for (char *tok = strtok(flags, " "); tok; tok = strtok(NULL, " "))
-        argv[n++] = tok;
-    static char opt_o[] = "-o", opt_lm[] = "-lm";
+    n = split_words(flags, argv, n, AOT_MAX_WORDS + 10);
+    char opt_o[] = "-o", opt_lm[] = "-lm";
     argv[n++] = opt_o;
     argv[n++] = tmp;
     argv[n++] = src;

@@ -54,15 +54,6 @@ MechrtOdeOptions mechrt_ode_default_options(void)
     return o;
 }
 
-const char *mechrt_ode_method_name(MechrtOdeMethod m)
-{
-    switch (m) {
-    case MECHRT_ODE_RK8PD: return "rk8pd";
-    case MECHRT_ODE_RKF45: return "rkf45";
-    }
-    return NULL;
-}
-
 bool mechrt_ode_method_from_name(const char *name, MechrtOdeMethod *out)
 {
     if (strcmp(name, "rk8pd") == 0)

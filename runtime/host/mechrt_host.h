@@ -37,7 +37,6 @@ typedef struct MechrtOdeOptions {
 
 MechrtOdeOptions mechrt_ode_default_options(void);
 /* "rk8pd" / "rkf45"; NULL for an unknown name */
-const char *mechrt_ode_method_name(MechrtOdeMethod m);
 /* Parses a method name; false when unknown. */
 bool mechrt_ode_method_from_name(const char *name, MechrtOdeMethod *out);
 
