@@ -10,68 +10,17 @@
 # Checks that need gcc or python3 are skipped (and say so) when those are
 # missing.
 set -u
-
-mechc=${1:-build/mechc}
-case $mechc in
-    /*) ;;
-    *) mechc=$(pwd)/$mechc ;;
-esac
-if [ ! -x "$mechc" ]; then
-    echo "cli: $mechc is not an executable" >&2
-    exit 2
-fi
-root=$(cd "$(dirname "$0")/.." && pwd)
-ex=$root/examples
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_cli.XXXXXX") || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-pass=0
-fail=0
-have_gcc=0
-command -v gcc > /dev/null 2>&1 && have_gcc=1
-have_python=0
-command -v python3 > /dev/null 2>&1 && have_python=1
-
-# check DESCRIPTION COMMAND...: runs COMMAND, counts the outcome.
-check() {
-    desc=$1
-    shift
-    if "$@"; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $desc" >&2
-        if [ -s "$tmp/err" ]; then
-            echo "  stderr was:" >&2
-            sed -n '1,6s/^/    /p' "$tmp/err" >&2
-        fi
-    fi
-}
-
-skip() {
-    echo "skip: $1" >&2
-}
-
-# run ARGS...: runs mechc, stdout to $tmp/out, stderr to $tmp/err, status in $rc.
-run() {
-    "$mechc" "$@" > "$tmp/out" 2> "$tmp/err"
-    rc=$?
-}
-
-rc_is() { [ "$rc" = "$1" ]; }
-out_empty() { [ ! -s "$tmp/out" ]; }
-out_has() { grep -F -q -- "$1" "$tmp/out"; }
-err_has() { grep -F -q -- "$1" "$tmp/err"; }
-first_out_line_is() { [ "$(sed -n 1p "$tmp/out")" = "$1" ]; }
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin cli "${1:-build/mechc}"
 
 # ---- help and version ----
 
 run --help
-check "--help exits 0" rc_is 0
+check "--help exits 0" status_is 0
 check "--help prints the usage on stdout" out_has "usage: mechc COMMAND"
 run --version
-check "--version exits 0" rc_is 0
+check "--version exits 0" status_is 0
 check "--version prints 'mechc X.Y.Z'" sh -c "grep -E -q '^mechc [0-9]+\.[0-9]+\.[0-9]+$' '$tmp/out'"
 
 for c in gen run eval check info bench; do
@@ -80,45 +29,45 @@ for c in gen run eval check info bench; do
         skip "$c --help: the command is not implemented yet"
         continue
     fi
-    check "$c --help exits 0" rc_is 0
+    check "$c --help exits 0" status_is 0
     check "$c --help prints its usage" out_has "usage: mechc $c"
 done
 
 # ---- usage errors ----
 
 run
-check "no arguments exits 2" rc_is 2
+check "no arguments exits 2" status_is 2
 run frobnicate "$ex/pendulum_distance.mech"
-check "unknown command exits 2" rc_is 2
+check "unknown command exits 2" status_is 2
 check "unknown command is named" err_has "unknown command 'frobnicate'"
 run --bogus
-check "unknown top-level option exits 2" rc_is 2
+check "unknown top-level option exits 2" status_is 2
 run eval "$ex/pendulum_distance.mech" --bogus
-check "unknown eval option exits 2" rc_is 2
+check "unknown eval option exits 2" status_is 2
 check "unknown eval option is named" err_has "--bogus"
 check "unknown eval option: nothing on stdout" out_empty
 run gen "$ex/pendulum_distance.mech" --real long
-check "gen --real long exits 2" rc_is 2
+check "gen --real long exits 2" status_is 2
 run eval
-check "eval without a file exits 2" rc_is 2
+check "eval without a file exits 2" status_is 2
 run eval "$ex/pendulum_distance.mech" --t abc
-check "eval --t abc exits 2" rc_is 2
+check "eval --t abc exits 2" status_is 2
 check "eval --t abc says why" err_has "error:"
 
 run eval "$ex/pendulum_distance.mech" --q 1,2,3
-check "eval --q with 3 values for 2 coordinates exits 2" rc_is 2
+check "eval --q with 3 values for 2 coordinates exits 2" status_is 2
 check "eval --q count message" err_has "--q needs 2"
 check "eval --q count: nothing on stdout" out_empty
 run eval "$ex/pendulum_distance.mech" --q 1
-check "eval --q with 1 value exits 2" rc_is 2
+check "eval --q with 1 value exits 2" status_is 2
 run eval "$ex/pendulum_distance.mech" --qd 1,2,3,4
-check "eval --qd with 4 values exits 2" rc_is 2
+check "eval --qd with 4 values exits 2" status_is 2
 check "eval --qd count message" err_has "--qd"
 run eval "$ex/pendulum_distance.mech" --q 1,x
-check "eval --q with a non-number exits 2" rc_is 2
+check "eval --q with a non-number exits 2" status_is 2
 
 run eval "$tmp/does_not_exist.mech"
-check "missing file exits 2" rc_is 2
+check "missing file exits 2" status_is 2
 check "missing file: error:" err_has "error:"
 check "missing file is named" err_has "does_not_exist.mech"
 check "missing file: nothing on stdout" out_empty
@@ -126,18 +75,18 @@ check "missing file: nothing on stdout" out_empty
 # ---- eval ----
 
 run eval "$ex/pendulum_distance.mech"
-check "eval pendulum exits 0" rc_is 0
+check "eval pendulum exits 0" status_is 0
 check "eval pendulum prints the row" out_has "rod"
 
 run eval "$ex/pendulum_distance.mech" --json
-check "eval --json exits 0" rc_is 0
+check "eval --json exits 0" status_is 0
 for key in '"coords"' '"rows"' '"name"' '"kind"' '"level"' '"phi"' '"jac"' '"nu"' '"gamma"' \
            '"m.x"' '"m.y"' '"distance"' '"position"'; do
     check "eval --json has $key" out_has "$key"
 done
 cp "$tmp/out" "$tmp/pendulum.json"
 
-if [ "$have_python" = 1 ]; then
+if have python3; then
     # strict parse and values: Phi = 1.732^2 + 1 - 4, Jacobian (3.464, 2)
     check "eval --json parses and has the spec's shape and values" python3 - "$tmp/pendulum.json" <<'EOF'
 import json, sys
@@ -153,7 +102,7 @@ assert d["nu"] == [0] and len(d["gamma"]) == 1 and d["gamma"][0] == 0, (d["nu"],
 EOF
     # gamma = -18 on the circle of radius 2 at 3 m/s
     run eval "$ex/pendulum_distance.mech" --q 1.7320508075688772,1 --qd -1.5,2.598076211353316 --json
-    check "eval --q --qd exits 0" rc_is 0
+    check "eval --q --qd exits 0" status_is 0
     cp "$tmp/out" "$tmp/pendulum18.json"
     check "eval --q --qd: gamma = -18, phi = 0" python3 - "$tmp/pendulum18.json" <<'EOF'
 import json, sys
@@ -163,7 +112,7 @@ assert abs(d["phi"][0]) < 1e-12, d["phi"]
 EOF
     # velocity-level rows: level "velocity", phi has NH = 0 entries, NR x NQ jac
     run eval "$ex/knife_cart.mech" --json --t 0.25
-    check "eval knife_cart --json exits 0" rc_is 0
+    check "eval knife_cart --json exits 0" status_is 0
     cp "$tmp/out" "$tmp/knife.json"
     check "eval knife_cart --json: velocity rows" python3 - "$tmp/knife.json" <<'EOF'
 import json, sys, math
@@ -180,14 +129,14 @@ fi
 
 # ---- bad input: FILE:LINE:COL: error:, the source line, a caret, exit 2 ----
 
-# bad NAME LINE COL TEXT [MESSAGE]: TEXT (printf %b escapes) must be rejected
-# at LINE:COL, with MESSAGE in the error if given.
-bad() {
+# bad_input NAME LINE COL TEXT [MESSAGE]: TEXT (printf %b escapes) must be
+# rejected at LINE:COL, with MESSAGE in the error if given.
+bad_input() {
     name=$1 line=$2 col=$3 text=$4 msg=${5:-}
     f=$tmp/$name.mech
     printf '%b' "$text" > "$f"
     run eval "$f"
-    check "$name: exit 2" rc_is 2
+    check "$name: exit 2" status_is 2
     check "$name: nothing on stdout" out_empty
     check "$name: '$f:$line:$col: error: ' first" \
         sh -c "head -n 1 '$tmp/err' | grep -F -q -- '$f:$line:$col: error: '"
@@ -202,33 +151,33 @@ bad() {
         [ "$(printf '%s' "$caret" | LC_ALL=C wc -c | tr -d ' ')" = "$((col + 4))" ]
 }
 
-bad unknown_name      2 22 'point m x = 1\ndistance rod: ground mm length = 2\n' "unknown name 'mm'"
-bad duplicate_name    2 7  'point m x = 1\npoint m x = 2\ndistance rod: ground m length = 2\n' "duplicate name 'm'"
-bad reserved_name     1 7  'point pi x = 1\n' "reserved"
-bad reserved_fn       1 6  'body sin x = 1\n' "reserved"
-bad particle_offset   2 22 'point m x = 1\ndistance rod: ground m(1, 0) length = 2\n' "point"
-bad prismatic_point   2 21 'point m x = 1\nprismatic P: ground m axis(1, 0)\n' "prismatic"
-bad zero_axis         2 23 'body b x = 1\nprismatic P: ground b axis(0, 0)\n' "zero"
-bad der_constraint    2 15 'point m x = 1\nconstraint c: der(m.x) = 0\n' "der()"
-bad param_t           1 13 'param p = 2*t\npoint m x = 1\ndistance rod: ground m length = 2\n' "'t'"
-bad param_div0        1 12 'param p = 1/0\npoint m x = 1\nconstraint c: m.x = p\n' "finite"
-bad component_z       2 17 'point m x = 1\nconstraint c: m.z = 0\n' "'z'"
-bad unbalanced_paren  2 24 'point m x = 1\nconstraint c: (m.x + 1 = 0\n' "')'"
-bad non_ascii         2 19 'point m x = 1 # ok \0303\0251\nconstraint c: m.x \0303\0251= 0\n' "non-ASCII"
-bad empty_file        1 1  '' "no statements"
-bad not_affine        2 1  'point m x = 1\nvelocity v: der(m.x)^2 = 1\n' "not affine"
-bad velocity_no_der   2 1  'point m x = 1\nvelocity v: m.x = 1\n' "der()"
-bad unknown_statement 2 1  'point m x = 1\nhinge h: ground m\n' "unknown statement"
-bad malformed_number  1 13 'point m x = 1.2.3\n' "malformed number"
-bad unknown_function  2 15 'point m x = 1\nconstraint c: foo(m.x) = 0\n' "foo"
-bad missing_colon     2 14 'point m x = 1\ndistance rod ground m length = 2\n' "':'"
-bad no_coordinates    1 1  'param a = 1\n' "no coordinates"
-bad tab_indent        2 22 'point m x = 1\n\tconstraint c: m.x = q\n' "unknown name 'q'"
+bad_input unknown_name      2 22 'point m x = 1\ndistance rod: ground mm length = 2\n' "unknown name 'mm'"
+bad_input duplicate_name    2 7  'point m x = 1\npoint m x = 2\ndistance rod: ground m length = 2\n' "duplicate name 'm'"
+bad_input reserved_name     1 7  'point pi x = 1\n' "reserved"
+bad_input reserved_fn       1 6  'body sin x = 1\n' "reserved"
+bad_input particle_offset   2 22 'point m x = 1\ndistance rod: ground m(1, 0) length = 2\n' "point"
+bad_input prismatic_point   2 21 'point m x = 1\nprismatic P: ground m axis(1, 0)\n' "prismatic"
+bad_input zero_axis         2 23 'body b x = 1\nprismatic P: ground b axis(0, 0)\n' "zero"
+bad_input der_constraint    2 15 'point m x = 1\nconstraint c: der(m.x) = 0\n' "der()"
+bad_input param_t           1 13 'param p = 2*t\npoint m x = 1\ndistance rod: ground m length = 2\n' "'t'"
+bad_input param_div0        1 12 'param p = 1/0\npoint m x = 1\nconstraint c: m.x = p\n' "finite"
+bad_input component_z       2 17 'point m x = 1\nconstraint c: m.z = 0\n' "'z'"
+bad_input unbalanced_paren  2 24 'point m x = 1\nconstraint c: (m.x + 1 = 0\n' "')'"
+bad_input non_ascii         2 19 'point m x = 1 # ok \0303\0251\nconstraint c: m.x \0303\0251= 0\n' "non-ASCII"
+bad_input empty_file        1 1  '' "no statements"
+bad_input not_affine        2 1  'point m x = 1\nvelocity v: der(m.x)^2 = 1\n' "not affine"
+bad_input velocity_no_der   2 1  'point m x = 1\nvelocity v: m.x = 1\n' "der()"
+bad_input unknown_statement 2 1  'point m x = 1\nhinge h: ground m\n' "unknown statement"
+bad_input malformed_number  1 13 'point m x = 1.2.3\n' "malformed number"
+bad_input unknown_function  2 15 'point m x = 1\nconstraint c: foo(m.x) = 0\n' "foo"
+bad_input missing_colon     2 14 'point m x = 1\ndistance rod ground m length = 2\n' "':'"
+bad_input no_coordinates    1 1  'param a = 1\n' "no coordinates"
+bad_input tab_indent        2 22 'point m x = 1\n\tconstraint c: m.x = q\n' "unknown name 'q'"
 
 # the same error from gen: nothing on stdout, no output file
 printf 'point m x = 1\nconstraint c: m.x = nope\n' > "$tmp/genbad.mech"
 run gen "$tmp/genbad.mech" -o "$tmp/genbad.c"
-check "gen on bad input exits 2" rc_is 2
+check "gen on bad input exits 2" status_is 2
 check "gen on bad input: FILE:LINE:COL" err_has "$tmp/genbad.mech:2:21: error: "
 check "gen on bad input writes no file" [ ! -e "$tmp/genbad.c" ]
 run gen "$tmp/genbad.mech"
@@ -237,27 +186,27 @@ check "gen on bad input: nothing on stdout" out_empty
 # ---- gen ----
 
 run gen "$ex/four_bar.mech"
-check "gen to stdout exits 0" rc_is 0
+check "gen to stdout exits 0" status_is 0
 check "gen: the banner is the first line" \
     sh -c "head -n 1 '$tmp/out' | grep -q '^/\*.*four_bar\.mech.*DO NOT EDIT'"
 
 run gen "$ex/four_bar.mech" -o "$tmp/fb.c" --prefix fb
-check "gen -o exits 0" rc_is 0
+check "gen -o exits 0" status_is 0
 check "gen -o: nothing on stdout" out_empty
 check "gen -o writes the file" [ -s "$tmp/fb.c" ]
 check "gen --prefix fb names the functions" grep -q 'void fb_all(' "$tmp/fb.c"
 check "gen --prefix fb names the macros" grep -q '#define FB_NQ' "$tmp/fb.c"
 
 run gen "$ex/slider_crank.mech" -o "$tmp/sc.c" --header "$tmp/sc.h" --prefix sc
-check "gen --header exits 0" rc_is 0
+check "gen --header exits 0" status_is 0
 check "gen --header writes the header" [ -s "$tmp/sc.h" ]
 check "gen --header: the source includes it" grep -q '#include "sc.h"' "$tmp/sc.c"
 
 run gen "$ex/all_statements.mech" -o "$tmp/af.c" --real float
-check "gen --real float exits 0" rc_is 0
+check "gen --real float exits 0" status_is 0
 check "gen --real float uses float" grep -q 'typedef float all_statements_real;' "$tmp/af.c"
 
-if [ "$have_gcc" = 1 ]; then
+if have gcc; then
     cflags="-std=c99 -Wall -Wextra -Wpedantic -Werror"
     check "gcc compiles gen -o output" gcc $cflags -c "$tmp/fb.c" -o "$tmp/fb.o"
     check "gcc compiles gen --header output" gcc $cflags -I"$tmp" -c "$tmp/sc.c" -o "$tmp/sc.o"
@@ -268,11 +217,10 @@ else
 fi
 
 run gen "$ex/four_bar.mech" --prefix 1bad -o "$tmp/bad_prefix.c"
-check "gen --prefix 1bad exits 2" rc_is 2
+check "gen --prefix 1bad exits 2" status_is 2
 check "gen --prefix 1bad says why" err_has "error:"
 check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
-check "gen --prefix int (a C keyword) exits 2" rc_is 2
+check "gen --prefix int (a C keyword) exits 2" status_is 2
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" = 0 ]
+suite_end

@@ -46,46 +46,42 @@
 # Flag lists ($FLAGS, $arch ...) are split into words on purpose.
 # shellcheck disable=SC2086,SC2046
 set -u
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin firmware_rules "${1:-build/mechc}"
 
-mechc=${1:-build/mechc}
-case $mechc in
-    /*) ;;
-    *) mechc=$(pwd)/$mechc ;;
-esac
-if [ ! -x "$mechc" ]; then
-    echo "firmware_rules: $mechc is not an executable" >&2
-    exit 2
-fi
-root=$(cd "$(dirname "$0")/.." && pwd)
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_firmware_rules.XXXXXX") || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-pass=0
-fail=0
 CC=${CC:-cc}
 FLAGS="-std=c99 -O2 -ffreestanding -Wall -Wextra -Wpedantic -Wconversion -Wdouble-promotion -Wvla -Werror"
 LIBM='sin|cos|tan|asin|acos|atan|atan2|sqrt|exp|log|sinh|cosh|tanh|pow|fabs'
 MEM='memset|memcpy|memmove|memcmp'
 
-# check DESCRIPTION COMMAND...: runs COMMAND (its output to $tmp/why),
-# counts the outcome, prints the output of a failure.
-check() {
-    desc=$1
-    shift
+# report DESCRIPTION LINES: says on stderr that DESCRIPTION failed, with
+# the first LINES lines of $tmp/why.
+report() {
+    echo "FAIL: $1" >&2
+    sed -n "1,${2}s/^/    /p" "$tmp/why" >&2
+}
+
+# try LINES DESCRIPTION COMMAND...: runs COMMAND with its output in $tmp/why
+# and counts the outcome (tests/lib.sh); a failure is reported with LINES
+# lines of that output, and try fails too.
+try() {
+    lines=$1 desc=$2
+    shift 2
     if "$@" > "$tmp/why" 2>&1; then
-        pass=$((pass + 1))
+        ok
     else
         fail=$((fail + 1))
-        echo "FAIL: $desc" >&2
-        sed -n '1,12s/^/    /p' "$tmp/why" >&2
+        report "$desc" "$lines"
+        return 1
     fi
 }
 
 for tool in "$CC" nm size objdump; do
-    if ! command -v "$tool" > /dev/null 2>&1; then
+    if ! have "$tool"; then
         echo "firmware_rules: $tool is missing" >&2
-        echo "firmware_rules: 0 passed, 1 failed"
+        fail=1
+        suite_end
         exit 1
     fi
 done
@@ -263,43 +259,25 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech"; do
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
-        if ! "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
-                -o "$d/$prefix.c" --header "$d/$prefix.h" > "$tmp/why" 2>&1; then
-            fail=$((fail + 1))
-            echo "FAIL: $name ($real): mechc gen" >&2
-            sed -n '1,5s/^/    /p' "$tmp/why" >&2
-            continue
-        fi
-        pass=$((pass + 1))
-        check "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
+        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
+            -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
+        try 12 "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
         if [ "$real" = float ]; then f=f; else f=; fi
-        echo "$toolchains" | while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+        while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
             case " $reals " in *" $real "*) ;; *) continue ;; esac
             allowed="^(($LIBM)$f|$MEM${extra:+|$extra})\$"
             o=$d/$prefix-$tc.o
-            if $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" > "$tmp/why" 2>&1; then
-                echo pass
-            else
-                echo "FAIL: $name ($real, $tc): $cc $FLAGS $arch" >&2
-                sed -n '1,10s/^/    /p' "$tmp/why" >&2
-                echo fail
-                continue
-            fi
+            try 10 "$name ($real, $tc): $cc $FLAGS $arch" \
+                $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" || continue
             for rule in "undefined_only $o $nm_ $allowed" \
                         "no_writable_data $o $nm_ $size_" \
                         "defined_prefixed $o $nm_ ^${prefix}_" \
                         "call_graph $o $objdump_ $allowed 0"; do
-                if $rule > "$tmp/why" 2>&1; then
-                    echo pass
-                else
-                    echo "FAIL: $name ($real, $tc): ${rule%% *}" >&2
-                    sed -n '1,10s/^/    /p' "$tmp/why" >&2
-                    echo fail
-                fi
+                try 10 "$name ($real, $tc): ${rule%% *}" $rule
             done
-        done > "$tmp/counts"
-        pass=$((pass + $(grep -c '^pass$' "$tmp/counts")))
-        fail=$((fail + $(grep -c '^fail$' "$tmp/counts")))
+        done <<EOF
+$toolchains
+EOF
     done
 done
 
@@ -313,49 +291,44 @@ rt_src_rules() {
         ! grep -n -E "$FORBIDDEN" "$tmp/code" || return 1
     done
 }
-check "runtime: includes and forbidden names" rt_src_rules $rt_sources "$root/runtime/mechrt.h"
-echo "$toolchains" | while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+# exported_only OBJ NM REGEX: every global defined symbol matches REGEX.
+exported_only() {
+    "$2" -g --defined-only "$1" |
+        awk -v re="$3" 'NF == 3 && $3 !~ re { print "exported: " $3; bad = 1 } END { exit bad }'
+}
+try 12 "runtime: includes and forbidden names" rt_src_rules $rt_sources "$root/runtime/mechrt.h"
+while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
     for real in $reals; do
         d=$tmp/runtime-$real-$tc
         mkdir -p "$d"
         def=""
         exported='^mechrt_'
         if [ "$real" = float ]; then def=-DMECHRT_REAL_FLOAT; exported='^mechrtf_'; fi
-        ok=1
+        built=1
         for src in $rt_sources; do
             if ! $cc $FLAGS $arch $def -I"$root/runtime" -c "$src" \
                     -o "$d/$(basename "$src" .c).o" > "$tmp/why" 2>&1; then
-                echo "FAIL: runtime ($real, $tc): $cc $FLAGS $arch $def $(basename "$src")" >&2
-                sed -n '1,10s/^/    /p' "$tmp/why" >&2
-                ok=0
+                report "runtime ($real, $tc): $cc $FLAGS $arch $def $(basename "$src")" 10
+                built=0
             fi
         done
-        if [ $ok = 0 ] || ! $cc $arch -r -nostdlib "$d"/*.o -o "$d/core.o" > "$tmp/why" 2>&1; then
-            echo fail
+        # the build counts once: passed, or failed (a failed -r link silently)
+        if [ $built = 0 ] || ! $cc $arch -r -nostdlib "$d"/*.o -o "$d/core.o" > "$tmp/why" 2>&1; then
+            fail=$((fail + 1))
             continue
         fi
-        echo pass
+        ok
         allowed="^($MEM${extra:+|$extra})\$"
         for rule in "undefined_only $d/core.o $nm_ $allowed" \
                     "no_writable_data $d/core.o $nm_ $size_" \
                     "call_graph $d/core.o $objdump_ $allowed 1"; do
-            if $rule > "$tmp/why" 2>&1; then echo pass; else
-                echo "FAIL: runtime ($real, $tc): ${rule%% *}" >&2
-                sed -n '1,10s/^/    /p' "$tmp/why" >&2
-                echo fail
-            fi
+            try 10 "runtime ($real, $tc): ${rule%% *}" $rule
         done
-        if $nm_ -g --defined-only "$d/core.o" | awk -v re="$exported" 'NF == 3 && $3 !~ re { print "exported: " $3; bad = 1 } END { exit bad }' > "$tmp/why"; then
-            echo pass
-        else
-            echo "FAIL: runtime ($real, $tc): exported names" >&2
-            sed -n '1,10s/^/    /p' "$tmp/why" >&2
-            echo fail
-        fi
+        try 10 "runtime ($real, $tc): exported names" exported_only "$d/core.o" "$nm_" "$exported"
     done
-done > "$tmp/counts"
-pass=$((pass + $(grep -c '^pass$' "$tmp/counts")))
-fail=$((fail + $(grep -c '^fail$' "$tmp/counts")))
+done <<EOF
+$toolchains
+EOF
 
 # ---- two mechanisms and the runtime in one program ---------------------------
 # run_P.c steps mechanism P from t = 0 to t_end through the runtime, with
@@ -417,7 +390,7 @@ build_units() {
         $CC $LINKFLAGS -DMECHRT_REAL_FLOAT -c "$src" -o "$link/rtf_$b.o" || return 1
     done
 }
-check "link: generate and compile sc, fb (double), fbf (float), both runtime builds" build_units
+try 12 "link: generate and compile sc, fb (double), fbf (float), both runtime builds" build_units
 # link_run NAME EXPECTED UNITS...: main calls run_UNIT(0.25, 25) for each
 # unit, links them with both runtime builds and compares with EXPECTED, a
 # list of VALUE:TOLERANCE.
@@ -442,10 +415,9 @@ link_run() {
         awk '{ d = $1 - $3; if (d < 0) d = -d; if (d > $2) bad = 1; n++ }
              END { exit bad || n == 0 }'
 }
-check "link: slider_crank (sc) + four_bar (fb) + runtime in one program: slider.x(0.25) = sqrt(0.08), rocker.phi(0.25) = 1.725386" \
+try 12 "link: slider_crank (sc) + four_bar (fb) + runtime in one program: slider.x(0.25) = sqrt(0.08), rocker.phi(0.25) = 1.725386" \
     link_run two "0.282842712475:1e-9 1.725386:1e-6" sc fb
-check "link: sc and fb in double, fbf in float, mechrt_* and mechrtf_* in one program" \
+try 12 "link: sc and fb in double, fbf in float, mechrt_* and mechrtf_* in one program" \
     link_run mixed "0.282842712475:1e-9 1.725386:1e-6 1.725386:1e-4" sc fb fbf
 
-echo "firmware_rules: $pass passed, $fail failed"
-[ "$fail" = 0 ]
+suite_end

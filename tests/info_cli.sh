@@ -9,74 +9,31 @@
 # non-zero on any failure. The JSON parse checks need python3 and are
 # skipped (and say so) without it.
 set -u
-
-mechc=${1:-build/mechc}
-case $mechc in
-    /*) ;;
-    *) mechc=$(pwd)/$mechc ;;
-esac
-if [ ! -x "$mechc" ]; then
-    echo "info_cli: $mechc is not an executable" >&2
-    exit 2
-fi
-root=$(cd "$(dirname "$0")/.." && pwd)
-ex=$root/examples
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_info.XXXXXX") || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-pass=0
-fail=0
-have_python=0
-command -v python3 > /dev/null 2>&1 && have_python=1
-
-check() {
-    desc=$1
-    shift
-    if "$@"; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $desc" >&2
-        if [ -s "$tmp/err" ]; then
-            echo "  stderr was:" >&2
-            sed -n '1,6s/^/    /p' "$tmp/err" >&2
-        fi
-    fi
-}
-
-skip() { echo "skip: $1" >&2; }
-
-run() {
-    "$mechc" "$@" > "$tmp/out" 2> "$tmp/err"
-    rc=$?
-}
-rc_is() { [ "$rc" = "$1" ]; }
-out_has() { grep -F -q -- "$1" "$tmp/out"; }
-err_has() { grep -F -q -- "$1" "$tmp/err"; }
-err_empty() { [ ! -s "$tmp/err" ]; }
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin info_cli "${1:-build/mechc}"
 
 # ---- usage and bad input: exit 2 ----
 
 run info --help
-check "info --help exits 0" rc_is 0
+check "info --help exits 0" status_is 0
 check "info --help shows the usage" out_has "usage: mechc info"
 run info
-check "info without a file exits 2" rc_is 2
+check "info without a file exits 2" status_is 2
 check "info without a file says so" err_has "no input file"
 run info "$ex/four_bar.mech" --frobnicate
-check "info with an unknown option exits 2" rc_is 2
+check "info with an unknown option exits 2" status_is 2
 run info "$ex/four_bar.mech" --rank-tol
-check "info --rank-tol without a value exits 2" rc_is 2
+check "info --rank-tol without a value exits 2" status_is 2
 run info "$ex/four_bar.mech" --rank-tol -1
-check "info --rank-tol -1 exits 2" rc_is 2
+check "info --rank-tol -1 exits 2" status_is 2
 run info "$ex/four_bar.mech" --rank-tol abc
-check "info --rank-tol abc exits 2" rc_is 2
+check "info --rank-tol abc exits 2" status_is 2
 run info "$tmp/does_not_exist.mech"
-check "info on a missing file exits 2" rc_is 2
+check "info on a missing file exits 2" status_is 2
 printf 'body b x = 0\nrevolute J: ground crnk\n' > "$tmp/bad.mech"
 run info "$tmp/bad.mech"
-check "info on bad input exits 2" rc_is 2
+check "info on bad input exits 2" status_is 2
 check "info on bad input reports FILE:LINE:COL: error:" err_has "bad.mech:2:20: error:"
 
 # ---- the analysis cannot assemble: exit 1, the report still printed ----
@@ -84,7 +41,7 @@ check "info on bad input reports FILE:LINE:COL: error:" err_has "bad.mech:2:20: 
 printf 'point m x = 0.5 y = 0.1\ndistance a: ground(0, 0) m length = 1\ndistance b: ground(5, 0) m length = 1\n' \
     > "$tmp/impossible.mech"
 run info "$tmp/impossible.mech"
-check "info on an impossible mechanism exits 1" rc_is 1
+check "info on an impossible mechanism exits 1" status_is 1
 check "info on an impossible mechanism names t = 0" err_has "t = 0"
 check "info on an impossible mechanism says the assembly failed" err_has "did not converge"
 check "info on an impossible mechanism still prints the report" out_has "verdict:"
@@ -93,9 +50,9 @@ check "info on an impossible mechanism still prints the report" out_has "verdict
 
 for f in "$ex"/*.mech; do
     run info "$f"
-    check "info $(basename "$f") exits 0" rc_is 0
+    check "info $(basename "$f") exits 0" status_is 0
     run info "$f" --json
-    check "info --json $(basename "$f") exits 0" rc_is 0
+    check "info --json $(basename "$f") exits 0" status_is 0
 done
 
 # ---- parallelogram: rank 11 of 12, A2.y redundant ----
@@ -145,14 +102,14 @@ check "skate_velocity --json: side not integrable" \
 # ---- the toggle position of slider_crank_toggle.mech ----
 
 run info "$ex/slider_crank_toggle.mech" --t 0.25
-check "slider_crank_toggle --t 0.25 exits 0" rc_is 0
+check "slider_crank_toggle --t 0.25 exits 0" status_is 0
 check "slider_crank_toggle --t 0.25: near-singular" out_has "near-singular"
 run info "$ex/slider_crank_toggle.mech"
 check "slider_crank_toggle at t = 0: regular" out_has "configuration: regular"
 
 # ---- the JSON parses and has the spec's shape ----
 
-if [ "$have_python" = 1 ]; then
+if have python3; then
     check "info --json parses with the spec's keys (parallelogram)" python3 - "$tmp/parallelogram.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -192,5 +149,4 @@ else
     skip "python3 not found: JSON parse checks"
 fi
 
-echo "info_cli: $pass passed, $fail failed"
-[ "$fail" = 0 ]
+suite_end

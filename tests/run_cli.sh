@@ -12,59 +12,12 @@
 # non-zero on any failure. Checks needing cc or python3 are skipped (and say
 # so) when those are missing.
 set -u
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin run_cli "${1:-build/mechc}"
 
-mechc=${1:-build/mechc}
-case $mechc in
-    /*) ;;
-    *) mechc=$(pwd)/$mechc ;;
-esac
-if [ ! -x "$mechc" ]; then
-    echo "run_cli: $mechc is not an executable" >&2
-    exit 2
-fi
-root=$(cd "$(dirname "$0")/.." && pwd)
-ex=$root/examples
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_run_cli.XXXXXX") || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-pass=0
-fail=0
-have_cc=0
-command -v cc > /dev/null 2>&1 && have_cc=1
-have_python=0
-command -v python3 > /dev/null 2>&1 && have_python=1
-
-# check DESCRIPTION COMMAND...: runs COMMAND, counts the outcome.
-check() {
-    desc=$1
-    shift
-    if "$@"; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $desc" >&2
-        if [ -s "$tmp/err" ]; then
-            echo "  stderr was:" >&2
-            sed -n '1,6s/^/    /p' "$tmp/err" >&2
-        fi
-    fi
-}
-
-skip() {
-    echo "skip: $1" >&2
-}
-
-# run ARGS...: runs mechc run, stdout to $tmp/out, stderr to $tmp/err, status in $rc.
-run() {
-    "$mechc" run "$@" > "$tmp/out" 2> "$tmp/err"
-    rc=$?
-}
-
-status_is() { [ "$rc" = "$1" ]; }
-err_has() { grep -q -- "$1" "$tmp/err"; }
-out_lines() { [ "$(wc -l < "$tmp/out")" = "$1" ]; }
-out_empty() { [ ! -s "$tmp/out" ]; }
+# run ARGS...: mechc run ARGS (tests/lib.sh).
+run() { run_mechc run "$@"; }
 
 # column NAME FILE: the 1-based index of a CSV column.
 column() {
@@ -151,7 +104,7 @@ check "--stats: cost in all-kernel calls" err_has "a step costs"
 # ---- JSON ------------------------------------------------------------------
 run "$ex/slider_crank.mech" --steps 4 --json
 check "--json: exit 0" status_is 0
-if [ "$have_python" = 1 ]; then
+if have python3; then
     check "--json: keys and sizes" python3 -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -168,15 +121,15 @@ fi
 # ---- failures ------------------------------------------------------------
 run "$ex/slider_crank_toggle.mech"
 check "toggle: exit 1" status_is 1
-check "toggle: the message names t = 0.25" err_has "error: t = 0\.25: "
-check "toggle: singular, or no convergence" err_has "singular\|no convergence"
-check "toggle: names slider.x" err_has "slider\.x"
+check "toggle: the message names t = 0.25" err_matches "error: t = 0\.25: "
+check "toggle: singular, or no convergence" err_matches "singular\|no convergence"
+check "toggle: names slider.x" err_matches "slider\.x"
 check "toggle: the 25 states before are written (header + 25)" out_lines 26
 check "toggle: the last row written is t = 0.24" \
     [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.24" ]
 run "$ex/slider_crank_toggle.mech" --json
 check "toggle --json: exit 1" status_is 1
-if [ "$have_python" = 1 ]; then
+if have python3; then
     check "toggle --json: valid, 25 states, ok false, the error's time" python3 -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -196,7 +149,7 @@ driver pull: p.x = 0.55 + t
 EOF
 run "$tmp/reach.mech" --steps 10
 check "out of reach: exit 1" status_is 1
-check "out of reach: t = 0.5, no convergence" err_has "error: t = 0\.5: .*no convergence"
+check "out of reach: t = 0.5, no convergence" err_matches "error: t = 0\.5: .*no convergence"
 check "out of reach: names the row" err_has "row circle"
 check "out of reach: assembly moved the rough initial values: a note" \
     err_has "note: assembly at t = 0 moved"
@@ -209,7 +162,7 @@ check "redundant parallelogram: exit 1 at t = 0, singular" \
 for f in pendulum_distance pendulum_constraint; do
     run "$ex/$f.mech"
     check "$f: exit 2" status_is 2
-    check "$f: 1 degree of freedom is not driven" err_has "$f.mech: error: 1 degree of freedom is not driven"
+    check "$f: 1 degree of freedom is not driven" err_matches "$f.mech: error: 1 degree of freedom is not driven"
     check "$f: no output" out_empty
 done
 cat > "$tmp/over.mech" <<'EOF'
@@ -266,7 +219,7 @@ for engine in generic aot; do
 done
 
 # ---- firmware: generated C + MECHRT_DEFINE_KERNELS + the runtime ----------
-if [ "$have_cc" = 1 ]; then
+if have cc; then
     cat > "$tmp/fw.c" <<'EOF'
 /* what firmware writes: the generated kernels and the runtime, no heap */
 #include <stdio.h>
@@ -306,7 +259,7 @@ EOF
                 -o "$tmp/fb.c" --header "$tmp/fb.h" 2> "$tmp/err" \
            && cc -std=c99 -pedantic -Wall -Wextra -Werror -O2 $def -I"$tmp" -I"$root/runtime" \
                 "$tmp/fw.c" "$tmp/fb.c" "$root"/runtime/*.c -lm -o "$tmp/fw_$real" 2> "$tmp/err"; then
-            pass=$((pass + 1))
+            ok
             "$tmp/fw_$real" > "$tmp/fw.out" 2> "$tmp/err"
             set -- $(cat "$tmp/fw.out") "" ""
             tol=1e-12
@@ -323,5 +276,4 @@ else
     skip "cc missing: firmware build"
 fi
 
-echo "run_cli: $pass passed, $fail failed"
-[ "$fail" = 0 ]
+suite_end

@@ -12,48 +12,13 @@
 # "security_cli: N passed, M failed", the exit status non-zero on failure.
 # The gcc checks are skipped when gcc is missing.
 set -u
-
-mechc=${1:-build/mechc}
-case $mechc in
-    /*) ;;
-    *) mechc=$(pwd)/$mechc ;;
-esac
-if [ ! -x "$mechc" ]; then
-    echo "security_cli: $mechc is not an executable" >&2
-    exit 2
-fi
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_security.XXXXXX") || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-pass=0
-fail=0
-have_gcc=0
-command -v gcc > /dev/null 2>&1 && have_gcc=1
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin security_cli "${1:-build/mechc}"
 # A hang is a failure: each mechc call gets at most this long.
-limit_seconds=60
-have_timeout=0
-command -v timeout > /dev/null 2>&1 && have_timeout=1
-
-ok() { pass=$((pass + 1)); }
-bad() {
-    fail=$((fail + 1))
-    echo "FAIL: $1" >&2
-    if [ -s "$tmp/err" ]; then
-        echo "  stderr was:" >&2
-        sed -n '1,4s/^/    /p' "$tmp/err" >&2
-    fi
-}
-
-# run ARGS...: mechc with stdout in $tmp/out, stderr in $tmp/err, status in $rc.
-run() {
-    if [ $have_timeout = 1 ]; then
-        timeout $limit_seconds "$mechc" "$@" > "$tmp/out" 2> "$tmp/err"
-    else
-        "$mechc" "$@" > "$tmp/out" 2> "$tmp/err"
-    fi
-    rc=$?
-}
+mechc_timeout=60
+# A failure shows 4 lines of stderr.
+err_shown=4
 
 # expect DESC STATUS PATTERN ARGS...: mechc ARGS exits STATUS and, unless
 # PATTERN is empty, prints PATTERN (grep -E) on stderr.
@@ -77,7 +42,7 @@ defined() {
     run "$@"
     case $rc in
         0|1|2) ok ;;
-        124) bad "$desc: did not finish within $limit_seconds s" ;;
+        124) bad "$desc: did not finish within $mechc_timeout s" ;;
         *) bad "$desc: exit $rc (a crash?)" ;;
     esac
 }
@@ -110,7 +75,7 @@ gen_path() {
         bad "$desc: the banner has $ends comment ends"
         return
     fi
-    if [ $have_gcc = 1 ] && ! gcc -std=c99 -pedantic -Wall -Wextra -Werror -c "$tmp/path.c" \
+    if have gcc && ! gcc -std=c99 -pedantic -Wall -Wextra -Werror -c "$tmp/path.c" \
             -o "$tmp/path.o" 2> "$tmp/err"; then
         bad "$desc: gcc rejects the C"
         return
@@ -256,7 +221,7 @@ if "$mechc" run --help > /dev/null 2>&1; then
     expect "run --steps huge refused" 2 "" run "$tmp/nan.mech" --steps 99999999999999
     defined "run on random bytes" run "$tmp/rand.mech"
 else
-    echo "skip: mechc run is not available" >&2
+    skip "mechc run is not available"
 fi
 
 # every other command on the hostile inputs: a defined end
@@ -268,5 +233,4 @@ for cmd in info check bench; do
     fi
 done
 
-echo "security_cli: $pass passed, $fail failed"
-[ "$fail" = 0 ]
+suite_end
