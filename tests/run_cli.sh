@@ -88,6 +88,22 @@ check "slider_crank: last t is exactly 1" \
     near "$(tail -1 "$tmp/sc.csv" | cut -d, -f1)" 1 0
 check "slider_crank: nothing on stderr" [ ! -s "$tmp/err" ]
 
+# ---- coarse steps: redone in substeps, not a jump to another branch -------
+run "$ex/slider_crank.mech" --steps 4 --stats
+check "--steps 4: exit 0" status_is 0
+check "--steps 4: slider.x(0.25) = sqrt(0.08) on the right branch" \
+    near "$(value_at 0.25 slider.x "$tmp/out")" 0.282842712474619 1e-9
+check "--steps 4: slider.x(0.5) = 0.2 on the right branch" \
+    near "$(value_at 0.5 slider.x "$tmp/out")" 0.2 1e-9
+check "--steps 4 --stats: the steps redone are counted" err_has "redone in substeps"
+run "$ex/slider_crank.mech" --steps 3 --max-substeps 1
+check "--steps 3 --max-substeps 1: exit 1" status_is 1
+check "--steps 3 --max-substeps 1: says the motion is too fast, at t = 0.333" \
+    err_matches "t = 0\.3333333333: .*too fast for the step"
+check "--steps 3 --max-substeps 1: the state at t = 0 is written" out_lines 2
+run "$ex/slider_crank.mech" --max-substeps 0
+check "--max-substeps 0: exit 2" status_is 2
+
 run "$ex/slider_crank.mech" --steps 8 --csv "$tmp/file.csv"
 check "--csv FILE: exit 0, stdout empty" out_empty
 check "--csv FILE: same content as stdout" cmp -s "$tmp/file.csv" "$tmp/sc.csv"

@@ -149,8 +149,11 @@ static void test_slider_crank_closed_form(void **state)
         assert_near(st[1 + iy], 0, 0, 1e-12);
     }
     assert_near(state_at(&c, (size_t)steps)[0], 1.0, 0, 0);   /* t1 exactly */
-    /* the predictor keeps Newton to about one iteration per step */
+    /* the predictor keeps Newton to about one iteration per step, and no
+       step needs the branch check's substeps */
     assert_true(c.res.newton_iterations <= 2 * steps);
+    assert_int_equal(c.res.subdivided, 0);
+    assert_int_equal(c.res.substeps, 0);
     assert_int_equal(c.res.warnings, 0);
     collected_free(&c);
     pipeline_free(mech);
@@ -307,6 +310,177 @@ static void test_examples_run(void **state)
     assert_near(st[1 + iy], 0, 0, 1e-12);
     assert_near(st[1 + nq + iy], M_PI, 1e-12, 1e-12);
     assert_near(st[1 + 2 * nq + ix], -M_PI * M_PI / 2, 1e-12, 1e-12);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* ---- coarse steps -------------------------------------------------------- */
+
+/* Every state of c equals the state of ref at the same time (ref's grid
+   must contain c's), positions, velocities and accelerations to 1e-8. */
+static void expect_same_states(const Collected *c, const Collected *ref, const char *what)
+{
+    size_t w = 1 + 3 * (size_t)c->trace.nq, j = 0;
+    for (size_t i = 0; i < c->trace.rows; i++) {
+        const double *st = state_at(c, i);
+        while (j < ref->trace.rows && state_at(ref, j)[0] != st[0])
+            j++;
+        if (j == ref->trace.rows)
+            fail_msg("%s: t = %.17g is not on the reference grid", what, st[0]);
+        const double *rs = state_at(ref, j);
+        for (size_t k = 1; k < w; k++)
+            if (!(fabs(st[k] - rs[k]) <= 1e-8 * (1 + fabs(rs[k]))))
+                fail_msg("%s: t = %g: value %zu is %.17g, the reference %.17g", what, st[0], k,
+                         st[k], rs[k]);
+    }
+}
+
+/* With one, two or three steps per crank turn the predictor lands nearer
+   the crossed assembly (or another turn of the coupler's angle) than the
+   right one, and Newton would converge there: the four-bar at t = 0.5 came
+   out with coupler.y = -0.936 instead of +0.936. The branch check redoes
+   such steps in substeps, and the grid states equal those of a fine run
+   (1200 steps: every point of the 1-, 2- and 3-step grids is on it). */
+static void test_coarse_steps_keep_branch(void **state)
+{
+    (void)state;
+    const char *files[] = {"examples/four_bar.mech", "examples/five_bar.mech",
+                           "examples/slider_crank.mech"};
+    for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
+        Mech *mech = load_file(files[f]);
+        RunOptions o = run_default_options();
+        o.steps = 1200;
+        Collected ref;
+        run_with(mech, ENGINE_JIT, o, &ref);
+        expect_ok(&ref, 1200);
+        for (int steps = 1; steps <= 3; steps++) {
+            char what[96];
+            snprintf(what, sizeof what, "%s, %d %s", files[f], steps, steps == 1 ? "step" : "steps");
+            Collected c;
+            o.steps = steps;
+            run_with(mech, ENGINE_JIT, o, &c);
+            if (c.status != RUN_OK)
+                fail_msg("%s: %s", what, c.res.message);
+            expect_ok(&c, steps);
+            expect_same_states(&c, &ref, what);
+            /* only the grid's states are delivered; the substeps are counted */
+            assert_true(c.res.subdivided >= 1);
+            assert_true(c.res.substeps >= 2 * c.res.subdivided);
+            assert_int_equal(c.res.steps_done, steps);
+            collected_free(&c);
+        }
+        collected_free(&ref);
+        pipeline_free(mech);
+    }
+}
+
+/* A crank started from rest (crank.phi = omega t^3): the first step's
+   predicted motion is nil at any step size, so only the agreement of two
+   subdivision levels can accept it; coarse runs still match the fine one. */
+static void test_coarse_steps_from_rest(void **state)
+{
+    (void)state;
+    FILE *f = fopen("examples/four_bar.mech", "r");
+    assert_non_null(f);
+    static char text[8192];
+    size_t n = fread(text, 1, sizeof text - 16, f);
+    fclose(f);
+    text[n] = '\0';
+    char *drive = strstr(text, "omega*t\n");
+    assert_non_null(drive);
+    memmove(drive + 9, drive + 7, strlen(drive + 7) + 1);
+    memcpy(drive + 7, "^3", 2);
+    assert_non_null(strstr(text, "crank.phi = omega*t^3\n"));
+    Mech *mech = load_text(text, "four_bar_from_rest.mech");
+    RunOptions o = run_default_options();
+    o.steps = 1200;
+    Collected ref;
+    run_with(mech, ENGINE_JIT, o, &ref);
+    expect_ok(&ref, 1200);
+    for (int steps = 1; steps <= 4; steps++) {
+        Collected c;
+        o.steps = steps;
+        run_with(mech, ENGINE_JIT, o, &c);
+        if (c.status != RUN_OK)
+            fail_msg("%d steps: %s", steps, c.res.message);
+        expect_ok(&c, steps);
+        expect_same_states(&c, &ref, "four-bar from rest");
+        collected_free(&c);
+    }
+    collected_free(&ref);
+    pipeline_free(mech);
+}
+
+/* Past max_substeps the run fails, exit status 1, naming the time and the
+   cause; it never goes on with a state it could not check. */
+static void test_substep_limit(void **state)
+{
+    (void)state;
+    Mech *mech = load_file("examples/four_bar.mech");
+    RunOptions o = run_default_options();
+    o.steps = 2;
+    o.max_substeps = 2;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.res.cause, MECHRT_ESTEP);
+    assert_int_equal(c.res.states, 1);   /* t = 0 only */
+    assert_int_equal((int)c.trace.rows, 1);
+    /* the first substep of the finest level (2 of 0 .. 0.5) still jumped */
+    assert_near(c.res.t_fail, 0.25, 0, 1e-15);
+    assert_non_null(strstr(c.res.message, "t = 0.25: position analysis failed: the motion is "
+                                          "too fast for the step: in 2 substeps of the step "
+                                          "from t = 0 to 0.5 "));
+    assert_non_null(strstr(c.res.message, "--max-substeps"));
+    collected_free(&c);
+
+    /* no subdivision at all: the unchecked step itself fails */
+    o.max_substeps = 1;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.res.cause, MECHRT_ESTEP);
+    assert_near(c.res.t_fail, 0.5, 0, 0);
+    assert_int_equal(c.res.states, 1);
+    assert_non_null(strstr(c.res.message, "t = 0.5: position analysis failed: the motion is too "
+                                          "fast for the step: in the step from t = 0 to 0.5 "
+                                          "(no substeps allowed)"));
+    assert_int_equal(c.res.substeps, 0);
+    collected_free(&c);
+
+    /* ten crank turns in one step are too many for the default 64 substeps */
+    o = run_default_options();
+    o.t1 = 10;
+    o.steps = 1;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.res.states, 1);
+    assert_true(c.res.t_fail > 0 && c.res.t_fail <= 10);
+    assert_non_null(strstr(c.res.message, "the motion is too fast for the step"));
+    assert_non_null(strstr(c.res.message, "in 64 substeps"));
+    collected_free(&c);
+    /* ... and enough with a higher limit, where the grid point matches a
+       fine run */
+    o.max_substeps = 1024;
+    run_with(mech, ENGINE_JIT, o, &c);
+    if (c.status != RUN_OK)
+        fail_msg("10 turns, 1 step, 1024 substeps: %s", c.res.message);
+    expect_ok(&c, 1);
+    Collected ref;
+    o.steps = 1000;
+    run_with(mech, ENGINE_JIT, o, &ref);
+    expect_ok(&ref, 1000);
+    expect_same_states(&c, &ref, "10 turns in 1 step");
+    collected_free(&ref);
+    collected_free(&c);
+
+    /* (a step that fails outright and that substeps cannot rescue keeps its
+       own message and time: test_toggle, test_out_of_reach) */
+
+    /* no substeps at all is bad input */
+    o = run_default_options();
+    o.max_substeps = 0;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
     collected_free(&c);
     pipeline_free(mech);
 }
@@ -748,6 +922,9 @@ int main(void)
         cmocka_unit_test(test_knife_cart_circle),
         cmocka_unit_test(test_rolling_wheel),
         cmocka_unit_test(test_examples_run),
+        cmocka_unit_test(test_coarse_steps_keep_branch),
+        cmocka_unit_test(test_coarse_steps_from_rest),
+        cmocka_unit_test(test_substep_limit),
         cmocka_unit_test(test_toggle),
         cmocka_unit_test(test_out_of_reach),
         cmocka_unit_test(test_assembly_and_nan),

@@ -10,6 +10,24 @@
  * integrated (runtime/host: GSL odeiv2, projection onto Phi = 0 after every
  * step) and its velocities and accelerations solved at each output time.
  *
+ * A coarse step can leave the branch it should follow: the predictor
+ * lands nearer another assembly (the crossed four-bar) or another turn of
+ * an angle, and Newton converges there without complaint. So every step is
+ * checked (step_quiet): Newton must have needed few iterations and
+ * corrected no coordinate by more than a small share of the motion the
+ * predictor gave it. An interval whose step fails the check, or fails, is
+ * redone from its start in 2, 4, 8 ... substeps (RunOptions.max_substeps at
+ * most), each a predictor and a corrector, until every substep of a level
+ * passes the check, or a level whose substeps all took few Newton
+ * iterations ends where the previous level did (a fully driven mechanism's
+ * position at a time depends only on its branch and turns, so two levels
+ * that agree followed the same one; this accepts a start from rest, where
+ * the predicted motion is nil at any step size). Only the grid's states are
+ * reported. Past the limit the run fails: "the motion is too fast for the
+ * step", or the error of the finest level. A fine step, one Newton
+ * iteration, passes the check for the price of saving the state it started
+ * from.
+ *
  * Failures stop the run and say when, why and where: the time as
  * `t = VALUE`, the runtime's cause, the row with the largest residual or
  * the coordinate where elimination found no pivot, and, from an SVD of the
@@ -36,6 +54,17 @@
 /* Above this many coordinates the dense SVD of a failure message (O(n^3))
    would take longer than the user should wait for an error: left out. */
 #define RUN_SVD_MAX_NQ 400
+/* A holonomic step is quiet (trusted) when Newton took at most
+   RUN_QUIET_ITER iterations and moved every coordinate away from the
+   prediction by at most RUN_QUIET_SHARE times the motion the predictor gave
+   it, |h qd| + h^2/2 |qdd|, plus tol_dq. On the branch the correction is the
+   predictor's O(h^3) error, a small share of the O(h) motion; a jump to
+   another branch or turn corrects by a link length or a radian. */
+#define RUN_QUIET_ITER 3
+#define RUN_QUIET_SHARE 0.05
+/* Two subdivision levels agree when their positions at the end of the
+   interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
+#define RUN_AGREE 10
 
 RunOptions run_default_options(void)
 {
@@ -43,6 +72,7 @@ RunOptions run_default_options(void)
     o.t0 = 0;
     o.t1 = 1;
     o.steps = 100;
+    o.max_substeps = 64;
     o.mechrt = mechrt_default_options();
     o.ode = mechrt_ode_default_options();
     o.move_note = 1e-3;
@@ -92,9 +122,14 @@ typedef struct Run {
     const RunOptions *o;
     RunResult *res;
     int nq, nr;
-    double *q, *qd, *qdd;
+    double *q, *qd, *qdd;    /* one block of 3 nq: qd == q + nq, qdd == q + 2 nq */
     double *work;
     size_t lwork;
+    /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
+       out like q | qd | qdd), the start of the interval being subdivided
+       (iq, the same layout), the end of the previous subdivision level (lq)
+       and a failed step's iterate (fq) */
+    double *sq, *sqd, *sqdd, *iq, *lq, *fq;
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -336,62 +371,230 @@ static double time_at(const RunOptions *o, int i)
     return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
 }
 
-/* Holonomic rows only: the runtime's predictor-corrector step. */
+/* A failed mechrt_step ending at t with iterate q: Newton's failure or the
+   velocity and acceleration analysis' after it. */
+static void fail_step(Run *r, MechrtStatus st, double t, const double *q,
+                      const MechrtReport *rep)
+{
+    const MechrtOptions *mo = &r->o->mechrt;
+    bool newton = rep->step < 0 || st == MECHRT_EMAXITER || rep->residual > mo->tol_phi
+                  || rep->step > mo->tol_dq;
+    fail(r, st, t, q, rep, newton ? "position analysis (Newton)"
+                                  : "velocity and acceleration analysis");
+}
+
+/* Why a step was not quiet: the coordinate corrected most beyond its share
+   (-1: none, too many iterations only). */
+typedef struct StepCheck {
+    int coord;
+    double correction, motion;
+    int iterations;
+} StepCheck;
+
+/* The check of the converged step of length h that went from (sq, sqd,
+   sqdd) to q: see RUN_QUIET_SHARE. NaN fails it. */
+static bool step_quiet(const Run *r, double h, const MechrtReport *rep, StepCheck *chk)
+{
+    const double tol = r->o->mechrt.tol_dq, h2 = 0.5 * h * h;
+    double worst = 0;
+    int bad = 0;
+    /* One Newton iteration (fine steps): the correction was that one step,
+       at most tol_dq in every coordinate, so the check holds. */
+    if (rep->iterations <= 1)
+        return true;
+    /* the common case, branch-free */
+    for (int i = 0; i < r->nq; i++) {
+        double corr = fabs(r->q[i] - (r->sq[i] + h * r->sqd[i] + h2 * r->sqdd[i]));
+        double motion = fabs(h * r->sqd[i]) + h2 * fabs(r->sqdd[i]);
+        bad |= !(corr <= RUN_QUIET_SHARE * motion + tol);
+    }
+    if (rep->iterations <= RUN_QUIET_ITER && !bad)
+        return true;
+    /* not quiet: which coordinate, for a message */
+    chk->coord = -1;
+    chk->iterations = rep->iterations;
+    for (int i = 0; i < r->nq; i++) {
+        double corr = fabs(r->q[i] - (r->sq[i] + h * r->sqd[i] + h2 * r->sqdd[i]));
+        double motion = fabs(h * r->sqd[i]) + h2 * fabs(r->sqdd[i]);
+        double allowed = RUN_QUIET_SHARE * motion + tol;
+        if (!(corr <= allowed)) {
+            if (!(corr <= worst * allowed)) {
+                worst = corr / allowed;
+                chk->coord = i;
+                chk->correction = corr;
+                chk->motion = motion;
+            }
+        }
+    }
+    return false;
+}
+
+/* One predictor-corrector step of the runtime from t to t + h, its start
+   kept in sq, sqd, sqdd; *quiet says whether it passed the check. */
+static MechrtStatus checked_step(Run *r, double t, double h, MechrtReport *rep, bool *quiet,
+                                 StepCheck *chk)
+{
+    memcpy(r->sq, r->q, 3 * (size_t)r->nq * sizeof(double));   /* q | qd | qdd */
+    MechrtStatus st = mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work,
+                                  r->lwork, rep);
+    r->res->newton_iterations += rep->iterations;
+    *quiet = st == MECHRT_OK && step_quiet(r, h, rep, chk);
+    return st;
+}
+
+/* The positions of two levels at the interval's end are the same solution. */
+static bool levels_agree(const Run *r, const double *a, const double *b)
+{
+    double tol = RUN_AGREE * r->o->mechrt.tol_dq;
+    for (int i = 0; i < r->nq; i++)
+        if (!(fabs(a[i] - b[i]) <= tol))
+            return false;
+    return true;
+}
+
+/* Past the subdivision limit with every level converging: the message. */
+static void fail_too_fast(Run *r, double t_start, double t_end, double t_bad, long levels,
+                          const StepCheck *chk)
+{
+    RunResult *res = r->res;
+    res->status = RUN_FAILED;
+    res->cause = MECHRT_ESTEP;
+    res->t_fail = t_bad;
+    res->message[0] = '\0';
+    msgf(r, "t = %.10g: position analysis failed: the motion is too fast for the step: ", t_bad);
+    if (levels > 1)
+        msgf(r, "in %ld substeps of the step from t = %.10g to %.10g ", levels, t_start, t_end);
+    else
+        msgf(r, "in the step from t = %.10g to %.10g (no substeps allowed) ", t_start, t_end);
+    if (chk->coord >= 0)
+        msgf(r, "Newton %scorrected %s by %.3g where the predictor moved it by %.3g",
+             levels > 1 ? "still " : "", r->m->coord_names[chk->coord], chk->correction,
+             chk->motion);
+    else
+        msgf(r, "Newton %sneeded %d iterations", levels > 1 ? "still " : "", chk->iterations);
+    msgf(r, ", so the motion may have jumped to another assembly branch or turn; use more "
+         "--steps or a larger --max-substeps");
+}
+
+/* The step over [t, tn] from (sq, sqd, sqdd) was not quiet (chk0 says
+   why), or failed with st0 (report *rep, iterate in q). Redoes the interval
+   in 2, 4, 8 ... substeps until a level is quiet throughout, or took few
+   iterations throughout and agrees with the previous level: true with the
+   state at tn in q, qd, qdd and the last substep's report in *rep. Past
+   max_substeps: false, the failure in r->res (the original step's own, at
+   tn, when it failed). */
+static bool subdivide(Run *r, double t, double tn, MechrtStatus st0, MechrtReport *rep,
+                      const StepCheck *chk0)
+{
+    const RunOptions *o = r->o;
+    size_t bytes = (size_t)r->nq * sizeof(double);
+    MechrtReport rep0 = *rep;
+    StepCheck chk = *chk0;
+    MechrtStatus st = st0;
+    double t_bad = tn;
+    bool have_last = st0 == MECHRT_OK;
+    long levels = 1;
+
+    memcpy(r->iq, r->sq, 3 * bytes);   /* q | qd | qdd */
+    memcpy(have_last ? r->lq : r->fq, r->q, bytes);
+    r->res->subdivided++;
+    for (long s = 2; s <= o->max_substeps; s *= 2) {
+        bool all_quiet = true, few_iterations = true;
+        double ta = t;
+        levels = s;
+        memcpy(r->q, r->iq, 3 * bytes);
+        st = MECHRT_OK;
+        for (long j = 1; j <= s && st == MECHRT_OK; j++) {
+            double tb = j == s ? tn : t + (tn - t) * (double)j / (double)s;
+            bool quiet;
+            StepCheck c = {-1, 0, 0, 0};
+            st = checked_step(r, ta, tb - ta, rep, &quiet, &c);
+            r->res->substeps++;
+            if (st != MECHRT_OK || (!quiet && all_quiet)) {
+                t_bad = tb;
+                if (st == MECHRT_OK)
+                    chk = c;
+            }
+            all_quiet = all_quiet && quiet;
+            few_iterations = few_iterations && rep->iterations <= RUN_QUIET_ITER;
+            ta = tb;
+        }
+        if (st == MECHRT_OK
+            && (all_quiet || (few_iterations && have_last && levels_agree(r, r->q, r->lq))))
+            return true;
+        have_last = st == MECHRT_OK;
+        if (have_last)
+            memcpy(r->lq, r->q, bytes);
+    }
+    if (st0 != MECHRT_OK) {
+        /* subdivision did not help: the step's own failure, as ever, and
+           where the substeps stopped */
+        memcpy(r->q, r->fq, bytes);
+        fail_step(r, st0, tn, r->q, &rep0);
+        if (levels > 1 && st != MECHRT_OK)
+            msgf(r, "; redone in up to %ld substeps, the step from t = %.10g failed again at "
+                 "t = %.10g", levels, t, t_bad);
+        else if (levels > 1)
+            msgf(r, "; redone in up to %ld substeps, the step from t = %.10g still seemed to "
+                 "leave its assembly branch: the motion may be too fast for the step (use "
+                 "more --steps or a larger --max-substeps)", levels, t);
+    } else if (st != MECHRT_OK) {
+        fail_step(r, st, t_bad, r->q, rep);
+        msgf(r, "; or the motion is too fast for the step: the step from t = %.10g to %.10g "
+             "seemed to leave its assembly branch and was redone in up to %ld substeps; use "
+             "more --steps or a larger --max-substeps", t, tn, levels);
+    } else {
+        fail_too_fast(r, t, tn, t_bad, levels, &chk);
+    }
+    return false;
+}
+
+/* Holonomic rows only: the runtime's predictor-corrector step, checked and
+   subdivided when needed (see the top of this file). */
 static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 {
     const RunOptions *o = r->o;
     MechrtReport rep;
-    double *q0 = xmalloc((size_t)r->nq * sizeof *q0);
-    memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
+    RunStatus status = RUN_OK;
+    size_t nq = (size_t)r->nq;
+    double *q0 = xmalloc(nq * sizeof *q0);
+    double *keep = xmalloc(8 * nq * sizeof *keep);
+    r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
+    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
+    memcpy(q0, r->q, nq * sizeof *q0);
     MechrtStatus st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work,
                                   r->lwork, &rep);
     r->res->assembly_iterations = rep.iterations;
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
-        free(q0);
-        return RUN_FAILED;
+        status = RUN_FAILED;
+        goto out;
     }
     note_move(r, q0);
-    free(q0);
     put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
         double c0 = pipeline_now();
-        double hh = tn - t, qp[64], mot[64];
-        for (int j = 0; j < r->nq && j < 64; j++) {
-            qp[j] = r->q[j] + hh * r->qd[j] + 0.5 * hh * hh * r->qdd[j];
-            mot[j] = fabs(hh * r->qd[j]) + 0.5 * hh * hh * fabs(r->qdd[j]);
-        }
-        st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, t, tn - t, r->work, r->lwork,
-                         &rep);
-        if (getenv("DBGSTEP")) {
-            double cinf = 0, minf = 0, rmax = 0; int jr = -1;
-            for (int j = 0; j < r->nq && j < 64; j++) {
-                double cj = fabs(r->q[j] - qp[j]);
-                if (cj > cinf) cinf = cj;
-                if (mot[j] > minf) minf = mot[j];
-                if (cj / (mot[j] + 1e-300) > rmax) { rmax = cj / (mot[j] + 1e-300); jr = j; }
-            }
-            fprintf(stderr, "t=%.5g it=%d st=%d corr=%.3g mot=%.3g ratio=%.3g maxcomp=%.3g (%s corr %.3g mot %.3g)\n",
-                    tn, rep.iterations, st, cinf, minf, cinf / minf, rmax, jr >= 0 ? r->m->coord_names[jr] : "-",
-                    jr >= 0 ? fabs(r->q[jr] - qp[jr]) : 0, jr >= 0 ? mot[jr] : 0);
-        }
+        bool quiet;
+        StepCheck chk = {-1, 0, 0, 0};
+        st = checked_step(r, t, tn - t, &rep, &quiet, &chk);
+        bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
         r->res->step_seconds += pipeline_now() - c0;
-        r->res->newton_iterations += rep.iterations;
-        if (st != MECHRT_OK) {
-            bool newton = rep.step < 0 || st == MECHRT_EMAXITER || rep.residual > o->mechrt.tol_phi
-                          || rep.step > o->mechrt.tol_dq;
-            fail(r, st, tn, r->q, &rep, newton ? "position analysis (Newton)"
-                                               : "velocity and acceleration analysis");
-            return RUN_FAILED;
+        if (!ok) {
+            status = RUN_FAILED;
+            goto out;
         }
         r->res->steps_done++;
         t = tn;
         put_state(r, t, &rep, state, ctx);
     }
-    return RUN_OK;
+out:
+    free(q0);
+    free(keep);
+    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = NULL;
+    return status;
 }
 
 /* Velocity-level rows: integrate the positions between output times. */
@@ -485,6 +688,9 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
                          o->t0, o->t1);
     if (o->steps < 1)
         return bad_input(res, "the number of steps must be at least 1, not %d", o->steps);
+    if (o->max_substeps < 1)
+        return bad_input(res, "the number of substeps must be at least 1, not %d",
+                         o->max_substeps);
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
@@ -511,9 +717,10 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     r.nq = m->nq;
     r.nr = m->nr;
     size_t nq = (size_t)m->nq;
-    r.q = xcalloc(nq, sizeof *r.q);
-    r.qd = xcalloc(nq, sizeof *r.qd);
-    r.qdd = xcalloc(nq, sizeof *r.qdd);
+    /* one block, q | qd | qdd, so that a step's start is saved in one copy */
+    r.q = xcalloc(3 * nq, sizeof *r.q);
+    r.qd = r.q + nq;
+    r.qdd = r.q + 2 * nq;
     r.lwork = mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -524,7 +731,7 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
         notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
-    free(r.q), free(r.qd), free(r.qdd), free(r.work);
+    free(r.q), free(r.work);
     return status;
 }
 

@@ -22,6 +22,11 @@
 typedef struct RunOptions {
     double t0, t1;           /* time interval, t1 != t0 (t1 < t0 runs backwards); 0, 1 */
     int steps;               /* equal intervals, >= 1: steps + 1 states; 100 */
+    /* Holonomic stepping: an interval whose step looks as if it left its
+       assembly branch (see run.c) is redone internally in 2, 4, 8 ...
+       predictor-corrector substeps, at most this many, >= 1 (1: never
+       subdivide, such a step fails); only grid states are reported. 64 */
+    int max_substeps;
     MechrtOptions mechrt;    /* Newton tolerances and cap, pivot and condition
                                 thresholds: mechrt_default_options() */
     MechrtOdeOptions ode;    /* integrator for velocity-level rows: rk8pd, 1e-10 */
@@ -44,7 +49,9 @@ enum { RUN_MESSAGE_MAX = 1024 };
 
 typedef struct RunResult {
     RunStatus status;
-    MechrtStatus cause;          /* the runtime's status behind RUN_FAILED */
+    MechrtStatus cause;          /* the runtime's status behind RUN_FAILED;
+                                    MECHRT_ESTEP also when an interval still
+                                    looked unreliable with max_substeps substeps */
     double t_fail;               /* when RUN_FAILED: the time that failed */
     char message[RUN_MESSAGE_MAX]; /* RUN_FAILED, RUN_BAD_INPUT: "t = 0.25: ..." */
     int states;                  /* states handed to the callback */
@@ -56,6 +63,10 @@ typedef struct RunResult {
     long newton_iterations;      /* Newton iterations (velocity rows: projection
                                     iterations) */
     double step_seconds;         /* wall time inside the analysis of those steps */
+    int subdivided;              /* intervals redone in substeps */
+    long substeps;               /* predictor-corrector substeps taken in them
+                                    (every level tried; their Newton iterations
+                                    are in newton_iterations) */
     double max_cond;             /* largest condition estimate seen (0: off) */
     bool integrated;             /* positions came from the integrator */
     MechrtHostStats host;        /* integrator counters when integrated */

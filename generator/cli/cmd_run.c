@@ -41,6 +41,10 @@ static const char usage[] =
     "  --tol X          Newton: converged when max |Phi_i| <= X and the last\n"
     "                   step max |dq_j| <= X (default 1e-8)\n"
     "  --max-iter N     Newton iterations per time step (default 25)\n"
+    "  --max-substeps N a step that seems to leave its assembly branch (Newton\n"
+    "                   corrects far more than the predicted motion) is redone\n"
+    "                   in 2, 4, 8 ... substeps, at most N (default 64), and\n"
+    "                   the run fails past that; substeps are not output\n"
     "  --pivot-tol X    singular when an LU pivot <= X times the largest\n"
     "                   Jacobian entry (default 1e-12)\n"
     "  --cond-warn X    warn where the Jacobian's condition estimate exceeds X\n"
@@ -167,6 +171,9 @@ static void print_stats(const RunResult *res, const MechrtKernels *k, const doub
     } else {
         fprintf(stderr, "mechc run: stats: %.3g Newton iterations per step (%ld in all)\n",
                 n > 0 ? (double)res->newton_iterations / n : 0, res->newton_iterations);
+        if (res->subdivided > 0)
+            fprintf(stderr, "mechc run: stats: %d %s redone in substeps (%ld substeps)\n",
+                    res->subdivided, res->subdivided == 1 ? "step" : "steps", res->substeps);
     }
     double ns_all = run_time_all(k, q, qd, t, 0.05);
     fprintf(stderr, "mechc run: stats: one `all` kernel call (Phi, Phi_q, nu, gamma) takes "
@@ -242,6 +249,8 @@ int cmd_run(int argc, char **argv)
                 ro.mechrt.tol_phi = ro.mechrt.tol_dq = x;
         } else if (strcmp(opt, "--max-iter") == 0) {
             args_int(&a, opt, 1, 10000, &ro.mechrt.max_iter);
+        } else if (strcmp(opt, "--max-substeps") == 0) {
+            args_int(&a, opt, 1, 1 << 20, &ro.max_substeps);
         } else if (strcmp(opt, "--pivot-tol") == 0) {
             if (positive_option(&a, opt, &x, true))
                 ro.mechrt.pivot_tol = x;
