@@ -9,6 +9,7 @@
 
 static const char usage[] =
     "usage: mechc check FILE.mech [--samples N] [--seed S] [--tol T] [--tol-engines T]\n"
+    "                   [--fd-step H] [--fd-step2 H] [--spread-q S] [--spread-qd S]\n"
     "                   [--no-aot] [--json]\n"
     "\n"
     "Compares the generated Jacobian, nu and gamma with finite differences of Phi\n"
@@ -22,10 +23,26 @@ static const char usage[] =
     "  --seed S          seed of the random states (default 1)\n"
     "  --tol T           tolerance against finite differences (default 1e-6)\n"
     "  --tol-engines T   tolerance between engines (default 1e-10)\n"
+    "  --fd-step H       first step of the first derivatives' finite differences\n"
+    "                    (jac, nu; gamma of velocity rows), times max(1, |x|)\n"
+    "                    (default 1e-4)\n"
+    "  --fd-step2 H      step of gamma's second differences, times max(1, |q|)^(1/6)\n"
+    "                    (default 2e-3)\n"
+    "  --spread-q S      sampled q = assembled q + uniform(-S, S) (default 0.05)\n"
+    "  --spread-qd S     sampled qd = uniform(-S, S) (default 1)\n"
     "  --no-aot          do not build and compare the aot engine\n"
     "  --json            print JSON: ok, samples, worst[{what, error, row, ...}]\n"
     "\n"
-    "Errors are |value - reference| / (1 + |reference|).\n";
+    "Errors are |value - reference| / (1 + |reference|). A value that disagrees with\n"
+    "its finite difference at the default step H is not failed yet: the difference\n"
+    "is redone at H/pi, H/pi^2, ... H/pi^8, then pi H and pi^2 H, until three\n"
+    "neighbouring steps agree within tol/2, and the value is judged against that\n"
+    "settled difference (truncation error shrinks with the step, a mistake does not).\n"
+    "The \"fd step\" column is the step of the worst comparison's difference\n"
+    "(\"exact\": none was needed); \"refined\" counts the comparisons judged at\n"
+    "another step than H. A comparison that no run of steps settles is reported as\n"
+    "unsettled, with a warning: the differences cannot tell, so it neither passes\n"
+    "nor fails.\n";
 
 static const char *row_name(const Model *m, int row)
 {
@@ -35,6 +52,16 @@ static const char *row_name(const Model *m, int row)
 static bool item_ok(const CheckItem *it)
 {
     return it->error <= it->tol;
+}
+
+static bool item_fd(const CheckItem *it, const CheckReport *rep)
+{
+    return it >= rep->items && it < rep->items + CHECK_PAIR_FIRST;
+}
+
+static const char *col_name(const Model *m, int col)
+{
+    return col >= 0 && col < m->nq ? m->coord_names[col] : "-";
 }
 
 static void print_json(const Model *m, const CheckReport *rep)
@@ -73,6 +100,22 @@ static void print_json(const Model *m, const CheckReport *rep)
         json_number(stdout, it->reference);
         printf(", \"t\": ");
         json_number(stdout, it->t);
+        if (item_fd(it, rep)) {
+            printf(", \"step\": ");
+            if (it->step > 0.0)
+                json_number(stdout, it->step);
+            else
+                printf("null");
+            printf(", \"refined\": %d, \"unsettled\": %d", it->refined, it->unsettled);
+            if (it->unsettled > 0) {
+                printf(", \"unsettled_row\": ");
+                json_string(stdout, row_name(m, it->unsettled_row));
+                if (it->unsettled_col >= 0) {
+                    printf(", \"unsettled_col\": ");
+                    json_string(stdout, col_name(m, it->unsettled_col));
+                }
+            }
+        }
         if (it->hint[0]) {
             printf(", \"hint\": ");
             json_string(stdout, it->hint);
@@ -106,17 +149,32 @@ static void print_text(const Model *m, const CheckReport *rep)
         if (it->col >= 0 && (int)strlen(m->coord_names[it->col]) > cw)
             cw = (int)strlen(m->coord_names[it->col]);
     }
-    printf("     %-17s  %11s  %9s  %-*s  %-*s  %s\n", "what", "worst error", "tolerance", rw, "row",
-           cw, "col", "t");
+    printf("     %-17s  %11s  %9s  %-*s  %-*s  %-10s  %s\n", "what", "worst error", "tolerance", rw, "row",
+           cw, "col", "t", "fd step");
     for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
         const CheckItem *it = &rep->items[w];
         if (!it->checked)
             continue;
         if (w == CHECK_PAIR_FIRST)
             printf("\n");
-        printf("%-4s %-17s  %11.3g  %9.3g  %-*s  %-*s  %.6g\n", item_ok(it) ? "ok" : "FAIL", it->what,
-               it->error, it->tol, rw, row_name(m, it->row), cw,
-               it->col >= 0 ? m->coord_names[it->col] : "-", it->t);
+        char step[40] = "";
+        if (item_fd(it, rep)) {
+            if (it->step > 0.0)
+                snprintf(step, sizeof step, "%.3g", it->step);
+            else
+                snprintf(step, sizeof step, "exact");
+        }
+        printf("%-4s %-17s  %11.3g  %9.3g  %-*s  %-*s  %-*.6g%s%s\n", item_ok(it) ? "ok" : "FAIL", it->what,
+               it->error, it->tol, rw, row_name(m, it->row), cw, col_name(m, it->col), step[0] ? 10 : 0, it->t,
+               step[0] ? "  " : "", step);
+        if (item_fd(it, rep) && it->refined > 0)
+            printf("       refined: %d comparison%s judged at another step than the default (a fast-varying row)\n",
+                   it->refined, it->refined == 1 ? "" : "s");
+        if (item_fd(it, rep) && it->unsettled > 0)
+            printf("       unsettled: %d comparison%s not judged, the finite differences agreeing at no run of\n"
+                   "       steps (first at row %s%s%s); try other --fd-step/--fd-step2\n",
+                   it->unsettled, it->unsettled == 1 ? "" : "s", row_name(m, it->unsettled_row),
+                   it->unsettled_col >= 0 ? ", column " : "", it->unsettled_col >= 0 ? col_name(m, it->unsettled_col) : "");
         if (!item_ok(it)) {
             printf("       value %.17g, reference %.17g\n", it->value, it->reference);
             if (it->hint[0])
@@ -160,6 +218,30 @@ int cmd_check(int argc, char **argv)
                     opt.tol_engines = v;
                 }
             }
+        } else if (strcmp(o, "--fd-step") == 0 || strcmp(o, "--fd-step2") == 0) {
+            double v;
+            if (args_double(&a, o, &v)) {
+                if (!(v > 0.0 && v <= 1.0)) {
+                    fprintf(stderr, "mechc check: error: %s needs a number in (0, 1]\n", o);
+                    a.failed = true;
+                } else if (strcmp(o, "--fd-step") == 0) {
+                    opt.fd_step = v;
+                } else {
+                    opt.fd_step2 = v;
+                }
+            }
+        } else if (strcmp(o, "--spread-q") == 0 || strcmp(o, "--spread-qd") == 0) {
+            double v;
+            if (args_double(&a, o, &v)) {
+                if (v < 0.0) {
+                    fprintf(stderr, "mechc check: error: %s needs a number >= 0\n", o);
+                    a.failed = true;
+                } else if (strcmp(o, "--spread-q") == 0) {
+                    opt.spread_q = v;
+                } else {
+                    opt.spread_qd = v;
+                }
+            }
         } else if (strcmp(o, "--no-aot") == 0) {
             opt.use_aot = false;
         } else if (strcmp(o, "--json") == 0) {
@@ -189,11 +271,20 @@ int cmd_check(int argc, char **argv)
                 if (it->checked && !item_ok(it)) {
                     fprintf(stderr, "%s: error: %s of row %s%s%s is off by %.3g (tolerance %.3g) at t = %.17g%s%s\n",
                             a.file, it->what, row_name(mech->model, it->row),
-                            it->col >= 0 ? ", column " : "", it->col >= 0 ? mech->model->coord_names[it->col] : "",
+                            it->col >= 0 ? ", column " : "", it->col >= 0 ? col_name(mech->model, it->col) : "",
                             it->error, it->tol, it->t, it->hint[0] ? ": " : "", it->hint);
                     break;
                 }
             }
+        }
+        for (int w = 0; w < CHECK_PAIR_FIRST; w++) {
+            const CheckItem *it = &rep.items[w];
+            if (it->unsettled > 0)
+                fprintf(stderr, "%s: warning: %d %s comparison%s unsettled (first at row %s%s%s): the finite "
+                        "differences agree at no run of steps; not judged\n", a.file, it->unsettled, it->what,
+                        it->unsettled == 1 ? "" : "s", row_name(mech->model, it->unsettled_row),
+                        it->unsettled_col >= 0 ? ", column " : "",
+                        it->unsettled_col >= 0 ? col_name(mech->model, it->unsettled_col) : "");
         }
     }
     pipeline_free(mech);

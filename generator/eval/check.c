@@ -16,9 +16,31 @@
  *           velocity rows: -d/dtau Psi(q + qd tau, qd, t + tau) at 0;
  *
  * and every pair of engines (jit, generic, aot) on phi, jac, nu, gamma.
- * Errors are |value - reference| / (1 + |reference|). Where the worst
- * error passes its tolerance, the two numbers are examined for the
- * classic textbook slips: a ratio of -1 or 2, a missing term, and for
+ * Errors are |value - reference| / (1 + |reference|).
+ *
+ * A finite difference is only as good as its step: a row that varies fast
+ * (sin(100 x)) leaves a truncation error at the default step that a fixed
+ * tolerance takes for a mistake, and a small step drowns in rounding. So a
+ * comparison above tolerance is not judged at the default step h alone
+ * (compare_fd): the difference is redone at h/r, h/r^2, ... h/r^8 (r = pi),
+ * then r h and r^2 h, until three neighbouring steps agree within tol/2
+ * (pairwise), and the value is judged against the middle one, whose step
+ * is reported. Truncation error shrinks by r^4 (about 100) a step (both
+ * differences are O(h^4)) and rounding error grows by r (first) or r^2
+ * (second difference), so in three agreeing steps the middle one is clear
+ * of both (its truncation below a hundredth of the first pair's spread,
+ * its rounding a third or less of the second pair's) and a correct value
+ * passes (two noisy steps alone could agree by chance), and r being
+ * irrational, agreeing steps are not an aliasing artefact (see FD_STEPS).
+ * So a correct value passes however fast its row varies, as long as some
+ * run of steps resolves it, while a mistake stays put at every step and
+ * still fails, its diagnosis taken at the settled step. Which steps settle
+ * depends only on the finite differences, never on the value under test.
+ * When no run of steps agrees, the differences cannot tell: the comparison
+ * is counted as unsettled, neither passed nor failed, and reported.
+ *
+ * Where the worst error passes its tolerance, the two numbers are examined
+ * for the classic textbook slips: a ratio of -1 or 2, a missing term, and for
  * gamma a decomposition of the finite difference into its -(Phi_q qd)_q qd,
  * -2 Phi_qt qd and -Phi_tt parts to name the one that was dropped.
  */
@@ -26,6 +48,7 @@
 
 #include "../../runtime/mechrt.h"
 #include "../base/arena.h"
+#include "../base/rng.h"
 #include "aot.h"
 #include "generic.h"
 
@@ -45,7 +68,24 @@ CheckOptions check_default_options(void)
     };
 }
 
-enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT, PAIR_COUNT = 3, FD_CACHE = 8 };
+enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT, PAIR_COUNT = 3 };
+
+/* The ladder of finite-difference steps: index i is the step
+   h * pi^(FD_COARSE - i), the default h at FD_COARSE, pi^2 h first, h/pi^8
+   last. The ratio is irrational so that no step is a whole multiple of
+   another: a row oscillating a whole number of times over one step (which
+   the difference cannot see) does not do so over the next ones, and
+   differences that agree across steps are not an aliasing artefact. With
+   a ratio of 4, sin(10^4 x) at a qd that fits 10 periods in the default
+   step settled, wrongly, at 16h, 4h and h. */
+enum { FD_COARSE = 2, FD_FINE = 8, FD_STEPS = FD_COARSE + 1 + FD_FINE };
+#define FD_RATIO 3.14159265358979323846
+/* Neighbouring steps settle when they agree within this part of the tolerance. */
+#define FD_SETTLE 0.5
+/* Points cached per function of one variable: the four of gsl_deriv_central
+   at each step of the ladder, shared by the rows of one column, and room
+   for its adaptive ones. */
+enum { FD_CACHE = 4 * FD_STEPS + 8 };
 
 static const char *const fd_names[3] = {"jac", "nu", "gamma"};
 static const char *const pair_names[PAIR_COUNT * QTY_COUNT] = {
@@ -72,6 +112,8 @@ typedef struct Checker {
     double *gamma0;                             /* fault hook scratch */
     double *save_q[3], *save_qd[3];             /* state of each FD item's worst */
     double *d2[5];                              /* second-difference points */
+    double *ladder[FD_STEPS];                   /* gamma's second differences at each step */
+    bool ladder_have[FD_STEPS];
 } Checker;
 
 /* ---- the engine under test, with the optional planted fault ---- */
@@ -124,7 +166,8 @@ static double rel_error(double value, double ref)
     return fabs(value - ref) / (1.0 + fabs(ref));
 }
 
-static void record(Checker *c, int what, int row, int col, double value, double ref)
+/* step: of the reference's finite difference (0: exact, or an engine). */
+static void record(Checker *c, int what, int row, int col, double value, double ref, double step)
 {
     CheckItem *it = &c->rep->items[what];
     double err = rel_error(value, ref);
@@ -138,6 +181,7 @@ static void record(Checker *c, int what, int row, int col, double value, double 
     it->reference = ref;
     it->sample = c->sample;
     it->t = c->t;
+    it->step = step;
     if (what < CHECK_PAIR_FIRST) {
         memcpy(c->save_q[what], c->q, (size_t)c->nq * sizeof *c->q);
         memcpy(c->save_qd[what], c->qd, (size_t)c->nq * sizeof *c->qd);
@@ -246,9 +290,106 @@ static void fd_second(VecFn *f, int n, double h, double *out)
 
 static double second_step(const Checker *c);
 
+/* One finite difference a value is compared with, as a function of the
+   step: sign times a component of gsl_deriv_central at x0 (step relative,
+   times scale = max(1, |x0|)), or of the second difference along a path
+   at 0 (absolute step; every component computed at once, kept per ladder
+   step so that the rows share them). */
+typedef struct FdProbe {
+    VecFn *f;
+    int comp;
+    double sign;
+    bool second;
+    double x0, scale;
+    int n;
+    Checker *c;
+} FdProbe;
+
+static double ladder_step(double h, int i)
+{
+    return h * pow(FD_RATIO, FD_COARSE - i);
+}
+
+static double probe_at(FdProbe *p, int i, double h)
+{
+    double step = ladder_step(h, i);
+    if (!p->second)
+        return p->sign * fd_first(p->f, p->comp, p->x0, step);
+    Checker *c = p->c;
+    if (!c->ladder_have[i]) {
+        fd_second(p->f, p->n, step, c->ladder[i]);
+        c->ladder_have[i] = true;
+    }
+    return p->sign * c->ladder[i][p->comp];
+}
+
+/* Judges value against the finite difference d0 taken at the default step
+   h; when they disagree, against the first run of three neighbouring steps
+   whose differences settle (see the top of the file). */
+static void compare_fd(Checker *c, int what, int row, int col, double value, double d0, FdProbe *p, double h)
+{
+    double tol = c->opt->tol;
+    if (rel_error(value, d0) <= tol) {
+        record(c, what, row, col, value, d0, h * p->scale);
+        return;
+    }
+    double d[FD_STEPS];
+    bool have[FD_STEPS] = {false};
+    d[FD_COARSE] = d0;
+    have[FD_COARSE] = true;
+    int bottom = FD_STEPS - 1, settled = -1;
+    /* the runs (i, i + 1, i + 2), with r = pi: (h, h/r, h/r^2), (h/r, h/r^2,
+       h/r^3), ..., then (r h, h, h/r), (r^2 h, r h, h) */
+    for (int k = 0; k < FD_STEPS - 2 && settled < 0; k++) {
+        int i = k < FD_FINE - 1 ? FD_COARSE + k : FD_COARSE - 1 - (k - (FD_FINE - 1));
+        bool agree = true;
+        for (int j = i; j <= i + 2 && agree; j++) {
+            if (j > bottom) {
+                agree = false;
+                break;
+            }
+            if (!have[j]) {
+                d[j] = probe_at(p, j, h);
+                have[j] = true;
+            }
+            if (j > FD_COARSE && d[j] == 0.0 && d[j - 1] != 0.0) {
+                bottom = j - 1;     /* the step is below what the row resolves */
+                agree = false;
+            } else if (j > i) {
+                agree = rel_error(d[j - 1], d[j]) <= FD_SETTLE * tol;
+            }
+        }
+        if (agree)
+            settled = i;
+    }
+    CheckItem *it = &c->rep->items[what];
+    if (settled < 0) {
+        /* no run of steps agrees: the differences cannot tell */
+        if (it->unsettled++ == 0) {
+            it->unsettled_row = row;
+            it->unsettled_col = col;
+        }
+        it->checked = true;
+        return;
+    }
+    /* the reference: the default's difference when the run confirms it, else the run's middle */
+    int r = settled <= FD_COARSE && FD_COARSE <= settled + 2 ? FD_COARSE : settled + 1;
+    if (r != FD_COARSE)
+        it->refined++;
+    record(c, what, row, col, value, d[r], ladder_step(h, r) * p->scale);
+}
+
+/* value against sign * d f_comp/dx at x0. */
+static void compare_first(Checker *c, int what, int row, int col, double value, VecFn *f, int comp,
+                          double x0, double sign)
+{
+    double h = c->opt->fd_step;
+    FdProbe p = {.f = f, .comp = comp, .sign = sign, .x0 = x0, .scale = fmax(1.0, fabs(x0)), .c = c};
+    compare_fd(c, what, row, col, value, sign * fd_first(f, comp, x0, h), &p, h);
+}
+
 static void check_fd(Checker *c, double *scratch, double *vec)
 {
-    const CheckOptions *o = c->opt;
     double **u = c->out[ENGINE_JIT];
     int nq = c->nq, nh = c->nh, nv = c->nv;
     VecFn f;
@@ -257,38 +398,44 @@ static void check_fd(Checker *c, double *scratch, double *vec)
         if (nh > 0) {
             vecfn_init(&f, c, FD_PHI_Q, j, false, false, scratch);
             for (int i = 0; i < nh; i++)
-                record(c, CHECK_JAC_FD, i, j, u[QTY_JAC][(size_t)i * nq + j], fd_first(&f, i, c->q[j], o->fd_step));
+                compare_first(c, CHECK_JAC_FD, i, j, u[QTY_JAC][(size_t)i * nq + j], &f, i, c->q[j], 1.0);
         }
         if (nv > 0) {
             vecfn_init(&f, c, FD_PSI_QD, j, false, false, scratch);
             for (int i = 0; i < nv; i++)
-                record(c, CHECK_JAC_FD, nh + i, j, u[QTY_JAC][(size_t)(nh + i) * nq + j],
-                       fd_first(&f, i, c->qd[j], o->fd_step));
+                compare_first(c, CHECK_JAC_FD, nh + i, j, u[QTY_JAC][(size_t)(nh + i) * nq + j], &f, i,
+                              c->qd[j], 1.0);
         }
     }
     /* nu */
     if (nh > 0) {
         vecfn_init(&f, c, FD_PHI_PATH, -1, false, true, scratch);
         for (int i = 0; i < nh; i++)
-            record(c, CHECK_NU_FD, i, -1, u[QTY_NU][i], -fd_first(&f, i, 0.0, o->fd_step));
+            compare_first(c, CHECK_NU_FD, i, -1, u[QTY_NU][i], &f, i, 0.0, -1.0);
     }
     if (nv > 0) {
         memset(c->qdw, 0, (size_t)nq * sizeof *c->qdw);
         generic_psi(c->eng[ENGINE_GENERIC].generic, c->q, c->qdw, c->t, vec);
         for (int i = 0; i < nv; i++)
-            record(c, CHECK_NU_FD, nh + i, -1, u[QTY_NU][nh + i], -vec[i]);
+            record(c, CHECK_NU_FD, nh + i, -1, u[QTY_NU][nh + i], -vec[i], 0.0);
     }
     /* gamma */
     if (nh > 0) {
         vecfn_init(&f, c, FD_PHI_PATH, -1, true, true, scratch);
-        fd_second(&f, nh, second_step(c), vec);
-        for (int i = 0; i < nh; i++)
-            record(c, CHECK_GAMMA_FD, i, -1, u[QTY_GAMMA][i], -vec[i]);
+        double h = second_step(c);
+        memset(c->ladder_have, 0, sizeof c->ladder_have);
+        fd_second(&f, nh, h, c->ladder[FD_COARSE]);
+        c->ladder_have[FD_COARSE] = true;
+        FdProbe p = {.f = &f, .sign = -1.0, .second = true, .scale = 1.0, .n = nh, .c = c};
+        for (int i = 0; i < nh; i++) {
+            p.comp = i;
+            compare_fd(c, CHECK_GAMMA_FD, i, -1, u[QTY_GAMMA][i], -c->ladder[FD_COARSE][i], &p, h);
+        }
     }
     if (nv > 0) {
         vecfn_init(&f, c, FD_PSI_PATH, -1, true, true, scratch);
         for (int i = 0; i < nv; i++)
-            record(c, CHECK_GAMMA_FD, nh + i, -1, u[QTY_GAMMA][nh + i], -fd_first(&f, i, 0.0, o->fd_step));
+            compare_first(c, CHECK_GAMMA_FD, nh + i, -1, u[QTY_GAMMA][nh + i], &f, i, 0.0, -1.0);
     }
 }
 
@@ -312,7 +459,7 @@ static void compare_pair(Checker *c, int pair)
         int n = qty == QTY_PHI ? c->nh : qty == QTY_JAC ? c->nr * nq : c->nr;
         for (int i = 0; i < n; i++) {
             int row = qty == QTY_JAC ? i / nq : i, col = qty == QTY_JAC ? i % nq : -1;
-            record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i]);
+            record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i], 0.0);
         }
         if (n == 0)
             c->rep->items[what].checked = true;
@@ -407,17 +554,19 @@ static double second_step(const Checker *c)
 }
 
 /* -(d/dtau)^2 of one position row (or -d/dtau of one velocity row) along
-   the path with only q moving, or only t. */
-static double gamma_part(Checker *c, int row, bool path_q, bool path_t, double *scratch, double *vec)
+   the path with only q moving, or only t, at the step of the reference
+   (absolute; both paths are at tau = 0, so no scale applies). */
+static double gamma_part(Checker *c, int row, bool path_q, bool path_t, double step, double *scratch,
+                         double *vec)
 {
     VecFn f;
     if (row < c->nh) {
         vecfn_init(&f, c, FD_PHI_PATH, -1, path_q, path_t, scratch);
-        fd_second(&f, c->nh, second_step(c), vec);
+        fd_second(&f, c->nh, step > 0.0 ? step : second_step(c), vec);
         return -vec[row];
     }
     vecfn_init(&f, c, FD_PSI_PATH, -1, path_q, path_t, scratch);
-    return -fd_first(&f, row - c->nh, 0.0, c->opt->fd_step);
+    return -fd_first(&f, row - c->nh, 0.0, step > 0.0 ? step : c->opt->fd_step);
 }
 
 static void hint_gamma(Checker *c, CheckItem *it, double *scratch, double *vec)
@@ -427,8 +576,8 @@ static void hint_gamma(Checker *c, CheckItem *it, double *scratch, double *vec)
     memcpy(c->q, c->save_q[CHECK_GAMMA_FD], (size_t)c->nq * sizeof *c->q);
     memcpy(c->qd, c->save_qd[CHECK_GAMMA_FD], (size_t)c->nq * sizeof *c->qd);
     c->t = it->t;
-    double gq = gamma_part(c, it->row, true, false, scratch, vec);   /* -(Phi_q qd)_q qd */
-    double gt = gamma_part(c, it->row, false, true, scratch, vec);   /* -Phi_tt */
+    double gq = gamma_part(c, it->row, true, false, it->step, scratch, vec);   /* -(Phi_q qd)_q qd */
+    double gt = gamma_part(c, it->row, false, true, it->step, scratch, vec);   /* -Phi_tt */
     double gx = r - gq - gt;                                         /* -2 Phi_qt qd */
     bool velocity = it->row >= c->nh;
     struct { double value; const char *text; } cand[] = {
@@ -503,14 +652,10 @@ static bool assemble(Checker *c, double *q)
     return st == MECHRT_OK;
 }
 
-/* splitmix64: a small, fully determined generator. */
+/* Uniform in [lo, hi) from the shared deterministic generator. */
 static double uniform(uint64_t *s, double lo, double hi)
 {
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
+    return lo + (hi - lo) * rng_unit(s);
 }
 
 bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep, Diag *diag)
@@ -527,6 +672,7 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
         it->what = w < CHECK_PAIR_FIRST ? fd_names[w] : pair_names[w - CHECK_PAIR_FIRST];
         it->tol = w < CHECK_PAIR_FIRST ? opt->tol : opt->tol_engines;
         it->row = it->col = -1;
+        it->unsettled_row = it->unsettled_col = -1;
     }
 
     bool ok = true;
@@ -548,7 +694,7 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
     double *mem = NULL;
     if (ok) {
         size_t total = ENGINE_KIND_COUNT * (2 * nr + nr * nq + nvec) + 12 * nq + nr + 6 * nvec
-                       + FD_CACHE * nvec + 2 * nq;
+                       + FD_STEPS * nvec + FD_CACHE * nvec + 2 * nq;
         mem = xcalloc(total, sizeof *mem);
         double *p = mem;
         for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
@@ -570,6 +716,8 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
         c.gamma0 = p, p += nr;
         for (int k = 0; k < 5; k++)
             c.d2[k] = p, p += nvec;
+        for (int k = 0; k < FD_STEPS; k++)
+            c.ladder[k] = p, p += nvec;
         double *vec = p;
         p += nvec;
         double *scratch = p;

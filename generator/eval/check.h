@@ -30,7 +30,12 @@ typedef struct CheckOptions {
     double tol_engines;     /* between engines (default 1e-10) */
     double spread_q;        /* q = q_assembled + U(-s, s), coordinate units (default 0.05) */
     double spread_qd;       /* qd = U(-s, s) (default 1) */
-    double fd_step;         /* first step of gsl_deriv_central (default 1e-4) */
+    /* The finite differences start at these steps. A comparison above
+       tolerance is not judged at the default step alone: the difference is
+       redone at h/pi, h/pi^2, ... (then pi h, pi^2 h) until three
+       neighbouring steps agree, and the value is judged against that
+       settled difference; see check.c. */
+    double fd_step;         /* first step of gsl_deriv_central, times max(1, |x|) (default 1e-4) */
     double fd_step2;        /* step of the second difference for gamma, times
                                max(1, |q|)^(1/6) (default 2e-3) */
     bool use_aot;           /* compare the aot engine too when a compiler exists (default true) */
@@ -56,6 +61,15 @@ typedef struct CheckItem {
     double value, reference;/* the two numbers at the worst place */
     int sample;
     double t;               /* time of the worst sample */
+    /* finite-difference items only */
+    double step;            /* the step of the worst comparison's finite difference
+                               (absolute; 0: the reference is exact, no difference) */
+    int refined;            /* comparisons judged at another step than the default,
+                               because the default disagreed (a fast-varying row) */
+    int unsettled;          /* comparisons the finite differences could not settle (no
+                               three neighbouring steps agreed): neither passed nor
+                               failed, as the differences cannot tell */
+    int unsettled_row, unsettled_col; /* the first of them */
     char hint[240];         /* when above tolerance: what mistake it looks like */
 } CheckItem;
 
