@@ -29,7 +29,7 @@ HOST_SRC  := $(wildcard runtime/host/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
 TMPL      := $(wildcard templates/*.tmpl)
 
-GEN_OBJ   := $(GEN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/gen/templates.o
+GEN_OBJ   := $(GEN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/gen/templates.o $(BUILD)/gen/sincos.o
 RT_OBJ    := $(RT_SRC:%.c=$(BUILD)/%.o)
 HOST_OBJ  := $(HOST_SRC:%.c=$(BUILD)/%.o)
 LIB       := $(BUILD)/libmechc.a
@@ -73,6 +73,17 @@ $(BUILD)/gen/templates.c: $(TMPL) Makefile
 	  done; } > $@
 
 $(BUILD)/gen/templates.o: $(BUILD)/gen/templates.c
+	$(Q)$(CC) $(CFLAGS_TOOL) -I. -c $< -o $@
+
+# The generated code's sincos, built into the tool too (the JIT calls it and
+# the generic evaluator uses it): one source, templates/sincos.tmpl.
+$(BUILD)/gen/sincos.c: templates/sincos.tmpl Makefile
+	@mkdir -p $(dir $@)
+	$(Q){ echo '/* Generated from templates/sincos.tmpl by the Makefile. Do not edit. */'; \
+	  echo '#include "generator/base/sincos.h"'; echo '#include <math.h>'; \
+	  sed -e 's/@P@/mechc/g' -e 's/@STATIC@//g' templates/sincos.tmpl; } > $@
+
+$(BUILD)/gen/sincos.o: $(BUILD)/gen/sincos.c
 	$(Q)$(CC) $(CFLAGS_TOOL) -I. -c $< -o $@
 
 $(LIB): $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)

@@ -206,9 +206,19 @@ run gen "$ex/all_statements.mech" -o "$tmp/af.c" --real float
 check "gen --real float exits 0" status_is 0
 check "gen --real float uses float" grep -q 'typedef float all_statements_real;' "$tmp/af.c"
 
+check "gen: sin and cos through the file's own sincos" grep -q 'sc_sincos(q\[2\], &' "$tmp/sc.c"
+run gen "$ex/slider_crank.mech" -o "$tmp/sl.c" --prefix sl --trig libm
+check "gen --trig libm exits 0" status_is 0
+check "gen --trig libm: no sincos of its own" sh -c '! grep -q sincos "$1"' _ "$tmp/sl.c"
+check "gen --trig libm: sin of <math.h>" grep -q '= sin(q\[2\]);' "$tmp/sl.c"
+run gen "$ex/slider_crank.mech" --trig fast
+check "gen --trig fast exits 2" status_is 2
+check "gen --trig fast names the choices" err_has "own or libm"
+
 if have gcc; then
     cflags="-std=c99 -Wall -Wextra -Wpedantic -Werror"
     check "gcc compiles gen -o output" gcc $cflags -c "$tmp/fb.c" -o "$tmp/fb.o"
+    check "gcc compiles gen --trig libm output" gcc $cflags -c "$tmp/sl.c" -o "$tmp/sl.o"
     check "gcc compiles gen --header output" gcc $cflags -I"$tmp" -c "$tmp/sc.c" -o "$tmp/sc.o"
     check "gcc compiles gen --real float output" \
         gcc $cflags -Wconversion -Wdouble-promotion -c "$tmp/af.c" -o "$tmp/af.o"

@@ -11,6 +11,7 @@
 
 #include "../generator/base/diag.h"
 #include "../generator/base/limits.h"
+#include "../generator/base/sincos.h"
 #include "../generator/emit/emit.h"
 #include "../generator/pipeline/pipeline.h"
 
@@ -461,7 +462,7 @@ static const char driver_c[] =
     "    return 0;\n"
     "}\n";
 
-static void compare_with_jit(const char *stem, bool real_float, int chunk)
+static void compare_with_jit(const char *stem, bool real_float, int chunk, bool libm_trig)
 {
     char path[600];
     snprintf(path, sizeof path, "%s/examples/%s.mech", root, stem);
@@ -475,6 +476,7 @@ static void compare_with_jit(const char *stem, bool real_float, int chunk)
     opt.real_float = real_float;
     opt.header_name = "fb.h";
     opt.chunk_nodes = chunk;
+    opt.libm_trig = libm_trig;
     EmitResult res;
     Diag ed;
     diag_init(&ed, "emit", NULL, 0);
@@ -546,12 +548,105 @@ static void test_gcc_build_matches_jit(void **state)
 {
     (void)state;
     need_gcc();
-    compare_with_jit("four_bar", false, 0);
-    compare_with_jit("four_bar", false, 8);         /* split into many parts */
-    compare_with_jit("four_bar", true, 0);
-    compare_with_jit("all_statements", false, 0);
-    compare_with_jit("skate_velocity", false, 0);
-    compare_with_jit("all_statements", true, 30);
+    compare_with_jit("four_bar", false, 0, false);
+    compare_with_jit("four_bar", false, 8, false);  /* split into many parts */
+    compare_with_jit("four_bar", true, 0, false);
+    compare_with_jit("four_bar", false, 0, true);   /* libm's sin and cos */
+    compare_with_jit("all_statements", false, 0, false);
+    compare_with_jit("skate_velocity", false, 0, false);
+    compare_with_jit("all_statements", true, 30, false);
+}
+
+/* ---- trigonometry: the file's own sincos, or libm's ---- */
+
+static void test_trig_choices(void **state)
+{
+    (void)state;
+    Diag diag;
+    char path[600];
+    snprintf(path, sizeof path, "%s/examples/four_bar.mech", root);
+    Mech *mech = load_path(path, &diag);
+    EmitResult res = emit(mech, "fb", false, NULL);
+    assert_non_null(strstr(res.c_text, "static const double fb_sincos_table[128]"));
+    assert_non_null(strstr(res.c_text, "static void fb_sincos(double x, double *s, double *c)"));
+    assert_non_null(strstr(res.c_text, "fb_sincos(q[2], &"));
+    assert_null(strstr(res.c_text, " sin(q"));
+    emit_result_free(&res);
+
+    EmitOptions opt = emit_default_options();
+    opt.prefix = "fb";
+    opt.libm_trig = true;
+    Diag ed;
+    diag_init(&ed, "emit", NULL, 0);
+    assert_true(emit_mechanism(&mech->kin, &opt, &res, &ed));
+    assert_null(strstr(res.c_text, "sincos"));
+    assert_non_null(strstr(res.c_text, "= sin(q[2])"));
+    assert_non_null(strstr(res.c_text, "= cos(q[2])"));
+    emit_result_free(&res);
+
+    res = emit(mech, "fb", true, NULL);      /* float: the C library's sinf, cosf */
+    assert_null(strstr(res.c_text, "sincos"));
+    assert_non_null(strstr(res.c_text, "sinf(q[2])"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+
+    /* no angle, no helper (an unused static function would not build with -Werror) */
+    mech = load_text("point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\ndriver d: m.y = t\n", &diag);
+    res = emit(mech, "pl", false, NULL);
+    assert_null(strstr(res.c_text, "sincos"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+}
+
+/* Error of v against the long double reference, in units in the last place
+   of the double nearest the reference. */
+static double ulps(double v, long double ref)
+{
+    double r = fabs((double)ref);
+    return (double)fabsl((long double)v - ref) / (nextafter(r, INFINITY) - r);
+}
+
+static void test_sincos_accuracy(void **state)
+{
+    (void)state;
+    static const double ranges[] = {1e-6, 0.8, 4, 100, 65536};
+    uint64_t rng = 12345;
+    for (size_t i = 0; i < sizeof ranges / sizeof *ranges; i++) {
+        double worst = 0, at = 0;
+        for (int n = 0; n < 200000; n++) {
+            rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+            double x = ((double)(rng >> 11) * 0x1.0p-53 * 2 - 1) * ranges[i];
+            double s, c;
+            mechc_sincos(x, &s, &c);
+            double e = fmax(ulps(s, sinl(x)), ulps(c, cosl(x)));
+            if (e > worst)
+                worst = e, at = x;
+        }
+        if (!(worst <= 2.5))
+            fail_msg("|x| <= %g: %.2f ulp at x = %.17g", ranges[i], worst, at);
+    }
+    /* the exact points of the table and of the reduction */
+    double s, c;
+    mechc_sincos(0.0, &s, &c);
+    assert_true(s == 0.0 && c == 1.0);
+    /* next to a zero of sin or cos the error is absolute, about 1e-26 (the
+       rounding of k times the second part of pi/32) */
+    mechc_sincos(M_PI / 2, &s, &c);
+    assert_true(s == 1.0 && fabsl(c - cosl(M_PI / 2)) <= 1e-25L);
+    mechc_sincos(M_PI, &s, &c);
+    assert_true(c == -1.0 && fabsl(s - sinl(M_PI)) <= 1e-25L);
+    mechc_sincos(-1000 * M_PI, &s, &c);
+    assert_true(c == 1.0 && fabsl(s - sinl(-1000 * M_PI)) <= 1e-22L);
+    /* past 2^16 rad, and what is not a number, the C library answers */
+    static const double far[] = {65537.0, -1e5, 1e6, 1e300};
+    for (size_t i = 0; i < sizeof far / sizeof *far; i++) {
+        mechc_sincos(far[i], &s, &c);
+        assert_true(s == sin(far[i]) && c == cos(far[i]));
+    }
+    mechc_sincos(NAN, &s, &c);
+    assert_true(isnan(s) && isnan(c));
+    mechc_sincos(INFINITY, &s, &c);
+    assert_true(isnan(s) && isnan(c));
 }
 
 int main(void)
@@ -565,6 +660,8 @@ int main(void)
         cmocka_unit_test(test_examples_compile),
         cmocka_unit_test(test_chain_compiles),
         cmocka_unit_test(test_gcc_build_matches_jit),
+        cmocka_unit_test(test_trig_choices),
+        cmocka_unit_test(test_sincos_accuracy),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

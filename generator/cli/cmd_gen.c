@@ -10,7 +10,7 @@
 
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
-    "                 [--real double|float] [--chunk N] [--stats]\n"
+    "                 [--real double|float] [--trig own|libm] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
@@ -20,6 +20,11 @@ static const char usage[] =
     "  --prefix NAME     symbol prefix (default: the mechanism name); macros use\n"
     "                    its upper case\n"
     "  --real TYPE       double (default) or float (float literals, sinf, ...)\n"
+    "  --trig own|libm   double kernels: sin and cos of each angle in one call of\n"
+    "                    the file's own PREFIX_sincos (own, the default; a table\n"
+    "                    and short series, within 2.5 ulp, libm past 2^16 rad)\n"
+    "                    or sin and cos of <math.h> as written (libm); float\n"
+    "                    kernels always call sinf and cosf\n"
     "  --chunk N         most operations per C function before it is split into\n"
     "                    static parts, counting operations and stores (default 150;\n"
     "                    keeps optimizing compilers fast)\n"
@@ -74,6 +79,7 @@ int cmd_gen(int argc, char **argv)
     args_init(&a, "gen", argc, argv);
     const char *out_path = NULL, *header_path = NULL, *opt_name;
     bool stats = false, dump = false;
+    char buf[256];
     EmitOptions opt = emit_default_options();
     MechLimits limits = mech_default_limits();
     while (!a.failed && (opt_name = args_next(&a))) {
@@ -94,7 +100,17 @@ int cmd_gen(int argc, char **argv)
             if (v && strcmp(v, "float") == 0)
                 opt.real_float = true;
             else if (v && strcmp(v, "double") != 0) {
-                fprintf(stderr, "mechc gen: error: --real takes double or float, not '%s'\n", v);
+                fprintf(stderr, "mechc gen: error: --real takes double or float, not '%s'\n",
+                        shown(v, buf, sizeof buf));
+                a.failed = true;
+            }
+        } else if (strcmp(opt_name, "--trig") == 0) {
+            const char *v = args_value(&a, opt_name);
+            if (v && strcmp(v, "libm") == 0)
+                opt.libm_trig = true;
+            else if (v && strcmp(v, "own") != 0) {
+                fprintf(stderr, "mechc gen: error: --trig takes own or libm, not '%s'\n",
+                        shown(v, buf, sizeof buf));
                 a.failed = true;
             }
         } else if (strcmp(opt_name, "--chunk") == 0) {
@@ -102,7 +118,8 @@ int cmd_gen(int argc, char **argv)
         } else if (strcmp(opt_name, "--dump") == 0) {
             const char *v = args_value(&a, opt_name);
             if (v && strcmp(v, "rows") != 0) {
-                fprintf(stderr, "mechc gen: error: --dump takes 'rows', not '%s'\n", v);
+                fprintf(stderr, "mechc gen: error: --dump takes 'rows', not '%s'\n",
+                        shown(v, buf, sizeof buf));
                 a.failed = true;
             }
             dump = true;
@@ -114,7 +131,6 @@ int cmd_gen(int argc, char **argv)
     }
     /* Names that reach the C text are checked before any work. */
     const char *why;
-    char buf[256];
     if (opt.prefix && (why = emit_check_prefix(opt.prefix))) {
         fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n",
                 shown(opt.prefix, buf, sizeof buf), why);

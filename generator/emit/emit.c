@@ -138,6 +138,8 @@ typedef struct Emitter {
     const char *prefix;
     const char *prefix_upper;
     Scheduler sched;
+    const char *sincos_name;    /* NULL: sin and cos of <math.h> as written */
+    bool sincos_used;           /* some function called sincos_name */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -203,17 +205,35 @@ static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top)
     }
 }
 
-/* For the JIT: the cos node of a sin node (or the reverse) when both have
-   a temporary in this chunk, so one sincos call computes the pair (libtcc
-   calls what is written; gcc merges such pairs itself, and sincos is not
-   C99, so file output never uses it). */
+/* With a sincos function (sincos_name): the cos node of a sin node (or the
+   reverse) when both have a temporary in this chunk, so one call computes
+   the pair; DAG_NONE when there is none. */
 static NodeId sincos_partner(const Emitter *e, NodeId id)
 {
-    DagOp op = dag_op(e->dag, id);
-    if (!e->opt->declare_math || e->opt->real_float || (op != OP_SIN && op != OP_COS))
-        return DAG_NONE;
-    NodeId other = dag_find(e->dag, op == OP_SIN ? OP_COS : OP_SIN, dag_node(e->dag, id)->a, -1);
+    NodeId other = dag_find(e->dag, dag_op(e->dag, id) == OP_SIN ? OP_COS : OP_SIN,
+                            dag_node(e->dag, id)->a, -1);
     return other != DAG_NONE && e->sched.temp[other] >= 0 ? other : DAG_NONE;
+}
+
+/* The temporary of a sin or cos node, with its partner's, through one
+   sincos call (a lone sin or cos gets a discarded w temporary). */
+static void put_sincos(Emitter *e, StrBuf *sb, NodeId id, NodeId partner)
+{
+    bool is_sin = dag_op(e->dag, id) == OP_SIN;
+    int t = e->sched.temp[id];
+    char ts[24], tc[24];
+    if (partner != DAG_NONE) {
+        int tp = e->sched.temp[partner];
+        snprintf(ts, sizeof ts, "u%d", is_sin ? t : tp);
+        snprintf(tc, sizeof tc, "u%d", is_sin ? tp : t);
+    } else {
+        snprintf(ts, sizeof ts, "%c%d", is_sin ? 'u' : 'w', t);
+        snprintf(tc, sizeof tc, "%c%d", is_sin ? 'w' : 'u', t);
+    }
+    sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
+    put_expr(e, sb, dag_node(e->dag, id)->a, false);
+    sb_printf(sb, ", &%s, &%s);\n", ts, tc);
+    e->sincos_used = true;
 }
 
 /* The statements of one chunk: temporaries in id order, then the stores. */
@@ -240,15 +260,11 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         NodeId id = c->nodes[i];
         if (e->sched.temp[id] < 0)
             continue;
-        NodeId partner = sincos_partner(e, id);
-        if (partner != DAG_NONE && partner < id)
-            continue;                       /* written with its partner */
-        if (partner != DAG_NONE) {
-            bool is_sin = dag_op(e->dag, id) == OP_SIN;
-            int ts = e->sched.temp[is_sin ? id : partner], tc = e->sched.temp[is_sin ? partner : id];
-            sb_printf(sb, "    %s_real u%d, u%d;\n    sincos(", e->prefix, ts, tc);
-            put_expr(e, sb, dag_node(e->dag, id)->a, false);
-            sb_printf(sb, ", &u%d, &u%d);\n", ts, tc);
+        DagOp op = dag_op(e->dag, id);
+        if (e->sincos_name && (op == OP_SIN || op == OP_COS)) {
+            NodeId partner = sincos_partner(e, id);
+            if (partner == DAG_NONE || partner > id)    /* else written with its partner */
+                put_sincos(e, sb, id, partner);
             continue;
         }
         sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
@@ -358,6 +374,41 @@ static void put_int_list(StrBuf *sb, const Kinematics *kin, bool rows)
         sb_puts(sb, "    0\n");
 }
 
+/* The zero-fill of the dense Jacobian before its nonzeros are stored. The
+   JIT calls memset (libtcc compiles loops and stores as written, a store
+   costs it a load and a store). Compiled code stores each structural zero
+   when the matrix is small (gcc turns a short fill loop into rep stos,
+   which costs more there), else loops. */
+enum { EMIT_ZERO_STORES_MAX = 256 };
+static void put_zero_fill(StrBuf *sb, const Kinematics *kin, const EmitOptions *opt,
+                          const char *prefix, const char *upper)
+{
+    const Model *m = kin->model;
+    if (!opt->declare_math && (long)m->nr * m->nq <= EMIT_ZERO_STORES_MAX) {
+        int k = 0, on_line = 0;
+        for (int r = 0; r < m->nr; r++)
+            for (int c = 0; c < m->nq; c++) {
+                if (k < kin->nnz && kin->jac[k].row == r && kin->jac[k].col == c) {
+                    k++;
+                    continue;
+                }
+                sb_printf(sb, "%sjac[%d] = 0;", on_line == 0 ? "    " : " ", r * m->nq + c);
+                if (++on_line == 8) {
+                    sb_putc(sb, '\n');
+                    on_line = 0;
+                }
+            }
+        if (on_line > 0)
+            sb_putc(sb, '\n');
+        sb_puts(sb, "    (void)jac;");
+    } else if (opt->declare_math) {
+        sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
+    } else {
+        sb_printf(sb, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;", upper,
+                  upper);
+    }
+}
+
 /* The banner names the input by its base name, with anything that could
    end the comment or confuse a reader replaced. */
 static void put_banner(StrBuf *sb, const char *source)
@@ -410,6 +461,16 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
 
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
                  .prefix_upper = upper};
+    /* Double kernels compute sin and cos in pairs: the JIT calls the tool's
+       mechc_sincos (or the C library's sincos with libm_trig), file output
+       its own P_sincos (templates/sincos.tmpl) or, with libm_trig, sin and
+       cos as written (sincos is not C99; gcc merges the pairs itself). */
+    char sincos_name[160];
+    snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
+    if (!opt->real_float && opt->declare_math)
+        e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
+    else if (!opt->real_float && !opt->libm_trig)
+        e.sincos_name = sincos_name;
     sched_init(&e.sched, &m->dag,
                opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
     e.sched.max_ops = opt->max_ops;
@@ -473,20 +534,23 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     }
     put_int_list(&jrow, kin, true);
     put_int_list(&jcol, kin, false);
+    put_zero_fill(&zero, kin, opt, out->prefix, upper);
     if (opt->declare_math) {
         sb_puts(&math, "/* libm, declared rather than included: no system headers needed */\n");
         for (int op = OP_POW; op < OP_COUNT; op++)
             sb_printf(&math, "double %s(double%s);\n", dag_op_info[op].c_double,
                       dag_op_info[op].arity == 2 ? ", double" : "");
-        sb_puts(&math, "void sincos(double, double *, double *);\n");
+        if (e.sincos_used)
+            sb_printf(&math, "void %s(double, double *, double *);\n", e.sincos_name);
         sb_puts(&math, "void *memset(void *, int, unsigned long);\n");
-        /* libtcc compiles loops as written: a library zero-fill is faster */
-        sb_printf(&zero, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", out->prefix,
-                  upper, upper);
     } else {
         sb_puts(&math, "#include <math.h>\n");
-        sb_printf(&zero, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;",
-                  upper, upper);
+        if (e.sincos_used) {
+            TemplateVar sv[] = {{"P", out->prefix}, {"STATIC", "static "}};
+            sb_puts(&math, "\n");
+            if (template_render(&math, template_sincos, sv, 2))
+                abort();    /* every placeholder of sincos.tmpl is given */
+        }
     }
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];

@@ -19,6 +19,10 @@ typedef struct EmitOptions {
     bool declare_math;          /* declare libm functions instead of
                                    #include <math.h> (the in-process JIT
                                    needs no system headers) */
+    bool libm_trig;             /* double kernels: sin and cos of <math.h>
+                                   rather than the emitted P_sincos
+                                   (templates/sincos.tmpl; float kernels
+                                   always call sinf and cosf) */
     int chunk_nodes;            /* most operations plus stores per C function (default 150) */
     const char *source_name;    /* the input file, named in the banner */
     long max_ops;               /* most operations in all functions together

@@ -19,6 +19,7 @@
 #include "generic_impl.h"
 
 #include "../base/arena.h"
+#include "../base/sincos.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -115,9 +116,10 @@ static void run(Call *c)
        position-level joints */
     int nangles = c->jac || c->gamma || c->psi ? g->nangles : c->phi ? g->nangles_pos : 0;
     for (int k = 0; k < nangles; k++) {
-        double phi = c->q[g->angles[k]];
-        g->cosq[g->angles[k]] = cos(phi);
-        g->sinq[g->angles[k]] = sin(phi);
+        int i = g->angles[k];
+        /* the generated kernels' trigonometry, so that the engines compare
+           code generation, not sin and cos */
+        mechc_sincos(c->q[i], &g->sinq[i], &g->cosq[i]);
     }
     if (c->jac)
         memset(c->jac, 0, (size_t)g->nr * (size_t)g->nq * sizeof *c->jac);

@@ -8,6 +8,7 @@
 #include "jit.h"
 
 #include "../base/arena.h"
+#include "../base/sincos.h"
 #include "../base/strbuf.h"
 
 #include <libtcc.h>
@@ -41,6 +42,7 @@ static void add_libm(TCCState *s)
     tcc_add_symbol(s, "atan2", (const void *)atan2);
     tcc_add_symbol(s, "memset", (const void *)memset);
     tcc_add_symbol(s, "sincos", (const void *)sincos);
+    tcc_add_symbol(s, "mechc_sincos", (const void *)mechc_sincos);
 }
 
 /* Keeps the source of a failed compile for the bug report. */
