@@ -161,13 +161,18 @@ static void expect(const CheckReport *rep, CheckWhat what, int row, const char *
         fail_msg("%s: hint '%s' does not mention '%s'", it->what, it->hint, hint_part);
 }
 
-static int row_of(const char *file, const char *row)
+/* The index of a row of a loaded mechanism, which it frees. */
+static int row_of_mech(Mech *mech, const char *row)
 {
-    Diag diag;
-    Mech *mech = load_example(file, &diag);
     int r = row_index(mech->model, row);
     pipeline_free(mech);
     return r;
+}
+
+static int row_of(const char *file, const char *row)
+{
+    Diag diag;
+    return row_of_mech(load_example(file, &diag), row);
 }
 
 static void test_jacobian_sign(void **state)
@@ -300,10 +305,7 @@ static void expect_pass(const char *name, const CheckReport *rep)
 static int fast_row(const char *text, const char *row)
 {
     Diag diag;
-    Mech *mech = load_text(text, &diag);
-    int r = row_index(mech->model, row);
-    pipeline_free(mech);
-    return r;
+    return row_of_mech(load_text(text, &diag), row);
 }
 
 /* sin(100 x): gamma = 100^2 sin(100 x) xd^2 is right, but the second

@@ -459,6 +459,12 @@ static const char driver_c[] =
     "    for (int i = 0; i < FB_NR * FB_NQ; i++) printf(\"%.17g\\n\", (double)jac[i]);\n"
     "    for (int i = 0; i < FB_NR; i++) printf(\"%.17g\\n\", (double)nu[i]);\n"
     "    for (int i = 0; i < FB_NR; i++) printf(\"%.17g\\n\", (double)gamma[i]);\n"
+    "    /* the fused kernel's Jacobian, zero-filled by itself, equals jac's */\n"
+    "    fb_real phi2[FB_NR + 1], jac2[FB_NR * FB_NQ], nu2[FB_NR], gamma2[FB_NR];\n"
+    "    for (int i = 0; i < FB_NR * FB_NQ; i++) jac2[i] = (fb_real)7;\n"
+    "    fb_all(q, qd, t, phi2, jac2, nu2, gamma2);\n"
+    "    for (int i = 0; i < FB_NR * FB_NQ; i++)\n"
+    "        if (jac2[i] != jac[i]) { fprintf(stderr, \"fb_all: jac[%d] differs\\n\", i); return 3; }\n"
     "    return 0;\n"
     "}\n";
 
@@ -490,14 +496,14 @@ static void compare_with_jit(const char *stem, bool real_float, int chunk, bool 
     write_file(file, driver_c);
     emit_result_free(&res);
     snprintf(cmd, sizeof cmd,
-             "cd '%s' && gcc %s -O2 fb.c driver.c -o driver -lm > gcc.log 2>&1 && ./driver > out.txt",
+             "cd '%s' && gcc %s -O2 fb.c driver.c -o driver -lm > gcc.log 2>&1 && ./driver > out.txt 2>> gcc.log",
              tmpdir, CFLAGS);
     if (system(cmd) != 0) {
         snprintf(file, sizeof file, "%s/gcc.log", tmpdir);
         char *log = read_file(file);
         fprintf(stderr, "%.3000s\n", log ? log : "");
         free(log);
-        fail_msg("%s: the gcc build of the generated C failed", stem);
+        fail_msg("%s: the gcc build of the generated C failed, or its fb_all disagreed with fb_jac", stem);
     }
     /* the JIT's values at the same state */
     Jit *jit = pipeline_jit(mech, &res, NULL, NULL, &diag);

@@ -166,6 +166,26 @@ bool args_engine(Args *a, const char *option, int *engine)
     return true;
 }
 
+int args_choice(Args *a, const char *option, const char *const *choices)
+{
+    const char *v = args_value(a, option);
+    if (!v)
+        return -1;
+    int n = 0;
+    for (; choices[n]; n++)
+        if (strcmp(v, choices[n]) == 0)
+            return n;
+    fprintf(stderr, "mechc %s: error: %s takes ", a->command, option);
+    for (int i = 0; i < n; i++)
+        fprintf(stderr, "%s%s", i == 0 ? "" : i == n - 1 ? " or " : ", ", choices[i]);
+    fputs(", not '", stderr);
+    for (const char *c = v; *c; c++)    /* control bytes shown as '?' */
+        fputc((unsigned char)*c < 0x20 || *c == 0x7f ? '?' : *c, stderr);
+    fputs("'\n", stderr);
+    a->failed = true;
+    return -1;
+}
+
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out)
 {
     int count = 0;

@@ -39,6 +39,10 @@ extern const char args_limits_usage[];
 /* --engine jit|generic|aot: true when option is --engine, its value then
    parsed into *engine (a->failed set on a bad value). */
 bool args_engine(Args *a, const char *option, int *engine);
+/* The value of option as an index into choices (NULL-terminated), or -1
+   with a->failed set and a message naming the choices ("--real takes
+   double or float, not 'long'"); -1 also when the value is missing. */
+int args_choice(Args *a, const char *option, const char *const *choices);
 /* A comma-separated list of exactly n finite numbers. */
 bool args_vector(const char *command, const char *option, const char *text, int n, double *out);
 void args_unknown(Args *a, const char *option);

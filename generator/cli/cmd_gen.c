@@ -79,7 +79,6 @@ int cmd_gen(int argc, char **argv)
     args_init(&a, "gen", argc, argv);
     const char *out_path = NULL, *header_path = NULL, *opt_name;
     bool stats = false, dump = false;
-    char buf[256];
     EmitOptions opt = emit_default_options();
     MechLimits limits = mech_default_limits();
     while (!a.failed && (opt_name = args_next(&a))) {
@@ -96,33 +95,16 @@ int cmd_gen(int argc, char **argv)
         } else if (strcmp(opt_name, "--prefix") == 0) {
             opt.prefix = args_value(&a, opt_name);
         } else if (strcmp(opt_name, "--real") == 0) {
-            const char *v = args_value(&a, opt_name);
-            if (v && strcmp(v, "float") == 0)
-                opt.real_float = true;
-            else if (v && strcmp(v, "double") != 0) {
-                fprintf(stderr, "mechc gen: error: --real takes double or float, not '%s'\n",
-                        shown(v, buf, sizeof buf));
-                a.failed = true;
-            }
+            static const char *const reals[] = {"double", "float", NULL};
+            opt.real_float = args_choice(&a, opt_name, reals) == 1;
         } else if (strcmp(opt_name, "--trig") == 0) {
-            const char *v = args_value(&a, opt_name);
-            if (v && strcmp(v, "libm") == 0)
-                opt.libm_trig = true;
-            else if (v && strcmp(v, "own") != 0) {
-                fprintf(stderr, "mechc gen: error: --trig takes own or libm, not '%s'\n",
-                        shown(v, buf, sizeof buf));
-                a.failed = true;
-            }
+            static const char *const trigs[] = {"own", "libm", NULL};
+            opt.libm_trig = args_choice(&a, opt_name, trigs) == 1;
         } else if (strcmp(opt_name, "--chunk") == 0) {
             args_int(&a, opt_name, 50, 1000000, &opt.chunk_nodes);
         } else if (strcmp(opt_name, "--dump") == 0) {
-            const char *v = args_value(&a, opt_name);
-            if (v && strcmp(v, "rows") != 0) {
-                fprintf(stderr, "mechc gen: error: --dump takes 'rows', not '%s'\n",
-                        shown(v, buf, sizeof buf));
-                a.failed = true;
-            }
-            dump = true;
+            static const char *const dumps[] = {"rows", NULL};
+            dump = args_choice(&a, opt_name, dumps) == 0;
         } else if (strcmp(opt_name, "--stats") == 0) {
             stats = true;
         } else {
@@ -131,6 +113,7 @@ int cmd_gen(int argc, char **argv)
     }
     /* Names that reach the C text are checked before any work. */
     const char *why;
+    char buf[256];
     if (opt.prefix && (why = emit_check_prefix(opt.prefix))) {
         fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n",
                 shown(opt.prefix, buf, sizeof buf), why);

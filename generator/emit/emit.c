@@ -384,29 +384,27 @@ static void put_zero_fill(StrBuf *sb, const Kinematics *kin, const EmitOptions *
                           const char *prefix, const char *upper)
 {
     const Model *m = kin->model;
-    if (!opt->declare_math && (long)m->nr * m->nq <= EMIT_ZERO_STORES_MAX) {
-        int k = 0, on_line = 0;
-        for (int r = 0; r < m->nr; r++)
-            for (int c = 0; c < m->nq; c++) {
-                if (k < kin->nnz && kin->jac[k].row == r && kin->jac[k].col == c) {
-                    k++;
-                    continue;
-                }
-                sb_printf(sb, "%sjac[%d] = 0;", on_line == 0 ? "    " : " ", r * m->nq + c);
-                if (++on_line == 8) {
-                    sb_putc(sb, '\n');
-                    on_line = 0;
-                }
-            }
-        if (on_line > 0)
-            sb_putc(sb, '\n');
-        sb_puts(sb, "    (void)jac;");
-    } else if (opt->declare_math) {
+    if (opt->declare_math) {
         sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
-    } else {
+        return;
+    }
+    if ((long)m->nr * m->nq > EMIT_ZERO_STORES_MAX) {
         sb_printf(sb, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;", upper,
                   upper);
+        return;
     }
+    /* eight stores a line; the template ends the last line */
+    int k = 0, stores = 0;
+    for (int r = 0; r < m->nr; r++)
+        for (int c = 0; c < m->nq; c++) {
+            if (k < kin->nnz && kin->jac[k].row == r && kin->jac[k].col == c) {
+                k++;
+                continue;
+            }
+            const char *sep = stores == 0 ? "    " : stores % 8 == 0 ? "\n    " : " ";
+            sb_printf(sb, "%sjac[%d] = 0;", sep, r * m->nq + c);
+            stores++;
+        }
 }
 
 /* The banner names the input by its base name, with anything that could
