@@ -206,7 +206,7 @@ run gen "$ex/all_statements.mech" -o "$tmp/af.c" --real float
 check "gen --real float exits 0" status_is 0
 check "gen --real float uses float" grep -q 'typedef float all_statements_real;' "$tmp/af.c"
 
-check "gen: sin and cos through the file's own sincos" grep -q 'sc_sincos(q\[2\], &' "$tmp/sc.c"
+check "gen: sin and cos of two angles through one call of the file's own sincos2" grep -q 'sc_sincos2(q\[2\], q\[5\], &' "$tmp/sc.c"
 run gen "$ex/slider_crank.mech" -o "$tmp/sl.c" --prefix sl --trig libm
 check "gen --trig libm exits 0" status_is 0
 check "gen --trig libm: no sincos of its own" sh -c '! grep -q sincos "$1"' _ "$tmp/sl.c"

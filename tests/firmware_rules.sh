@@ -218,7 +218,7 @@ source_rules() {
         awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|"[A-Za-z0-9_]+\.h")$/ {
             print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
         ! grep -n -E "$FORBIDDEN" "$tmp/code" &&
-        ! grep -n -w static "$tmp/code" | grep -v -E 'static const|#define [A-Z0-9_]+_PART static|static void [A-Za-z0-9_]+_sincos\(double' ||
+        ! grep -n -w static "$tmp/code" | grep -v -E 'static const|#define [A-Z0-9_]+_(PART|TRIG) static|static void [A-Za-z0-9_]+_sincos2_apart\(double' ||
         return 1
     done
 }

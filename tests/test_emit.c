@@ -574,8 +574,17 @@ static void test_trig_choices(void **state)
     Mech *mech = load_path(path, &diag);
     EmitResult res = emit(mech, "fb", false, NULL);
     assert_non_null(strstr(res.c_text, "static const double fb_sincos_table[128]"));
-    assert_non_null(strstr(res.c_text, "static void fb_sincos(double x, double *s, double *c)"));
-    assert_non_null(strstr(res.c_text, "fb_sincos(q[2], &"));
+    assert_non_null(strstr(res.c_text, "FB_TRIG void fb_sincos(double x, double *s, double *c)"));
+    /* three angles: a pair through the two-angle function, then the third */
+    const char *gamma = strstr(res.c_text, "void fb_gamma(const fb_real *q, const fb_real *qd, "
+                                           "fb_real t, fb_real *gamma)\n{");
+    assert_non_null(gamma);
+    const char *end = strstr(gamma, "\n}\n");
+    const char *pair = strstr(gamma, "fb_sincos2(q[2], q[5], &u1, &u0, &u3, &u2);");
+    const char *lone = strstr(gamma, "fb_sincos(q[8], &");
+    assert_true(pair && lone && pair < lone && lone < end);
+    const char *after = strstr(lone + 1, "fb_sincos");
+    assert_true(after == NULL || after > end);
     assert_null(strstr(res.c_text, " sin(q"));
     emit_result_free(&res);
 
@@ -655,6 +664,37 @@ static void test_sincos_accuracy(void **state)
     assert_true(isnan(s) && isnan(c));
 }
 
+/* The two-angle function does what two calls of the one-angle function do,
+   to the bit, in range and out of it. */
+static void test_sincos_pairs(void **state)
+{
+    (void)state;
+    static const double special[] = {0.0, -0.0, 1e-300, M_PI, 65536.0, 65537.0, -1e9, NAN,
+                                     INFINITY, -INFINITY};
+    const int nspecial = (int)(sizeof special / sizeof *special);
+    uint64_t rng = 777;
+    for (int n = 0; n < 100000 + nspecial * nspecial; n++) {
+        double x[2];
+        for (int k = 0; k < 2; k++) {
+            rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+            x[k] = ((double)(rng >> 11) * 0x1.0p-53 * 2 - 1) * (k ? 7.0 : 300.0);
+        }
+        if (n >= 100000) {
+            x[0] = special[(n - 100000) / nspecial];
+            x[1] = special[(n - 100000) % nspecial];
+        }
+        double s0, c0, s1, c1, e[4];
+        mechc_sincos2(x[0], x[1], &s0, &c0, &s1, &c1);
+        mechc_sincos(x[0], &e[0], &e[1]);
+        mechc_sincos(x[1], &e[2], &e[3]);
+        double got[4] = {s0, c0, s1, c1};
+        for (int k = 0; k < 4; k++)
+            if (memcmp(&got[k], &e[k], sizeof(double)) != 0)
+                fail_msg("x = %.17g, %.17g: result %d is %.17g, one by one %.17g", x[0], x[1], k,
+                         got[k], e[k]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -668,6 +708,7 @@ int main(void)
         cmocka_unit_test(test_gcc_build_matches_jit),
         cmocka_unit_test(test_trig_choices),
         cmocka_unit_test(test_sincos_accuracy),
+        cmocka_unit_test(test_sincos_pairs),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

@@ -7,4 +7,7 @@
    every engine computes the same trigonometry. */
 void mechc_sincos(double x, double *s, double *c);
 
+/* Two angles at once, with the results of two mechc_sincos calls. */
+void mechc_sincos2(double x0, double x1, double *s0, double *c0, double *s1, double *c1);
+
 #endif

@@ -37,6 +37,12 @@ void dag_free(Dag *dag);
 
 static inline const DagNode *dag_node(const Dag *dag, NodeId id) { return &dag->nodes[id]; }
 static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes[id].op; }
+/* A constant, coordinate, velocity or time: nothing to compute. */
+static inline bool dag_is_leaf(const Dag *dag, NodeId id)
+{
+    DagOp op = dag_op(dag, id);
+    return op == OP_CONST || op == OP_VAR || op == OP_VARD || op == OP_TIME;
+}
 bool dag_is_const(const Dag *dag, NodeId id, double *value);
 bool dag_is_zero(const Dag *dag, NodeId id);
 

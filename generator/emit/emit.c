@@ -139,7 +139,10 @@ typedef struct Emitter {
     const char *prefix_upper;
     Scheduler sched;
     const char *sincos_name;    /* NULL: sin and cos of <math.h> as written */
-    bool sincos_used;           /* some function called sincos_name */
+    const char *sincos2_name;   /* two angles in one call; NULL: no such function */
+    bool sincos_used;           /* some function called sincos_name or sincos2_name */
+    bool *written;              /* per node: its sincos call was already written
+                                   (paired with an earlier one) in this chunk */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -215,25 +218,70 @@ static NodeId sincos_partner(const Emitter *e, NodeId id)
     return other != DAG_NONE && e->sched.temp[other] >= 0 ? other : DAG_NONE;
 }
 
-/* The temporary of a sin or cos node, with its partner's, through one
-   sincos call (a lone sin or cos gets a discarded w temporary). */
-static void put_sincos(Emitter *e, StrBuf *sb, NodeId id, NodeId partner)
+/* The names that receive sin and cos of a sin or cos node's argument: the
+   node's and its partner's temporaries (a lone sin or cos gets a discarded
+   w temporary for the other). */
+static void sincos_targets(const Emitter *e, NodeId id, NodeId partner, char ts[24], char tc[24])
 {
     bool is_sin = dag_op(e->dag, id) == OP_SIN;
     int t = e->sched.temp[id];
-    char ts[24], tc[24];
     if (partner != DAG_NONE) {
         int tp = e->sched.temp[partner];
-        snprintf(ts, sizeof ts, "u%d", is_sin ? t : tp);
-        snprintf(tc, sizeof tc, "u%d", is_sin ? tp : t);
+        snprintf(ts, 24, "u%d", is_sin ? t : tp);
+        snprintf(tc, 24, "u%d", is_sin ? tp : t);
     } else {
-        snprintf(ts, sizeof ts, "%c%d", is_sin ? 'u' : 'w', t);
-        snprintf(tc, sizeof tc, "%c%d", is_sin ? 'w' : 'u', t);
+        snprintf(ts, 24, "%c%d", is_sin ? 'u' : 'w', t);
+        snprintf(tc, 24, "%c%d", is_sin ? 'w' : 'u', t);
     }
-    sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
-    put_expr(e, sb, dag_node(e->dag, id)->a, false);
-    sb_printf(sb, ", &%s, &%s);\n", ts, tc);
+}
+
+/* id itself when id is the first node of a sin/cos group whose call is
+   still to be written (the call belongs there), else DAG_NONE. */
+static NodeId sincos_leader(const Emitter *e, NodeId id)
+{
+    DagOp op = dag_op(e->dag, id);
+    if (!e->sincos_name || (op != OP_SIN && op != OP_COS) || e->sched.temp[id] < 0 ||
+        e->written[id])
+        return DAG_NONE;
+    NodeId partner = sincos_partner(e, id);
+    return partner == DAG_NONE || partner > id ? id : DAG_NONE;
+}
+
+/* The sin and cos temporaries of the group led by id, through one sincos
+   call; with a two-angle function, a later group of the chunk whose
+   argument is already at hand (a leaf, or a node whose id is below id's:
+   ids are a topological order and temporaries are written in id order)
+   shares the call, so that both angles go through one instruction stream. */
+static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
+{
+    char ts[24], tc[24], ts2[24], tc2[24];
+    NodeId arg = dag_node(e->dag, id)->a;
+    sincos_targets(e, id, sincos_partner(e, id), ts, tc);
+    NodeId other = DAG_NONE;
+    for (int j = at + 1; e->sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
+        NodeId cand = sincos_leader(e, c->nodes[j]);
+        NodeId cand_arg = cand == DAG_NONE ? DAG_NONE : dag_node(e->dag, cand)->a;
+        if (cand != DAG_NONE && (dag_is_leaf(e->dag, cand_arg) || cand_arg < id))
+            other = cand;
+    }
     e->sincos_used = true;
+    if (other == DAG_NONE) {
+        sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
+        put_expr(e, sb, arg, false);
+        sb_printf(sb, ", &%s, &%s);\n", ts, tc);
+        return;
+    }
+    NodeId other_partner = sincos_partner(e, other);
+    sincos_targets(e, other, other_partner, ts2, tc2);
+    e->written[other] = true;
+    if (other_partner != DAG_NONE)
+        e->written[other_partner] = true;
+    sb_printf(sb, "    %s_real %s, %s, %s, %s;\n    %s(", e->prefix, ts, tc, ts2, tc2,
+              e->sincos2_name);
+    put_expr(e, sb, arg, false);
+    sb_puts(sb, ", ");
+    put_expr(e, sb, dag_node(e->dag, other)->a, false);
+    sb_printf(sb, ", &%s, &%s, &%s, &%s);\n", ts, tc, ts2, tc2);
 }
 
 /* The statements of one chunk: temporaries in id order, then the stores. */
@@ -262,9 +310,8 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
             continue;
         DagOp op = dag_op(e->dag, id);
         if (e->sincos_name && (op == OP_SIN || op == OP_COS)) {
-            NodeId partner = sincos_partner(e, id);
-            if (partner == DAG_NONE || partner > id)    /* else written with its partner */
-                put_sincos(e, sb, id, partner);
+            if (sincos_leader(e, id) != DAG_NONE)   /* else written with its partner */
+                put_sincos(e, sb, c, i, id);
             continue;
         }
         sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
@@ -277,8 +324,10 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         put_expr(e, sb, o->value, false);
         sb_puts(sb, ";\n");
     }
-    for (int i = 0; i < c->nnodes; i++)     /* temporaries end with their chunk */
+    for (int i = 0; i < c->nnodes; i++) {   /* temporaries end with their chunk */
         e->sched.temp[c->nodes[i]] = -1;
+        e->written[c->nodes[i]] = false;
+    }
 }
 
 /* "q, qd, t, gamma" -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
@@ -463,12 +512,17 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
        mechc_sincos (or the C library's sincos with libm_trig), file output
        its own P_sincos (templates/sincos.tmpl) or, with libm_trig, sin and
        cos as written (sincos is not C99; gcc merges the pairs itself). */
-    char sincos_name[160];
+    char sincos_name[160], sincos2_name[160];
     snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
-    if (!opt->real_float && opt->declare_math)
+    snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
+    if (!opt->real_float && opt->declare_math) {
         e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
-    else if (!opt->real_float && !opt->libm_trig)
+        e.sincos2_name = opt->libm_trig ? NULL : "mechc_sincos2";
+    } else if (!opt->real_float && !opt->libm_trig) {
         e.sincos_name = sincos_name;
+        e.sincos2_name = sincos2_name;
+    }
+    e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
     sched_init(&e.sched, &m->dag,
                opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
     e.sched.max_ops = opt->max_ops;
@@ -495,6 +549,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         sched_function_free(&fn);
     }
     sched_free(&e.sched);
+    free(e.written);
     if (too_big) {
         for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
             sb_free(&parts[f]);
@@ -538,14 +593,25 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         for (int op = OP_POW; op < OP_COUNT; op++)
             sb_printf(&math, "double %s(double%s);\n", dag_op_info[op].c_double,
                       dag_op_info[op].arity == 2 ? ", double" : "");
-        if (e.sincos_used)
+        if (e.sincos_used) {
             sb_printf(&math, "void %s(double, double *, double *);\n", e.sincos_name);
+            if (e.sincos2_name)
+                sb_printf(&math, "void %s(double, double, double *, double *, double *, double *);\n",
+                          e.sincos2_name);
+        }
         sb_puts(&math, "void *memset(void *, int, unsigned long);\n");
     } else {
         sb_puts(&math, "#include <math.h>\n");
         if (e.sincos_used) {
-            TemplateVar sv[] = {{"P", out->prefix}, {"STATIC", "static "}};
-            sb_puts(&math, "\n");
+            char trig[160];
+            snprintf(trig, sizeof trig, "%s_TRIG ", upper);
+            TemplateVar sv[] = {{"P", out->prefix}, {"STATIC", trig}};
+            /* gcc splits the pair function at its rare-case test and calls
+               the rest out of line, through memory, unless forced */
+            sb_printf(&math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
+                      "they inline it */\n#if defined(__GNUC__) && defined(__SSE2__)\n"
+                      "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
+                      "#define %s_TRIG static inline\n#endif\n", upper, upper);
             if (template_render(&math, template_sincos, sv, 2))
                 abort();    /* every placeholder of sincos.tmpl is given */
         }

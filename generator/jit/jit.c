@@ -43,6 +43,7 @@ static void add_libm(TCCState *s)
     tcc_add_symbol(s, "memset", (const void *)memset);
     tcc_add_symbol(s, "sincos", (const void *)sincos);
     tcc_add_symbol(s, "mechc_sincos", (const void *)mechc_sincos);
+    tcc_add_symbol(s, "mechc_sincos2", (const void *)mechc_sincos2);
 }
 
 /* Keeps the source of a failed compile for the bug report. */

@@ -14,12 +14,6 @@
 
 enum { MAX_INLINE_DEPTH = 6 };
 
-static bool is_leaf(const Dag *dag, NodeId id)
-{
-    DagOp op = dag_op(dag, id);
-    return op == OP_CONST || op == OP_VAR || op == OP_VARD || op == OP_TIME;
-}
-
 void sched_init(Scheduler *s, const Dag *dag, int chunk_nodes)
 {
     memset(s, 0, sizeof *s);
@@ -48,7 +42,7 @@ void sched_free(Scheduler *s)
 static void collect(Scheduler *s, NodeId root, NodeId **list, int *n, int *cap)
 {
     const Dag *dag = s->dag;
-    if (s->mark[root] == s->stamp || is_leaf(dag, root))
+    if (s->mark[root] == s->stamp || dag_is_leaf(dag, root))
         return;
     int top = 0;
     s->mark[root] = s->stamp;
@@ -63,7 +57,7 @@ static void collect(Scheduler *s, NodeId root, NodeId **list, int *n, int *cap)
         const DagNode *node = dag_node(dag, id);
         NodeId kids[2] = {node->a, node->b};
         for (int k = 0; k < dag_op_info[node->op].arity; k++) {
-            if (s->mark[kids[k]] != s->stamp && !is_leaf(dag, kids[k])) {
+            if (s->mark[kids[k]] != s->stamp && !dag_is_leaf(dag, kids[k])) {
                 s->mark[kids[k]] = s->stamp;
                 s->stack[top++] = kids[k];
             }
@@ -142,11 +136,11 @@ void sched_prepare_chunk(Scheduler *s, const SchedFunction *fn, int index)
         const DagNode *node = dag_node(dag, c->nodes[i]);
         NodeId kids[2] = {node->a, node->b};
         for (int k = 0; k < dag_op_info[node->op].arity; k++)
-            if (!is_leaf(dag, kids[k]))
+            if (!dag_is_leaf(dag, kids[k]))
                 s->uses[kids[k]]++;
     }
     for (int i = c->first; i < c->first + c->count; i++)
-        if (!is_leaf(dag, fn->outputs[i].value))
+        if (!dag_is_leaf(dag, fn->outputs[i].value))
             s->uses[fn->outputs[i].value]++;
     int ntemps = 0;
     for (int i = 0; i < c->nnodes; i++) {
@@ -155,7 +149,7 @@ void sched_prepare_chunk(Scheduler *s, const SchedFunction *fn, int index)
         int depth = 0;
         NodeId kids[2] = {node->a, node->b};
         for (int k = 0; k < dag_op_info[node->op].arity; k++)
-            if (!is_leaf(dag, kids[k]) && s->temp[kids[k]] < 0 && s->depth[kids[k]] > depth)
+            if (!dag_is_leaf(dag, kids[k]) && s->temp[kids[k]] < 0 && s->depth[kids[k]] > depth)
                 depth = s->depth[kids[k]];
         s->depth[id] = (uint8_t)(depth + 1);
         bool shared = s->uses[id] > 1;
