@@ -75,13 +75,14 @@ $(BUILD)/gen/templates.c: $(TMPL) Makefile
 $(BUILD)/gen/templates.o: $(BUILD)/gen/templates.c
 	$(Q)$(CC) $(CFLAGS_TOOL) -I. -c $< -o $@
 
-# The generated code's sincos, built into the tool too (the JIT calls it and
-# the generic evaluator uses it): one source, templates/sincos.tmpl.
-$(BUILD)/gen/sincos.c: templates/sincos.tmpl Makefile
+# The generated code's sincos and sincos2, built into the tool too (the JIT
+# calls them and the generic evaluator uses sincos): one source each,
+# templates/sincos.tmpl and sincos2.tmpl.
+$(BUILD)/gen/sincos.c: templates/sincos.tmpl templates/sincos2.tmpl Makefile
 	@mkdir -p $(dir $@)
-	$(Q){ echo '/* Generated from templates/sincos.tmpl by the Makefile. Do not edit. */'; \
+	$(Q){ echo '/* Generated from templates/sincos.tmpl and sincos2.tmpl by the Makefile. Do not edit. */'; \
 	  echo '#include "generator/base/sincos.h"'; echo '#include <math.h>'; \
-	  sed -e 's/@P@/mechc/g' -e 's/@STATIC@//g' templates/sincos.tmpl; } > $@
+	  sed -e 's/@P@/mechc/g' -e 's/@STATIC@//g' templates/sincos.tmpl templates/sincos2.tmpl; } > $@
 
 $(BUILD)/gen/sincos.o: $(BUILD)/gen/sincos.c
 	$(Q)$(CC) $(CFLAGS_TOOL) -I. -c $< -o $@

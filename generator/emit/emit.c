@@ -140,7 +140,8 @@ typedef struct Emitter {
     Scheduler sched;
     const char *sincos_name;    /* NULL: sin and cos of <math.h> as written */
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
-    bool sincos_used;           /* some function called sincos_name or sincos2_name */
+    bool sincos_used;           /* some function called sincos_name */
+    bool sincos2_used;          /* some function called sincos2_name */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
 } Emitter;
@@ -264,7 +265,7 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
         if (cand != DAG_NONE && (dag_is_leaf(e->dag, cand_arg) || cand_arg < id))
             other = cand;
     }
-    e->sincos_used = true;
+    e->sincos_used = true;      /* sincos2 needs sincos for its rare case */
     if (other == DAG_NONE) {
         sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
         put_expr(e, sb, arg, false);
@@ -273,6 +274,7 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     }
     NodeId other_partner = sincos_partner(e, other);
     sincos_targets(e, other, other_partner, ts2, tc2);
+    e->sincos2_used = true;
     e->written[other] = true;
     if (other_partner != DAG_NONE)
         e->written[other_partner] = true;
@@ -595,7 +597,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
                       dag_op_info[op].arity == 2 ? ", double" : "");
         if (e.sincos_used) {
             sb_printf(&math, "void %s(double, double *, double *);\n", e.sincos_name);
-            if (e.sincos2_name)
+            if (e.sincos2_used)
                 sb_printf(&math, "void %s(double, double, double *, double *, double *, double *);\n",
                           e.sincos2_name);
         }
@@ -607,13 +609,17 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
             snprintf(trig, sizeof trig, "%s_TRIG ", upper);
             TemplateVar sv[] = {{"P", out->prefix}, {"STATIC", trig}};
             /* gcc splits the pair function at its rare-case test and calls
-               the rest out of line, through memory, unless forced */
+               the rest out of line, through memory, unless forced; without
+               a vector unit, inlining only multiplies the code (it doubled
+               the Cortex-M3 kernels at -O2) */
             sb_printf(&math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
-                      "they inline it */\n#if defined(__GNUC__) && defined(__SSE2__)\n"
+                      "they inline it;\n   elsewhere one copy serves all calls */\n"
+                      "#if defined(__GNUC__) && defined(__SSE2__)\n"
                       "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
-                      "#define %s_TRIG static inline\n#endif\n", upper, upper);
-            if (template_render(&math, template_sincos, sv, 2))
-                abort();    /* every placeholder of sincos.tmpl is given */
+                      "#define %s_TRIG static\n#endif\n", upper, upper);
+            if (template_render(&math, template_sincos, sv, 2) ||
+                (e.sincos2_used && (sb_puts(&math, "\n"), template_render(&math, template_sincos2, sv, 2))))
+                abort();    /* every placeholder of the sincos templates is given */
         }
     }
 
