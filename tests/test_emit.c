@@ -590,9 +590,16 @@ static void test_trig_choices(void **state)
 
     EmitOptions opt = emit_default_options();
     opt.prefix = "fb";
-    opt.libm_trig = true;
+    opt.declare_math = true;    /* as for the JIT: the tool's own functions */
     Diag ed;
     diag_init(&ed, "emit", NULL, 0);
+    assert_true(emit_mechanism(&mech->kin, &opt, &res, &ed));
+    assert_non_null(strstr(res.c_text, "mechc_sincos2(q[2], q[5], &"));
+    assert_non_null(strstr(res.c_text, "mechc_sincos(q[8], &"));
+    emit_result_free(&res);
+
+    opt.declare_math = false;
+    opt.libm_trig = true;
     assert_true(emit_mechanism(&mech->kin, &opt, &res, &ed));
     assert_null(strstr(res.c_text, "sincos"));
     assert_non_null(strstr(res.c_text, "= sin(q[2])"));

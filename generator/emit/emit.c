@@ -261,8 +261,10 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     NodeId other = DAG_NONE;
     for (int j = at + 1; e->sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
         NodeId cand = sincos_leader(e, c->nodes[j]);
-        NodeId cand_arg = cand == DAG_NONE ? DAG_NONE : dag_node(e->dag, cand)->a;
-        if (cand != DAG_NONE && (dag_is_leaf(e->dag, cand_arg) || cand_arg < id))
+        if (cand == DAG_NONE)
+            continue;
+        NodeId cand_arg = dag_node(e->dag, cand)->a;
+        if (dag_is_leaf(e->dag, cand_arg) || cand_arg < id)
             other = cand;
     }
     e->sincos_used = true;      /* sincos2 needs sincos for its rare case */
@@ -510,10 +512,12 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
 
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
                  .prefix_upper = upper};
-    /* Double kernels compute sin and cos in pairs: the JIT calls the tool's
-       mechc_sincos (or the C library's sincos with libm_trig), file output
-       its own P_sincos (templates/sincos.tmpl) or, with libm_trig, sin and
-       cos as written (sincos is not C99; gcc merges the pairs itself). */
+    /* Double kernels compute sin and cos together, of two angles at once
+       where they can: the JIT calls the tool's mechc_sincos and
+       mechc_sincos2 (or the C library's sincos with libm_trig), file output
+       its own P_sincos and P_sincos2 (templates/sincos*.tmpl) or, with
+       libm_trig, sin and cos as written (sincos is not C99; gcc merges the
+       pairs itself). */
     char sincos_name[160], sincos2_name[160];
     snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
     snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
@@ -617,9 +621,13 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
                       "#if defined(__GNUC__) && defined(__SSE2__)\n"
                       "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
                       "#define %s_TRIG static\n#endif\n", upper, upper);
-            if (template_render(&math, template_sincos, sv, 2) ||
-                (e.sincos2_used && (sb_puts(&math, "\n"), template_render(&math, template_sincos2, sv, 2))))
+            if (template_render(&math, template_sincos, sv, 2))
                 abort();    /* every placeholder of the sincos templates is given */
+            if (e.sincos2_used) {
+                sb_puts(&math, "\n");
+                if (template_render(&math, template_sincos2, sv, 2))
+                    abort();
+            }
         }
     }
 
