@@ -137,6 +137,8 @@ typedef struct Emitter {
     const EmitOptions *opt;
     const char *prefix;
     const char *prefix_upper;
+    const char *kernel_attr;    /* written before each kernel definition:
+                                   "P_KERNEL " with cpu_clones, else "" */
     Scheduler sched;
     const char *sincos_name;    /* NULL: sin and cos of <math.h> as written */
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
@@ -364,7 +366,8 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
     }
     const char *p = e->prefix;
     for (int c = 0; c < fn->nchunks; c++) {
-        sb_printf(parts, "%s_PART void %s_%s_part%d(", e->prefix_upper, p, emit_function_names[which], c);
+        sb_printf(parts, "%s_PART %svoid %s_%s_part%d(", e->prefix_upper, e->kernel_attr, p,
+                  emit_function_names[which], c);
         put_signature(parts, p, which);
         sb_puts(parts, ")\n{\n");
         put_chunk(e, parts, fn, c, which);
@@ -510,8 +513,10 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     for (size_t i = 0; i <= plen; i++)
         upper[i] = (char)toupper((unsigned char)out->prefix[i]);
 
+    char kernel_attr[160];
+    snprintf(kernel_attr, sizeof kernel_attr, "%s_KERNEL ", upper);
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
-                 .prefix_upper = upper};
+                 .prefix_upper = upper, .kernel_attr = opt->cpu_clones ? kernel_attr : ""};
     /* Double kernels compute sin and cos together, of two angles at once
        where they can: the JIT calls the tool's mechc_sincos and
        mechc_sincos2 (or the C library's sincos with libm_trig), file output
@@ -570,9 +575,9 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
     }
 
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, clones, jac;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac};
+                          &zero, &clones, &jac};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
@@ -631,6 +636,22 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         }
     }
 
+    /* The v3 clone has AVX2 and FMA: gcc then computes the paired angles
+       with three-operand and fused instructions (four-bar gamma about a
+       fifth faster under gcc -O2). ifuncs need glibc; gcc 12 is the first
+       to dispatch on arch=x86-64-v3 by CPU features. */
+    if (opt->cpu_clones)
+        sb_printf(&clones,
+                 "\n/* Each kernel is compiled twice, for the x86-64 baseline and for x86-64-v3\n"
+                 "   (AVX2, FMA), and the loader picks the one this CPU runs (GCC's\n"
+                 "   target_clones, an ifunc). Define %s_KERNEL to override. */\n"
+                 "#if !defined(%s_KERNEL)\n"
+                 "#if defined(__GNUC__) && __GNUC__ >= 12 && !defined(__clang__) && "
+                 "defined(__x86_64__) && defined(__GLIBC__)\n"
+                 "#define %s_KERNEL __attribute__((target_clones(\"arch=x86-64-v3\", \"default\")))\n"
+                 "#else\n#define %s_KERNEL\n#endif\n#endif\n",
+                 upper, upper, upper, upper);
+
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
     snprintf(nh, sizeof nh, "%d", m->nh);
@@ -651,7 +672,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"JAC", ""},
+        {"ZERO_JAC", zero.data}, {"CLONES", clones.data}, {"KERNEL", e.kernel_attr}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     const char *bad = template_render(&iface, template_interface, vars, nvars);
