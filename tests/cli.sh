@@ -228,6 +228,18 @@ fi
 
 run gen --help
 check "gen --help documents --cpu-clones" out_has "--cpu-clones"
+check "gen --help documents --jac" out_has "--jac HOW"
+run gen "$ex/four_bar.mech" --jac direct --prefix fbd -o "$tmp/fbd.c"
+check "gen --jac direct exits 0" status_is 0
+check "gen --jac direct: the dense Jacobian stores its own entries" \
+    sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "fbd_jac_nz(q, t, jac);" "$1"' _ "$tmp/fbd.c"
+check "gen default: the dense Jacobian is spread from jac_nz" grep -q "fb_jac_nz(q, t, jac);" "$tmp/fb.c"
+if have gcc; then
+    check "gcc compiles gen --jac direct output" gcc $cflags -c "$tmp/fbd.c" -o "$tmp/fbd.o"
+fi
+run gen "$ex/four_bar.mech" --jac sideways
+check "gen --jac sideways exits 2" status_is 2
+check "gen --jac sideways names the choices" err_has "spread or direct"
 run gen "$ex/four_bar.mech" --cpu-clones --prefix fbc -o "$tmp/fbc.c"
 check "gen --cpu-clones exits 0" status_is 0
 check "gen --cpu-clones: the kernels carry the clones macro" grep -q '^FBC_KERNEL void fbc_gamma(' "$tmp/fbc.c"

@@ -178,7 +178,8 @@ check "redundant parallelogram: exit 1 at t = 0, singular" \
 for f in pendulum_distance pendulum_constraint; do
     run "$ex/$f.mech"
     check "$f: exit 2" status_is 2
-    check "$f: 1 degree of freedom is not driven" err_matches "$f.mech: error: 1 degree of freedom is not driven"
+    check "$f: 1 degree of freedom is not driven" err_matches "$f.mech:[0-9]*:1: error: 1 degree of freedom is not driven"
+    check "$f: the last statement, with a caret" err_matches '^    \^$'
     check "$f: no output" out_empty
 done
 cat > "$tmp/over.mech" <<'EOF'
@@ -190,6 +191,7 @@ EOF
 run "$tmp/over.mech"
 check "one row too many: exit 2" status_is 2
 check "one row too many: says so" err_has "1 more row than coordinates"
+check "one row too many: points at the last statement" err_has "over.mech:4:1: error:"
 
 # ---- every example runs, or fails as its header says -----------------------
 for f in "$ex"/*.mech; do

@@ -678,6 +678,27 @@ static RunStatus bad_input(RunResult *res, const char *fmt, ...)
     return RUN_BAD_INPUT;
 }
 
+bool run_rows_match(const Model *m, char *why, size_t size)
+{
+    if (m->nr < m->nq) {
+        int dof = m->nq - m->nr;
+        snprintf(why, size, "%d degree%s of freedom %s not driven (%d coordinates, %d %s): "
+                 "add %s%s", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are", m->nq,
+                 m->nr, plural(m->nr, "row", "rows"), dof == 1 ? "a driver" : "drivers",
+                 dof == 1 ? "" : " (one per degree of freedom)");
+        return false;
+    }
+    if (m->nr > m->nq) {
+        int extra = m->nr - m->nq;
+        snprintf(why, size, "the mechanism has %d more %s than coordinates (%d rows, %d "
+                 "coordinates): run needs exactly one row per coordinate; remove "
+                 "redundant rows or drivers", extra, plural(extra, "row", "rows"),
+                 m->nr, m->nq);
+        return false;
+    }
+    return true;
+}
+
 RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
                        RunStateFn state, void *state_ctx, RunResult *res)
 {
@@ -694,20 +715,9 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (m->nr < m->nq) {
-        int dof = m->nq - m->nr;
-        return bad_input(res, "%d degree%s of freedom %s not driven (%d coordinates, %d %s): "
-                         "add %s%s", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are", m->nq,
-                         m->nr, plural(m->nr, "row", "rows"), dof == 1 ? "a driver" : "drivers",
-                         dof == 1 ? "" : " (one per degree of freedom)");
-    }
-    if (m->nr > m->nq) {
-        int extra = m->nr - m->nq;
-        return bad_input(res, "the mechanism has %d more %s than coordinates (%d rows, %d "
-                         "coordinates): run needs exactly one row per coordinate; remove "
-                         "redundant rows or drivers", extra, plural(extra, "row", "rows"),
-                         m->nr, m->nq);
-    }
+    char why[sizeof res->message];
+    if (!run_rows_match(m, why, sizeof why))
+        return bad_input(res, "%s", why);
 
     Run r = {0};
     r.m = m;

@@ -80,6 +80,11 @@ typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *q
    the Engine as its context. The engine must outlive the kernels. */
 MechrtKernels run_engine_kernels(const Engine *engine);
 
+/* True when m has one row per coordinate, as a run needs; otherwise false
+   with why (size bytes) saying how many degrees of freedom are not driven
+   or how many rows are too many. */
+bool run_rows_match(const Model *m, char *why, size_t size);
+
 /* The run. m gives sizes, names and initial values; k evaluates m's rows.
    Needs k->nh + k->nv == k->nq, otherwise RUN_BAD_INPUT saying how many
    degrees of freedom are not driven (or how many rows are too many). */

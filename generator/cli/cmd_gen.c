@@ -10,8 +10,8 @@
 
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
-    "                 [--real double|float] [--trig own|libm] [--cpu-clones]\n"
-    "                 [--chunk N] [--stats]\n"
+    "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
+    "                 [--cpu-clones] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
@@ -26,6 +26,10 @@ static const char usage[] =
     "                    and short series, within 2.5 ulp, libm past 2^16 rad)\n"
     "                    or sin and cos of <math.h> as written (libm); float\n"
     "                    kernels always call sinf and cosf\n"
+    "  --jac HOW         the dense PREFIX_jac: spread (default) fills it from\n"
+    "                    PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
+    "                    direct stores every entry itself, zeros included: more\n"
+    "                    code, a faster dense Jacobian (what jit and aot use)\n"
     "  --cpu-clones      x86-64 with gcc >= 12 and glibc: compile every kernel\n"
     "                    also for x86-64-v3 (AVX2, FMA) and let the loader pick\n"
     "                    by CPU (target_clones), as the aot engine does; needs\n"
@@ -106,6 +110,9 @@ int cmd_gen(int argc, char **argv)
         } else if (strcmp(opt_name, "--trig") == 0) {
             static const char *const trigs[] = {"own", "libm", NULL};
             opt.libm_trig = args_choice(&a, opt_name, trigs) == 1;
+        } else if (strcmp(opt_name, "--jac") == 0) {
+            static const char *const jacs[] = {"spread", "direct", NULL};
+            opt.direct_jac = args_choice(&a, opt_name, jacs) == 1;
         } else if (strcmp(opt_name, "--cpu-clones") == 0) {
             opt.cpu_clones = true;
         } else if (strcmp(opt_name, "--chunk") == 0) {

@@ -295,6 +295,13 @@ int cmd_run(int argc, char **argv)
     if (!mech)
         return EXIT_USAGE;
     const Model *m = mech->model;
+    char why[300];
+    if (!run_rows_match(m, why, sizeof why)) {  /* before the engine's compile */
+        diag_error(&diag, m->last_pos, "%s", why);
+        diag_print(&diag, stderr);
+        pipeline_free(mech);
+        return EXIT_USAGE;
+    }
     SvgTrace traces[MAX_TRACES];
     SvgPlotVar vars[MAX_PLOT_VARS];
     int nvars = 0;
@@ -327,11 +334,9 @@ int cmd_run(int argc, char **argv)
                   .t0 = ro.t0, .t1 = ro.t1};
     mechrt_trace_init(&out.trace, m->nq);
     int status = EXIT_OK;
-    /* a mechanism that cannot run (row count) leaves no output file behind */
-    bool runnable = m->nr == m->nq;
     if (csv_stdout) {
         out.csv = stdout;
-    } else if (csv_path && runnable) {
+    } else if (csv_path) {
         out.csv = fopen(csv_path, "w");
         if (!out.csv) {
             fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", csv_path, strerror(errno));
@@ -341,12 +346,10 @@ int cmd_run(int argc, char **argv)
         }
     }
 
-    /* the header goes out only for a runnable mechanism, so that a
-       row-count error leaves the output empty */
     MechrtKernels k = run_engine_kernels(&e);
     RunResult res;
     ro.notes = stderr;
-    if (out.csv && runnable)
+    if (out.csv)
         mechrt_csv_header(out.csv, m->nq, m->coord_names);
     LastState last = {&out, ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};

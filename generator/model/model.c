@@ -399,6 +399,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     }
     m->dag.where = -1;
     SrcPos where = last ? last->pos : (SrcPos){0};
+    m->last_pos = where;
     if (m->nq == 0)
         diag_fail(b->diag, where, "the mechanism has no coordinates: declare a body, point or coord");
     if (b->npos + b->nvel == 0)

@@ -48,6 +48,8 @@ typedef struct Model {
     Row *rows;
     int njoints;
     Joint *joints;
+    SrcPos last_pos;    /* the last statement: where diagnostics about the
+                           mechanism as a whole point */
 } Model;
 
 /* Reads, parses and resolves a .mech text. Returns NULL with diag filled
