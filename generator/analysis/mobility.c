@@ -291,6 +291,58 @@ static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, c
     free(vals), free(cols), free(all);
 }
 
+/* Ranks of the dense Jacobian jac (nr x nq, evaluated) by SVD: of the
+   holonomic rows, of all rows, and of both without drivers; marks the
+   redundant rows in red. sub: nr x nq scratch. Leaves a rank at -1 when
+   the SVD fails (NaN or Inf). */
+static void dense_ranks(MechrtSvd *w, double *jac, double *sub, const Model *m, InfoReport *rep,
+                        const int *undriven, int nu, int nuh, const AnalysisOptions *opt,
+                        bool *red)
+{
+    int nq = m->nq, nh = m->nh, nr = m->nr;
+    MechrtSvdResult sv;
+    if (!mechrt_svd(w, jac, nh, nq, nq, opt->rank_tol, &sv))
+        return;
+    rep->rank = sv.rank;
+    rep->rank_tol = sv.tol;
+    rep->sigma_max = sv.sigma_max;
+    rep->sigma_min = sv.sigma_min;
+    rep->cond = nh ? sv.cond : 0.0;
+    rep->nredundant = svd_redundant_rows(w, jac, nh, nq, nq, sv.tol, 0, sv.rank, red);
+    /* all rows, velocity level included (the same matrix when nv == 0) */
+    MechrtSvdResult sa = sv;
+    if (m->nv > 0 && !mechrt_svd(w, jac, nr, nq, nq, opt->rank_tol, &sa))
+        return;
+    rep->rank_all = sa.rank;
+    rep->nredundant_velocity = svd_redundant_rows(w, jac, nr, nq, nq, sa.tol, nh, sa.rank, red);
+    if (sa.rank == nr) {        /* independent rows: so is every subset */
+        rep->rank_undriven_h = nuh;
+        rep->rank_undriven = nu;
+    } else {
+        pick_rows(jac, nq, undriven, nu, sub);
+        rep->rank_undriven_h = rank_of(w, sub, nuh, nq, sv.tol);
+        rep->rank_undriven = rank_of(w, sub, nu, nq, sa.tol);
+    }
+}
+
+/* Why the holonomic rows lose rank, from the ranks with and without
+   drivers and the generic rank (rank_undriven_h < nuh: the mechanism
+   itself is singular there). */
+static Singularity classify_singularity(const InfoReport *rep, int nuh)
+{
+    if (rep->rank < 0)
+        return SING_UNKNOWN;
+    if (rep->rank == rep->nh)
+        return SING_NONE;
+    if (rep->generic_rank >= 0 && rep->rank_undriven_h < rep->generic_rank)
+        return SING_POSITION;
+    if (rep->rank_undriven_h == nuh)
+        return SING_DRIVERS;
+    if (rep->generic_rank >= 0 && rep->generic_rank == rep->rank_undriven_h)
+        return SING_PERMANENT;
+    return SING_UNKNOWN;
+}
+
 bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
 {
     Model *m = mech->model;
@@ -340,37 +392,11 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
         rep->assembled = analysis_assemble_sparse(&me, nh, t, rep->q, opt, &rep->assembly);
     }
-    if (w)
-        mech_eval(&me, rep->q, t, NULL, jac);
-    else
-        sparse_ranks(&mech->kin, &me, rep, undriven, nu, nuh, opt, red);
-
     if (w) {
-        /* holonomic rows */
-        MechrtSvdResult sv;
-        if (mechrt_svd(w, jac, nh, nq, nq, opt->rank_tol, &sv)) {
-            rep->rank = sv.rank;
-            rep->rank_tol = sv.tol;
-            rep->sigma_max = sv.sigma_max;
-            rep->sigma_min = sv.sigma_min;
-            rep->cond = nh ? sv.cond : 0.0;
-            rep->nredundant = svd_redundant_rows(w, jac, nh, nq, nq, sv.tol, 0, sv.rank, red);
-            /* all rows, velocity level included (the same matrix when nv == 0) */
-            MechrtSvdResult sa = sv;
-            if (m->nv == 0 || mechrt_svd(w, jac, nr, nq, nq, opt->rank_tol, &sa)) {
-                rep->rank_all = sa.rank;
-                rep->nredundant_velocity =
-                    svd_redundant_rows(w, jac, nr, nq, nq, sa.tol, nh, sa.rank, red);
-                if (sa.rank == nr) {        /* independent rows: so is every subset */
-                    rep->rank_undriven_h = nuh;
-                    rep->rank_undriven = nu;
-                } else {
-                    pick_rows(jac, nq, undriven, nu, sub);
-                    rep->rank_undriven_h = rank_of(w, sub, nuh, nq, sv.tol);
-                    rep->rank_undriven = rank_of(w, sub, nu, nq, sa.tol);
-                }
-            }
-        }
+        mech_eval(&me, rep->q, t, NULL, jac);
+        dense_ranks(w, jac, sub, m, rep, undriven, nu, nuh, opt, red);
+    } else {
+        sparse_ranks(&mech->kin, &me, rep, undriven, nu, nuh, opt, red);
     }
     if (rep->rank < 0 || rep->rank_all < 0) {       /* NaN or Inf in the Jacobian */
         rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
@@ -388,18 +414,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
         rep->dof_rank = nq - rep->rank_all;
         rep->mobility_rank = nq - rep->rank_undriven;
     }
-    if (rep->rank < 0)
-        rep->singularity = SING_UNKNOWN;
-    else if (rep->rank == nh)
-        rep->singularity = SING_NONE;
-    else if (rep->generic_rank >= 0 && rep->rank_undriven_h < rep->generic_rank)
-        rep->singularity = SING_POSITION;
-    else if (rep->rank_undriven_h == nuh)
-        rep->singularity = SING_DRIVERS;
-    else if (rep->generic_rank >= 0 && rep->generic_rank == rep->rank_undriven_h)
-        rep->singularity = SING_PERMANENT;
-    else
-        rep->singularity = SING_UNKNOWN;
+    rep->singularity = classify_singularity(rep, nuh);
     rep->verdict = make_verdict(rep);
     rep->singular = make_singular(rep, nuh);
 

@@ -199,147 +199,176 @@ static void on_state_keep(void *ctx, double t, const double *q, const double *qd
     memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
 }
 
-int cmd_run(int argc, char **argv)
-{
-    Args a;
-    args_init(&a, "run", argc, argv);
-    RunOptions ro = run_default_options();
-    const char *csv_path = NULL, *svg_path = NULL, *plot_path = NULL, *plot_list = NULL, *opt;
+/* What the command line asked for. */
+typedef struct RunCli {
+    RunOptions ro;
+    MechLimits limits;
+    const char *csv_path, *svg_path, *plot_path, *plot_list;
     const char *trace_text[MAX_TRACES];
-    int ntraces = 0;
-    bool json = false, stats = false;
-    int engine = ENGINE_JIT, digits = 0;
+    int ntraces;
+    bool json, stats, pictures, csv_stdout;
+    int engine, digits;
+} RunCli;
+
+/* Reads the options into c. Returns -1 to go on, else the exit status
+   (--help, or bad usage already reported). */
+static int parse_options(Args *a, RunCli *c)
+{
+    const char *opt;
     double x;
-    MechLimits limits = mech_default_limits();
-    while (!a.failed && (opt = args_next(&a))) {
+    while (!a->failed && (opt = args_next(a))) {
         if (args_is_help(opt)) {
             fputs(usage, stdout);
             fputs(args_limits_usage, stdout);
             return EXIT_OK;
-        } else if (args_limit(&a, opt, &limits) || args_engine(&a, opt, &engine)) {
+        } else if (args_limit(a, opt, &c->limits) || args_engine(a, opt, &c->engine)) {
             continue;
         } else if (strcmp(opt, "--t0") == 0) {
-            args_double(&a, opt, &ro.t0);
+            args_double(a, opt, &c->ro.t0);
         } else if (strcmp(opt, "--t1") == 0) {
-            args_double(&a, opt, &ro.t1);
+            args_double(a, opt, &c->ro.t1);
         } else if (strcmp(opt, "--steps") == 0) {
-            args_int(&a, opt, 1, 100000000, &ro.steps);
+            args_int(a, opt, 1, 100000000, &c->ro.steps);
         } else if (strcmp(opt, "--csv") == 0) {
-            csv_path = args_value(&a, opt);
+            c->csv_path = args_value(a, opt);
         } else if (strcmp(opt, "--json") == 0) {
-            json = true;
+            c->json = true;
         } else if (strcmp(opt, "--svg") == 0) {
-            svg_path = args_value(&a, opt);
+            c->svg_path = args_value(a, opt);
         } else if (strcmp(opt, "--trace") == 0) {
-            const char *v = args_value(&a, opt);
-            if (v && ntraces == MAX_TRACES) {
+            const char *v = args_value(a, opt);
+            if (v && c->ntraces == MAX_TRACES) {
                 fprintf(stderr, "mechc run: error: at most %d --trace points\n", MAX_TRACES);
-                a.failed = true;
+                a->failed = true;
             } else if (v) {
-                trace_text[ntraces++] = v;
+                c->trace_text[c->ntraces++] = v;
             }
         } else if (strcmp(opt, "--plot") == 0) {
-            plot_path = args_value(&a, opt);
+            c->plot_path = args_value(a, opt);
         } else if (strcmp(opt, "--plot-vars") == 0) {
-            plot_list = args_value(&a, opt);
+            c->plot_list = args_value(a, opt);
         } else if (strcmp(opt, "--digits") == 0) {
-            args_int(&a, opt, 1, 17, &digits);
+            args_int(a, opt, 1, 17, &c->digits);
         } else if (strcmp(opt, "--tol") == 0) {
-            if (positive_option(&a, opt, &x, false))
-                ro.mechrt.tol_phi = ro.mechrt.tol_dq = x;
+            if (positive_option(a, opt, &x, false))
+                c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = x;
         } else if (strcmp(opt, "--max-iter") == 0) {
-            args_int(&a, opt, 1, 10000, &ro.mechrt.max_iter);
+            args_int(a, opt, 1, 10000, &c->ro.mechrt.max_iter);
         } else if (strcmp(opt, "--max-substeps") == 0) {
-            args_int(&a, opt, 1, 1 << 20, &ro.max_substeps);
+            args_int(a, opt, 1, 1 << 20, &c->ro.max_substeps);
         } else if (strcmp(opt, "--pivot-tol") == 0) {
-            if (positive_option(&a, opt, &x, true))
-                ro.mechrt.pivot_tol = x;
+            if (positive_option(a, opt, &x, true))
+                c->ro.mechrt.pivot_tol = x;
         } else if (strcmp(opt, "--cond-warn") == 0) {
-            if (positive_option(&a, opt, &x, true))
-                ro.mechrt.cond_warn = x;
+            if (positive_option(a, opt, &x, true))
+                c->ro.mechrt.cond_warn = x;
         } else if (strcmp(opt, "--ode") == 0) {
-            const char *v = args_value(&a, opt);
-            if (v && !mechrt_ode_method_from_name(v, &ro.ode.method)) {
+            const char *v = args_value(a, opt);
+            if (v && !mechrt_ode_method_from_name(v, &c->ro.ode.method)) {
                 fprintf(stderr, "mechc run: error: --ode takes rk8pd or rkf45, not '%s'\n", v);
-                a.failed = true;
+                a->failed = true;
             }
         } else if (strcmp(opt, "--ode-tol") == 0) {
-            if (positive_option(&a, opt, &x, false))
-                ro.ode.tol = x;
+            if (positive_option(a, opt, &x, false))
+                c->ro.ode.tol = x;
         } else if (strcmp(opt, "--stats") == 0) {
-            stats = true;
+            c->stats = true;
         } else {
-            args_unknown(&a, opt);
+            args_unknown(a, opt);
         }
     }
-    if (!args_need_file(&a))
+    if (!args_need_file(a))
         return EXIT_USAGE;
-    if (ro.t0 == ro.t1) {
-        fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", ro.t0);
-        return EXIT_USAGE;
-    }
-    if ((ntraces > 0 && !svg_path) || (plot_list && !plot_path)) {
-        fprintf(stderr, "mechc run: error: %s goes with %s\n", ntraces ? "--trace" : "--plot-vars",
-                ntraces ? "--svg FILE" : "--plot FILE");
+    if (c->ro.t0 == c->ro.t1) {
+        fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", c->ro.t0);
         return EXIT_USAGE;
     }
-    bool pictures = svg_path || plot_path;
-    bool csv_stdout = csv_path ? strcmp(csv_path, "-") == 0 : !json && !pictures;
-    if (csv_stdout && json) {
+    if ((c->ntraces > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
+        fprintf(stderr, "mechc run: error: %s goes with %s\n",
+                c->ntraces ? "--trace" : "--plot-vars", c->ntraces ? "--svg FILE" : "--plot FILE");
+        return EXIT_USAGE;
+    }
+    c->pictures = c->svg_path || c->plot_path;
+    c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0 : !c->json && !c->pictures;
+    if (c->csv_stdout && c->json) {
         fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
         return EXIT_USAGE;
     }
+    return -1;
+}
+
+/* The --trace points and --plot variables by name; false (reported) when
+   one is unknown. */
+static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
+                             SvgPlotVar *vars, int *nvars)
+{
+    char err[256];
+    *nvars = 0;
+    for (int i = 0; i < c->ntraces; i++) {
+        if (!svg_parse_trace(m, c->trace_text[i], &traces[i], err, sizeof err)) {
+            fprintf(stderr, "mechc run: error: %s\n", err);
+            return false;
+        }
+    }
+    if (c->plot_path && c->plot_list) {
+        *nvars = svg_plot_resolve(m, c->plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
+        if (*nvars <= 0) {
+            fprintf(stderr, "mechc run: error: %s\n", err);
+            return false;
+        }
+    } else if (c->plot_path) {
+        for (int i = 0; i < m->nq && *nvars < MAX_PLOT_VARS; i++)
+            vars[(*nvars)++] = (SvgPlotVar){i, 0};
+    }
+    return true;
+}
+
+int cmd_run(int argc, char **argv)
+{
+    Args a;
+    args_init(&a, "run", argc, argv);
+    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
+                .engine = ENGINE_JIT};
+    int status = parse_options(&a, &c);
+    if (status >= 0)
+        return status;
 
     Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
+    Mech *mech = cli_load(&a, &c.limits, &diag);
     if (!mech)
         return EXIT_USAGE;
     const Model *m = mech->model;
     char why[300];
+    SvgTrace traces[MAX_TRACES];
+    SvgPlotVar vars[MAX_PLOT_VARS];
+    int nvars;
     if (!run_rows_match(m, why, sizeof why)) {  /* before the engine's compile */
         diag_error(&diag, m->last_pos, "%s", why);
         diag_print(&diag, stderr);
         pipeline_free(mech);
         return EXIT_USAGE;
     }
-    SvgTrace traces[MAX_TRACES];
-    SvgPlotVar vars[MAX_PLOT_VARS];
-    int nvars = 0;
-    char err[256];
-    for (int i = 0; i < ntraces; i++) {
-        if (!svg_parse_trace(m, trace_text[i], &traces[i], err, sizeof err)) {
-            fprintf(stderr, "mechc run: error: %s\n", err);
-            pipeline_free(mech);
-            return EXIT_USAGE;
-        }
-    }
-    if (plot_path && plot_list) {
-        nvars = svg_plot_resolve(m, plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
-        if (nvars <= 0) {
-            fprintf(stderr, "mechc run: error: %s\n", err);
-            pipeline_free(mech);
-            return EXIT_USAGE;
-        }
-    } else if (plot_path) {
-        for (int i = 0; i < m->nq && nvars < MAX_PLOT_VARS; i++)
-            vars[nvars++] = (SvgPlotVar){i, 0};
+    if (!resolve_pictures(m, &c, traces, vars, &nvars)) {
+        pipeline_free(mech);
+        return EXIT_USAGE;
     }
     Engine e;
-    if (!cli_engine_open(&a, &e, (EngineKind)engine, mech, NULL, &diag)) {
+    if (!cli_engine_open(&a, &e, (EngineKind)c.engine, mech, NULL, &diag)) {
         pipeline_free(mech);
         return EXIT_USAGE;
     }
 
-    Output out = {.csv = NULL, .json = json || pictures, .digits = digits, .nq = m->nq,
+    RunOptions ro = c.ro;
+    Output out = {.csv = NULL, .json = c.json || c.pictures, .digits = c.digits, .nq = m->nq,
                   .t0 = ro.t0, .t1 = ro.t1};
     mechrt_trace_init(&out.trace, m->nq);
-    int status = EXIT_OK;
-    if (csv_stdout) {
+    status = EXIT_OK;
+    if (c.csv_stdout) {
         out.csv = stdout;
-    } else if (csv_path) {
-        out.csv = fopen(csv_path, "w");
+    } else if (c.csv_path) {
+        out.csv = fopen(c.csv_path, "w");
         if (!out.csv) {
-            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", csv_path, strerror(errno));
+            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c.csv_path, strerror(errno));
             engine_close(&e);
             pipeline_free(mech);
             return EXIT_USAGE;
@@ -362,11 +391,11 @@ int cmd_run(int argc, char **argv)
         fprintf(stderr, "%s: error: %s\n", m->file, res.message);
         status = EXIT_USAGE;
     } else {
-        if (pictures && !write_pictures(m, &out.trace, svg_path, traces, ntraces, plot_path,
-                                        vars, nvars))
+        if (c.pictures && !write_pictures(m, &out.trace, c.svg_path, traces, c.ntraces,
+                                          c.plot_path, vars, nvars))
             status = EXIT_USAGE;
-        if (json)
-            mechrt_json_write(stdout, &out.trace, m->coord_names, digits,
+        if (c.json)
+            mechrt_json_write(stdout, &out.trace, m->coord_names, c.digits,
                               rs == RUN_FAILED ? res.message : NULL, res.t_fail);
         if (rs == RUN_FAILED) {
             fprintf(stderr, "%s: error: %s\n", m->file, res.message);
@@ -380,12 +409,12 @@ int cmd_run(int argc, char **argv)
             fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
             status = EXIT_ANALYSIS;
         }
-        if (stats)
+        if (c.stats)
             print_stats(&res, &k, last.q, last.qd, last.t);
     }
     if (out.csv && out.csv != stdout) {
         if (fclose(out.csv) != 0) {
-            fprintf(stderr, "mechc run: error: writing '%s': %s\n", csv_path, strerror(errno));
+            fprintf(stderr, "mechc run: error: writing '%s': %s\n", c.csv_path, strerror(errno));
             status = status == EXIT_OK ? EXIT_USAGE : status;
         }
     } else if (fflush(stdout) != 0 || ferror(stdout)) {

@@ -475,10 +475,10 @@ static void put_banner(StrBuf *sb, const char *source)
     sb_puts(sb, ". DO NOT EDIT.");
 }
 
-bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag)
+/* The prefix (out, from opt or the mechanism name) and the options that
+   reach the C text: false with diag filled when one is unusable. */
+static bool check_options(const Model *m, const EmitOptions *opt, EmitResult *out, Diag *diag)
 {
-    const Model *m = kin->model;
-    memset(out, 0, sizeof *out);
     if (opt->prefix) {
         const char *why = emit_check_prefix(opt->prefix);
         if (why) {
@@ -508,6 +508,208 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
             return false;
         }
     }
+    return true;
+}
+
+/* Schedules and writes every function into parts and bodies (initialized
+   here, freed by the caller); false when the code would pass max_ops. */
+static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
+{
+    const EmitOptions *opt = e->opt;
+    sched_init(&e->sched, e->dag,
+               opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
+    e->sched.max_ops = opt->max_ops;
+    bool fits = true;
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        sb_init(&parts[f]);
+        sb_init(&bodies[f]);
+        sb_puts(&parts[f], "");
+        sb_puts(&bodies[f], "");
+        if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
+            continue;
+        SchedOutput *outs;
+        int n;
+        collect_outputs(e->kin, (EmitFunction)f, &outs, &n);
+        SchedFunction fn;
+        if (sched_function(&e->sched, outs, n, &fn)) {
+            put_function(e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
+            out->ops[f] = fn.ops;
+            out->chunks[f] = fn.nchunks;
+        } else {
+            fits = false;
+        }
+        sched_function_free(&fn);
+    }
+    sched_free(&e->sched);
+    if (!opt->direct_jac) {
+        out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
+        out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
+    }
+    return fits;
+}
+
+/* What the kernels call for math: libm declared (JIT) or included, and
+   the sincos functions the emitter used. */
+static void put_math(StrBuf *math, const Emitter *e)
+{
+    const char *upper = e->prefix_upper;
+    if (e->opt->declare_math) {
+        sb_puts(math, "/* libm, declared rather than included: no system headers needed */\n");
+        for (int op = OP_POW; op < OP_COUNT; op++)
+            sb_printf(math, "double %s(double%s);\n", dag_op_info[op].c_double,
+                      dag_op_info[op].arity == 2 ? ", double" : "");
+        if (e->sincos_used) {
+            sb_printf(math, "void %s(double, double *, double *);\n", e->sincos_name);
+            if (e->sincos2_used)
+                sb_printf(math, "void %s(double, double, double *, double *, double *, double *);\n",
+                          e->sincos2_name);
+        }
+        sb_puts(math, "void *memset(void *, int, unsigned long);\n");
+        return;
+    }
+    sb_puts(math, "#include <math.h>\n");
+    if (!e->sincos_used)
+        return;
+    char trig[160];
+    snprintf(trig, sizeof trig, "%s_TRIG ", upper);
+    TemplateVar sv[] = {{"P", e->prefix}, {"STATIC", trig}};
+    /* gcc splits the pair function at its rare-case test and calls the rest
+       out of line, through memory, unless forced; without a vector unit,
+       inlining only multiplies the code (it doubled the Cortex-M3 kernels
+       at -O2) */
+    sb_printf(math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
+              "they inline it;\n   elsewhere one copy serves all calls */\n"
+              "#if defined(__GNUC__) && defined(__SSE2__)\n"
+              "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
+              "#define %s_TRIG static\n#endif\n", upper, upper);
+    if (template_render(math, template_sincos, sv, 2))
+        abort();    /* every placeholder of the sincos templates is given */
+    if (e->sincos2_used) {
+        sb_puts(math, "\n");
+        if (template_render(math, template_sincos2, sv, 2))
+            abort();
+    }
+}
+
+/* The v3 clone has AVX2 and FMA: gcc then computes the paired angles with
+   three-operand and fused instructions (four-bar gamma about a fifth
+   faster under gcc -O2). ifuncs need glibc; gcc 12 is the first to
+   dispatch on arch=x86-64-v3 by CPU features. */
+static void put_clones(StrBuf *clones, const char *upper)
+{
+    sb_printf(clones,
+              "\n/* Each kernel is compiled twice, for the x86-64 baseline and for x86-64-v3\n"
+              "   (AVX2, FMA), and the loader picks the one this CPU runs (GCC's\n"
+              "   target_clones, an ifunc). Define %s_KERNEL to override. */\n"
+              "#if !defined(%s_KERNEL)\n"
+              "#if defined(__GNUC__) && __GNUC__ >= 12 && !defined(__clang__) && "
+              "defined(__x86_64__) && defined(__GLIBC__)\n"
+              "#define %s_KERNEL __attribute__((target_clones(\"arch=x86-64-v3\", \"default\")))\n"
+              "#else\n#define %s_KERNEL\n#endif\n#endif\n",
+              upper, upper, upper, upper);
+}
+
+/* The data section's lists: initial values, names, Jacobian structure. */
+static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows, StrBuf *jrow,
+                     StrBuf *jcol)
+{
+    const Model *m = e->kin->model;
+    for (int i = 0; i < m->nq; i++) {
+        sb_puts(q0, "    ");
+        put_literal(q0, m->q0[i], e->opt->real_float);
+        sb_puts(q0, ",\n");
+    }
+    put_string_list(coords, m->coord_names, m->nq);
+    for (int r = 0; r < m->nr; r++) {
+        sb_puts(rows, "    ");
+        sb_put_c_string(rows, m->rows[r].name);
+        sb_puts(rows, ",\n");
+    }
+    put_int_list(jrow, e->kin, true);
+    put_int_list(jcol, e->kin, false);
+}
+
+/* Fills the templates with the written functions: out's source and header. */
+static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
+{
+    const EmitOptions *opt = e->opt;
+    const Model *m = e->kin->model;
+    const char *upper = e->prefix_upper;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, clones, jac, inc;
+    StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
+                          &zero, &clones, &jac, &inc};
+    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
+        sb_init(all_bufs[i]);
+        sb_puts(all_bufs[i], "");
+    }
+    put_banner(&banner, opt->source_name ? opt->source_name : m->file);
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
+    put_data(e, &q0, &coords, &rows, &jrow, &jcol);
+    put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
+    put_math(&math, e);
+    if (opt->cpu_clones)
+        put_clones(&clones, upper);
+
+    char nq[32], nh[32], nv[32], nnz[32], guard[160];
+    snprintf(nq, sizeof nq, "%d", m->nq);
+    snprintf(nh, sizeof nh, "%d", m->nh);
+    snprintf(nv, sizeof nv, "%d", m->nv);
+    /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
+       placeholder entry (row 0, column 0, value 0). */
+    snprintf(nnz, sizeof nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
+    snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
+    enum { VAR_INTERFACE = 11 };
+    TemplateVar vars[] = {
+        {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
+        {"REAL", opt->real_float ? "float" : "double"}, {"NQ", nq}, {"NH", nh}, {"NV", nv},
+        {"NNZ", nnz}, {"GUARD", guard}, {"MATH", math.data}, {"INTERFACE", ""},
+        {"Q0", q0.data}, {"COORD_NAMES", coords.data}, {"ROW_NAMES", rows.data},
+        {"JAC_ROW", jrow.data}, {"JAC_COL", jcol.data},
+        {"PHI_PARTS", parts[EMIT_PHI].data}, {"PHI_BODY", bodies[EMIT_PHI].data},
+        {"JAC_NZ_PARTS", parts[EMIT_JAC_NZ].data}, {"JAC_NZ_BODY", bodies[EMIT_JAC_NZ].data},
+        {"NU_PARTS", parts[EMIT_NU].data}, {"NU_BODY", bodies[EMIT_NU].data},
+        {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
+        {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
+        {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
+        {"ZERO_JAC", zero.data}, {"CLONES", clones.data}, {"KERNEL", e->kernel_attr}, {"JAC", ""},
+    };
+    int nvars = (int)(sizeof vars / sizeof *vars);
+    const char *bad = template_render(&iface, template_interface, vars, nvars);
+    vars[VAR_INTERFACE].value = iface.data;
+    if (!bad)
+        bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
+                              vars, nvars);
+    vars[nvars - 1].value = jac.data;               /* JAC */
+    StrBuf header, source;
+    sb_init(&header);
+    sb_init(&source);
+    if (!bad)
+        bad = template_render(&header, template_mech_h, vars, nvars);
+    if (opt->header_name) {     /* the source includes the header instead */
+        sb_puts(&inc, "#include ");
+        sb_put_c_string(&inc, opt->header_name);
+        sb_puts(&inc, "\n");
+        vars[VAR_INTERFACE].value = inc.data;
+    }
+    if (!bad)
+        bad = template_render(&source, template_mech_c, vars, nvars);
+    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++)
+        sb_free(all_bufs[i]);
+    if (bad) {
+        fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", bad);
+        abort();
+    }
+    out->c_text = sb_take(&source);
+    out->h_text = sb_take(&header);
+}
+
+bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag)
+{
+    const Model *m = kin->model;
+    memset(out, 0, sizeof *out);
+    if (!check_options(m, opt, out, diag))
+        return false;
     char upper[128];
     size_t plen = strlen(out->prefix);
     for (size_t i = 0; i <= plen; i++)
@@ -534,184 +736,19 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         e.sincos2_name = sincos2_name;
     }
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
-    sched_init(&e.sched, &m->dag,
-               opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
-    e.sched.max_ops = opt->max_ops;
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
-    bool too_big = false;
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
-        sb_init(&parts[f]);
-        sb_init(&bodies[f]);
-        sb_puts(&parts[f], "");
-        sb_puts(&bodies[f], "");
-        if ((f == EMIT_JAC && !opt->direct_jac) || too_big)  /* jac_spread.tmpl: on jac_nz */
-            continue;
-        SchedOutput *outs;
-        int n;
-        collect_outputs(kin, (EmitFunction)f, &outs, &n);
-        SchedFunction fn;
-        if (sched_function(&e.sched, outs, n, &fn)) {
-            put_function(&e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
-            out->ops[f] = fn.ops;
-            out->chunks[f] = fn.nchunks;
-        } else {
-            too_big = true;
-        }
-        sched_function_free(&fn);
-    }
-    sched_free(&e.sched);
+    bool fits = put_functions(&e, parts, bodies, out);
     free(e.written);
-    if (too_big) {
-        for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
-            sb_free(&parts[f]);
-            sb_free(&bodies[f]);
-        }
+    if (fits)
+        render_files(&e, parts, bodies, out);
+    else
         diag_error_nopos(diag, "the generated code would have more than %ld operations, "
                          "the limit (see --max-code-ops)", opt->max_ops);
-        return false;
-    }
-    if (!opt->direct_jac) {
-        out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
-        out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
-    }
-
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, clones, jac;
-    StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &clones, &jac};
-    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
-        sb_init(all_bufs[i]);
-        sb_puts(all_bufs[i], "");
-    }
-    put_banner(&banner, opt->source_name ? opt->source_name : m->file);
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
-        sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
-    for (int i = 0; i < m->nq; i++) {
-        sb_puts(&q0, "    ");
-        put_literal(&q0, m->q0[i], opt->real_float);
-        sb_puts(&q0, ",\n");
-    }
-    put_string_list(&coords, m->coord_names, m->nq);
-    for (int r = 0; r < m->nr; r++) {
-        sb_puts(&rows, "    ");
-        sb_put_c_string(&rows, m->rows[r].name);
-        sb_puts(&rows, ",\n");
-    }
-    put_int_list(&jrow, kin, true);
-    put_int_list(&jcol, kin, false);
-    put_zero_fill(&zero, kin, opt, out->prefix, upper);
-    if (opt->declare_math) {
-        sb_puts(&math, "/* libm, declared rather than included: no system headers needed */\n");
-        for (int op = OP_POW; op < OP_COUNT; op++)
-            sb_printf(&math, "double %s(double%s);\n", dag_op_info[op].c_double,
-                      dag_op_info[op].arity == 2 ? ", double" : "");
-        if (e.sincos_used) {
-            sb_printf(&math, "void %s(double, double *, double *);\n", e.sincos_name);
-            if (e.sincos2_used)
-                sb_printf(&math, "void %s(double, double, double *, double *, double *, double *);\n",
-                          e.sincos2_name);
-        }
-        sb_puts(&math, "void *memset(void *, int, unsigned long);\n");
-    } else {
-        sb_puts(&math, "#include <math.h>\n");
-        if (e.sincos_used) {
-            char trig[160];
-            snprintf(trig, sizeof trig, "%s_TRIG ", upper);
-            TemplateVar sv[] = {{"P", out->prefix}, {"STATIC", trig}};
-            /* gcc splits the pair function at its rare-case test and calls
-               the rest out of line, through memory, unless forced; without
-               a vector unit, inlining only multiplies the code (it doubled
-               the Cortex-M3 kernels at -O2) */
-            sb_printf(&math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
-                      "they inline it;\n   elsewhere one copy serves all calls */\n"
-                      "#if defined(__GNUC__) && defined(__SSE2__)\n"
-                      "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
-                      "#define %s_TRIG static\n#endif\n", upper, upper);
-            if (template_render(&math, template_sincos, sv, 2))
-                abort();    /* every placeholder of the sincos templates is given */
-            if (e.sincos2_used) {
-                sb_puts(&math, "\n");
-                if (template_render(&math, template_sincos2, sv, 2))
-                    abort();
-            }
-        }
-    }
-
-    /* The v3 clone has AVX2 and FMA: gcc then computes the paired angles
-       with three-operand and fused instructions (four-bar gamma about a
-       fifth faster under gcc -O2). ifuncs need glibc; gcc 12 is the first
-       to dispatch on arch=x86-64-v3 by CPU features. */
-    if (opt->cpu_clones)
-        sb_printf(&clones,
-                 "\n/* Each kernel is compiled twice, for the x86-64 baseline and for x86-64-v3\n"
-                 "   (AVX2, FMA), and the loader picks the one this CPU runs (GCC's\n"
-                 "   target_clones, an ifunc). Define %s_KERNEL to override. */\n"
-                 "#if !defined(%s_KERNEL)\n"
-                 "#if defined(__GNUC__) && __GNUC__ >= 12 && !defined(__clang__) && "
-                 "defined(__x86_64__) && defined(__GLIBC__)\n"
-                 "#define %s_KERNEL __attribute__((target_clones(\"arch=x86-64-v3\", \"default\")))\n"
-                 "#else\n#define %s_KERNEL\n#endif\n#endif\n",
-                 upper, upper, upper, upper);
-
-    char nq[32], nh[32], nv[32], nnz[32], guard[160];
-    snprintf(nq, sizeof nq, "%d", m->nq);
-    snprintf(nh, sizeof nh, "%d", m->nh);
-    snprintf(nv, sizeof nv, "%d", m->nv);
-    /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
-       placeholder entry (row 0, column 0, value 0). */
-    snprintf(nnz, sizeof nnz, "%d", kin->nnz > 0 ? kin->nnz : 1);
-    snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
-    TemplateVar vars[] = {
-        {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
-        {"REAL", opt->real_float ? "float" : "double"}, {"NQ", nq}, {"NH", nh}, {"NV", nv},
-        {"NNZ", nnz}, {"GUARD", guard}, {"MATH", math.data}, {"INTERFACE", ""},
-        {"Q0", q0.data}, {"COORD_NAMES", coords.data}, {"ROW_NAMES", rows.data},
-        {"JAC_ROW", jrow.data}, {"JAC_COL", jcol.data},
-        {"PHI_PARTS", parts[EMIT_PHI].data}, {"PHI_BODY", bodies[EMIT_PHI].data},
-        {"JAC_NZ_PARTS", parts[EMIT_JAC_NZ].data}, {"JAC_NZ_BODY", bodies[EMIT_JAC_NZ].data},
-        {"NU_PARTS", parts[EMIT_NU].data}, {"NU_BODY", bodies[EMIT_NU].data},
-        {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
-        {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
-        {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"CLONES", clones.data}, {"KERNEL", e.kernel_attr}, {"JAC", ""},
-    };
-    int nvars = (int)(sizeof vars / sizeof *vars);
-    const char *bad = template_render(&iface, template_interface, vars, nvars);
-    vars[11].value = iface.data;                    /* INTERFACE */
-    if (!bad)
-        bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
-                              vars, nvars);
-    vars[nvars - 1].value = jac.data;               /* JAC */
-    StrBuf header, source;
-    sb_init(&header);
-    sb_init(&source);
-    if (!bad)
-        bad = template_render(&header, template_mech_h, vars, nvars);
-    if (opt->header_name) {
-        StrBuf inc;
-        sb_init(&inc);
-        sb_puts(&inc, "#include ");
-        sb_put_c_string(&inc, opt->header_name);
-        sb_puts(&inc, "\n");
-        vars[11].value = inc.data;
-        if (!bad)
-            bad = template_render(&source, template_mech_c, vars, nvars);
-        sb_free(&inc);
-    } else if (!bad) {
-        bad = template_render(&source, template_mech_c, vars, nvars);
-    }
-    for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++)
-        sb_free(all_bufs[i]);
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
         sb_free(&parts[f]);
         sb_free(&bodies[f]);
     }
-    if (bad) {
-        fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", bad);
-        abort();
-    }
-    out->c_text = sb_take(&source);
-    out->h_text = sb_take(&header);
-    return true;
+    return fits;
 }
 
 void emit_result_free(EmitResult *out)
