@@ -227,7 +227,6 @@ else
 fi
 
 run gen --help
-check "gen --help documents --cpu-clones" out_has "--cpu-clones"
 check "gen --help documents --jac" out_has "--jac HOW"
 run gen "$ex/four_bar.mech" --jac direct --prefix fbd -o "$tmp/fbd.c"
 check "gen --jac direct exits 0" status_is 0
@@ -240,24 +239,6 @@ fi
 run gen "$ex/four_bar.mech" --jac sideways
 check "gen --jac sideways exits 2" status_is 2
 check "gen --jac sideways names the choices" err_has "spread or direct"
-run gen "$ex/four_bar.mech" --cpu-clones --prefix fbc -o "$tmp/fbc.c"
-check "gen --cpu-clones exits 0" status_is 0
-check "gen --cpu-clones: the kernels carry the clones macro" grep -q '^FBC_KERNEL void fbc_gamma(' "$tmp/fbc.c"
-if have gcc; then
-    check "gcc builds gen --cpu-clones output as a shared library" \
-        gcc $cflags -O2 -fPIC -shared "$tmp/fbc.c" -o "$tmp/fbc.so" -lm
-    probe='#include <math.h>
-#if defined(__GNUC__) && __GNUC__ >= 12 && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__)
-clones_here
-#endif'
-    if printf '%s\n' "$probe" | gcc -E -P - 2>/dev/null | grep -q clones_here; then
-        check "gen --cpu-clones: gcc built an x86-64-v3 clone of gamma" \
-            sh -c 'nm "$1" | grep -q "fbc_gamma\.arch_x86_64_v3"' _ "$tmp/fbc.so"
-    else
-        skip "gcc < 12, not x86-64 or not glibc: no clones to look for"
-    fi
-fi
-
 run gen "$ex/four_bar.mech" --prefix 1bad -o "$tmp/bad_prefix.c"
 check "gen --prefix 1bad exits 2" status_is 2
 check "gen --prefix 1bad says why" err_has "error:"

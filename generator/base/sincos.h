@@ -2,7 +2,7 @@
 #ifndef MECHC_SINCOS_H
 #define MECHC_SINCOS_H
 
-/* sin x and cos x; within 2 ulp of the C library's. The JIT's kernels call
+/* sin x and cos x, within 2.5 ulp of the exact values. The JIT's kernels call
    it (symbol "mechc_sincos") and the generic evaluator uses it, so that
    every engine computes the same trigonometry. */
 void mechc_sincos(double x, double *s, double *c);

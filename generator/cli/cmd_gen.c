@@ -11,7 +11,7 @@
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
-    "                 [--cpu-clones] [--chunk N] [--stats]\n"
+    "                 [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
@@ -30,11 +30,7 @@ static const char usage[] =
     "                    PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
     "                    direct stores every entry itself, zeros included: more\n"
     "                    code, a faster dense Jacobian (what jit and aot use)\n"
-    "  --cpu-clones      x86-64 with gcc >= 12 and glibc: compile every kernel\n"
-    "                    also for x86-64-v3 (AVX2, FMA) and let the loader pick\n"
-    "                    by CPU (target_clones), as the aot engine does; needs\n"
-    "                    libgcc, so not for freestanding builds (elsewhere the\n"
-    "                    source is unchanged)\n"
+
     "  --chunk N         most operations per C function before it is split into\n"
     "                    static parts, counting operations and stores (default 150;\n"
     "                    keeps optimizing compilers fast)\n"
@@ -113,8 +109,6 @@ int cmd_gen(int argc, char **argv)
         } else if (strcmp(opt_name, "--jac") == 0) {
             static const char *const jacs[] = {"spread", "direct", NULL};
             opt.direct_jac = args_choice(&a, opt_name, jacs) == 1;
-        } else if (strcmp(opt_name, "--cpu-clones") == 0) {
-            opt.cpu_clones = true;
         } else if (strcmp(opt_name, "--chunk") == 0) {
             args_int(&a, opt_name, 50, 1000000, &opt.chunk_nodes);
         } else if (strcmp(opt_name, "--dump") == 0) {

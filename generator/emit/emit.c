@@ -137,8 +137,6 @@ typedef struct Emitter {
     const EmitOptions *opt;
     const char *prefix;
     const char *prefix_upper;
-    const char *kernel_attr;    /* written before each kernel definition:
-                                   "P_KERNEL " with cpu_clones, else "" */
     Scheduler sched;
     const char *sincos_name;    /* NULL: sin and cos of <math.h> as written */
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
@@ -366,8 +364,7 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
     }
     const char *p = e->prefix;
     for (int c = 0; c < fn->nchunks; c++) {
-        sb_printf(parts, "%s_PART %svoid %s_%s_part%d(", e->prefix_upper, e->kernel_attr, p,
-                  emit_function_names[which], c);
+        sb_printf(parts, "%s_PART void %s_%s_part%d(", e->prefix_upper, p, emit_function_names[which], c);
         put_signature(parts, p, which);
         sb_puts(parts, ")\n{\n");
         put_chunk(e, parts, fn, c, which);
@@ -591,24 +588,6 @@ static void put_math(StrBuf *math, const Emitter *e)
     }
 }
 
-/* The v3 clone has AVX2 and FMA: gcc then computes the paired angles with
-   three-operand and fused instructions (four-bar gamma about a fifth
-   faster under gcc -O2). ifuncs need glibc; gcc 12 is the first to
-   dispatch on arch=x86-64-v3 by CPU features. */
-static void put_clones(StrBuf *clones, const char *upper)
-{
-    sb_printf(clones,
-              "\n/* Each kernel is compiled twice, for the x86-64 baseline and for x86-64-v3\n"
-              "   (AVX2, FMA), and the loader picks the one this CPU runs (GCC's\n"
-              "   target_clones, an ifunc). Define %s_KERNEL to override. */\n"
-              "#if !defined(%s_KERNEL)\n"
-              "#if defined(__GNUC__) && __GNUC__ >= 12 && !defined(__clang__) && "
-              "defined(__x86_64__) && defined(__GLIBC__)\n"
-              "#define %s_KERNEL __attribute__((target_clones(\"arch=x86-64-v3\", \"default\")))\n"
-              "#else\n#define %s_KERNEL\n#endif\n#endif\n",
-              upper, upper, upper, upper);
-}
-
 /* The data section's lists: initial values, names, Jacobian structure. */
 static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows, StrBuf *jrow,
                      StrBuf *jcol)
@@ -635,9 +614,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     const EmitOptions *opt = e->opt;
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, clones, jac, inc;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &clones, &jac, &inc};
+                          &zero, &jac, &inc};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
@@ -648,8 +627,6 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     put_data(e, &q0, &coords, &rows, &jrow, &jcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
     put_math(&math, e);
-    if (opt->cpu_clones)
-        put_clones(&clones, upper);
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
@@ -672,7 +649,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"CLONES", clones.data}, {"KERNEL", e->kernel_attr}, {"JAC", ""},
+        {"ZERO_JAC", zero.data}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     const char *bad = template_render(&iface, template_interface, vars, nvars);
@@ -715,10 +692,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     for (size_t i = 0; i <= plen; i++)
         upper[i] = (char)toupper((unsigned char)out->prefix[i]);
 
-    char kernel_attr[160];
-    snprintf(kernel_attr, sizeof kernel_attr, "%s_KERNEL ", upper);
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
-                 .prefix_upper = upper, .kernel_attr = opt->cpu_clones ? kernel_attr : ""};
+                 .prefix_upper = upper};
     /* Double kernels compute sin and cos together, of two angles at once
        where they can: the JIT calls the tool's mechc_sincos and
        mechc_sincos2 (or the C library's sincos with libm_trig), file output

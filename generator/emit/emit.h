@@ -23,11 +23,6 @@ typedef struct EmitOptions {
                                    rather than the emitted P_sincos
                                    (templates/sincos.tmpl; float kernels
                                    always call sinf and cosf) */
-    bool cpu_clones;            /* x86-64 with gcc >= 12 and glibc: every
-                                   kernel also built for x86-64-v3 (AVX2,
-                                   FMA), the loader picking by CPU (GCC's
-                                   target_clones; needs libgcc's CPU
-                                   probe, so not for freestanding builds) */
     int chunk_nodes;            /* most operations plus stores per C function (default 150) */
     const char *source_name;    /* the input file, named in the banner */
     long max_ops;               /* most operations in all functions together
