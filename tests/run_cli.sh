@@ -181,6 +181,10 @@ for f in pendulum_distance pendulum_constraint; do
     check "$f: 1 degree of freedom is not driven" err_matches "$f.mech:[0-9]*:1: error: 1 degree of freedom is not driven"
     check "$f: the last statement, with a caret" err_matches '^    \^$'
     check "$f: no output" out_empty
+    run "$ex/$f.mech" --csv "$tmp/$f.csv" --svg "$tmp/$f.svg"
+    check "$f --csv FILE --svg FILE: exit 2" status_is 2
+    check "$f --csv FILE --svg FILE: no file written" \
+        sh -c '[ ! -e "$1" ] && [ ! -e "$2" ]' _ "$tmp/$f.csv" "$tmp/$f.svg"
 done
 cat > "$tmp/over.mech" <<'EOF'
 point p x = 0 y = 0
