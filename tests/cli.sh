@@ -236,6 +236,11 @@ check "gen default: the dense Jacobian is spread from jac_nz" grep -q "fb_jac_nz
 if have gcc; then
     check "gcc compiles gen --jac direct output" gcc $cflags -c "$tmp/fbd.c" -o "$tmp/fbd.o"
 fi
+printf 'point p x = 0 y = 0\nconstraint a: p.x = 1e-50*p.y\ndriver d: p.y = t\n' > "$tmp/tiny.mech"
+run gen "$tmp/tiny.mech" --real float
+check "gen --real float with a constant float rounds to 0: exit 2" status_is 2
+check "gen --real float with a constant float rounds to 0: the file and why" \
+    err_has "tiny.mech: error: the constant 1e-50 is too small for float"
 run gen "$ex/four_bar.mech" --jac sideways
 check "gen --jac sideways exits 2" status_is 2
 check "gen --jac sideways names the choices" err_has "spread or direct"

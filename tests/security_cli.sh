@@ -154,7 +154,7 @@ expect "--max-nodes too small" 2 "pend.mech:2:1: error: the expression graph pas
 expect "--max-nodes not a number" 2 "--max-nodes needs a whole number" eval "$tmp/pend.mech" --max-nodes x
 expect "--max-nodes out of range" 2 "--max-nodes needs a whole number" eval "$tmp/pend.mech" --max-nodes 99999999999
 expect "--max-depth 0" 2 "--max-depth needs a whole number from 1" gen "$tmp/pend.mech" --max-depth 0
-expect "--max-code-ops 5" 2 "more than 5 operations" gen "$tmp/pend.mech" --max-code-ops 5
+expect "--max-code-ops 5" 2 "pend.mech: error: the generated code would have more than 5 operations" gen "$tmp/pend.mech" --max-code-ops 5
 expect "--max-name-length 2" 2 "pend.mech:2:10: error: name longer than the limit of 2" \
     eval "$tmp/pend.mech" --max-name-length=2
 expect "--max-jac-entries 1" 2 "more than the limit of 1" eval "$tmp/pend.mech" --max-jac-entries 1

@@ -151,8 +151,8 @@ int cmd_gen(int argc, char **argv)
     opt.source_name = a.file;
     EmitResult res;
     double t0 = pipeline_now();
-    if (!emit_mechanism(&mech->kin, &opt, &res, &diag)) {
-        fprintf(stderr, "mechc gen: error: %s\n", diag.message);
+    if (!emit_mechanism(&mech->kin, &opt, &res, &diag)) {     /* about the file: "FILE: error: ..." */
+        diag_print(&diag, stderr);
         pipeline_free(mech);
         return EXIT_USAGE;
     }
