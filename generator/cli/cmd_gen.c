@@ -30,7 +30,6 @@ static const char usage[] =
     "                    PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
     "                    direct stores every entry itself, zeros included: more\n"
     "                    code, a faster dense Jacobian (what jit and aot use)\n"
-
     "  --chunk N         most operations per C function before it is split into\n"
     "                    static parts, counting operations and stores (default 150;\n"
     "                    keeps optimizing compilers fast)\n"

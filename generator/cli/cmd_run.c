@@ -358,9 +358,8 @@ int cmd_run(int argc, char **argv)
         return EXIT_USAGE;
     }
 
-    RunOptions ro = c.ro;
     Output out = {.csv = NULL, .json = c.json || c.pictures, .digits = c.digits, .nq = m->nq,
-                  .t0 = ro.t0, .t1 = ro.t1};
+                  .t0 = c.ro.t0, .t1 = c.ro.t1};
     mechrt_trace_init(&out.trace, m->nq);
     status = EXIT_OK;
     if (c.csv_stdout) {
@@ -377,14 +376,14 @@ int cmd_run(int argc, char **argv)
 
     MechrtKernels k = run_engine_kernels(&e);
     RunResult res;
-    ro.notes = stderr;
+    c.ro.notes = stderr;
     if (out.csv)
         mechrt_csv_header(out.csv, m->nq, m->coord_names);
-    LastState last = {&out, ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
+    LastState last = {&out, c.ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
     progress_start(&out.progress, "run", 1000);
-    RunStatus rs = run_analysis(m, &k, &ro, on_state_keep, &last, &res);
+    RunStatus rs = run_analysis(m, &k, &c.ro, on_state_keep, &last, &res);
     progress_finish(&out.progress);
 
     if (rs == RUN_BAD_INPUT) {
