@@ -102,7 +102,10 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 
 # The README's test command. Runs every cmocka suite, the CLI script and the
 # generated-C compile checks; stops at the first failing suite.
-check: deps $(MECHC) $(TESTS)
+# deps runs first and alone: under -j the objects would otherwise compile
+# before a fresh machine has the headers.
+check: deps
+	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
 	$(Q)sh tests/run_all $(BUILD)
 
 test: check
@@ -114,8 +117,9 @@ sanitize: check-asan
 
 # The cmocka suites under memcheck (the JIT's code included): any error or
 # definite leak fails.
-check-valgrind: deps $(TESTS)
+check-valgrind: deps
 	$(Q)sh .ci/deps valgrind
+	$(Q)$(MAKE) --no-print-directory $(TESTS)
 	$(Q)sh tests/run_valgrind $(BUILD)
 
 # An example's animated SVG rendered in headless Chromium at two instants
@@ -135,8 +139,9 @@ $(BUILD)/tests/browser/pngdiff: tests/browser/pngdiff.c
 # run, then tests/firmware_rules.sh with the Cortex-M builds. Installs the
 # cross toolchain and QEMU first when missing (.ci/deps firmware).
 .PHONY: firmware-check
-firmware-check: deps $(MECHC)
+firmware-check: deps
 	$(Q)sh .ci/deps firmware
+	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)$(MAKE) --no-print-directory -C examples/firmware check \
 	  MECHC=$(abspath $(MECHC)) OUT=$(abspath $(BUILD))/firmware
 	$(Q)sh tests/firmware_rules.sh $(MECHC)
@@ -157,10 +162,12 @@ fuzz:
 	  -dict=tests/fuzz/mech.dict -artifact_prefix=$(FUZZ_BUILD)/artifacts/ \
 	  $(FUZZ_BUILD)/corpus tests/fuzz/corpus tests/fuzz/regressions
 
-demo: deps $(MECHC)
+demo: deps
+	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)sh examples/demo $(MECHC)
 
-bench: deps $(MECHC)
+bench: deps
+	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)sh bench/run $(MECHC)
 
 install: $(MECHC)
