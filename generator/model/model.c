@@ -372,6 +372,24 @@ static void build_joint(Builder *b, const Stmt *s)
         push_row(b, j, i, rows[i]);
 }
 
+/* The body table: the bodies and points among the declared names. */
+static void collect_bodies(Builder *b)
+{
+    Model *m = b->model;
+    int n = 0;
+    for (int i = 0; i < b->nentities; i++)
+        n += b->entities[i].kind == ENT_BODY || b->entities[i].kind == ENT_POINT;
+    m->bodies = arena_alloc_array(&m->arena, (size_t)n, sizeof *m->bodies);
+    for (int i = 0; i < b->nentities; i++) {
+        const Entity *e = &b->entities[i];
+        if (e->kind != ENT_BODY && e->kind != ENT_POINT)
+            continue;
+        bool body = e->kind == ENT_BODY;
+        m->bodies[m->nbodies++] = (Body){.name = e->name, .q = e->q, .nq = body ? 3 : 2,
+                                         .has_phi = body};
+    }
+}
+
 static void build(Builder *b, const Program *prog, const char *default_name)
 {
     Model *m = b->model;
@@ -398,6 +416,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
         }
     }
     m->dag.where = -1;
+    collect_bodies(b);
     SrcPos where = last ? last->pos : (SrcPos){0};
     m->last_pos = where;
     if (m->nq == 0)
@@ -491,6 +510,14 @@ void model_free(Model *model)
     dag_free(&model->dag);
     arena_free(&model->arena);
     free(model);
+}
+
+const Body *model_find_body(const Model *m, const char *name)
+{
+    for (int i = 0; i < m->nbodies; i++)
+        if (strcmp(m->bodies[i].name, name) == 0)
+            return &m->bodies[i];
+    return NULL;
 }
 
 char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag)

@@ -36,6 +36,18 @@ typedef struct Row {
     SrcPos pos;         /* the statement, for diagnostics */
 } Row;
 
+/* A body or a point: the owner of the consecutive coordinates q .. q + nq - 1,
+   named NAME.x, NAME.y, then NAME.phi for a body that turns. Scalar coords
+   own no Body. Another kind of body (spatial) would add a kind and own more
+   coordinates; code that walks a body's coordinates uses nq. */
+typedef struct Body {
+    const char *name;
+    int q;              /* index of its x coordinate */
+    int nq;             /* coordinates it owns: 3 (body), 2 (point) */
+    bool has_phi;       /* a body: phi is coordinate q + 2; a point (a
+                           particle) has none (as Attach.has_phi) */
+} Body;
+
 typedef struct Model {
     Arena arena;        /* owns every string and array below */
     Dag dag;            /* owns the expression graph (rows and derivatives) */
@@ -48,6 +60,9 @@ typedef struct Model {
     Row *rows;
     int njoints;
     Joint *joints;
+    int nbodies;
+    Body *bodies;       /* bodies and points in declaration order (which is
+                           also the order of their coordinates) */
     SrcPos last_pos;    /* the last statement: where diagnostics about the
                            mechanism as a whole point */
 } Model;
@@ -58,6 +73,10 @@ typedef struct Model {
 Model *model_load(const char *text, int text_len, const char *file,
                   const char *default_name, const MechLimits *limits, Diag *diag);
 void model_free(Model *model);
+
+/* The body or point called name, or NULL (ground, a scalar coord, a param,
+   a joint or an unknown name). */
+const Body *model_find_body(const Model *m, const char *name);
 
 /* Reads a whole file ("-" = stdin) into a NUL-terminated buffer (free()).
    Returns NULL with diag filled when it cannot be read or is too large. */
