@@ -180,22 +180,23 @@ static const char style_sheet[] =
     ".legend line{stroke-width:3}\n"
     "</style>\n";
 
-bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
-                        const SvgSeries *series, int nseries, const SvgPlotOptions *opt)
+static bool valid_plot_input(FILE *out, const double *t, int n, const SvgSeries *series,
+                             int nseries, const SvgPlotOptions *o)
 {
-    SvgPlotOptions o = opt ? *opt : svg_plot_default_options();
-    bool ok = out && t && n >= 1 && nseries >= 0 && (nseries == 0 || series) && o.width >= 100 &&
-              o.height >= 60;
+    bool ok = out && t && n >= 1 && nseries >= 0 && (nseries == 0 || series) && o->width >= 100 &&
+              o->height >= 60;
     for (int k = 0; ok && k < n; k++)
         ok = isfinite(t[k]) && (k == 0 || t[k] >= t[k - 1]);
     for (int i = 0; ok && i < nseries; i++)
         ok = series[i].values != NULL && series[i].stride >= 0;
-    if (!ok) {
-        errno = EINVAL;
-        return false;
-    }
+    return ok;
+}
 
-    /* ranges */
+/* The plot area and its axes: x over the run's time span, y over the
+   finite values of all series, widened to whole ticks. */
+static Frame plot_frame(const double *t, int n, const SvgSeries *series, int nseries,
+                        const SvgPlotOptions *o)
+{
     double vlo = INFINITY, vhi = -INFINITY;
     for (int i = 0; i < nseries; i++)
         for (int k = 0; k < n; k++) {
@@ -212,10 +213,16 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
     f.ay = make_axis(vlo, vhi, true);
     f.x0 = LEFT_PX;
     f.y0 = TOP_PX;
-    f.w = o.width;
-    f.h = o.height;
+    f.w = o->width;
+    f.h = o->height;
+    return f;
+}
 
-    /* legend width from the longest name (about 7 px per character) */
+/* The whole picture's size: the plot area, its margins and the legend to
+   its right (about 7 px per character of the longest name). */
+static void plot_size(const SvgSeries *series, int nseries, const SvgPlotOptions *o,
+                      int *width, int *height)
+{
     size_t longest = 0;
     for (int i = 0; i < nseries; i++)
         if (series[i].name && strlen(series[i].name) > longest)
@@ -223,13 +230,15 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
     if (longest > 60)
         longest = 60;
     int legend_w = nseries > 0 ? (int)(36 + 7.2 * (double)longest) : 0;
-    int width = (int)(LEFT_PX + o.width + RIGHT_PX + (nseries > 0 ? LEGEND_GAP_PX + legend_w : 0));
-    int height = TOP_PX + o.height + BOTTOM_PX;
+    *width = (int)(LEFT_PX + o->width + RIGHT_PX + (nseries > 0 ? LEGEND_GAP_PX + legend_w : 0));
+    *height = TOP_PX + o->height + BOTTOM_PX;
     int legend_h = TOP_PX + 8 + LEGEND_LINE_PX * nseries;
-    if (legend_h > height)
-        height = legend_h;
+    if (legend_h > *height)
+        *height = legend_h;
+}
 
-    clearerr(out);
+static void write_head(FILE *out, const char *title, const Frame *f, int width, int height)
+{
     fprintf(out, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                  "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">\n"
                  "<title>",
@@ -238,54 +247,94 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
     fputs("</title>\n", out);
     fputs(style_sheet, out);
     fprintf(out, "<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n", width, height);
-    fprintf(out, "<text class=\"title\" x=\"%.1f\" y=\"24\" text-anchor=\"middle\">", f.x0 + 0.5 * f.w);
+    fprintf(out, "<text class=\"title\" x=\"%.1f\" y=\"24\" text-anchor=\"middle\">", f->x0 + 0.5 * f->w);
     svg_put_escaped(out, title ? title : "");
     fputs("</text>\n", out);
+}
 
-    /* grid and ticks */
+/* Grid lines, ticks and tick labels of both axes; the zero line stands out. */
+static void write_ticks(FILE *out, const Frame *f)
+{
     char buf[SVG_NUM_MAX];
     fputs("<g class=\"xticks\">\n", out);
     for (int i = 0; i < 100; i++) {
-        double v = f.ax.first + i * f.ax.step;
-        if (v > f.ax.hi + 1e-9 * f.ax.step)
+        double v = f->ax.first + i * f->ax.step;
+        if (v > f->ax.hi + 1e-9 * f->ax.step)
             break;
-        double x = map_x(&f, v);
-        fprintf(out, "<line class=\"grid\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", x, f.y0, x, f.y0 + f.h);
-        fprintf(out, "<line class=\"tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", x, f.y0 + f.h, x,
-                f.y0 + f.h + 5);
-        tick_label(buf, v, f.ax.step);
-        fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%s</text>\n", x, f.y0 + f.h + 19, buf);
+        double x = map_x(f, v);
+        fprintf(out, "<line class=\"grid\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", x, f->y0, x, f->y0 + f->h);
+        fprintf(out, "<line class=\"tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", x, f->y0 + f->h, x,
+                f->y0 + f->h + 5);
+        tick_label(buf, v, f->ax.step);
+        fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%s</text>\n", x, f->y0 + f->h + 19, buf);
     }
     fputs("</g>\n<g class=\"yticks\">\n", out);
     for (int i = 0; i < 100; i++) {
-        double v = f.ay.first + i * f.ay.step;
-        if (v > f.ay.hi + 1e-9 * f.ay.step)
+        double v = f->ay.first + i * f->ay.step;
+        if (v > f->ay.hi + 1e-9 * f->ay.step)
             break;
-        double y = map_y(&f, v);
-        bool zero = fabs(v) < 1e-9 * f.ay.step;
+        double y = map_y(f, v);
+        bool zero = fabs(v) < 1e-9 * f->ay.step;
         fprintf(out, "<line class=\"%s\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", zero ? "zero" : "grid",
-                f.x0, y, f.x0 + f.w, y);
-        fprintf(out, "<line class=\"tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", f.x0 - 5, y, f.x0, y);
-        tick_label(buf, v, f.ay.step);
-        fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%s</text>\n", f.x0 - 8, y + 4, buf);
+                f->x0, y, f->x0 + f->w, y);
+        fprintf(out, "<line class=\"tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>", f->x0 - 5, y, f->x0, y);
+        tick_label(buf, v, f->ay.step);
+        fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%s</text>\n", f->x0 - 8, y + 4, buf);
     }
     fputs("</g>\n", out);
-    fprintf(out, "<rect class=\"axis\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f.x0, f.y0, f.w,
-            f.h);
-    if (o.xlabel) {
-        fprintf(out, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", f.x0 + 0.5 * f.w,
-                f.y0 + f.h + 42);
-        svg_put_escaped(out, o.xlabel);
+}
+
+/* The frame around the plot area and the axis labels. */
+static void write_axes(FILE *out, const Frame *f, const SvgPlotOptions *o)
+{
+    fprintf(out, "<rect class=\"axis\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", f->x0, f->y0, f->w,
+            f->h);
+    if (o->xlabel) {
+        fprintf(out, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", f->x0 + 0.5 * f->w,
+                f->y0 + f->h + 42);
+        svg_put_escaped(out, o->xlabel);
         fputs("</text>\n", out);
     }
-    if (o.ylabel) {
-        double x = 18, y = f.y0 + 0.5 * f.h;
+    if (o->ylabel) {
+        double x = 18, y = f->y0 + 0.5 * f->h;
         fprintf(out, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" "
                      "transform=\"rotate(-90 %.1f %.1f)\">", x, y, x, y);
-        svg_put_escaped(out, o.ylabel);
+        svg_put_escaped(out, o->ylabel);
         fputs("</text>\n", out);
     }
+}
 
+static void write_legend(FILE *out, const Frame *f, const SvgSeries *series, int nseries)
+{
+    double lx = f->x0 + f->w + LEGEND_GAP_PX;
+    fputs("<g class=\"legend\">\n", out);
+    for (int i = 0; i < nseries; i++) {
+        double y = f->y0 + 8 + LEGEND_LINE_PX * i;
+        fprintf(out, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" style=\"stroke:%s\"/>", lx, y,
+                lx + 22, y, svg_palette[i % SVG_PALETTE_SIZE]);
+        fprintf(out, "<text x=\"%.1f\" y=\"%.1f\">", lx + 28, y + 4);
+        svg_put_escaped(out, series[i].name ? series[i].name : "");
+        fputs("</text>\n", out);
+    }
+    fputs("</g>\n", out);
+}
+
+bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
+                        const SvgSeries *series, int nseries, const SvgPlotOptions *opt)
+{
+    SvgPlotOptions o = opt ? *opt : svg_plot_default_options();
+    if (!valid_plot_input(out, t, n, series, nseries, &o)) {
+        errno = EINVAL;
+        return false;
+    }
+    Frame f = plot_frame(t, n, series, nseries, &o);
+    int width, height;
+    plot_size(series, nseries, &o, &width, &height);
+
+    clearerr(out);
+    write_head(out, title, &f, width, height);
+    write_ticks(out, &f);
+    write_axes(out, &f, &o);
     /* curves, clipped to the plot area */
     fprintf(out, "<clipPath id=\"area\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n",
             f.x0 - 2, f.y0 - 2, f.w + 4, f.h + 4);
@@ -293,21 +342,8 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
     for (int i = 0; i < nseries; i++)
         write_series(out, &f, t, n, &series[i], svg_palette[i % SVG_PALETTE_SIZE]);
     fputs("</g>\n", out);
-
-    /* legend */
-    if (nseries > 0) {
-        double lx = f.x0 + f.w + LEGEND_GAP_PX;
-        fputs("<g class=\"legend\">\n", out);
-        for (int i = 0; i < nseries; i++) {
-            double y = f.y0 + 8 + LEGEND_LINE_PX * i;
-            fprintf(out, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" style=\"stroke:%s\"/>", lx, y,
-                    lx + 22, y, svg_palette[i % SVG_PALETTE_SIZE]);
-            fprintf(out, "<text x=\"%.1f\" y=\"%.1f\">", lx + 28, y + 4);
-            svg_put_escaped(out, series[i].name ? series[i].name : "");
-            fputs("</text>\n", out);
-        }
-        fputs("</g>\n", out);
-    }
+    if (nseries > 0)
+        write_legend(out, &f, series, nseries);
     fputs("</svg>\n", out);
     return fflush(out) == 0 && !ferror(out);
 }
