@@ -1,4 +1,4 @@
-/* test_model.c - the model builder's input errors (names, attachments, joint sanity, row levels) and option parsing. */
+/* test_model.c - the model builder's input errors (names, attachments, joint sanity, row levels), its body table, and option parsing. */
 #include "testutil.h"
 
 #include "../generator/cli/cli.h"
@@ -65,6 +65,50 @@ static void test_time_in_options_is_fine(void **state)
     pipeline_free(mech);
 }
 
+/* The body table: bodies and points in declaration order with their first
+   coordinate, scalar coords, params and joints left out. */
+static void test_body_table(void **state)
+{
+    (void)state;
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load_text("coord c = 1\nbody b x = 0.5\nparam k = 2\npoint p x = 0.5\n"
+                                    "coord d\nbody w phi = 0.3\nrevolute R: b p\n"
+                                    "distance D: w ground(1, 0) length = k\n",
+                                    "bodies.mech", &limits, &diag);
+    if (!mech)
+        fail_msg("rejected: %s", diag.message);
+    const Model *m = mech->model;
+    assert_int_equal(m->nq, 10);
+    assert_int_equal(m->nbodies, 3);
+    static const struct { const char *name; int q, nq; bool has_phi; } want[] = {
+        {"b", 1, 3, true}, {"p", 4, 2, false}, {"w", 7, 3, true},
+    };
+    for (int i = 0; i < 3; i++) {
+        const Body *b = &m->bodies[i];
+        assert_string_equal(b->name, want[i].name);
+        assert_int_equal(b->q, want[i].q);
+        assert_int_equal(b->nq, want[i].nq);
+        assert_int_equal(b->has_phi, want[i].has_phi);
+        /* its coordinates are NAME.x, NAME.y (, NAME.phi) */
+        char x[16];
+        snprintf(x, sizeof x, "%s.x", b->name);
+        assert_string_equal(m->coord_names[b->q], x);
+        assert_ptr_equal(model_find_body(m, b->name), b);
+    }
+    assert_string_equal(m->coord_names[m->bodies[2].q + 2], "w.phi");
+    assert_near(m->q0[m->bodies[0].q], 0.5, 0, 0);
+    /* the joints' attachments agree with the table */
+    assert_int_equal(m->joints[0].a.q, m->bodies[0].q);
+    assert_int_equal(m->joints[0].b.q, m->bodies[1].q);
+    assert_false(m->joints[0].b.has_phi);
+    static const char *const not_bodies[] = {"c", "d", "k", "R", "D", "ground", "b.x", "", "bb"};
+    for (size_t i = 0; i < sizeof not_bodies / sizeof *not_bodies; i++)
+        if (model_find_body(m, not_bodies[i]))
+            fail_msg("'%s' found as a body", not_bodies[i]);
+    pipeline_free(mech);
+}
+
 /* Runs the option loop the commands use; returns the options seen. */
 static int parse(char **argv, int argc, Args *a, const char **seen, const char **values)
 {
@@ -116,6 +160,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_time_in_options_is_fine),
+        cmocka_unit_test(test_body_table),
         cmocka_unit_test(test_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -4,16 +4,21 @@
  * (balanced tags, one root, quoted attributes without '<', known entities
  * only), then its content is checked: how many links, pins and sliders, the
  * <animate> values, the viewBox against the drawing's size, equal x and y
- * scales (a crank keeps its pixel length while it turns), traces, escaping.
+ * scales (a crank keeps its pixel length while it turns), traces, escaping,
+ * the generic drawing a joint kind gets when the renderer has none for it,
+ * and the convex hull that outlines a body.
  * xmllint, when installed, checks the files again (the test does not need it).
  */
 #include "testutil.h"
 
 #include "../generator/pipeline/pipeline.h"
+#include "../generator/render/hull.h"
 #include "../generator/render/progress.h"
+#include "../generator/render/scene.h"
 #include "../generator/render/svg_anim.h"
 #include "../generator/render/svg_common.h"
 #include "../generator/render/svg_plot.h"
+#include "../generator/render/svg_write.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -623,12 +628,12 @@ static const char all_statements[] =
     "velocity fwd: der(cart.x)*cos(cart.phi) + der(cart.y)*sin(cart.phi) = 1\n"
     "driver steer: cart.phi = 0.5*t\n";
 
-static void test_anim_all_kinds(void **state)
+/* all_statements moved by a made-up motion of n frames over t = 0 .. 0.025 (n - 1). */
+static Fixture *load_all_statements(int n)
 {
-    (void)state;
     Fixture *fx = load_text(all_statements);
     const Model *m = fx->mech->model;
-    int n = 41, nq = m->nq;
+    int nq = m->nq;
     fx->n = n;
     fx->t = malloc((size_t)n * sizeof *fx->t);
     fx->q = malloc((size_t)n * (size_t)nq * sizeof *fx->q);
@@ -637,6 +642,14 @@ static void test_anim_all_kinds(void **state)
         for (int i = 0; i < nq; i++)
             fx->q[(size_t)k * nq + i] = m->q0[i] + 0.1 * sin(0.7 * i + 0.15 * k);
     }
+    return fx;
+}
+
+static void test_anim_all_kinds(void **state)
+{
+    (void)state;
+    Fixture *fx = load_all_statements(41);
+    const Model *m = fx->mech->model;
     SvgTrace tr;
     char err[256];
     assert_true(svg_parse_trace(m, "tip", &tr, err, sizeof err));
@@ -657,6 +670,8 @@ static void test_anim_all_kinds(void **state)
     assert_int_equal(count(s, "class=\"guide\""), 3);       /* guide, rail, floor */
     assert_int_equal(count(s, "class=\"dot\""), 2);         /* on rail and floor */
     assert_int_equal(count(s, "class=\"trace\""), 1);
+    /* every kind has a drawing of its own: none falls back to the generic one */
+    assert_int_equal(count(s, "class=\"joint\""), 0);
     /* base (welded: reference point and the prismatic's point), arm (line),
        cart (its reference point and the knife point): wheel and slide are
        drawn as their disk and block */
@@ -673,6 +688,106 @@ static void test_anim_all_kinds(void **state)
     xmllint_if_present(s);
     free(s);
     fixture_free(fx);
+}
+
+/* P = r + A(phi) s of attachment a at coordinates q, written out. */
+static void attach_at(Attach a, const double *q, double *x, double *y)
+{
+    if (a.q < 0) {
+        *x = a.sx;
+        *y = a.sy;
+        return;
+    }
+    double phi = a.has_phi ? q[a.q + 2] : 0;
+    *x = q[a.q] + cos(phi) * a.sx - sin(phi) * a.sy;
+    *y = q[a.q + 1] + sin(phi) * a.sx + cos(phi) * a.sy;
+}
+
+/* The drawing a joint kind gets when the renderer has none for it: a line
+   between two attachments (under the bodies), a square at one (over them),
+   nothing for a row statement; it follows the attachments and is written
+   as well-formed SVG. */
+static void test_anim_generic_drawing(void **state)
+{
+    (void)state;
+    Fixture *fx = load_all_statements(41);
+    const Model *m = fx->mech->model;
+    Scene sc;
+    scene_init(&sc, m, fx->t, fx->q, fx->n, NULL, 0, 200);
+    sc.L = 1;
+    sc.px = 0.01;
+    int lines = 0, marks = 0;
+    const double *q7 = fx->q + (size_t)7 * m->nq;
+    for (int j = 0; j < m->njoints; j++) {
+        const Joint *jt = &m->joints[j];
+        int na = joint_info[jt->kind].attachments;
+        for (int over = 0; over < 2; over++) {
+            int before = sc.nsh;
+            scene_draw_generic(&sc, jt, over);
+            bool drawn = over ? na == 1 : na == 2;
+            assert_int_equal(sc.nsh - before, drawn);
+            if (!drawn)
+                continue;
+            const Shape *sh = &sc.sh[before];
+            assert_string_equal(sh->cls, "joint");
+            assert_string_equal(sh->name, jt->name);
+            assert_int_equal(sh->kind, over ? SHAPE_MARK : SHAPE_POLYLINE);
+            assert_int_equal(sh->nv, na);
+            for (int k = 0; k < na; k++) {
+                double x, y, ex, ey;
+                scene_vtx_world(&sc.v[sh->v0 + k], q7, &x, &y);
+                attach_at(k ? jt->b : jt->a, q7, &ex, &ey);
+                assert_near(x, ex, 0, 1e-12);
+                assert_near(y, ey, 0, 1e-12);
+            }
+            lines += !over;
+            marks += over;
+        }
+    }
+    /* weld, prismatic, 2 pointlines, distance, revolute; rolling, knife */
+    assert_int_equal(lines, 6);
+    assert_int_equal(marks, 2);
+    SvgAnimOptions o = svg_anim_default_options();
+    SvgPixelMap pm = svg_pixel_map(svg_scene_extent(&sc, true), &o, 4);   /* 4 drivers */
+    Capture c;
+    FILE *f = capture_open(&c);
+    svg_write_scene(f, &sc, &pm, "generic", &o);
+    char *s = capture_close(&c);
+    assert_xml(s);
+    assert_int_equal(count(s, "<polyline class=\"joint\" points=\""), 6);
+    assert_int_equal(count(s, "<rect class=\"joint\""), 2);
+    assert_int_equal(count(s, "style=\"stroke:#444;fill:none\" stroke-width=\"1.5\">"), 6);
+    assert_non_null(strstr(s, "<title>blade</title>"));
+    keep_copy(s, "generic");
+    free(s);
+    scene_free(&sc);
+    fixture_free(fx);
+}
+
+/* The outline of a body: hull of its local points, counter-clockwise, with
+   repeated, interior and collinear points dropped. */
+static void test_hull(void **state)
+{
+    (void)state;
+    HullPoint h[8];
+    HullPoint square[] = {{1, 1}, {0, 0}, {0.5, 0.4}, {1, 0}, {0, 1}, {1, 1}, {0.5, 0}};
+    assert_int_equal(hull_convex(square, 7, h, 1e-9), 4);
+    static const HullPoint ccw[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int i = 0; i < 4; i++) {
+        assert_near(h[i].x, ccw[i].x, 0, 0);
+        assert_near(h[i].y, ccw[i].y, 0, 0);
+    }
+    HullPoint line[] = {{2, 1}, {0, 0}, {1, 0.5}, {-2, -1}};
+    assert_int_equal(hull_convex(line, 4, h, 1e-9), 2);
+    assert_near(h[0].x, -2, 0, 0);
+    assert_near(h[1].x, 2, 0, 0);
+    /* within tol: one point (a body drawn as a mark) */
+    HullPoint one[] = {{0.3, 0.3}, {0.3, 0.3 + 1e-12}, {0.3, 0.3}};
+    assert_int_equal(hull_convex(one, 3, h, 1e-9), 1);
+    assert_near(h[0].x, 0.3, 0, 0);
+    /* a triangle whose third point is barely off the line still counts */
+    HullPoint tri[] = {{0, 0}, {1, 0}, {0.5, 1e-3}};
+    assert_int_equal(hull_convex(tri, 3, h, 1e-9), 3);
 }
 
 /* ---- plots ---- */
@@ -866,6 +981,8 @@ int main(void)
         cmocka_unit_test(test_anim_bad_input),
         cmocka_unit_test(test_anim_single_frame),
         cmocka_unit_test(test_anim_all_kinds),
+        cmocka_unit_test(test_anim_generic_drawing),
+        cmocka_unit_test(test_hull),
         cmocka_unit_test(test_plot),
         cmocka_unit_test(test_plot_gaps_and_thinning),
         cmocka_unit_test(test_plot_resolve),
