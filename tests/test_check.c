@@ -8,9 +8,9 @@
  */
 #include "testutil.h"
 
+#include "../generator/analysis/check.h"
 #include "../generator/base/arena.h"
-#include "../generator/eval/aot.h"
-#include "../generator/eval/check.h"
+#include "../generator/engine/aot.h"
 
 #include <dirent.h>
 #include <stdlib.h>

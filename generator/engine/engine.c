@@ -2,14 +2,14 @@
  *
  * jit:     generated C (libm declared, not included) compiled in memory by libtcc.
  * aot:     the same C with <math.h>, built by the system compiler into a
- *          cached shared library and loaded with dlopen (generator/eval/aot.c).
+ *          cached shared library and loaded with dlopen (generator/engine/aot.c).
  * generic: no code generation; formulas and an interpreter over the joint
  *          list (generator/eval/generic.c).
  * jit and aot end up as the same Kernels; generic is called through its state.
  */
 #include "engine.h"
 
-#include "../eval/aot.h"
+#include "aot.h"
 #include "../eval/generic.h"
 
 #include <stdio.h>

@@ -49,8 +49,8 @@
 #include "../../runtime/mechrt.h"
 #include "../base/arena.h"
 #include "../base/rng.h"
-#include "aot.h"
-#include "generic.h"
+#include "../engine/aot.h"
+#include "../eval/generic.h"
 
 #include <gsl/gsl_deriv.h>
 #include <math.h>
