@@ -626,14 +626,6 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
 
 /* ---- the run ---- */
 
-static void k_phi(void *ctx, const double *q, double t, double *o) { engine_phi(ctx, q, t, o); }
-static void k_jac(void *ctx, const double *q, double t, double *o) { engine_jac(ctx, q, t, o); }
-static void k_nu(void *ctx, const double *q, double t, double *o) { engine_nu(ctx, q, t, o); }
-static void k_gamma(void *ctx, const double *q, const double *qd, double t, double *o)
-{
-    engine_gamma(ctx, q, qd, t, o);
-}
-
 /* The base state: Newton from the initial values at t = 0 when the
    holonomic rows are square, else the initial values. */
 static bool assemble(Checker *c, double *q)
@@ -641,8 +633,9 @@ static bool assemble(Checker *c, double *q)
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
     if (c->nh != c->nq)
         return false;
-    MechrtKernels k = {.nq = c->nq, .nh = c->nh, .nv = c->nv, .ctx = &c->eng[ENGINE_JIT],
-                       .phi = k_phi, .jac = k_jac, .nu = k_nu, .gamma = k_gamma};
+    /* Newton on the engine under test's phi and jac, not its fused all */
+    MechrtKernels k = c->eng[ENGINE_JIT].k;
+    k.all = NULL;
     size_t lwork = mechrt_workspace_size(c->nq, c->nr);
     double *work = xmalloc(lwork * sizeof *work);
     MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
