@@ -8,9 +8,9 @@
  */
 #include "testutil.h"
 
+#include "../generator/analysis/check.h"
 #include "../generator/base/arena.h"
-#include "../generator/eval/aot.h"
-#include "../generator/eval/check.h"
+#include "../generator/engine/aot.h"
 
 #include <dirent.h>
 #include <stdlib.h>
@@ -130,6 +130,44 @@ static void test_examples_pass(void **state)
     }
     closedir(d);
     assert_true(count >= 10);
+}
+
+/* The engines check compares, and the note saying why aot was left out:
+   not asked for, or no compiler ($CC pointed at nothing). The pairs with
+   aot are then not compared at all. */
+static void test_aot_left_out(void **state)
+{
+    (void)state;
+    Diag diag;
+    Mech *mech = load_example("four_bar.mech", &diag);
+    CheckOptions opt = check_default_options();
+    opt.samples = 3;
+    opt.use_aot = false;
+    CheckReport rep;
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    assert_true(rep.ok && rep.assembled);
+    assert_int_equal(rep.samples, 3);
+    assert_true(rep.engine_used[ENGINE_JIT] && rep.engine_used[ENGINE_GENERIC]);
+    assert_false(rep.engine_used[ENGINE_AOT]);
+    assert_string_equal(rep.note, "aot not compared (not asked for)");
+    for (int w = CHECK_PAIR_FIRST; w < CHECK_WHAT_COUNT; w++)
+        assert_int_equal(rep.items[w].checked, strstr(rep.items[w].what, "aot") == NULL);
+
+    const char *cc = getenv("CC");
+    char *saved = cc ? strdup(cc) : NULL;
+    setenv("CC", "/nonexistent/mechc-test-cc", 1);
+    opt.use_aot = true;
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    if (saved)
+        setenv("CC", saved, 1);
+    else
+        unsetenv("CC");
+    free(saved);
+    assert_true(rep.ok);
+    assert_false(rep.engine_used[ENGINE_AOT]);
+    assert_string_equal(rep.note, "aot not compared: no C compiler found (set CC)");
+    assert_false(rep.items[CHECK_PAIR_FIRST + 4].checked);     /* phi jit/aot */
+    pipeline_free(mech);
 }
 
 /* Runs check on an example with one fault; returns the report. */
@@ -456,6 +494,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_examples_pass),
+        cmocka_unit_test(test_aot_left_out),
         cmocka_unit_test(test_jacobian_sign),
         cmocka_unit_test(test_jacobian_factor_two),
         cmocka_unit_test(test_jacobian_missing_term),

@@ -10,8 +10,8 @@
 #include "testutil.h"
 
 #include "../generator/base/arena.h"
+#include "../generator/engine/aot.h"
 #include "../generator/engine/engine.h"
-#include "../generator/eval/aot.h"
 #include "../generator/eval/generic.h"
 
 #include <dirent.h>

@@ -82,36 +82,9 @@ RunOptions run_default_options(void)
 
 /* ---- the engine as runtime kernels ------------------------------------- */
 
-static void ek_phi(void *ctx, const double *q, double t, double *out)
-{
-    engine_phi(ctx, q, t, out);
-}
-
-static void ek_jac(void *ctx, const double *q, double t, double *out)
-{
-    engine_jac(ctx, q, t, out);
-}
-
-static void ek_nu(void *ctx, const double *q, double t, double *out)
-{
-    engine_nu(ctx, q, t, out);
-}
-
-static void ek_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
-{
-    engine_gamma(ctx, q, qd, t, out);
-}
-
-static void ek_all(void *ctx, const double *q, const double *qd, double t,
-                   double *phi, double *jac, double *nu, double *gamma)
-{
-    engine_all(ctx, q, qd, t, phi, jac, nu, gamma);
-}
-
 MechrtKernels run_engine_kernels(const Engine *e)
 {
-    MechrtKernels k = {e->nq, e->nh, e->nv, (void *)e, ek_phi, ek_jac, ek_nu, ek_gamma, ek_all};
-    return k;
+    return e->k;
 }
 
 /* ---- the state of one run ---------------------------------------------- */

@@ -76,8 +76,8 @@ typedef struct RunResult {
 typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *qd,
                            const double *qdd);
 
-/* The runtime's view of an open engine: every kernel calls engine_* with
-   the Engine as its context. The engine must outlive the kernels. */
+/* The runtime's view of an open engine: its kernels, engine->k. Valid
+   until engine_close. */
 MechrtKernels run_engine_kernels(const Engine *engine);
 
 /* True when m has one row per coordinate, as a run needs; otherwise false

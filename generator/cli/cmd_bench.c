@@ -11,7 +11,7 @@
 #include "../render/progress.h"
 
 #include "../base/arena.h"
-#include "../eval/aot.h"
+#include "../engine/aot.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -2,15 +2,14 @@
  *
  * jit:     generated C (libm declared, not included) compiled in memory by libtcc.
  * aot:     the same C with <math.h>, built by the system compiler into a
- *          cached shared library and loaded with dlopen (generator/eval/aot.c).
+ *          cached shared library and loaded with dlopen (generator/engine/aot.c).
  * generic: no code generation; formulas and an interpreter over the joint
  *          list (generator/eval/generic.c).
- * jit and aot end up as the same Kernels; generic is called through its state.
+ * All three fill one MechrtKernels: jit and aot through thunks whose ctx is
+ * the compiled unit's Kernels, generic through wrappers whose ctx is its
+ * state. Everything downstream (engine_phi..., check, run) calls e->k.
  */
 #include "engine.h"
-
-#include "../eval/aot.h"
-#include "../eval/generic.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -30,6 +29,70 @@ EngineOptions engine_default_options(void)
     return (EngineOptions){.aot_fresh = false};
 }
 
+/* ---- jit and aot: ctx is the compiled unit's context-free Kernels ---- */
+
+static void code_phi(void *ctx, const double *q, double t, double *out)
+{
+    ((const Kernels *)ctx)->phi(q, t, out);
+}
+
+static void code_jac(void *ctx, const double *q, double t, double *out)
+{
+    ((const Kernels *)ctx)->jac(q, t, out);
+}
+
+static void code_nu(void *ctx, const double *q, double t, double *out)
+{
+    ((const Kernels *)ctx)->nu(q, t, out);
+}
+
+static void code_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    ((const Kernels *)ctx)->gamma(q, qd, t, out);
+}
+
+static void code_all(void *ctx, const double *q, const double *qd, double t,
+                     double *phi, double *jac, double *nu, double *gamma)
+{
+    ((const Kernels *)ctx)->all(q, qd, t, phi, jac, nu, gamma);
+}
+
+/* ---- generic: ctx is the evaluator's state ---- */
+
+static void gen_phi(void *ctx, const double *q, double t, double *out)
+{
+    generic_phi(ctx, q, t, out);
+}
+
+static void gen_jac(void *ctx, const double *q, double t, double *out)
+{
+    generic_jac(ctx, q, t, out);
+}
+
+static void gen_nu(void *ctx, const double *q, double t, double *out)
+{
+    generic_nu(ctx, q, t, out);
+}
+
+static void gen_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    generic_gamma(ctx, q, qd, t, out);
+}
+
+static void gen_all(void *ctx, const double *q, const double *qd, double t,
+                    double *phi, double *jac, double *nu, double *gamma)
+{
+    generic_all(ctx, q, qd, t, phi, jac, nu, gamma);
+}
+
+/* e->k for compiled code (jit, aot) whose functions code holds. */
+static void bind_code(Engine *e, const Kernels *code)
+{
+    e->kernels = *code;
+    e->k = (MechrtKernels){e->nq, e->nh, e->nv, (void *)code,
+                           code_phi, code_jac, code_nu, code_gamma, code_all};
+}
+
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
 {
     EmitOptions eo = emit_default_options();
@@ -45,9 +108,10 @@ static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag
         return false;
     e->gen_seconds = pipeline_now() - t0;
     AotResult res;
-    if (!aot_load(e->emitted.c_text, e->emitted.prefix, opt->aot_fresh, &e->kernels, &res, diag))
+    e->aot = aot_load(e->emitted.c_text, e->emitted.prefix, opt->aot_fresh, &res, diag);
+    if (!e->aot)
         return false;
-    e->library = res.handle;
+    bind_code(e, aot_kernels(e->aot));
     e->compile_seconds = res.seconds;
     e->aot_cached = res.cached;
     return true;
@@ -72,12 +136,14 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
             emit_result_free(&e->emitted);
             return false;
         }
-        e->kernels = *jit_kernels(e->jit);
+        bind_code(e, jit_kernels(e->jit));
         return true;
     case ENGINE_GENERIC: {
         double t0 = pipeline_now();
         e->generic = generic_open(mech->model);
         e->gen_seconds = pipeline_now() - t0;
+        e->k = (MechrtKernels){e->nq, e->nh, e->nv, e->generic,
+                               gen_phi, gen_jac, gen_nu, gen_gamma, gen_all};
         return true;
     }
     case ENGINE_AOT:
@@ -101,49 +167,8 @@ bool engine_open(Engine *e, EngineKind kind, const Mech *mech, Diag *diag)
 void engine_close(Engine *e)
 {
     jit_free(e->jit);
-    aot_unload(e->library);
+    aot_unload(e->aot);
     generic_free(e->generic);
     emit_result_free(&e->emitted);
     memset(e, 0, sizeof *e);
-}
-
-void engine_phi(const Engine *e, const double *q, double t, double *phi)
-{
-    if (e->generic)
-        generic_phi(e->generic, q, t, phi);
-    else
-        e->kernels.phi(q, t, phi);
-}
-
-void engine_jac(const Engine *e, const double *q, double t, double *jac)
-{
-    if (e->generic)
-        generic_jac(e->generic, q, t, jac);
-    else
-        e->kernels.jac(q, t, jac);
-}
-
-void engine_nu(const Engine *e, const double *q, double t, double *nu)
-{
-    if (e->generic)
-        generic_nu(e->generic, q, t, nu);
-    else
-        e->kernels.nu(q, t, nu);
-}
-
-void engine_gamma(const Engine *e, const double *q, const double *qd, double t, double *gamma)
-{
-    if (e->generic)
-        generic_gamma(e->generic, q, qd, t, gamma);
-    else
-        e->kernels.gamma(q, qd, t, gamma);
-}
-
-void engine_all(const Engine *e, const double *q, const double *qd, double t,
-                double *phi, double *jac, double *nu, double *gamma)
-{
-    if (e->generic)
-        generic_all(e->generic, q, qd, t, phi, jac, nu, gamma);
-    else
-        e->kernels.all(q, qd, t, phi, jac, nu, gamma);
 }

@@ -2,8 +2,11 @@
 #ifndef MECHC_ENGINE_H
 #define MECHC_ENGINE_H
 
+#include "../../runtime/mechrt.h"
+#include "../eval/generic.h"
 #include "../jit/jit.h"
 #include "../pipeline/pipeline.h"
+#include "aot.h"
 
 typedef enum EngineKind { ENGINE_JIT, ENGINE_GENERIC, ENGINE_AOT, ENGINE_KIND_COUNT } EngineKind;
 
@@ -13,10 +16,16 @@ typedef struct Engine {
     EngineKind kind;
     const Mech *mech;
     int nq, nh, nv, nr;
-    Kernels kernels;        /* jit and aot */
+    /* What every kind is evaluated through. k.ctx is heap memory the
+       engine owns (the compiled unit's Kernels for jit and aot, the
+       evaluator's state for generic): copies of k, and the Engine moved,
+       stay valid until engine_close. */
+    MechrtKernels k;
+    Kernels kernels;        /* jit and aot: the compiled functions themselves
+                               (context-free; bench also times jac_nz) */
     Jit *jit;
-    void *library;          /* aot: dlopen handle */
-    void *generic;          /* generic evaluator state */
+    Aot *aot;
+    Generic *generic;       /* generic evaluator state (check uses its Psi) */
     EmitResult emitted;     /* jit and aot: the source compiled */
     double gen_seconds;     /* emission time (generic: set-up time) */
     double compile_seconds; /* libtcc or cc time (aot: with the cache lookup and dlopen) */
@@ -41,13 +50,34 @@ bool engine_open_with(Engine *engine, EngineKind kind, const Mech *mech,
                       const EngineOptions *options, Diag *diag);
 void engine_close(Engine *engine);
 
-/* The generic engine keeps scratch memory in its state: one Engine serves
-   one thread at a time. */
-void engine_phi(const Engine *e, const double *q, double t, double *phi);
-void engine_jac(const Engine *e, const double *q, double t, double *jac);
-void engine_nu(const Engine *e, const double *q, double t, double *nu);
-void engine_gamma(const Engine *e, const double *q, const double *qd, double t, double *gamma);
-void engine_all(const Engine *e, const double *q, const double *qd, double t,
-                double *phi, double *jac, double *nu, double *gamma);
+/* Evaluation through e->k (spec section 4's kernels). The generic engine
+   keeps scratch memory in its state: one Engine serves one thread at a
+   time. */
+static inline void engine_phi(const Engine *e, const double *q, double t, double *phi)
+{
+    e->k.phi(e->k.ctx, q, t, phi);
+}
+
+static inline void engine_jac(const Engine *e, const double *q, double t, double *jac)
+{
+    e->k.jac(e->k.ctx, q, t, jac);
+}
+
+static inline void engine_nu(const Engine *e, const double *q, double t, double *nu)
+{
+    e->k.nu(e->k.ctx, q, t, nu);
+}
+
+static inline void engine_gamma(const Engine *e, const double *q, const double *qd, double t,
+                                double *gamma)
+{
+    e->k.gamma(e->k.ctx, q, qd, t, gamma);
+}
+
+static inline void engine_all(const Engine *e, const double *q, const double *qd, double t,
+                              double *phi, double *jac, double *nu, double *gamma)
+{
+    e->k.all(e->k.ctx, q, qd, t, phi, jac, nu, gamma);
+}
 
 #endif

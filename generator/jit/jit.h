@@ -9,8 +9,10 @@ typedef void (*KernelGamma)(const double *q, const double *qd, double t, double 
 typedef void (*KernelAll)(const double *q, const double *qd, double t,
                           double *phi, double *jac, double *nu, double *gamma);
 
-/* The generated functions of one mechanism, however they were obtained
-   (libtcc, dlopen of a cc-built library). */
+/* The generated functions of one mechanism as the compiled unit exports
+   them (libtcc, dlopen of a cc-built library): context-free, with jac_nz
+   and its pattern. Engines evaluate through a MechrtKernels whose ctx is
+   this struct (engine.c). */
 typedef struct Kernels {
     KernelPhi phi, jac, jac_nz, nu;
     KernelGamma gamma;

@@ -12,6 +12,7 @@
 #define _GNU_SOURCE 1
 #include "aot.h"
 
+#include "../base/arena.h"
 #include "../base/strbuf.h"
 #include "../pipeline/pipeline.h"
 
@@ -208,14 +209,18 @@ static bool build(const char *dir, const char *hex, const char *source, const ch
     return ok;
 }
 
-bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
-              AotResult *out, Diag *diag)
+struct Aot {
+    void *handle;           /* dlopen's */
+    Kernels kernels;
+};
+
+Aot *aot_load(const char *source, const char *prefix, bool fresh, AotResult *out, Diag *diag)
 {
     memset(out, 0, sizeof *out);
     double t0 = pipeline_now();
     char dir[1024];
     if (!aot_cache_dir(dir, sizeof dir, diag))
-        return false;
+        return NULL;
     char cc_buf[1024], *words[AOT_MAX_WORDS];
     int n = compiler_words(cc_buf, sizeof cc_buf, words);
     Hash h = {14695981039346656037ull, 0x84222325cbf29ce4ull};
@@ -229,25 +234,30 @@ bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
 
     out->cached = !fresh && access(out->path, R_OK) == 0;
     if (!out->cached && !build(dir, hex, source, out->path, diag))
-        return false;
+        return NULL;
     void *handle = dlopen(out->path, RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
         diag_error_nopos(diag, "the aot engine cannot load %s: %s", out->path, dlerror());
-        return false;
+        return NULL;
     }
-    if (!kernels_bind(k, dlsym, handle, prefix)) {
+    Aot *aot = xcalloc(1, sizeof *aot);
+    aot->handle = handle;
+    if (!kernels_bind(&aot->kernels, dlsym, handle, prefix)) {
         diag_error_nopos(diag, "internal error: %s lacks a generated function (remove it and retry)",
                          out->path);
-        dlclose(handle);
-        return false;
+        aot_unload(aot);
+        return NULL;
     }
-    out->handle = handle;
     out->seconds = pipeline_now() - t0;
-    return true;
+    return aot;
 }
 
-void aot_unload(void *handle)
+const Kernels *aot_kernels(const Aot *aot) { return &aot->kernels; }
+
+void aot_unload(Aot *aot)
 {
-    if (handle)
-        dlclose(handle);
+    if (!aot)
+        return;
+    dlclose(aot->handle);
+    free(aot);
 }

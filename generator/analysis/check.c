@@ -49,8 +49,8 @@
 #include "../../runtime/mechrt.h"
 #include "../base/arena.h"
 #include "../base/rng.h"
-#include "aot.h"
-#include "generic.h"
+#include "../engine/aot.h"
+#include "../eval/generic.h"
 
 #include <gsl/gsl_deriv.h>
 #include <math.h>
@@ -106,6 +106,7 @@ typedef struct Checker {
     Engine eng[ENGINE_KIND_COUNT];
     bool open[ENGINE_KIND_COUNT];
     double *out[ENGINE_KIND_COUNT][QTY_COUNT];  /* each engine's results at the sample */
+    double *base;                               /* the assembled state */
     double *q, *qd, t;                          /* the sample */
     int sample;
     double *qw, *qdw;                           /* perturbed copies */
@@ -114,6 +115,9 @@ typedef struct Checker {
     double *d2[5];                              /* second-difference points */
     double *ladder[FD_STEPS];                   /* gamma's second differences at each step */
     bool ladder_have[FD_STEPS];
+    double *vec;                                /* one vector of rows */
+    double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
+    Arena buffers;                              /* owns every array above */
 } Checker;
 
 /* ---- the engine under test, with the optional planted fault ---- */
@@ -626,14 +630,6 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
 
 /* ---- the run ---- */
 
-static void k_phi(void *ctx, const double *q, double t, double *o) { engine_phi(ctx, q, t, o); }
-static void k_jac(void *ctx, const double *q, double t, double *o) { engine_jac(ctx, q, t, o); }
-static void k_nu(void *ctx, const double *q, double t, double *o) { engine_nu(ctx, q, t, o); }
-static void k_gamma(void *ctx, const double *q, const double *qd, double t, double *o)
-{
-    engine_gamma(ctx, q, qd, t, o);
-}
-
 /* The base state: Newton from the initial values at t = 0 when the
    holonomic rows are square, else the initial values. */
 static bool assemble(Checker *c, double *q)
@@ -641,8 +637,9 @@ static bool assemble(Checker *c, double *q)
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
     if (c->nh != c->nq)
         return false;
-    MechrtKernels k = {.nq = c->nq, .nh = c->nh, .nv = c->nv, .ctx = &c->eng[ENGINE_JIT],
-                       .phi = k_phi, .jac = k_jac, .nu = k_nu, .gamma = k_gamma};
+    /* Newton on the engine under test's phi and jac, not its fused all */
+    MechrtKernels k = c->eng[ENGINE_JIT].k;
+    k.all = NULL;
     size_t lwork = mechrt_workspace_size(c->nq, c->nr);
     double *work = xmalloc(lwork * sizeof *work);
     MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
@@ -658,15 +655,9 @@ static double uniform(uint64_t *s, double lo, double hi)
     return lo + (hi - lo) * rng_unit(s);
 }
 
-bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep, Diag *diag)
+/* Item names, tolerances and "nowhere yet". */
+static void init_items(CheckReport *rep, const CheckOptions *opt)
 {
-    CheckOptions defaults = check_default_options();
-    if (!opt)
-        opt = &defaults;
-    memset(rep, 0, sizeof *rep);
-    Checker c = {.m = mech->model, .opt = opt, .rep = rep};
-    const Model *m = mech->model;
-    c.nq = m->nq, c.nh = m->nh, c.nv = m->nv, c.nr = m->nr;
     for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
         CheckItem *it = &rep->items[w];
         it->what = w < CHECK_PAIR_FIRST ? fd_names[w] : pair_names[w - CHECK_PAIR_FIRST];
@@ -674,10 +665,15 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
         it->row = it->col = -1;
         it->unsettled_row = it->unsettled_col = -1;
     }
+}
 
-    bool ok = true;
-    for (int k = 0; k < ENGINE_KIND_COUNT && ok; k++) {
-        if (k == ENGINE_AOT && !opt->use_aot) {
+/* jit and generic always, aot when asked for and a compiler exists (else
+   rep->note says why not). False with diag filled when one fails. */
+static bool open_engines(Checker *c, const Mech *mech, Diag *diag)
+{
+    CheckReport *rep = c->rep;
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
+        if (k == ENGINE_AOT && !c->opt->use_aot) {
             snprintf(rep->note, sizeof rep->note, "aot not compared (not asked for)");
             continue;
         }
@@ -685,84 +681,127 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
             snprintf(rep->note, sizeof rep->note, "aot not compared: no C compiler found (set CC)");
             continue;
         }
-        c.open[k] = engine_open(&c.eng[k], (EngineKind)k, mech, diag);
-        ok = c.open[k];
-        rep->engine_used[k] = c.open[k];
+        c->open[k] = engine_open(&c->eng[k], (EngineKind)k, mech, diag);
+        rep->engine_used[k] = c->open[k];
+        if (!c->open[k])
+            return false;
     }
+    return true;
+}
 
-    size_t nq = (size_t)c.nq, nr = (size_t)c.nr, nvec = (size_t)(c.nh > c.nv ? c.nh : c.nv) + 1;
-    double *mem = NULL;
-    if (ok) {
-        size_t total = ENGINE_KIND_COUNT * (2 * nr + nr * nq + nvec) + 12 * nq + nr + 6 * nvec
-                       + FD_STEPS * nvec + FD_CACHE * nvec + 2 * nq;
-        mem = xcalloc(total, sizeof *mem);
-        double *p = mem;
-        for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
-            c.out[k][QTY_PHI] = p, p += nvec;
-            c.out[k][QTY_JAC] = p, p += nr * nq;
-            c.out[k][QTY_NU] = p, p += nr;
-            c.out[k][QTY_GAMMA] = p, p += nr;
-        }
-        double *base = p;
-        p += nq;
-        c.q = p, p += nq;
-        c.qd = p, p += nq;
-        c.qw = p, p += nq;
-        c.qdw = p, p += nq;
-        for (int k = 0; k < 3; k++) {
-            c.save_q[k] = p, p += nq;
-            c.save_qd[k] = p, p += nq;
-        }
-        c.gamma0 = p, p += nr;
-        for (int k = 0; k < 5; k++)
-            c.d2[k] = p, p += nvec;
-        for (int k = 0; k < FD_STEPS; k++)
-            c.ladder[k] = p, p += nvec;
-        double *vec = p;
-        p += nvec;
-        double *scratch = p;
-
-        rep->assembled = assemble(&c, base);
-        uint64_t rng = (uint64_t)opt->seed * 0x2545f4914f6cdd1dull + 1;
-        for (int s = 0; s < opt->samples; s++) {
-            c.sample = s;
-            for (size_t i = 0; i < nq; i++) {
-                c.q[i] = base[i] + (s == 0 ? 0.0 : uniform(&rng, -opt->spread_q, opt->spread_q));
-                c.qd[i] = uniform(&rng, -opt->spread_qd, opt->spread_qd);
-            }
-            c.t = s == 0 ? 0.0 : uniform(&rng, 0.0, 1.0);
-            under_test(&c);
-            for (int k = 1; k < ENGINE_KIND_COUNT; k++)
-                if (c.open[k])
-                    eval_engine(&c, (EngineKind)k);
-            for (int pair = 0; pair < PAIR_COUNT; pair++)
-                if (c.open[pair_engines[pair][0]] && c.open[pair_engines[pair][1]])
-                    compare_pair(&c, pair);
-            check_fd(&c, scratch, vec);
-        }
-        rep->samples = opt->samples;
-        rep->ok = true;
-        for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
-            CheckItem *it = &rep->items[w];
-            if (!it->checked || it->error <= it->tol)
-                continue;
-            rep->ok = false;
-            if (w == CHECK_JAC_FD)
-                hint_jac(&c, it);
-            else if (w == CHECK_NU_FD)
-                hint_nu(&c, it);
-            else if (w == CHECK_GAMMA_FD)
-                hint_gamma(&c, it, scratch, vec);
-        }
-        for (int w = CHECK_PAIR_FIRST; w < CHECK_WHAT_COUNT; w++) {
-            CheckItem *it = &rep->items[w];
-            if (it->checked && !(it->error <= it->tol))
-                hint_pair(&c, it, (w - CHECK_PAIR_FIRST) / QTY_COUNT, (w - CHECK_PAIR_FIRST) % QTY_COUNT);
-        }
-    }
-    free(mem);
+static void close_engines(Checker *c)
+{
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-        if (c.open[k])
-            engine_close(&c.eng[k]);
+        if (c->open[k])
+            engine_close(&c->eng[k]);
+}
+
+static double *take(Checker *c, size_t n)
+{
+    return arena_alloc_array(&c->buffers, n, sizeof(double));
+}
+
+/* Every working array, zero-filled, from c->buffers. */
+static void take_buffers(Checker *c)
+{
+    size_t nq = (size_t)c->nq, nr = (size_t)c->nr, nvec = (size_t)(c->nh > c->nv ? c->nh : c->nv) + 1;
+    arena_init(&c->buffers);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
+        c->out[k][QTY_PHI] = take(c, nvec);
+        c->out[k][QTY_JAC] = take(c, nr * nq);
+        c->out[k][QTY_NU] = take(c, nr);
+        c->out[k][QTY_GAMMA] = take(c, nr);
+    }
+    c->base = take(c, nq);
+    c->q = take(c, nq);
+    c->qd = take(c, nq);
+    c->qw = take(c, nq);
+    c->qdw = take(c, nq);
+    for (int k = 0; k < 3; k++) {
+        c->save_q[k] = take(c, nq);
+        c->save_qd[k] = take(c, nq);
+    }
+    c->gamma0 = take(c, nr);
+    for (int k = 0; k < 5; k++)
+        c->d2[k] = take(c, nvec);
+    for (int k = 0; k < FD_STEPS; k++)
+        c->ladder[k] = take(c, nvec);
+    c->vec = take(c, nvec);
+    c->scratch = take(c, FD_CACHE * nvec);
+}
+
+/* Sample s: the assembled state itself at s = 0, then random states
+   around it (the draws' order fixes the states for a seed). */
+static void draw_sample(Checker *c, int s, uint64_t *rng)
+{
+    const CheckOptions *opt = c->opt;
+    c->sample = s;
+    for (int i = 0; i < c->nq; i++) {
+        c->q[i] = c->base[i] + (s == 0 ? 0.0 : uniform(rng, -opt->spread_q, opt->spread_q));
+        c->qd[i] = uniform(rng, -opt->spread_qd, opt->spread_qd);
+    }
+    c->t = s == 0 ? 0.0 : uniform(rng, 0.0, 1.0);
+}
+
+/* Every comparison at every sample, recorded in the report's items. */
+static void sample_loop(Checker *c)
+{
+    c->rep->assembled = assemble(c, c->base);
+    uint64_t rng = (uint64_t)c->opt->seed * 0x2545f4914f6cdd1dull + 1;
+    for (int s = 0; s < c->opt->samples; s++) {
+        draw_sample(c, s, &rng);
+        under_test(c);
+        for (int k = 1; k < ENGINE_KIND_COUNT; k++)
+            if (c->open[k])
+                eval_engine(c, (EngineKind)k);
+        for (int pair = 0; pair < PAIR_COUNT; pair++)
+            if (c->open[pair_engines[pair][0]] && c->open[pair_engines[pair][1]])
+                compare_pair(c, pair);
+        check_fd(c, c->scratch, c->vec);
+    }
+    c->rep->samples = c->opt->samples;
+}
+
+/* The verdict, and a hint for every item above its tolerance. */
+static void diagnose(Checker *c)
+{
+    CheckReport *rep = c->rep;
+    rep->ok = true;
+    for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
+        CheckItem *it = &rep->items[w];
+        if (!it->checked || it->error <= it->tol)
+            continue;
+        rep->ok = false;
+        if (w == CHECK_JAC_FD)
+            hint_jac(c, it);
+        else if (w == CHECK_NU_FD)
+            hint_nu(c, it);
+        else if (w == CHECK_GAMMA_FD)
+            hint_gamma(c, it, c->scratch, c->vec);
+    }
+    for (int w = CHECK_PAIR_FIRST; w < CHECK_WHAT_COUNT; w++) {
+        CheckItem *it = &rep->items[w];
+        if (it->checked && !(it->error <= it->tol))
+            hint_pair(c, it, (w - CHECK_PAIR_FIRST) / QTY_COUNT, (w - CHECK_PAIR_FIRST) % QTY_COUNT);
+    }
+}
+
+bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep, Diag *diag)
+{
+    CheckOptions defaults = check_default_options();
+    if (!opt)
+        opt = &defaults;
+    memset(rep, 0, sizeof *rep);
+    const Model *m = mech->model;
+    Checker c = {.m = m, .opt = opt, .rep = rep, .nq = m->nq, .nh = m->nh, .nv = m->nv, .nr = m->nr};
+    init_items(rep, opt);
+    bool ok = open_engines(&c, mech, diag);
+    if (ok) {
+        take_buffers(&c);
+        sample_loop(&c);
+        diagnose(&c);
+        arena_free(&c.buffers);
+    }
+    close_engines(&c);
     return ok;
 }

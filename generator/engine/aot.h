@@ -11,8 +11,10 @@
    every library is built with. */
 #define AOT_FLAGS "-O2 -fPIC -shared"
 
+/* A loaded library and its kernels; the kernel pointers die with it. */
+typedef struct Aot Aot;
+
 typedef struct AotResult {
-    void *handle;           /* dlopen handle: aot_unload it */
     double seconds;         /* compile (or cache lookup) plus load time */
     bool cached;            /* the library came from the cache */
     char path[1200];        /* the library's file */
@@ -23,11 +25,12 @@ typedef struct AotResult {
    without XDG_CACHE_HOME), HASH being that of the source, compiler and
    flags; reuses the file when it exists, unless fresh. The library is
    written under a temporary name and renamed, so concurrent runs never see
-   half a file. Fills k from dlsym. Returns false with diag filled when no
-   compiler is found, it fails, or the library cannot be loaded. */
-bool aot_load(const char *source, const char *prefix, bool fresh, Kernels *k,
-              AotResult *out, Diag *diag);
-void aot_unload(void *handle);
+   half a file. Returns the loaded library (aot_unload it), or NULL with
+   diag filled when no compiler is found, it fails, or the library cannot
+   be loaded. */
+Aot *aot_load(const char *source, const char *prefix, bool fresh, AotResult *out, Diag *diag);
+const Kernels *aot_kernels(const Aot *aot);
+void aot_unload(Aot *aot);
 
 /* The cache folder, created (mode 0700) when missing; false with diag
    filled when there is none. */

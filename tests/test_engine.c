@@ -1,0 +1,278 @@
+/* test_engine.c - every engine kind is one MechrtKernels: same sizes, same values, valid wherever the Engine goes.
+ *
+ * engine_open fills Engine.k for jit, aot and generic; check, run and the
+ * runtime call nothing else. These tests hold k to that: its sizes are the
+ * model's, calling it gives exactly what the kind's own functions give,
+ * its fused `all` agrees with the four separate kernels, the runtime's
+ * Newton assembles through it, and a copy of k keeps working after the
+ * Engine itself is moved (k.ctx is memory the engine owns, never the
+ * Engine struct). The aot library cache goes to a private folder.
+ */
+#include "testutil.h"
+
+#include "../generator/base/arena.h"
+#include "../generator/engine/aot.h"
+#include "../generator/engine/engine.h"
+
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static char cache_dir[256];
+static bool have_cc;
+
+static void remove_tree(const char *dir, int depth)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    struct dirent *e;
+    char path[900];
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.')
+            continue;
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (unlink(path) != 0 && depth > 0)
+            remove_tree(path, depth - 1);
+    }
+    closedir(d);
+    rmdir(dir);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    const char *tmp = getenv("TMPDIR");
+    snprintf(cache_dir, sizeof cache_dir, "%s/mechc-test-engine-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    if (!mkdtemp(cache_dir))
+        return -1;
+    setenv("XDG_CACHE_HOME", cache_dir, 1);
+    have_cc = aot_compiler_available();
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    remove_tree(cache_dir, 2);
+    return 0;
+}
+
+static Mech *load_example(const char *name)
+{
+    const char *dir = getenv("MECHC_EXAMPLES");
+    char path[600];
+    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load(path, &limits, &diag);
+    if (!mech)
+        fail_msg("%s: %s", path, diag.message);
+    return mech;
+}
+
+/* The four quantities of one evaluation, sized for m. */
+typedef struct Out {
+    double *phi, *jac, *nu, *gamma;
+} Out;
+
+static void out_alloc(Out *o, const Model *m)
+{
+    o->phi = xcalloc((size_t)m->nh + 1, sizeof(double));
+    o->jac = xcalloc((size_t)m->nr * (size_t)m->nq + 1, sizeof(double));
+    o->nu = xcalloc((size_t)m->nr + 1, sizeof(double));
+    o->gamma = xcalloc((size_t)m->nr + 1, sizeof(double));
+}
+
+static void out_free(Out *o)
+{
+    free(o->phi), free(o->jac), free(o->nu), free(o->gamma);
+}
+
+static void evaluate(const MechrtKernels *k, const double *q, const double *qd, double t, Out *o)
+{
+    k->phi(k->ctx, q, t, o->phi);
+    k->jac(k->ctx, q, t, o->jac);
+    k->nu(k->ctx, q, t, o->nu);
+    k->gamma(k->ctx, q, qd, t, o->gamma);
+}
+
+/* The kind's own functions, bypassing k. */
+static void evaluate_directly(const Engine *e, const double *q, const double *qd, double t, Out *o)
+{
+    if (e->kind == ENGINE_GENERIC) {
+        generic_phi(e->generic, q, t, o->phi);
+        generic_jac(e->generic, q, t, o->jac);
+        generic_nu(e->generic, q, t, o->nu);
+        generic_gamma(e->generic, q, qd, t, o->gamma);
+        return;
+    }
+    e->kernels.phi(q, t, o->phi);
+    e->kernels.jac(q, t, o->jac);
+    e->kernels.nu(q, t, o->nu);
+    e->kernels.gamma(q, qd, t, o->gamma);
+}
+
+static void assert_same(const char *what, const double *got, const double *want, int n, double rtol)
+{
+    for (int i = 0; i < n; i++)
+        if (!(fabs(got[i] - want[i]) <= rtol * (1.0 + fabs(want[i]))))
+            fail_msg("%s[%d] = %.17g, expected %.17g", what, i, got[i], want[i]);
+}
+
+static void assert_outs(const char *ctx, const Model *m, const Out *got, const Out *want, double rtol)
+{
+    char what[120];
+    snprintf(what, sizeof what, "%s phi", ctx);
+    assert_same(what, got->phi, want->phi, m->nh, rtol);
+    snprintf(what, sizeof what, "%s jac", ctx);
+    assert_same(what, got->jac, want->jac, m->nr * m->nq, rtol);
+    snprintf(what, sizeof what, "%s nu", ctx);
+    assert_same(what, got->nu, want->nu, m->nr, rtol);
+    snprintf(what, sizeof what, "%s gamma", ctx);
+    assert_same(what, got->gamma, want->gamma, m->nr, rtol);
+}
+
+/* A high-entropy state near the initial values. */
+static void state(const Model *m, double *q, double *qd, double *t)
+{
+    for (int i = 0; i < m->nq; i++) {
+        q[i] = m->q0[i] + 0.0731 * (i % 5) - 0.113;
+        qd[i] = 0.7371 - 0.291 * (i % 3);
+    }
+    *t = 0.4137;
+}
+
+static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
+{
+    if (kind == ENGINE_AOT && !have_cc)
+        return false;
+    Diag diag;
+    if (!engine_open(e, kind, mech, &diag))
+        fail_msg("%s: %s", engine_names[kind], diag.message);
+    return true;
+}
+
+/* k's sizes are the model's, all five kernels are there, and k gives
+   bit for bit what the kind's own functions give. */
+static void check_kernels(const char *file)
+{
+    Mech *mech = load_example(file);
+    const Model *m = mech->model;
+    double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd), t;
+    state(m, q, qd, &t);
+    Out via_k, direct, all;
+    out_alloc(&via_k, m), out_alloc(&direct, m), out_alloc(&all, m);
+    for (int kind = 0; kind < ENGINE_KIND_COUNT; kind++) {
+        Engine e;
+        if (!open_kind(&e, (EngineKind)kind, mech))
+            continue;
+        const MechrtKernels *k = &e.k;
+        assert_int_equal(k->nq, m->nq);
+        assert_int_equal(k->nh, m->nh);
+        assert_int_equal(k->nv, m->nv);
+        assert_non_null(k->ctx);
+        assert_true(k->phi && k->jac && k->nu && k->gamma && k->all);
+        evaluate(k, q, qd, t, &via_k);
+        evaluate_directly(&e, q, qd, t, &direct);
+        assert_outs(engine_names[kind], m, &via_k, &direct, 0.0);
+        k->all(k->ctx, q, qd, t, all.phi, all.jac, all.nu, all.gamma);
+        assert_outs(engine_names[kind], m, &all, &via_k, 1e-13);
+        engine_close(&e);
+    }
+    out_free(&via_k), out_free(&direct), out_free(&all);
+    free(q), free(qd);
+    pipeline_free(mech);
+}
+
+static void test_kernels_position_rows(void **s)
+{
+    (void)s;
+    check_kernels("four_bar.mech");
+}
+
+static void test_kernels_velocity_rows(void **s)
+{
+    (void)s;
+    check_kernels("all_statements.mech");
+}
+
+/* A copy of k, taken before the Engine is moved and the old place
+   poisoned, still evaluates, and gives what it gave before. */
+static void test_kernels_survive_a_moved_engine(void **s)
+{
+    (void)s;
+    Mech *mech = load_example("four_bar.mech");
+    const Model *m = mech->model;
+    double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd), t;
+    state(m, q, qd, &t);
+    Out before, after;
+    out_alloc(&before, m), out_alloc(&after, m);
+    for (int kind = 0; kind < ENGINE_KIND_COUNT; kind++) {
+        Engine *first = xcalloc(1, sizeof *first);
+        if (!open_kind(first, (EngineKind)kind, mech)) {
+            free(first);
+            continue;
+        }
+        MechrtKernels k = first->k;
+        evaluate(&k, q, qd, t, &before);
+        Engine moved = *first;
+        memset(first, 0xa5, sizeof *first);     /* poison the old place */
+        evaluate(&k, q, qd, t, &after);
+        free(first);    /* only now: the compiler drops a memset just before free */
+        assert_outs(engine_names[kind], m, &after, &before, 0.0);
+        evaluate(&moved.k, q, qd, t, &after);
+        assert_outs(engine_names[kind], m, &after, &before, 0.0);
+        engine_close(&moved);
+    }
+    out_free(&before), out_free(&after);
+    free(q), free(qd);
+    pipeline_free(mech);
+}
+
+/* The runtime takes an engine's k as it is: Newton assembles the four-bar
+   through every kind to the same configuration. */
+static void test_runtime_assembles_through_k(void **s)
+{
+    (void)s;
+    Mech *mech = load_example("four_bar.mech");
+    const Model *m = mech->model;
+    size_t nq = (size_t)m->nq, lwork = mechrt_workspace_size(m->nq, m->nr);
+    double *work = xcalloc(lwork, sizeof *work), *q = xcalloc(nq, sizeof *q);
+    double *first = xcalloc(nq, sizeof *first);
+    bool have_first = false;
+    for (int kind = 0; kind < ENGINE_KIND_COUNT; kind++) {
+        Engine e;
+        if (!open_kind(&e, (EngineKind)kind, mech))
+            continue;
+        memcpy(q, m->q0, nq * sizeof *q);
+        MechrtReport rep;
+        assert_int_equal(mechrt_assemble(&e.k, NULL, q, 0.0, work, lwork, &rep), MECHRT_OK);
+        assert_true(rep.residual <= 1e-8);
+        double *phi = xcalloc((size_t)m->nh + 1, sizeof *phi);
+        engine_phi(&e, q, 0.0, phi);
+        for (int i = 0; i < m->nh; i++)
+            assert_near(phi[i], 0.0, 0.0, 1e-8);
+        free(phi);
+        if (!have_first)
+            memcpy(first, q, nq * sizeof *q);
+        assert_same(engine_names[kind], q, first, m->nq, 1e-9);
+        have_first = true;
+        engine_close(&e);
+    }
+    assert_true(have_first);
+    free(work), free(q), free(first);
+    pipeline_free(mech);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_kernels_position_rows),
+        cmocka_unit_test(test_kernels_velocity_rows),
+        cmocka_unit_test(test_kernels_survive_a_moved_engine),
+        cmocka_unit_test(test_runtime_assembles_through_k),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
