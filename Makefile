@@ -9,7 +9,7 @@ Q        = $(if $(filter 1,$(V)),,@)
 
 VERSION := 0.1.0
 WARN    := -Wall -Wextra -Wshadow -Wpointer-arith -Wwrite-strings -Wundef \
-           -Wmissing-prototypes -Wstrict-prototypes -Wformat=2
+           -Wmissing-prototypes -Wstrict-prototypes -Wformat=2 -Werror=switch
 OPT     ?= -O2 -g
 SAN     ?=
 CFLAGS_TOOL    := -std=c11 $(OPT) $(WARN) $(SAN) -D_DEFAULT_SOURCE \

@@ -786,6 +786,46 @@ static void test_joint_table(void **state)
     }
 }
 
+/* Reads a file of the repository (from the root or from tests/) into buf. */
+static void read_repo_file(const char *path, char *buf, size_t size)
+{
+    char alt[256];
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(alt, sizeof alt, "../%s", path);
+        fp = fopen(alt, "rb");
+    }
+    if (!fp)
+        fail_msg("cannot open %s (run from the repository root)", path);
+    size_t n = fread(buf, 1, size - 1, fp);
+    fclose(fp);
+    if (n == size - 1)
+        fail_msg("%s is longer than the test's buffer", path);
+    buf[n] = '\0';
+}
+
+/* Every joints.def kind is used in all_statements.mech, the file the
+   jit/generic/aot and finite-difference agreement tests compile (and in
+   its copy among the fuzz seeds), so a new kind cannot go untested. */
+static void test_all_statements_has_every_kind(void **state)
+{
+    Parsed *r = *state;
+    static const char *const files[] = {"examples/all_statements.mech",
+                                        "tests/fuzz/corpus/all_statements.mech"};
+    static char text[1 << 16];
+    for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
+        read_repo_file(files[f], text, sizeof text);
+        const Program *prog = parse_ok(r, text);
+        bool seen[JOINT_KIND_COUNT] = {false};
+        for (const Stmt *st = prog->first; st; st = st->next)
+            if (st->kind == STMT_JOINT)
+                seen[st->joint] = true;
+        for (int k = 0; k < JOINT_KIND_COUNT; k++)
+            if (!seen[k])
+                fail_msg("%s has no '%s' statement", files[f], joint_info[k].keyword);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -802,6 +842,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_deep_nesting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_long_flat_expression, setup, teardown),
         cmocka_unit_test(test_joint_table),
+        cmocka_unit_test_setup_teardown(test_all_statements_has_every_kind, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -31,23 +31,13 @@ static const double NEAR_SINGULAR_COND = 1e8;
 
 const char *const singularity_names[] = {"none", "position", "drivers", "permanent", "unknown"};
 
+/* What each kind removes is its joints.def row count (revolute 2, prismatic
+   2, weld 3, the others 1: the textbook table, which test_info checks), so
+   a new kind needs no case here. */
 int info_textbook_rows(JointKind kind, bool *velocity)
 {
-    *velocity = false;
-    switch (kind) {
-    case JOINT_REVOLUTE:   return 2;    /* two translations */
-    case JOINT_PRISMATIC:  return 2;    /* one translation, the rotation */
-    case JOINT_DISTANCE:   return 1;
-    case JOINT_POINTLINE:  return 1;
-    case JOINT_WELD:       return 3;    /* everything */
-    case JOINT_CONSTRAINT: return 1;
-    case JOINT_DRIVER:     return 1;    /* either level */
-    case JOINT_ROLLING:    *velocity = true; return 1;
-    case JOINT_KNIFE:      *velocity = true; return 1;
-    case JOINT_VELOCITY:   *velocity = true; return 1;
-    case JOINT_KIND_COUNT: break;
-    }
-    return 0;
+    *velocity = joint_info[kind].level == LEVEL_VELOCITY;
+    return joint_info[kind].rows;
 }
 
 /* Copies the listed rows of jac (nq columns) into out. */
@@ -343,60 +333,57 @@ static Singularity classify_singularity(const InfoReport *rep, int nuh)
     return SING_UNKNOWN;
 }
 
-bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
+/* Marks the drivers and counts them. undriven[] lists the rows without
+   drivers (holonomic rows first, *nuh of them), hrows[] every holonomic
+   row; returns how many rows undriven[] holds. */
+static int count_rows(const Model *m, InfoReport *rep, int *undriven, int *hrows, int *nuh)
 {
-    Model *m = mech->model;
-    int nq = m->nq, nh = m->nh, nr = m->nr;
-    memset(rep, 0, sizeof *rep);
-    rep->model = m;
-    rep->t = t;
-    rep->nq = nq, rep->nh = nh, rep->nv = m->nv, rep->nr = nr;
-    rep->rows = xcalloc((size_t)nr + 1, sizeof *rep->rows);
-    int *undriven = xmalloc(((size_t)nr + 1) * sizeof *undriven);
-    int *hrows = xmalloc(((size_t)nh + 1) * sizeof *hrows);
-    int nu = 0, nuh = 0;
-    for (int r = 0; r < nr; r++) {
+    int nu = 0, nh = m->nh;
+    *nuh = 0;
+    for (int r = 0; r < m->nr; r++) {
         bool driver = m->rows[r].kind == JOINT_DRIVER;
         rep->rows[r].driver = driver;
         if (driver)
             *(r < nh ? &rep->nh_drivers : &rep->nv_drivers) += 1;
         else {
             undriven[nu++] = r;
-            nuh += r < nh;
+            *nuh += r < nh;
         }
         if (r < nh)
             hrows[r] = r;
     }
-    rep->dof = nq - nh - m->nv;
-    rep->mobility = nq - nu;
-    rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
-    rep->generic_rank = -1;
-    rep->q = xmalloc((size_t)nq * sizeof *rep->q);
-    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
-    rep->dense = (double)nr * (double)nq <= opt->max_dense;
+    rep->dof = m->nq - nh - m->nv;
+    rep->mobility = m->nq - nu;
+    return nu;
+}
 
-    MechEval me;
-    mech_eval_init(&me, &mech->kin);
-    MechrtSvd *w = rep->dense ? svd_work_new(nr, nq) : NULL;
+/* Assembly at t, then the ranks at the assembled configuration, the
+   redundant rows and, where rows are lost, the generic rank. w is NULL
+   beyond the dense limit (sparse QR instead of SVD). */
+static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
+                              const int *hrows, const int *undriven, int nu, int nuh,
+                              const AnalysisOptions *opt)
+{
+    const Model *m = mech->model;
+    int nq = m->nq, nh = m->nh, nr = m->nr;
+    double t = rep->t;
     size_t dense_len = w ? (size_t)nr * (size_t)nq : 0;
     double *jac = xcalloc(dense_len + 1, sizeof *jac);
     double *sub = xcalloc(dense_len + 1, sizeof *sub);
     bool *red = xcalloc((size_t)nr + 1, sizeof *red);
-
-    /* assembly at t */
     if (nh == 0) {
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
-        rep->assembled = analysis_assemble(&me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
+        rep->assembled = analysis_assemble(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
-        rep->assembled = analysis_assemble_sparse(&me, nh, t, rep->q, opt, &rep->assembly);
+        rep->assembled = analysis_assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
     }
     if (w) {
-        mech_eval(&me, rep->q, t, NULL, jac);
+        mech_eval(me, rep->q, t, NULL, jac);
         dense_ranks(w, jac, sub, m, rep, undriven, nu, nuh, opt, red);
     } else {
-        sparse_ranks(&mech->kin, &me, rep, undriven, nu, nuh, opt, red);
+        sparse_ranks(&mech->kin, me, rep, undriven, nu, nuh, opt, red);
     }
     if (rep->rank < 0 || rep->rank_all < 0) {       /* NaN or Inf in the Jacobian */
         rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
@@ -408,12 +395,38 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     if (w) {
         if (rep->rank >= 0 && rep->rank_undriven_h >= 0 && opt->generic_samples > 0
             && (rep->rank < nh || rep->rank_undriven_h < nuh))
-            rep->generic_rank = generic_rank(&me, undriven, nuh, rep->q, t, opt, w);
+            rep->generic_rank = generic_rank(me, undriven, nuh, rep->q, t, opt, w);
     }
     if (rep->rank_all >= 0) {
         rep->dof_rank = nq - rep->rank_all;
         rep->mobility_rank = nq - rep->rank_undriven;
     }
+    free(jac), free(sub), free(red);
+}
+
+bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
+{
+    Model *m = mech->model;
+    int nq = m->nq, nh = m->nh, nr = m->nr;
+    memset(rep, 0, sizeof *rep);
+    rep->model = m;
+    rep->t = t;
+    rep->nq = nq, rep->nh = nh, rep->nv = m->nv, rep->nr = nr;
+    rep->rows = xcalloc((size_t)nr + 1, sizeof *rep->rows);
+    int *undriven = xmalloc(((size_t)nr + 1) * sizeof *undriven);
+    int *hrows = xmalloc(((size_t)nh + 1) * sizeof *hrows);
+    int nuh;
+    int nu = count_rows(m, rep, undriven, hrows, &nuh);
+    rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
+    rep->generic_rank = -1;
+    rep->q = xmalloc((size_t)nq * sizeof *rep->q);
+    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
+    rep->dense = (double)nr * (double)nq <= opt->max_dense;
+
+    MechEval me;
+    mech_eval_init(&me, &mech->kin);
+    MechrtSvd *w = rep->dense ? svd_work_new(nr, nq) : NULL;
+    assemble_and_rank(mech, &me, w, rep, hrows, undriven, nu, nuh, opt);
     rep->singularity = classify_singularity(rep, nuh);
     rep->verdict = make_verdict(rep);
     rep->singular = make_singular(rep, nuh);
@@ -428,7 +441,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
 
     mech_eval_free(&me);
     mechrt_svd_free(w);
-    free(jac), free(sub), free(red), free(undriven), free(hrows);
+    free(undriven), free(hrows);
     if (!ok)
         info_report_free(rep);
     return ok;

@@ -24,12 +24,29 @@ const char *const emit_function_names[EMIT_FUNCTION_COUNT] = {
     "phi", "jac", "jac_nz", "nu", "gamma", "all",
 };
 
-/* Parameters of each generated function, in order (all are void-cast so
-   no mechanism triggers an unused-parameter warning). */
-static const char *const function_params[EMIT_FUNCTION_COUNT] = {
-    "q, t, phi", "q, t, jac", "q, t, vals", "q, t, nu", "q, qd, t, gamma",
-    "q, qd, t, phi, jac, nu, gamma",
+/* A parameter of the generated functions. */
+typedef struct Param {
+    const char *name;
+    bool input;         /* read only: const P_real * (q, qd) */
+    bool scalar;        /* by value: P_real (t); else written: P_real * */
+} Param;
+
+#define IN(name) {name, true, false}
+#define VALUE(name) {name, false, true}
+#define OUT(name) {name, false, false}
+/* Parameters of each generated function, in order, up to a NULL name (all
+   are void-cast so no mechanism triggers an unused-parameter warning). */
+static const Param function_params[EMIT_FUNCTION_COUNT][8] = {
+    [EMIT_PHI] = {IN("q"), VALUE("t"), OUT("phi")},
+    [EMIT_JAC] = {IN("q"), VALUE("t"), OUT("jac")},
+    [EMIT_JAC_NZ] = {IN("q"), VALUE("t"), OUT("vals")},
+    [EMIT_NU] = {IN("q"), VALUE("t"), OUT("nu")},
+    [EMIT_GAMMA] = {IN("q"), IN("qd"), VALUE("t"), OUT("gamma")},
+    [EMIT_ALL] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac"), OUT("nu"), OUT("gamma")},
 };
+#undef IN
+#undef VALUE
+#undef OUT
 
 EmitOptions emit_default_options(void)
 {
@@ -295,18 +312,8 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     sched_prepare_chunk(&e->sched, fn, chunk);
     const SchedChunk *c = &fn->chunks[chunk];
     sb_puts(sb, "    ");
-    const char *params = function_params[which];
-    for (const char *p = params; *p;) {
-        size_t len = strcspn(p, ",");
-        sb_puts(sb, "(void)");
-        sb_putn(sb, p, len);
-        sb_puts(sb, ";");
-        p += len;
-        while (*p == ',' || *p == ' ')
-            p++;
-        if (*p)
-            sb_putc(sb, ' ');
-    }
+    for (const Param *p = function_params[which]; p->name; p++)
+        sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
     sb_putc(sb, '\n');
     for (int i = 0; i < c->nnodes; i++) {
         NodeId id = c->nodes[i];
@@ -334,23 +341,19 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     }
 }
 
-/* "q, qd, t, gamma" -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
+/* q, qd, t, gamma -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
 static void put_signature(StrBuf *sb, const char *prefix, EmitFunction which)
 {
-    const char *p = function_params[which];
-    bool first = true;
-    while (*p) {
-        size_t len = strcspn(p, ",");
-        bool input = (len == 1 && p[0] == 'q') || (len == 2 && memcmp(p, "qd", 2) == 0);
-        bool scalar = len == 1 && p[0] == 't';
-        sb_printf(sb, "%s%s%s_real %s", first ? "" : ", ", input ? "const " : "", prefix,
-                  scalar ? "" : "*");
-        sb_putn(sb, p, len);
-        first = false;
-        p += len;
-        while (*p == ',' || *p == ' ')
-            p++;
-    }
+    for (const Param *p = function_params[which]; p->name; p++)
+        sb_printf(sb, "%s%s%s_real %s%s", p == function_params[which] ? "" : ", ",
+                  p->input ? "const " : "", prefix, p->scalar ? "" : "*", p->name);
+}
+
+/* q, qd, t, gamma -> "q, qd, t, gamma" */
+static void put_arguments(StrBuf *sb, EmitFunction which)
+{
+    for (const Param *p = function_params[which]; p->name; p++)
+        sb_printf(sb, "%s%s", p == function_params[which] ? "" : ", ", p->name);
 }
 
 /* Fills parts (static helpers, one per chunk) and body (the function's
@@ -369,8 +372,9 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
         sb_puts(parts, ")\n{\n");
         put_chunk(e, parts, fn, c, which);
         sb_puts(parts, "}\n\n");
-        sb_printf(body, "    %s_%s_part%d(%s);\n", p, emit_function_names[which], c,
-                  function_params[which]);
+        sb_printf(body, "    %s_%s_part%d(", p, emit_function_names[which], c);
+        put_arguments(body, which);
+        sb_puts(body, ");\n");
     }
 }
 
@@ -636,7 +640,6 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
        placeholder entry (row 0, column 0, value 0). */
     snprintf(nnz, sizeof nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
     snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
-    enum { VAR_INTERFACE = 11 };
     TemplateVar vars[] = {
         {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
         {"REAL", opt->real_float ? "float" : "double"}, {"NQ", nq}, {"NH", nh}, {"NV", nv},
@@ -652,12 +655,13 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"ZERO_JAC", zero.data}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
+    /* INTERFACE and JAC are rendered from the others, then filled in */
     const char *bad = template_render(&iface, template_interface, vars, nvars);
-    vars[VAR_INTERFACE].value = iface.data;
+    template_set(vars, nvars, "INTERFACE", iface.data);
     if (!bad)
         bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
                               vars, nvars);
-    vars[nvars - 1].value = jac.data;               /* JAC */
+    template_set(vars, nvars, "JAC", jac.data);
     StrBuf header, source;
     sb_init(&header);
     sb_init(&source);
@@ -667,7 +671,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         sb_puts(&inc, "#include ");
         sb_put_c_string(&inc, opt->header_name);
         sb_puts(&inc, "\n");
-        vars[VAR_INTERFACE].value = inc.data;
+        template_set(vars, nvars, "INTERFACE", inc.data);
     }
     if (!bad)
         bad = template_render(&source, template_mech_c, vars, nvars);

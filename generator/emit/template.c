@@ -1,6 +1,8 @@
 /* template.c - placeholder substitution: @NAME@ (upper case, digits, _) becomes its value. */
 #include "template.h"
 
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static int placeholder_length(const char *p)
@@ -37,4 +39,15 @@ const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *va
         p = at + n + 2;
     }
     return NULL;
+}
+
+void template_set(TemplateVar *vars, int nvars, const char *name, const char *value)
+{
+    for (int i = 0; i < nvars; i++)
+        if (strcmp(vars[i].name, name) == 0) {
+            vars[i].value = value;
+            return;
+        }
+    fprintf(stderr, "mechc: internal error: no template variable '%s'\n", name);
+    abort();
 }

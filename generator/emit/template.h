@@ -13,4 +13,8 @@ typedef struct TemplateVar {
    value is a bug in mechc: returns its name so the caller can report it. */
 const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *vars, int nvars);
 
+/* Gives the variable called name its value. A name not in vars is a bug
+   in mechc: aborts. */
+void template_set(TemplateVar *vars, int nvars, const char *name, const char *value);
+
 #endif

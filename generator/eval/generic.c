@@ -125,8 +125,8 @@ static void run(Call *c)
         memset(c->jac, 0, (size_t)g->nr * (size_t)g->nq * sizeof *c->jac);
     for (int i = 0; i < g->nplans; i++) {
         const Plan *p = &g->plans[i];
-        if (p->prog < 0)
-            generic_joint_rows(c, p);
+        if (p->rows)
+            p->rows(c, p);
         else if (p->j->velocity)
             velocity_row(c, &g->progs[p->prog], p->row);
         else
@@ -173,17 +173,6 @@ static int add_tape(Generic *g, const Model *m, NodeId root, CompileScratch *cs)
     return g->nprogs++;
 }
 
-/* The formulas rotate s or the axis by A(phi) for these attachments:
-   need[phi] = 1 for velocity-level joints, 2 for position-level ones. */
-static void need_angle(char *need, const Attach *at, bool normal, bool velocity)
-{
-    if (at->q >= 0 && at->has_phi && (normal || at->sx != 0.0 || at->sy != 0.0)) {
-        char level = velocity ? 1 : 2;
-        if (need[at->q + 2] < level)
-            need[at->q + 2] = level;
-    }
-}
-
 Generic *generic_open(const Model *m)
 {
     Generic *g = xcalloc(1, sizeof *g);
@@ -205,28 +194,9 @@ Generic *generic_open(const Model *m)
         const Joint *j = &m->joints[i];
         Plan *p = &g->plans[i];
         *p = (Plan){.j = j, .row = j->first_row, .prog = -1, .opt = {.constant = true, .prog = -1}};
-        switch (j->kind) {
-        case JOINT_CONSTRAINT:
-        case JOINT_DRIVER:
-        case JOINT_VELOCITY:
+        p->rows = generic_joint_formula(j, need);
+        if (!p->rows)
             p->prog = add_tape(g, m, j->expr, &cs);
-            break;
-        case JOINT_PRISMATIC:
-        case JOINT_POINTLINE:
-        case JOINT_KNIFE:
-            need_angle(need, &j->a, true, j->velocity);
-            need_angle(need, &j->b, false, j->velocity);
-            break;
-        case JOINT_REVOLUTE:
-        case JOINT_DISTANCE:
-        case JOINT_WELD:
-        case JOINT_ROLLING:
-            need_angle(need, &j->a, false, j->velocity);
-            need_angle(need, &j->b, false, j->velocity);
-            break;
-        case JOINT_KIND_COUNT:
-            break;
-        }
         if (joint_info[j->kind].option != OPTION_NONE
             && !dag_is_const(&m->dag, j->option, &p->opt.value)) {
             p->opt.constant = false;

@@ -12,13 +12,20 @@ typedef struct Option {
     int prog;           /* index into Generic.progs, -1 when constant */
 } Option;
 
+typedef struct Call Call;
+typedef struct Plan Plan;
+
+/* A standard joint's rows by its formulas (generic_joints.c). */
+typedef void GenericRows(const Call *c, const Plan *p);
+
 /* One joint, ready to evaluate. */
-typedef struct Plan {
+struct Plan {
     const Joint *j;
     int row;            /* its first row */
+    GenericRows *rows;  /* a standard joint's formulas; else NULL and: */
     int prog;           /* constraint, driver, velocity: the row's program; else -1 */
     Option opt;
-} Plan;
+};
 
 struct Generic {
     const Model *m;
@@ -37,7 +44,7 @@ struct Generic {
 
 /* One evaluation: the state and where each requested quantity goes (NULL:
    not requested). jac is zero-filled by the caller; formulas add to it. */
-typedef struct Call {
+struct Call {
     Generic *g;
     const double *q, *qd;   /* qd NULL unless gamma or psi is requested */
     double t;
@@ -46,7 +53,7 @@ typedef struct Call {
     double *nu;         /* nr */
     double *gamma;      /* nr */
     double *psi;        /* nv, indexed by row - nh */
-} Call;
+};
 
 /* Options (generic.c). */
 double option_value(const Call *c, const Option *o);
@@ -57,7 +64,10 @@ Jet option_along(const Call *c, const Option *o, int order);
 /* row[j] += coef * d option/dq_j for every coordinate the option reads. */
 void option_jac(const Call *c, const Option *o, double coef, double *row);
 
-/* The rows of one standard joint (generic_joints.c). */
-void generic_joint_rows(const Call *c, const Plan *p);
+/* The formulas of j's kind (generic_joints.c), NULL for a kind whose row
+   is interpreted (constraint, driver, velocity). Raises need[k] (one per
+   coordinate) for each angle q[k] whose A(phi) they rotate: to 2 for a
+   position-level joint, to 1 for a velocity-level one. */
+GenericRows *generic_joint_formula(const Joint *j, char *need);
 
 #endif

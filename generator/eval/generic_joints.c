@@ -177,8 +177,9 @@ static void angle_row(const Call *c, const Plan *p, int r)
    df/dr_B = 2d, df/dphi_B = 2 d . perp(A_B s_B), the negatives for A,
    -2 L L_q; nu = 2 L L_t;
    D2 f = 2 d'.d' + 2 d.d'' - 2 (DL)^2 - 2 L D2L; gamma = -D2 f. */
-static void distance_row(const Call *c, const Plan *p, int r)
+static void distance_row(const Call *c, const Plan *p)
 {
+    int r = p->row;
     const Joint *j = p->j;
     Pt a = point_at(c, &j->a), b = point_at(c, &j->b);
     double dx = b.x - a.x, dy = b.y - a.y;
@@ -205,8 +206,9 @@ static void distance_row(const Call *c, const Plan *p, int r)
 
 /* rolling (velocity level): Psi = x_B' + R phi_B'.
    a = (1 on x, R on phi); nu = -Psi(qd = 0) = 0; gamma = -(DR) phi_B'. */
-static void rolling_row(const Call *c, const Plan *p, int r)
+static void rolling_row(const Call *c, const Plan *p)
 {
+    int r = p->row;
     const Attach *at = &p->j->a;
     double radius = option_value(c, &p->opt);
     if (c->psi)
@@ -226,8 +228,9 @@ static void rolling_row(const Call *c, const Plan *p, int r)
 /* knife (velocity level): Psi = n_A . dP_A/dt.
    a = (n on x, y; n . perp(A s) on phi); nu = 0;
    gamma = -(perp(n) phi' . P' + n . P'') with P'' = -A s phi'^2. */
-static void knife_row(const Call *c, const Plan *p, int r)
+static void knife_row(const Call *c, const Plan *p)
 {
+    int r = p->row;
     const Joint *j = p->j;
     Pt a = point_at(c, &j->a);
     double nx, ny;
@@ -244,38 +247,78 @@ static void knife_row(const Call *c, const Plan *p, int r)
     }
 }
 
-void generic_joint_rows(const Call *c, const Plan *p)
+static void revolute_joint(const Call *c, const Plan *p)
 {
-    const Joint *j = p->j;
-    int r = p->row;
-    switch (j->kind) {
-    case JOINT_REVOLUTE:
-        revolute_rows(c, j, r);
-        return;
-    case JOINT_PRISMATIC:
-        normal_row(c, j, r);
-        angle_row(c, p, r + 1);
-        return;
-    case JOINT_DISTANCE:
-        distance_row(c, p, r);
-        return;
-    case JOINT_POINTLINE:
-        normal_row(c, j, r);
-        return;
-    case JOINT_WELD:
-        revolute_rows(c, j, r);
-        angle_row(c, p, r + 2);
-        return;
-    case JOINT_ROLLING:
-        rolling_row(c, p, r);
-        return;
-    case JOINT_KNIFE:
-        knife_row(c, p, r);
-        return;
+    revolute_rows(c, p->j, p->row);
+}
+
+static void prismatic_joint(const Call *c, const Plan *p)
+{
+    normal_row(c, p->j, p->row);
+    angle_row(c, p, p->row + 1);
+}
+
+static void pointline_joint(const Call *c, const Plan *p)
+{
+    normal_row(c, p->j, p->row);
+}
+
+static void weld_joint(const Call *c, const Plan *p)
+{
+    revolute_rows(c, p->j, p->row);
+    angle_row(c, p, p->row + 2);
+}
+
+/* What a kind's formulas rotate by A(phi), so that generic.c computes cos
+   and sin of those angles before a call: */
+enum {
+    TURN_SA = 1,        /* A's offset: P_A = r_A + A(phi_A) s_A */
+    TURN_SB = 2,        /* B's offset */
+    TURN_AXIS = 4,      /* A's axis: n_A = A(phi_A) (-uy, ux) */
+};
+
+typedef struct Formula {
+    GenericRows *rows;  /* NULL: the row is interpreted (generic.c) */
+    int turns;          /* TURN_* */
+} Formula;
+
+/* A new kind adds its case here, beside its formulas above. */
+static Formula formula_of(JointKind kind)
+{
+    switch (kind) {
+    case JOINT_REVOLUTE:   return (Formula){revolute_joint, TURN_SA | TURN_SB};
+    case JOINT_PRISMATIC:  return (Formula){prismatic_joint, TURN_SA | TURN_SB | TURN_AXIS};
+    case JOINT_DISTANCE:   return (Formula){distance_row, TURN_SA | TURN_SB};
+    case JOINT_POINTLINE:  return (Formula){pointline_joint, TURN_SA | TURN_SB | TURN_AXIS};
+    case JOINT_WELD:       return (Formula){weld_joint, TURN_SA | TURN_SB};
+    case JOINT_ROLLING:    return (Formula){rolling_row, 0};   /* phi' only, no rotation */
+    case JOINT_KNIFE:      return (Formula){knife_row, TURN_SA | TURN_AXIS};
     case JOINT_CONSTRAINT:
     case JOINT_DRIVER:
     case JOINT_VELOCITY:
     case JOINT_KIND_COUNT:
-        break;      /* interpreted rows: generic.c */
+        break;
     }
+    return (Formula){NULL, 0};
+}
+
+/* need[phi] = 1 for velocity-level joints, 2 for position-level ones;
+   an attachment without an angle, or an offset of zero, rotates nothing. */
+static void need_angle(char *need, const Attach *at, bool axis, bool offset, bool velocity)
+{
+    if (at->q >= 0 && at->has_phi && (axis || (offset && (at->sx != 0.0 || at->sy != 0.0)))) {
+        char level = velocity ? 1 : 2;
+        if (need[at->q + 2] < level)
+            need[at->q + 2] = level;
+    }
+}
+
+GenericRows *generic_joint_formula(const Joint *j, char *need)
+{
+    Formula f = formula_of(j->kind);
+    if (f.rows) {
+        need_angle(need, &j->a, f.turns & TURN_AXIS, f.turns & TURN_SA, j->velocity);
+        need_angle(need, &j->b, false, f.turns & TURN_SB, j->velocity);
+    }
+    return f.rows;
 }
