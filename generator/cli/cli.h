@@ -83,7 +83,8 @@ typedef struct CliOption {
     const char *help;
 } CliOption;
 
-/* offsetof(T, field), refused at compile time when field is not of type type. */
+/* offsetof(T, field); the compiler warns ("incompatible pointer type")
+   when field is not of type type, so a kind cannot meet a wrong field. */
 #define CLI_AT(T, field, type) (offsetof(T, field) + 0 * sizeof((type *){0} = &((T *)0)->field))
 /* An entry's kind and field: {"--steps", CLI_INT_AT(RunCli, ro.steps, 1, 1000), ...}. */
 #define CLI_FLAG_AT(T, f)           .kind = CLI_FLAG, .offset = CLI_AT(T, f, bool)
@@ -107,6 +108,12 @@ typedef struct CliCommand {
     int column;                 /* where --help starts an option's text */
     const char *epilogue;       /* --help after the options, or NULL */
     size_t limits_offset;
+    /* After the options, before the file is loaded (NULL: nothing): checks
+       them together and fills what they imply; false when they cannot be
+       used (reported). Called also when one option was wrong. */
+    bool (*finish)(Args *a, void *opts);
+    /* The command's work on the loaded mechanism; returns the exit status. */
+    int (*run)(const Args *a, Mech *mech, Diag *diag, void *opts);
 } CliCommand;
 
 #define CLI_OPTIONS(table) .options = (table), .count = (int)(sizeof(table) / sizeof *(table))
@@ -122,6 +129,10 @@ extern const char *const cli_engine_choices[];
 
 /* ---- after the options (common.c) ---- */
 
+/* A whole command: reads the options into opts (holding the defaults),
+   then cmd->finish, loads the file with the limits read, runs cmd->run and
+   frees the mechanism. Returns the exit status. */
+int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts);
 /* Loads a->file (no file: the usage error of args_need_file) with limits
    (NULL: the defaults). On bad input prints the diagnostic and returns
    NULL: exit status 2. diag must outlive the Mech (pipeline_load). */

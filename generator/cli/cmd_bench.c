@@ -42,11 +42,6 @@ static const CliOption options[] = {
              "gen_s, tcc_s, cc_s, ops{...}, speedup{...}"},
 };
 
-static const CliCommand command = {
-    .name = "bench", .usage = usage, CLI_OPTIONS(options), .column = 15,
-    .limits_offset = offsetof(BenchCli, limits),
-};
-
 /* jac_nz (the sparse Jacobian) exists only in generated code. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_COUNT };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz"};
@@ -248,7 +243,7 @@ static void print_text(const Model *m, const Bench *b, int repeat)
 }
 
 /* Opens every engine asked for (aot only with a compiler); false (reported) when one fails. */
-static bool open_engines(Args *a, Bench *b, const Mech *mech, bool use_aot, Diag *diag)
+static bool open_engines(const Args *a, Bench *b, const Mech *mech, bool use_aot, Diag *diag)
 {
     EngineOptions eo = engine_default_options();
     eo.aot_fresh = true;        /* time the compiler, not the cache */
@@ -295,26 +290,31 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
     free(b->q), free(b->qd), free(b->phi), free(b->jac), free(b->nu), free(b->gamma);
 }
 
-int cmd_bench(int argc, char **argv)
+/* The engines timed and reported. */
+static int bench_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    BenchCli c = {.limits = mech_default_limits(), .repeat = 15, .use_aot = true};
-    if (!cli_parse(&a, &command, argc, argv, &c))
-        return EXIT_OK;
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
+    const BenchCli *c = opts;
     Bench *b = xcalloc(1, sizeof *b);
     int status = EXIT_USAGE;
-    if (open_engines(&a, b, mech, c.use_aot, &diag)) {
-        run_bench(b, mech->model, c.repeat, c.json);
+    if (open_engines(a, b, mech, c->use_aot, diag)) {
+        run_bench(b, mech->model, c->repeat, c->json);
         status = EXIT_OK;
     }
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         if (b->open[k])
             engine_close(&b->eng[k]);
     free(b);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "bench", .usage = usage, CLI_OPTIONS(options), .column = 15,
+    .limits_offset = offsetof(BenchCli, limits),
+    .run = bench_file,
+};
+
+int cmd_bench(int argc, char **argv)
+{
+    BenchCli c = {.limits = mech_default_limits(), .repeat = 15, .use_aot = true};
+    return cli_main(&command, argc, argv, &c);
 }

@@ -68,11 +68,6 @@ static const char epilogue[] =
     "unsettled, with a warning: the differences cannot tell, so it neither passes\n"
     "nor fails.\n";
 
-static const CliCommand command = {
-    .name = "check", .usage = usage, CLI_OPTIONS(options), .column = 20, .epilogue = epilogue,
-    .limits_offset = offsetof(CheckCli, limits),
-};
-
 static const char *row_name(const Model *m, int row)
 {
     return row >= 0 && row < m->nr ? m->rows[row].name : "-";
@@ -238,32 +233,33 @@ static void report_failures(const char *file, const Model *m, const CheckReport 
     }
 }
 
+/* The comparisons, their report on stdout and the failures on stderr. */
+static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    CheckCli *c = opts;
+    CheckReport rep;
+    c->opt.seed = (unsigned long)c->seed;
+    if (!check_mechanism(mech, &c->opt, &rep, diag)) {
+        cli_error(a, diag);
+        return EXIT_USAGE;
+    }
+    if (c->json)
+        print_json(mech->model, &rep);
+    else
+        print_text(mech->model, &rep);
+    report_failures(a->file, mech->model, &rep);
+    return rep.ok ? EXIT_OK : EXIT_ANALYSIS;
+}
+
+static const CliCommand command = {
+    .name = "check", .usage = usage, CLI_OPTIONS(options), .column = 20, .epilogue = epilogue,
+    .limits_offset = offsetof(CheckCli, limits),
+    .run = check_file,
+};
+
 int cmd_check(int argc, char **argv)
 {
-    Args a;
     CheckCli c = {.opt = check_default_options(), .limits = mech_default_limits()};
     c.seed = (int)c.opt.seed;
-    if (!cli_parse(&a, &command, argc, argv, &c))
-        return EXIT_OK;
-    c.opt.seed = (unsigned long)c.seed;
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    CheckReport rep;
-    int status = EXIT_OK;
-    if (!check_mechanism(mech, &c.opt, &rep, &diag)) {
-        cli_error(&a, &diag);
-        status = EXIT_USAGE;
-    } else {
-        if (c.json)
-            print_json(mech->model, &rep);
-        else
-            print_text(mech->model, &rep);
-        if (!rep.ok)
-            status = EXIT_ANALYSIS;
-        report_failures(a.file, mech->model, &rep);
-    }
-    pipeline_free(mech);
-    return status;
+    return cli_main(&command, argc, argv, &c);
 }

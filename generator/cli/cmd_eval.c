@@ -34,11 +34,6 @@ static const CliOption options[] = {
     {"--json", CLI_FLAG_AT(EvalCli, json), .help = "print JSON: coords, rows, phi, jac, nu, gamma"},
 };
 
-static const CliCommand command = {
-    .name = "eval", .usage = usage, CLI_OPTIONS(options), .column = 17,
-    .limits_offset = offsetof(EvalCli, limits),
-};
-
 static const char *row_level(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
 static void print_json(const Model *m, double t, const double *q, const double *qd, const double *phi,
@@ -156,25 +151,30 @@ static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const do
     return true;
 }
 
-int cmd_eval(int argc, char **argv)
+/* The state from --q and --qd (default: the file's q0 and zeros), evaluated. */
+static int eval_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    EvalCli c = {.limits = mech_default_limits(), .engine = ENGINE_JIT};
-    if (!cli_parse(&a, &command, argc, argv, &c))
-        return EXIT_OK;
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
+    const EvalCli *c = opts;
     const Model *m = mech->model;
     double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     int status = EXIT_OK;
-    if ((c.q_text && !args_vector("eval", "--q", c.q_text, m->nq, q))
-        || (c.qd_text && !args_vector("eval", "--qd", c.qd_text, m->nq, qd))
-        || !evaluate(&a, &c, mech, q, qd, &diag))
+    if ((c->q_text && !args_vector("eval", "--q", c->q_text, m->nq, q))
+        || (c->qd_text && !args_vector("eval", "--qd", c->qd_text, m->nq, qd))
+        || !evaluate(a, c, mech, q, qd, diag))
         status = EXIT_USAGE;
     free(q), free(qd);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "eval", .usage = usage, CLI_OPTIONS(options), .column = 17,
+    .limits_offset = offsetof(EvalCli, limits),
+    .run = eval_file,
+};
+
+int cmd_eval(int argc, char **argv)
+{
+    EvalCli c = {.limits = mech_default_limits(), .engine = ENGINE_JIT};
+    return cli_main(&command, argc, argv, &c);
 }

@@ -65,11 +65,6 @@ static const CliOption options[] = {
              "(Phi, or Psi for velocity rows) instead of C"},
 };
 
-static const CliCommand command = {
-    .name = "gen", .usage = usage, CLI_OPTIONS(options), .column = 20,
-    .limits_offset = offsetof(GenCli, limits),
-};
-
 /* One row per line: "name level expression"; the input for outside tools
    (bench/sympy_ops.py) that compare against other derivations. */
 static void dump_rows(const Mech *mech)
@@ -109,10 +104,16 @@ static const char *shown(const char *value, char *buf, size_t size)
     return buf;
 }
 
-/* Names that reach the C text are checked before any work; false
-   (reported) when one cannot be used. */
-static bool check_names(GenCli *c)
+/* The choices into EmitOptions; the names that reach the C text checked
+   before any work: false (reported) when one cannot be used. */
+static bool finish(Args *a, void *opts)
 {
+    GenCli *c = opts;
+    (void)a;
+    c->emit.real_float = c->real == 1;
+    c->emit.libm_trig = c->trig == 1;
+    c->emit.direct_jac = c->jac == 1;
+    c->emit.max_ops = c->limits.max_code_ops;
     const char *why;
     char buf[256];
     if (c->emit.prefix && (why = emit_check_prefix(c->emit.prefix))) {
@@ -169,41 +170,37 @@ static bool write_outputs(const GenCli *c, const EmitResult *res)
     return ok;
 }
 
-int cmd_gen(int argc, char **argv)
+/* The generated C (or the rows) for the file. */
+static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    GenCli c = {.emit = emit_default_options(), .limits = mech_default_limits(), .dump = -1};
-    if (!cli_parse(&a, &command, argc, argv, &c))
-        return EXIT_OK;
-    c.emit.real_float = c.real == 1;
-    c.emit.libm_trig = c.trig == 1;
-    c.emit.direct_jac = c.jac == 1;
-    if (!check_names(&c))
-        return EXIT_USAGE;
-    c.emit.max_ops = c.limits.max_code_ops;
-
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    if (c.dump == 0) {
+    GenCli *c = opts;
+    if (c->dump == 0) {
         dump_rows(mech);
-        pipeline_free(mech);
         return EXIT_OK;
     }
-    c.emit.source_name = a.file;
+    c->emit.source_name = a->file;
     EmitResult res;
     double t0 = pipeline_now();
-    if (!emit_mechanism(&mech->kin, &c.emit, &res, &diag)) {     /* about the file: "FILE: error: ..." */
-        diag_print(&diag, stderr);
-        pipeline_free(mech);
+    if (!emit_mechanism(&mech->kin, &c->emit, &res, diag)) {     /* about the file: "FILE: error: ..." */
+        diag_print(diag, stderr);
         return EXIT_USAGE;
     }
     double emit_seconds = pipeline_now() - t0;
-    bool ok = write_outputs(&c, &res);
-    if (c.stats)
-        print_stats(mech, &res, emit_seconds, &diag);
+    bool ok = write_outputs(c, &res);
+    if (c->stats)
+        print_stats(mech, &res, emit_seconds, diag);
     emit_result_free(&res);
-    pipeline_free(mech);
     return ok ? EXIT_OK : EXIT_USAGE;
+}
+
+static const CliCommand command = {
+    .name = "gen", .usage = usage, CLI_OPTIONS(options), .column = 20,
+    .limits_offset = offsetof(GenCli, limits),
+    .finish = finish, .run = gen_file,
+};
+
+int cmd_gen(int argc, char **argv)
+{
+    GenCli c = {.emit = emit_default_options(), .limits = mech_default_limits(), .dump = -1};
+    return cli_main(&command, argc, argv, &c);
 }

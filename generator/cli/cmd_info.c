@@ -54,11 +54,6 @@ static const char epilogue[] =
     "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
     "printed, at the last iterate), 2 bad usage or bad input.\n";
 
-static const CliCommand command = {
-    .name = "info", .usage = usage, CLI_OPTIONS(options), .column = 17, .epilogue = epilogue,
-    .limits_offset = offsetof(InfoCli, limits),
-};
-
 static const char *level_name(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
 static const char *evidence(const Integrability *it)
@@ -331,23 +326,16 @@ static void print_text(const InfoReport *rep)
     printf("\nverdict: %s\n", rep->verdict);
 }
 
-int cmd_info(int argc, char **argv)
+/* The analysis at t and its report; exit status 1 when the assembly did not converge. */
+static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits()};
-    if (!cli_parse(&a, &command, argc, argv, &c))
-        return EXIT_OK;
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
+    const InfoCli *c = opts;
     InfoReport rep;
-    if (!info_analyse(mech, c.t, &c.analysis, &rep, &diag)) {
-        cli_error(&a, &diag);
-        pipeline_free(mech);
+    if (!info_analyse(mech, c->t, &c->analysis, &rep, diag)) {
+        cli_error(a, diag);
         return EXIT_USAGE;
     }
-    if (c.json)
+    if (c->json)
         print_json(&rep);
     else
         print_text(&rep);
@@ -355,13 +343,24 @@ int cmd_info(int argc, char **argv)
     if (!rep.assembled) {
         const Model *m = mech->model;
         fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
-                c.t, rep.assembly.residual);
+                c->t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
         fprintf(stderr, ")\n");
         status = EXIT_ANALYSIS;
     }
     info_report_free(&rep);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "info", .usage = usage, CLI_OPTIONS(options), .column = 17, .epilogue = epilogue,
+    .limits_offset = offsetof(InfoCli, limits),
+    .run = info_file,
+};
+
+int cmd_info(int argc, char **argv)
+{
+    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits()};
+    return cli_main(&command, argc, argv, &c);
 }

@@ -110,11 +110,6 @@ static const char epilogue[] =
     "failure are written); 2 bad usage or input, or not as many rows as\n"
     "coordinates.\n";
 
-static const CliCommand command = {
-    .name = "run", .usage = usage, CLI_OPTIONS(options), .column = 19, .epilogue = epilogue,
-    .limits_offset = offsetof(RunCli, limits),
-};
-
 /* Where the states go. */
 typedef struct Output {
     FILE *csv;              /* NULL: no CSV */
@@ -231,34 +226,33 @@ static void on_state_keep(void *ctx, double t, const double *q, const double *qd
     memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
 }
 
-/* Reads the options into c and checks them together. Returns -1 to go
-   on, else the exit status (--help, or bad usage already reported). */
-static int parse_options(Args *a, RunCli *c, int argc, char **argv)
+/* Checks the options together and fills what they imply; false when
+   they cannot be used (reported). */
+static bool finish(Args *a, void *opts)
 {
-    if (!cli_parse(a, &command, argc, argv, c))
-        return EXIT_OK;
+    RunCli *c = opts;
     if (!args_need_file(a))
-        return EXIT_USAGE;
+        return false;
     if (c->tol > 0)
         c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = c->tol;
     if (c->ode >= 0)
         mechrt_ode_method_from_name(ode_methods[c->ode], &c->ro.ode.method);
     if (c->ro.t0 == c->ro.t1) {
         fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", c->ro.t0);
-        return EXIT_USAGE;
+        return false;
     }
     if ((c->traces.n > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
         fprintf(stderr, "mechc run: error: %s goes with %s\n",
                 c->traces.n ? "--trace" : "--plot-vars", c->traces.n ? "--svg FILE" : "--plot FILE");
-        return EXIT_USAGE;
+        return false;
     }
     c->pictures = c->svg_path || c->plot_path;
     c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0 : !c->json && !c->pictures;
     if (c->csv_stdout && c->json) {
         fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
-        return EXIT_USAGE;
+        return false;
     }
-    return -1;
+    return true;
 }
 
 /* The --trace points and --plot variables by name; false (reported) when
@@ -389,26 +383,28 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
     return status;
 }
 
-int cmd_run(int argc, char **argv)
+/* Rows, pictures and engine ready, then the analysis. */
+static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT, .ode = -1};
-    int status = parse_options(&a, &c, argc, argv);
-    if (status >= 0)
-        return status;
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
+    RunCli *c = opts;
     Pictures pics;
     Engine e;
-    if (!prepare(&a, &c, mech, &pics, &e, &diag)) {
-        pipeline_free(mech);
+    if (!prepare(a, c, mech, &pics, &e, diag))
         return EXIT_USAGE;
-    }
-    status = analyse(&c, mech->model, &e, &pics);
+    int status = analyse(c, mech->model, &e, &pics);
     engine_close(&e);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "run", .usage = usage, CLI_OPTIONS(options), .column = 19, .epilogue = epilogue,
+    .limits_offset = offsetof(RunCli, limits),
+    .finish = finish, .run = run_file,
+};
+
+int cmd_run(int argc, char **argv)
+{
+    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
+                .engine = ENGINE_JIT, .ode = -1};
+    return cli_main(&command, argc, argv, &c);
 }
