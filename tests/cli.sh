@@ -31,6 +31,13 @@ for c in gen run eval check info bench; do
     fi
     check "$c --help exits 0" status_is 0
     check "$c --help prints its usage" out_has "usage: mechc $c"
+    # every option the help names (synopsis, list, limits) is one the command reads
+    opts=$(grep -o -e '--[a-z][a-z0-9-]*' -e '^  -[a-z] ' "$tmp/out" | tr -d ' ' | sort -u)
+    check "$c --help names options" [ -n "$opts" ]
+    for o in $opts; do
+        run "$c" "$o"
+        check "$c reads $o, which its --help names" sh -c "! grep -q 'unknown option' '$tmp/err'"
+    done
 done
 
 # ---- usage errors ----

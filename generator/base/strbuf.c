@@ -93,17 +93,3 @@ void sb_put_c_string(StrBuf *sb, const char *s)
     }
     sb_putc(sb, '"');
 }
-
-void sb_put_json_string(StrBuf *sb, const char *s)
-{
-    sb_putc(sb, '"');
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            sb_printf(sb, "\\%c", *p);
-        else if (*p < 0x20 || *p == 0x7f)
-            sb_printf(sb, "\\u%04x", *p);
-        else
-            sb_putc(sb, (char)*p);
-    }
-    sb_putc(sb, '"');
-}

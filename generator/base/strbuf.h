@@ -24,7 +24,5 @@ char *sb_take(StrBuf *sb);
 /* A C string literal body for s: quotes, backslashes and every byte outside
    printable ASCII escaped, so no input text can leave the literal. */
 void sb_put_c_string(StrBuf *sb, const char *s);
-/* JSON string literal (with the quotes). */
-void sb_put_json_string(StrBuf *sb, const char *s);
 
 #endif

@@ -1,11 +1,7 @@
-/* args.c - option parsing shared by every subcommand; usage errors exit 2 through the caller. */
+/* args.c - walks argv and reads option values (numbers, choices, lists); usage errors exit 2 through the caller. */
 #include "cli.h"
 
-#include "../base/strbuf.h"
-#include "../../runtime/host/mechrt_host.h"
-
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -113,59 +109,6 @@ bool args_int(Args *a, const char *option, int min, int max, int *out)
     return true;
 }
 
-/* Each limit's option and the range it accepts. The upper bounds keep what
-   the limits protect: the parser's and differentiator's recursion stays
-   far from the stack's end, and int indices (file offsets, the dense
-   Jacobian of the generated C) cannot overflow. */
-static const struct LimitOption {
-    const char *option;
-    size_t offset;
-    int min, max;
-} limit_options[] = {
-    {"--max-file-bytes", offsetof(MechLimits, max_file_bytes), 1, INT_MAX - 1},
-    {"--max-line-length", offsetof(MechLimits, max_line_length), 1, INT_MAX - 1},
-    {"--max-name-length", offsetof(MechLimits, max_name_length), 1, 4000},
-    {"--max-depth", offsetof(MechLimits, max_depth), 1, 1000},
-    {"--max-expr-tokens", offsetof(MechLimits, max_expr_tokens), 1, 20000},
-    {"--max-coords", offsetof(MechLimits, max_coords), 1, 10000000},
-    {"--max-rows", offsetof(MechLimits, max_rows), 1, 10000000},
-    {"--max-jac-entries", offsetof(MechLimits, max_jac_entries), 1, INT_MAX},
-    {"--max-nodes", offsetof(MechLimits, max_nodes), 16, INT_MAX - 1},
-    {"--max-code-ops", offsetof(MechLimits, max_code_ops), 1, INT_MAX},
-};
-
-const char args_limits_usage[] =
-    "limits (defaults in examples/README.md, section Limits; a value N each):\n"
-    "  --max-file-bytes --max-line-length --max-name-length --max-depth\n"
-    "  --max-expr-tokens --max-coords --max-rows --max-jac-entries --max-nodes\n"
-    "  --max-code-ops\n";
-
-bool args_limit(Args *a, const char *option, MechLimits *limits)
-{
-    for (size_t i = 0; i < sizeof limit_options / sizeof *limit_options; i++) {
-        const struct LimitOption *l = &limit_options[i];
-        if (strcmp(option, l->option) != 0)
-            continue;
-        int value;
-        if (args_int(a, option, l->min, l->max, &value))
-            memcpy((char *)limits + l->offset, &value, sizeof value);
-        return true;
-    }
-    return false;
-}
-
-bool args_engine(Args *a, const char *option, int *engine)
-{
-    if (strcmp(option, "--engine") != 0)
-        return false;
-    const char *v = args_value(a, option);
-    if (v && (*engine = engine_from_name(v)) < 0) {
-        fprintf(stderr, "mechc %s: error: --engine takes jit, generic or aot, not '%s'\n", a->command, v);
-        a->failed = true;
-    }
-    return true;
-}
-
 int args_choice(Args *a, const char *option, const char *const *choices)
 {
     const char *v = args_value(a, option);
@@ -249,34 +192,4 @@ bool args_need_file(Args *a)
 bool args_is_help(const char *option)
 {
     return strcmp(option, "--help") == 0 || strcmp(option, "-h") == 0;
-}
-
-void json_number(FILE *out, double v)
-{
-    char buf[40];
-    if (!isfinite(v)) {
-        fputs("null", out);
-        return;
-    }
-    mechrt_format_real(buf, sizeof buf, v, 0);  /* as run's JSON: 0.3, not 0.29999999999999999 */
-    fputs(buf, out);
-}
-
-void json_string(FILE *out, const char *s)
-{
-    StrBuf sb;
-    sb_init(&sb);
-    sb_put_json_string(&sb, s);
-    fputs(sb.data, out);
-    sb_free(&sb);
-}
-
-void json_string_list(FILE *out, const char *const *s, int n)
-{
-    fputc('[', out);
-    for (int i = 0; i < n; i++) {
-        fputs(i ? ", " : "", out);
-        json_string(out, s[i]);
-    }
-    fputc(']', out);
 }

@@ -16,6 +16,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What the command line asked for. */
+typedef struct BenchCli {
+    MechLimits limits;
+    int repeat;
+    bool json, use_aot;
+} BenchCli;
+
 static const char usage[] =
     "usage: mechc bench FILE.mech [--repeat N] [--no-aot] [--json]\n"
     "\n"
@@ -24,11 +31,16 @@ static const char usage[] =
     "by the system compiler, $CC or cc, with " AOT_FLAGS "). Reports ns per call\n"
     "(median of interleaved repeats), the speed-up against generic, generation and\n"
     "compile times, code size and operation counts.\n"
-    "\n"
-    "  --repeat N   timed repeats per engine and function (default 15)\n"
-    "  --no-aot     leave the aot engine out\n"
-    "  --json       print JSON: engines{generic,jit,aot}{phi,jac,nu,gamma,all} in ns,\n"
-    "               gen_s, tcc_s, cc_s, ops{...}, speedup{...}\n";
+    "\n";
+
+static const CliOption options[] = {
+    {"--repeat", CLI_INT_AT(BenchCli, repeat, 1, 100000), .metavar = "N",
+     .help = "timed repeats per engine and function (default 15)"},
+    {"--no-aot", CLI_CLEAR_AT(BenchCli, use_aot), .help = "leave the aot engine out"},
+    {"--json", CLI_FLAG_AT(BenchCli, json),
+     .help = "print JSON: engines{generic,jit,aot}{phi,jac,nu,gamma,all} in ns,\n"
+             "gen_s, tcc_s, cc_s, ops{...}, speedup{...}"},
+};
 
 /* jac_nz (the sparse Jacobian) exists only in generated code. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_COUNT };
@@ -230,81 +242,79 @@ static void print_text(const Model *m, const Bench *b, int repeat)
         printf("generic evaluator set-up: %.3f ms\n", 1e3 * b->eng[ENGINE_GENERIC].gen_seconds);
 }
 
-int cmd_bench(int argc, char **argv)
+/* Opens every engine asked for (aot only with a compiler); false (reported) when one fails. */
+static bool open_engines(const Args *a, Bench *b, const Mech *mech, bool use_aot, Diag *diag)
 {
-    Args a;
-    args_init(&a, "bench", argc, argv);
-    MechLimits limits = mech_default_limits();
-    int repeat = 15;
-    bool json = false, use_aot = true;
-    const char *o;
-    while (!a.failed && (o = args_next(&a))) {
-        if (args_is_help(o)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(&a, o, &limits)) {
-            continue;
-        } else if (strcmp(o, "--repeat") == 0) {
-            args_int(&a, o, 1, 100000, &repeat);
-        } else if (strcmp(o, "--no-aot") == 0) {
-            use_aot = false;
-        } else if (strcmp(o, "--json") == 0) {
-            json = true;
-        } else {
-            args_unknown(&a, o);
-        }
-    }
-    Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    const Model *m = mech->model;
-    Bench *b = xcalloc(1, sizeof *b);
     EngineOptions eo = engine_default_options();
     eo.aot_fresh = true;        /* time the compiler, not the cache */
-    int status = EXIT_OK;
-    for (int i = 0; i < ENGINE_KIND_COUNT && status == EXIT_OK; i++) {
+    for (int i = 0; i < ENGINE_KIND_COUNT; i++) {
         EngineKind k = order[i];
         if (k == ENGINE_AOT && (!use_aot || !aot_compiler_available())) {
             if (use_aot)
                 fprintf(stderr, "mechc bench: note: no C compiler found (set CC): aot left out\n");
             continue;
         }
-        b->open[k] = cli_engine_open(&a, &b->eng[k], k, mech, &eo, &diag);
+        b->open[k] = cli_engine_open(a, &b->eng[k], k, mech, &eo, diag);
         if (!b->open[k])
-            status = EXIT_USAGE;
+            return false;
     }
+    return true;
+}
+
+/* Times the open engines at one fixed state and prints the report. */
+static void run_bench(Bench *b, const Model *m, int repeat, bool json)
+{
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
-    if (status == EXIT_OK) {
-        b->q = xcalloc(nq, sizeof *b->q);
-        b->qd = xcalloc(nq, sizeof *b->qd);
-        b->phi = xcalloc((size_t)m->nh + 1, sizeof *b->phi);
-        b->jac = xcalloc(nr * nq + 1, sizeof *b->jac);
-        b->nu = xcalloc(nr + 1, sizeof *b->nu);
-        b->gamma = xcalloc(nr + 1, sizeof *b->gamma);
-        for (size_t i = 0; i < nq; i++) {
-            b->q[i] = m->q0[i] + 0.01 * (double)((i * 7) % 5);
-            b->qd[i] = 0.3 + 0.1 * (double)((i * 3) % 7);
-        }
-        b->t = 0.37;
-        for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-            for (int fn = 0; fn < FN_COUNT; fn++)
-                b->ns[k][fn] = xcalloc((size_t)repeat, sizeof(double));
-        measure(b, repeat);
-        if (json)
-            print_json(m, b, repeat);
-        else
-            print_text(m, b, repeat);
-        for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-            for (int fn = 0; fn < FN_COUNT; fn++)
-                free(b->ns[k][fn]);
-        free(b->q), free(b->qd), free(b->phi), free(b->jac), free(b->nu), free(b->gamma);
+    b->q = xcalloc(nq, sizeof *b->q);
+    b->qd = xcalloc(nq, sizeof *b->qd);
+    b->phi = xcalloc((size_t)m->nh + 1, sizeof *b->phi);
+    b->jac = xcalloc(nr * nq + 1, sizeof *b->jac);
+    b->nu = xcalloc(nr + 1, sizeof *b->nu);
+    b->gamma = xcalloc(nr + 1, sizeof *b->gamma);
+    for (size_t i = 0; i < nq; i++) {
+        b->q[i] = m->q0[i] + 0.01 * (double)((i * 7) % 5);
+        b->qd[i] = 0.3 + 0.1 * (double)((i * 3) % 7);
+    }
+    b->t = 0.37;
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        for (int fn = 0; fn < FN_COUNT; fn++)
+            b->ns[k][fn] = xcalloc((size_t)repeat, sizeof(double));
+    measure(b, repeat);
+    if (json)
+        print_json(m, b, repeat);
+    else
+        print_text(m, b, repeat);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        for (int fn = 0; fn < FN_COUNT; fn++)
+            free(b->ns[k][fn]);
+    free(b->q), free(b->qd), free(b->phi), free(b->jac), free(b->nu), free(b->gamma);
+}
+
+/* The engines timed and reported. */
+static int bench_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    const BenchCli *c = opts;
+    Bench *b = xcalloc(1, sizeof *b);
+    int status = EXIT_USAGE;
+    if (open_engines(a, b, mech, c->use_aot, diag)) {
+        run_bench(b, mech->model, c->repeat, c->json);
+        status = EXIT_OK;
     }
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         if (b->open[k])
             engine_close(&b->eng[k]);
     free(b);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "bench", .usage = usage, CLI_OPTIONS(options), .column = 15,
+    .limits_offset = offsetof(BenchCli, limits),
+    .run = bench_file,
+};
+
+int cmd_bench(int argc, char **argv)
+{
+    BenchCli c = {.limits = mech_default_limits(), .repeat = 15, .use_aot = true};
+    return cli_main(&command, argc, argv, &c);
 }

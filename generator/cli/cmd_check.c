@@ -7,6 +7,14 @@
 #include <math.h>
 #include <string.h>
 
+/* What the command line asked for. */
+typedef struct CheckCli {
+    CheckOptions opt;
+    MechLimits limits;
+    int seed;               /* opt.seed, read as an int */
+    bool json;
+} CheckCli;
+
 static const char usage[] =
     "usage: mechc check FILE.mech [--samples N] [--seed S] [--tol T] [--tol-engines T]\n"
     "                   [--fd-step H] [--fd-step2 H] [--spread-q S] [--spread-qd S]\n"
@@ -18,20 +26,36 @@ static const char usage[] =
     "assembled at t = 0. Prints the worst error of each comparison and the row where\n"
     "it occurs; exit status 1 when one is above its tolerance, with a guess at the\n"
     "textbook mistake it looks like.\n"
-    "\n"
-    "  --samples N       states to sample (default 20)\n"
-    "  --seed S          seed of the random states (default 1)\n"
-    "  --tol T           tolerance against finite differences (default 1e-6)\n"
-    "  --tol-engines T   tolerance between engines (default 1e-10)\n"
-    "  --fd-step H       first step of the first derivatives' finite differences\n"
-    "                    (jac, nu; gamma of velocity rows), times max(1, |x|)\n"
-    "                    (default 1e-4)\n"
-    "  --fd-step2 H      step of gamma's second differences, times max(1, |q|)^(1/6)\n"
-    "                    (default 2e-3)\n"
-    "  --spread-q S      sampled q = assembled q + uniform(-S, S) (default 0.05)\n"
-    "  --spread-qd S     sampled qd = uniform(-S, S) (default 1)\n"
-    "  --no-aot          do not build and compare the aot engine\n"
-    "  --json            print JSON: ok, samples, worst[{what, error, row, ...}]\n"
+    "\n";
+
+#define UNIT .min = 0, .above_min = true, .max = 1, .what = "a number in (0, 1]"
+
+static const CliOption options[] = {
+    {"--samples", CLI_INT_AT(CheckCli, opt.samples, 1, 1000000), .metavar = "N",
+     .help = "states to sample (default 20)"},
+    {"--seed", CLI_INT_AT(CheckCli, seed, 0, INT_MAX), .metavar = "S",
+     .help = "seed of the random states (default 1)"},
+    {"--tol", CLI_REAL_AT(CheckCli, opt.tol), CLI_POSITIVE, .what = "a positive number",
+     .metavar = "T", .help = "tolerance against finite differences (default 1e-6)"},
+    {"--tol-engines", CLI_REAL_AT(CheckCli, opt.tol_engines), CLI_POSITIVE,
+     .what = "a positive number", .metavar = "T", .help = "tolerance between engines (default 1e-10)"},
+    {"--fd-step", CLI_REAL_AT(CheckCli, opt.fd_step), UNIT, .metavar = "H",
+     .help = "first step of the first derivatives' finite differences\n"
+             "(jac, nu; gamma of velocity rows), times max(1, |x|)\n"
+             "(default 1e-4)"},
+    {"--fd-step2", CLI_REAL_AT(CheckCli, opt.fd_step2), UNIT, .metavar = "H",
+     .help = "step of gamma's second differences, times max(1, |q|)^(1/6)\n"
+             "(default 2e-3)"},
+    {"--spread-q", CLI_REAL_AT(CheckCli, opt.spread_q), CLI_NONNEGATIVE, .what = "a number >= 0",
+     .metavar = "S", .help = "sampled q = assembled q + uniform(-S, S) (default 0.05)"},
+    {"--spread-qd", CLI_REAL_AT(CheckCli, opt.spread_qd), CLI_NONNEGATIVE, .what = "a number >= 0",
+     .metavar = "S", .help = "sampled qd = uniform(-S, S) (default 1)"},
+    {"--no-aot", CLI_CLEAR_AT(CheckCli, opt.use_aot), .help = "do not build and compare the aot engine"},
+    {"--json", CLI_FLAG_AT(CheckCli, json),
+     .help = "print JSON: ok, samples, worst[{what, error, row, ...}]"},
+};
+
+static const char epilogue[] =
     "\n"
     "Errors are |value - reference| / (1 + |reference|). A value that disagrees with\n"
     "its finite difference at the default step H is not failed yet: the difference\n"
@@ -185,108 +209,57 @@ static void print_text(const Model *m, const CheckReport *rep)
                              : "FAILED: see the lines marked FAIL");
 }
 
+/* On stderr: the first failed comparison, and every unsettled one. */
+static void report_failures(const char *file, const Model *m, const CheckReport *rep)
+{
+    for (int w = 0; w < CHECK_WHAT_COUNT && !rep->ok; w++) {
+        const CheckItem *it = &rep->items[w];
+        if (it->checked && !item_ok(it)) {
+            fprintf(stderr, "%s: error: %s of row %s%s%s is off by %.3g (tolerance %.3g) at t = %.17g%s%s\n",
+                    file, it->what, row_name(m, it->row),
+                    it->col >= 0 ? ", column " : "", it->col >= 0 ? col_name(m, it->col) : "",
+                    it->error, it->tol, it->t, it->hint[0] ? ": " : "", it->hint);
+            break;
+        }
+    }
+    for (int w = 0; w < CHECK_PAIR_FIRST; w++) {
+        const CheckItem *it = &rep->items[w];
+        if (it->unsettled > 0)
+            fprintf(stderr, "%s: warning: %d %s comparison%s unsettled (first at row %s%s%s): the finite "
+                    "differences agree at no run of steps; not judged\n", file, it->unsettled, it->what,
+                    it->unsettled == 1 ? "" : "s", row_name(m, it->unsettled_row),
+                    it->unsettled_col >= 0 ? ", column " : "",
+                    it->unsettled_col >= 0 ? col_name(m, it->unsettled_col) : "");
+    }
+}
+
+/* The comparisons, their report on stdout and the failures on stderr. */
+static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    CheckCli *c = opts;
+    CheckReport rep;
+    c->opt.seed = (unsigned long)c->seed;
+    if (!check_mechanism(mech, &c->opt, &rep, diag)) {
+        cli_error(a, diag);
+        return EXIT_USAGE;
+    }
+    if (c->json)
+        print_json(mech->model, &rep);
+    else
+        print_text(mech->model, &rep);
+    report_failures(a->file, mech->model, &rep);
+    return rep.ok ? EXIT_OK : EXIT_ANALYSIS;
+}
+
+static const CliCommand command = {
+    .name = "check", .usage = usage, CLI_OPTIONS(options), .column = 20, .epilogue = epilogue,
+    .limits_offset = offsetof(CheckCli, limits),
+    .run = check_file,
+};
+
 int cmd_check(int argc, char **argv)
 {
-    Args a;
-    args_init(&a, "check", argc, argv);
-    MechLimits limits = mech_default_limits();
-    CheckOptions opt = check_default_options();
-    bool json = false;
-    const char *o;
-    while (!a.failed && (o = args_next(&a))) {
-        if (args_is_help(o)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(&a, o, &limits)) {
-            continue;
-        } else if (strcmp(o, "--samples") == 0) {
-            args_int(&a, o, 1, 1000000, &opt.samples);
-        } else if (strcmp(o, "--seed") == 0) {
-            int seed = 1;
-            if (args_int(&a, o, 0, INT_MAX, &seed))
-                opt.seed = (unsigned long)seed;
-        } else if (strcmp(o, "--tol") == 0 || strcmp(o, "--tol-engines") == 0) {
-            double v;
-            if (args_double(&a, o, &v)) {
-                if (v <= 0.0) {
-                    fprintf(stderr, "mechc check: error: %s needs a positive number\n", o);
-                    a.failed = true;
-                } else if (strcmp(o, "--tol") == 0) {
-                    opt.tol = v;
-                } else {
-                    opt.tol_engines = v;
-                }
-            }
-        } else if (strcmp(o, "--fd-step") == 0 || strcmp(o, "--fd-step2") == 0) {
-            double v;
-            if (args_double(&a, o, &v)) {
-                if (!(v > 0.0 && v <= 1.0)) {
-                    fprintf(stderr, "mechc check: error: %s needs a number in (0, 1]\n", o);
-                    a.failed = true;
-                } else if (strcmp(o, "--fd-step") == 0) {
-                    opt.fd_step = v;
-                } else {
-                    opt.fd_step2 = v;
-                }
-            }
-        } else if (strcmp(o, "--spread-q") == 0 || strcmp(o, "--spread-qd") == 0) {
-            double v;
-            if (args_double(&a, o, &v)) {
-                if (v < 0.0) {
-                    fprintf(stderr, "mechc check: error: %s needs a number >= 0\n", o);
-                    a.failed = true;
-                } else if (strcmp(o, "--spread-q") == 0) {
-                    opt.spread_q = v;
-                } else {
-                    opt.spread_qd = v;
-                }
-            }
-        } else if (strcmp(o, "--no-aot") == 0) {
-            opt.use_aot = false;
-        } else if (strcmp(o, "--json") == 0) {
-            json = true;
-        } else {
-            args_unknown(&a, o);
-        }
-    }
-    Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    CheckReport rep;
-    int status = EXIT_OK;
-    if (!check_mechanism(mech, &opt, &rep, &diag)) {
-        cli_error(&a, &diag);
-        status = EXIT_USAGE;
-    } else {
-        if (json)
-            print_json(mech->model, &rep);
-        else
-            print_text(mech->model, &rep);
-        if (!rep.ok) {
-            status = EXIT_ANALYSIS;
-            for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
-                const CheckItem *it = &rep.items[w];
-                if (it->checked && !item_ok(it)) {
-                    fprintf(stderr, "%s: error: %s of row %s%s%s is off by %.3g (tolerance %.3g) at t = %.17g%s%s\n",
-                            a.file, it->what, row_name(mech->model, it->row),
-                            it->col >= 0 ? ", column " : "", it->col >= 0 ? col_name(mech->model, it->col) : "",
-                            it->error, it->tol, it->t, it->hint[0] ? ": " : "", it->hint);
-                    break;
-                }
-            }
-        }
-        for (int w = 0; w < CHECK_PAIR_FIRST; w++) {
-            const CheckItem *it = &rep.items[w];
-            if (it->unsettled > 0)
-                fprintf(stderr, "%s: warning: %d %s comparison%s unsettled (first at row %s%s%s): the finite "
-                        "differences agree at no run of steps; not judged\n", a.file, it->unsettled, it->what,
-                        it->unsettled == 1 ? "" : "s", row_name(mech->model, it->unsettled_row),
-                        it->unsettled_col >= 0 ? ", column " : "",
-                        it->unsettled_col >= 0 ? col_name(mech->model, it->unsettled_col) : "");
-        }
-    }
-    pipeline_free(mech);
-    return status;
+    CheckCli c = {.opt = check_default_options(), .limits = mech_default_limits()};
+    c.seed = (int)c.opt.seed;
+    return cli_main(&command, argc, argv, &c);
 }

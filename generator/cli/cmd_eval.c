@@ -6,19 +6,33 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What the command line asked for. */
+typedef struct EvalCli {
+    MechLimits limits;
+    const char *q_text, *qd_text;
+    double t;
+    int engine;
+    bool json;
+} EvalCli;
+
 static const char usage[] =
     "usage: mechc eval FILE.mech [--q v,v,...] [--qd v,v,...] [--t T]\n"
     "                  [--engine jit|generic|aot] [--json]\n"
     "\n"
     "Evaluates Phi, Phi_q, nu and gamma at exactly the given state (no assembly).\n"
-    "\n"
-    "  --q LIST       coordinates, comma-separated in declaration order\n"
-    "                 (default: the file's initial values)\n"
-    "  --qd LIST      velocities (default: zeros)\n"
-    "  --t T          time (default 0)\n"
-    "  --engine E     jit (default: generated C compiled in memory), generic\n"
-    "                 (no code generation) or aot (system compiler)\n"
-    "  --json         print JSON: coords, rows, phi, jac, nu, gamma\n";
+    "\n";
+
+static const CliOption options[] = {
+    {"--q", CLI_STRING_AT(EvalCli, q_text), .metavar = "LIST",
+     .help = "coordinates, comma-separated in declaration order\n"
+             "(default: the file's initial values)"},
+    {"--qd", CLI_STRING_AT(EvalCli, qd_text), .metavar = "LIST", .help = "velocities (default: zeros)"},
+    {"--t", CLI_REAL_AT(EvalCli, t), .metavar = "T", .help = "time (default 0)"},
+    {"--engine", CLI_CHOICE_AT(EvalCli, engine, cli_engine_choices), .metavar = "E",
+     .help = "jit (default: generated C compiled in memory), generic\n"
+             "(no code generation) or aot (system compiler)"},
+    {"--json", CLI_FLAG_AT(EvalCli, json), .help = "print JSON: coords, rows, phi, jac, nu, gamma"},
+};
 
 static const char *row_level(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
@@ -112,65 +126,55 @@ static void print_text(const Model *m, double t, const double *q, const double *
     }
 }
 
-int cmd_eval(int argc, char **argv)
+/* Evaluates every kernel at (q, qd, t) with the engine asked for and prints
+   the report; false (reported) when the engine does not open. */
+static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const double *q,
+                     const double *qd, Diag *diag)
 {
-    Args a;
-    args_init(&a, "eval", argc, argv);
-    const char *q_text = NULL, *qd_text = NULL, *opt;
-    double t = 0.0;
-    bool json = false;
-    int engine = ENGINE_JIT;
-    MechLimits limits = mech_default_limits();
-    while (!a.failed && (opt = args_next(&a))) {
-        if (args_is_help(opt)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(&a, opt, &limits) || args_engine(&a, opt, &engine)) {
-            continue;
-        } else if (strcmp(opt, "--q") == 0) {
-            q_text = args_value(&a, opt);
-        } else if (strcmp(opt, "--qd") == 0) {
-            qd_text = args_value(&a, opt);
-        } else if (strcmp(opt, "--t") == 0) {
-            args_double(&a, opt, &t);
-        } else if (strcmp(opt, "--json") == 0) {
-            json = true;
-        } else {
-            args_unknown(&a, opt);
-        }
-    }
-    Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
     const Model *m = mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
-    double *q = xcalloc(nq, sizeof *q), *qd = xcalloc(nq, sizeof *qd);
+    Engine e;
+    if (!cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag))
+        return false;
     double *phi = xcalloc((size_t)m->nh + 1, sizeof *phi), *nu = xcalloc(nr, sizeof *nu);
     double *gamma = xcalloc(nr, sizeof *gamma), *jac = xcalloc(nr * nq, sizeof *jac);
-    memcpy(q, m->q0, nq * sizeof *q);
+    engine_phi(&e, q, c->t, phi);
+    engine_jac(&e, q, c->t, jac);
+    engine_nu(&e, q, c->t, nu);
+    engine_gamma(&e, q, qd, c->t, gamma);
+    engine_close(&e);
+    if (c->json)
+        print_json(m, c->t, q, qd, phi, jac, nu, gamma);
+    else
+        print_text(m, c->t, q, qd, phi, jac, nu, gamma);
+    free(phi), free(nu), free(gamma), free(jac);
+    return true;
+}
+
+/* The state from --q and --qd (default: the file's q0 and zeros), evaluated. */
+static int eval_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    const EvalCli *c = opts;
+    const Model *m = mech->model;
+    double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd);
+    memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     int status = EXIT_OK;
-    if ((q_text && !args_vector("eval", "--q", q_text, m->nq, q))
-        || (qd_text && !args_vector("eval", "--qd", qd_text, m->nq, qd))) {
+    if ((c->q_text && !args_vector("eval", "--q", c->q_text, m->nq, q))
+        || (c->qd_text && !args_vector("eval", "--qd", c->qd_text, m->nq, qd))
+        || !evaluate(a, c, mech, q, qd, diag))
         status = EXIT_USAGE;
-    } else {
-        Engine e;
-        if (!cli_engine_open(&a, &e, (EngineKind)engine, mech, NULL, &diag)) {
-            status = EXIT_USAGE;
-        } else {
-            engine_phi(&e, q, t, phi);
-            engine_jac(&e, q, t, jac);
-            engine_nu(&e, q, t, nu);
-            engine_gamma(&e, q, qd, t, gamma);
-            engine_close(&e);
-            if (json)
-                print_json(m, t, q, qd, phi, jac, nu, gamma);
-            else
-                print_text(m, t, q, qd, phi, jac, nu, gamma);
-        }
-    }
-    free(q), free(qd), free(phi), free(nu), free(gamma), free(jac);
-    pipeline_free(mech);
+    free(q), free(qd);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "eval", .usage = usage, CLI_OPTIONS(options), .column = 17,
+    .limits_offset = offsetof(EvalCli, limits),
+    .run = eval_file,
+};
+
+int cmd_eval(int argc, char **argv)
+{
+    EvalCli c = {.limits = mech_default_limits(), .engine = ENGINE_JIT};
+    return cli_main(&command, argc, argv, &c);
 }

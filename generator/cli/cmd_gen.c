@@ -8,6 +8,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What the command line asked for. */
+typedef struct GenCli {
+    EmitOptions emit;
+    MechLimits limits;
+    const char *out_path, *header_path;
+    int real, trig, jac, dump;      /* indices into the choices below */
+    bool stats;
+} GenCli;
+
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
@@ -15,29 +24,46 @@ static const char usage[] =
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
-    "\n"
-    "  -o OUT.c          write the source to OUT.c (default: standard output)\n"
-    "  --header OUT.h    also write the interface to OUT.h; the source includes it\n"
-    "  --prefix NAME     symbol prefix (default: the mechanism name); macros use\n"
-    "                    its upper case\n"
-    "  --real TYPE       double (default) or float (float literals, sinf, ...)\n"
-    "  --trig own|libm   double kernels: sin and cos of each angle in one call of\n"
-    "                    the file's own PREFIX_sincos (own, the default; a table\n"
-    "                    and short series, within 2.5 ulp, libm past 2^16 rad)\n"
-    "                    or sin and cos of <math.h> as written (libm); float\n"
-    "                    kernels always call sinf and cosf\n"
-    "  --jac HOW         the dense PREFIX_jac: spread (default) fills it from\n"
-    "                    PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
-    "                    direct stores every entry itself, zeros included: more\n"
-    "                    code, a faster dense Jacobian (what jit and aot use)\n"
-    "  --chunk N         most operations per C function before it is split into\n"
-    "                    static parts, counting operations and stores (default 150;\n"
-    "                    keeps optimizing compilers fast)\n"
-    "  --stats           print to stderr the operation count of each function and\n"
-    "                    the time of each stage, including an in-process libtcc\n"
-    "                    compile of the kernels (what eval and run do)\n"
-    "  --dump rows       print each row as an expression of q[i], qd[i] and t\n"
-    "                    (Phi, or Psi for velocity rows) instead of C\n";
+    "\n";
+
+static const char *const reals[] = {"double", "float", NULL};
+static const char *const trigs[] = {"own", "libm", NULL};
+static const char *const jacs[] = {"spread", "direct", NULL};
+static const char *const dumps[] = {"rows", NULL};
+
+static const CliOption options[] = {
+    {"-o", CLI_STRING_AT(GenCli, out_path), .alias = "--output", .metavar = "OUT.c",
+     .help = "write the source to OUT.c (default: standard output)"},
+    {"--header", CLI_STRING_AT(GenCli, header_path), .metavar = "OUT.h",
+     .help = "also write the interface to OUT.h; the source includes it"},
+    {"--prefix", CLI_STRING_AT(GenCli, emit.prefix), .metavar = "NAME",
+     .help = "symbol prefix (default: the mechanism name); macros use\n"
+             "its upper case"},
+    {"--real", CLI_CHOICE_AT(GenCli, real, reals), .metavar = "TYPE",
+     .help = "double (default) or float (float literals, sinf, ...)"},
+    {"--trig", CLI_CHOICE_AT(GenCli, trig, trigs), .metavar = "own|libm",
+     .help = "double kernels: sin and cos of each angle in one call of\n"
+             "the file's own PREFIX_sincos (own, the default; a table\n"
+             "and short series, within 2.5 ulp, libm past 2^16 rad)\n"
+             "or sin and cos of <math.h> as written (libm); float\n"
+             "kernels always call sinf and cosf"},
+    {"--jac", CLI_CHOICE_AT(GenCli, jac, jacs), .metavar = "HOW",
+     .help = "the dense PREFIX_jac: spread (default) fills it from\n"
+             "PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
+             "direct stores every entry itself, zeros included: more\n"
+             "code, a faster dense Jacobian (what jit and aot use)"},
+    {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
+     .help = "most operations per C function before it is split into\n"
+             "static parts, counting operations and stores (default 150;\n"
+             "keeps optimizing compilers fast)"},
+    {"--stats", CLI_FLAG_AT(GenCli, stats),
+     .help = "print to stderr the operation count of each function and\n"
+             "the time of each stage, including an in-process libtcc\n"
+             "compile of the kernels (what eval and run do)"},
+    {"--dump", CLI_CHOICE_AT(GenCli, dump, dumps), .metavar = "rows",
+     .help = "print each row as an expression of q[i], qd[i] and t\n"
+             "(Phi, or Psi for velocity rows) instead of C"},
+};
 
 /* One row per line: "name level expression"; the input for outside tools
    (bench/sympy_ops.py) that compare against other derivations. */
@@ -78,113 +104,103 @@ static const char *shown(const char *value, char *buf, size_t size)
     return buf;
 }
 
-int cmd_gen(int argc, char **argv)
+/* The choices into EmitOptions; the names that reach the C text checked
+   before any work: false (reported) when one cannot be used. */
+static bool finish(Args *a, void *opts)
 {
-    Args a;
-    args_init(&a, "gen", argc, argv);
-    const char *out_path = NULL, *header_path = NULL, *opt_name;
-    bool stats = false, dump = false;
-    EmitOptions opt = emit_default_options();
-    MechLimits limits = mech_default_limits();
-    while (!a.failed && (opt_name = args_next(&a))) {
-        if (args_is_help(opt_name)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(&a, opt_name, &limits)) {
-            continue;
-        } else if (strcmp(opt_name, "-o") == 0 || strcmp(opt_name, "--output") == 0) {
-            out_path = args_value(&a, opt_name);
-        } else if (strcmp(opt_name, "--header") == 0) {
-            header_path = args_value(&a, opt_name);
-        } else if (strcmp(opt_name, "--prefix") == 0) {
-            opt.prefix = args_value(&a, opt_name);
-        } else if (strcmp(opt_name, "--real") == 0) {
-            static const char *const reals[] = {"double", "float", NULL};
-            opt.real_float = args_choice(&a, opt_name, reals) == 1;
-        } else if (strcmp(opt_name, "--trig") == 0) {
-            static const char *const trigs[] = {"own", "libm", NULL};
-            opt.libm_trig = args_choice(&a, opt_name, trigs) == 1;
-        } else if (strcmp(opt_name, "--jac") == 0) {
-            static const char *const jacs[] = {"spread", "direct", NULL};
-            opt.direct_jac = args_choice(&a, opt_name, jacs) == 1;
-        } else if (strcmp(opt_name, "--chunk") == 0) {
-            args_int(&a, opt_name, 50, 1000000, &opt.chunk_nodes);
-        } else if (strcmp(opt_name, "--dump") == 0) {
-            static const char *const dumps[] = {"rows", NULL};
-            dump = args_choice(&a, opt_name, dumps) == 0;
-        } else if (strcmp(opt_name, "--stats") == 0) {
-            stats = true;
-        } else {
-            args_unknown(&a, opt_name);
-        }
-    }
-    /* Names that reach the C text are checked before any work. */
+    GenCli *c = opts;
+    (void)a;
+    c->emit.real_float = c->real == 1;
+    c->emit.libm_trig = c->trig == 1;
+    c->emit.direct_jac = c->jac == 1;
+    c->emit.max_ops = c->limits.max_code_ops;
     const char *why;
     char buf[256];
-    if (opt.prefix && (why = emit_check_prefix(opt.prefix))) {
+    if (c->emit.prefix && (why = emit_check_prefix(c->emit.prefix))) {
         fprintf(stderr, "mechc gen: error: --prefix '%s' cannot be used: %s\n",
-                shown(opt.prefix, buf, sizeof buf), why);
-        return EXIT_USAGE;
+                shown(c->emit.prefix, buf, sizeof buf), why);
+        return false;
     }
-    if (header_path) {
-        const char *base = strrchr(header_path, '/');
-        opt.header_name = base ? base + 1 : header_path;
-        if ((why = emit_check_header_name(opt.header_name))) {
+    if (c->header_path) {
+        const char *base = strrchr(c->header_path, '/');
+        c->emit.header_name = base ? base + 1 : c->header_path;
+        if ((why = emit_check_header_name(c->emit.header_name))) {
             fprintf(stderr, "mechc gen: error: --header '%s' cannot be used: %s\n",
-                    shown(header_path, buf, sizeof buf), why);
-            return EXIT_USAGE;
+                    shown(c->header_path, buf, sizeof buf), why);
+            return false;
         }
     }
-    opt.max_ops = limits.max_code_ops;
+    return true;
+}
 
-    Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    if (dump) {
+/* --stats: sizes, operation counts, stage times, and an in-process compile. */
+static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, Diag *diag)
+{
+    fprintf(stderr, "mechc gen: %s: %d coordinates, %d rows (%d holonomic, %d velocity level), "
+            "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
+            mech->model->nh, mech->model->nv, mech->kin.nnz);
+    fprintf(stderr, "mechc gen: operations after sharing:");
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        fprintf(stderr, " %s %d%s", emit_function_names[f], res->ops[f], f + 1 < EMIT_FUNCTION_COUNT ? "," : "\n");
+    fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
+            (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
+    EmitResult jit_src;
+    double jit_emit = 0, jit_tcc = 0;
+    Jit *jit = pipeline_jit(mech, &jit_src, &jit_emit, &jit_tcc, diag);
+    if (jit)
+        fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
+                "file to machine code %.3f s\n", jit_emit, jit_tcc,
+                mech->load_seconds + mech->diff_seconds + jit_emit + jit_tcc);
+    else
+        fprintf(stderr, "mechc gen: %s\n", diag->message);
+    jit_free(jit);
+    emit_result_free(&jit_src);
+}
+
+/* The header, then the source (to stdout without -o); false (reported) on a write error. */
+static bool write_outputs(const GenCli *c, const EmitResult *res)
+{
+    bool ok = true;
+    if (c->header_path)
+        ok = write_file(c->header_path, res->h_text);
+    if (ok && c->out_path)
+        ok = write_file(c->out_path, res->c_text);
+    else if (ok)
+        fputs(res->c_text, stdout);
+    return ok;
+}
+
+/* The generated C (or the rows) for the file. */
+static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    GenCli *c = opts;
+    if (c->dump == 0) {
         dump_rows(mech);
-        pipeline_free(mech);
         return EXIT_OK;
     }
-    opt.source_name = a.file;
+    c->emit.source_name = a->file;
     EmitResult res;
     double t0 = pipeline_now();
-    if (!emit_mechanism(&mech->kin, &opt, &res, &diag)) {     /* about the file: "FILE: error: ..." */
-        diag_print(&diag, stderr);
-        pipeline_free(mech);
+    if (!emit_mechanism(&mech->kin, &c->emit, &res, diag)) {     /* about the file: "FILE: error: ..." */
+        diag_print(diag, stderr);
         return EXIT_USAGE;
     }
     double emit_seconds = pipeline_now() - t0;
-    bool ok = true;
-    if (header_path)
-        ok = write_file(header_path, res.h_text);
-    if (ok && out_path)
-        ok = write_file(out_path, res.c_text);
-    else if (ok)
-        fputs(res.c_text, stdout);
-    if (stats) {
-        fprintf(stderr, "mechc gen: %s: %d coordinates, %d rows (%d holonomic, %d velocity level), "
-                "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
-                mech->model->nh, mech->model->nv, mech->kin.nnz);
-        fprintf(stderr, "mechc gen: operations after sharing:");
-        for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
-            fprintf(stderr, " %s %d%s", emit_function_names[f], res.ops[f], f + 1 < EMIT_FUNCTION_COUNT ? "," : "\n");
-        fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
-                (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
-        EmitResult jit_src;
-        double jit_emit = 0, jit_tcc = 0;
-        Jit *jit = pipeline_jit(mech, &jit_src, &jit_emit, &jit_tcc, &diag);
-        if (jit)
-            fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
-                    "file to machine code %.3f s\n", jit_emit, jit_tcc,
-                    mech->load_seconds + mech->diff_seconds + jit_emit + jit_tcc);
-        else
-            fprintf(stderr, "mechc gen: %s\n", diag.message);
-        jit_free(jit);
-        emit_result_free(&jit_src);
-    }
+    bool ok = write_outputs(c, &res);
+    if (c->stats)
+        print_stats(mech, &res, emit_seconds, diag);
     emit_result_free(&res);
-    pipeline_free(mech);
     return ok ? EXIT_OK : EXIT_USAGE;
+}
+
+static const CliCommand command = {
+    .name = "gen", .usage = usage, CLI_OPTIONS(options), .column = 20,
+    .limits_offset = offsetof(GenCli, limits),
+    .finish = finish, .run = gen_file,
+};
+
+int cmd_gen(int argc, char **argv)
+{
+    GenCli c = {.emit = emit_default_options(), .limits = mech_default_limits(), .dump = -1};
+    return cli_main(&command, argc, argv, &c);
 }

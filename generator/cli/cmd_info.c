@@ -8,6 +8,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What the command line asked for. */
+typedef struct InfoCli {
+    AnalysisOptions analysis;
+    MechLimits limits;
+    double t;
+    bool json;
+} InfoCli;
+
 static const char usage[] =
     "usage: mechc info FILE.mech [--json] [--rank-tol T] [--t T] [--samples N]\n"
     "                  [--max-dense N]\n"
@@ -20,16 +28,28 @@ static const char usage[] =
     "on the rows before it), tells a singular position from a permanent\n"
     "redundancy, and tests every velocity-level row for integrability\n"
     "(holonomic in disguise, with its position law, or nonholonomic).\n"
-    "\n"
-    "  --json         print JSON (keys: coords, rows, nq, nh, nv, dof, rank,\n"
-    "                 redundant, and more)\n"
-    "  --rank-tol T   singular values above T count toward the rank\n"
-    "                 (default max(rows, coords) * eps * largest singular value)\n"
-    "  --t T          analyse at time T instead of 0 (drivers move with t)\n"
-    "  --samples N    random states for the numerical integrability check (default 8)\n"
-    "  --max-dense N  rows x coordinates up to which the rank comes from a dense SVD\n"
-    "                 (default 500000); larger Jacobians use a sparse QR, which gives\n"
-    "                 the rank and the redundant rows but no condition number\n"
+    "\n";
+
+static const CliOption options[] = {
+    {"--json", CLI_FLAG_AT(InfoCli, json),
+     .help = "print JSON (keys: coords, rows, nq, nh, nv, dof, rank,\n"
+             "redundant, and more)"},
+    {"--rank-tol", CLI_REAL_AT(InfoCli, analysis.rank_tol), CLI_NONNEGATIVE, .what = "a number >= 0",
+     .metavar = "T",
+     .help = "singular values above T count toward the rank\n"
+             "(default max(rows, coords) * eps * largest singular value)"},
+    {"--t", CLI_REAL_AT(InfoCli, t), .metavar = "T",
+     .help = "analyse at time T instead of 0 (drivers move with t)"},
+    {"--samples", CLI_INT_AT(InfoCli, analysis.samples, 1, 1000), .metavar = "N",
+     .help = "random states for the numerical integrability check (default 8)"},
+    {"--max-dense", CLI_REAL_AT(InfoCli, analysis.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
+     .metavar = "N",
+     .help = "rows x coordinates up to which the rank comes from a dense SVD\n"
+             "(default 500000); larger Jacobians use a sparse QR, which gives\n"
+             "the rank and the redundant rows but no condition number"},
+};
+
+static const char epilogue[] =
     "\n"
     "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
     "printed, at the last iterate), 2 bad usage or bad input.\n";
@@ -70,13 +90,10 @@ static void json_num(const char *key, double v)
     json_number(stdout, v);
 }
 
-static void print_json(const InfoReport *rep)
+/* "rows": every row with its joint, kind, level and verdicts. */
+static void json_rows(const InfoReport *rep)
 {
     const Model *m = rep->model;
-    printf("{\"mechanism\": ");
-    json_string(stdout, m->name);
-    printf(",\n \"coords\": ");
-    json_string_list(stdout, m->coord_names, m->nq);
     printf(",\n \"rows\": [");
     for (int r = 0; r < m->nr; r++) {
         const Row *row = &m->rows[r];
@@ -104,7 +121,13 @@ static void print_json(const InfoReport *rep)
         }
         printf("}");
     }
-    printf("],\n \"joints\": [");
+    printf("]");
+}
+
+/* "joints": rows of each joint against the textbook table. */
+static void json_joints(const Model *m)
+{
+    printf(",\n \"joints\": [");
     for (int j = 0; j < m->njoints; j++) {
         const Joint *jt = &m->joints[j];
         bool vel;
@@ -115,6 +138,17 @@ static void print_json(const InfoReport *rep)
                jt->nrows, table);
     }
     printf("]");
+}
+
+static void print_json(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    printf("{\"mechanism\": ");
+    json_string(stdout, m->name);
+    printf(",\n \"coords\": ");
+    json_string_list(stdout, m->coord_names, m->nq);
+    json_rows(rep);
+    json_joints(m);
     printf(",\n \"nq\": %d, \"nh\": %d, \"nv\": %d, \"nr\": %d", rep->nq, rep->nh, rep->nv, rep->nr);
     printf(",\n \"dof\": %d", rep->dof);
     json_int_or_null("rank", rep->rank);
@@ -171,7 +205,8 @@ static const char *coord_name(const Model *m, int i) { return m->coord_names[i];
 static const char *row_name(const Model *m, int i) { return m->rows[i].name; }
 static const char *joint_name(const Model *m, int i) { return m->joints[i].name; }
 
-static void print_text(const InfoReport *rep)
+/* Coordinates, rows, joints and the mobility count. */
+static void print_structure(const InfoReport *rep)
 {
     const Model *m = rep->model;
     printf("mechanism %s: %d coordinate%s, %d row%s (%d holonomic, %d velocity level)\n\n",
@@ -206,7 +241,12 @@ static void print_text(const InfoReport *rep)
     printf("  %d coordinates - %d holonomic - %d velocity-level rows = %d DOF\n",
            rep->nq, rep->nh, rep->nv, rep->dof);
     printf("  without the %d driver%s: %d DOF\n", drivers, drivers == 1 ? "" : "s", rep->mobility);
+}
 
+/* The Newton assembly at t: converged or not, and how far. */
+static void print_assembly(const InfoReport *rep)
+{
+    const Model *m = rep->model;
     printf("\nassembly at t = %g (minimum-norm Newton on the holonomic rows%s):\n  ", rep->t,
            rep->dense ? "" : ", sparse QR");
     if (rep->nh == 0)
@@ -218,7 +258,12 @@ static void print_text(const InfoReport *rep)
                rep->assembly.worst_row >= 0 && !rep->assembled ? ", worst row " : "",
                rep->assembly.worst_row >= 0 && !rep->assembled
                    ? m->rows[rep->assembly.worst_row].name : "");
+}
 
+/* Rank, singular values, the configuration's verdict and the redundant rows. */
+static void print_rank(const InfoReport *rep)
+{
+    const Model *m = rep->model;
     printf("\nrank (%s at the assembled configuration):\n", rep->dense ? "SVD" : "sparse QR");
     if (rep->rank < 0) {
         printf("  not computed (%s)\n", rep->dense ? "NaN or Inf in the Jacobian"
@@ -244,77 +289,53 @@ static void print_text(const InfoReport *rep)
         printf("%s\n", n ? "" : "none");
         printf("  DOF by the rank: %d with drivers, %d without\n", rep->dof_rank, rep->mobility_rank);
     }
+}
 
-    if (m->nv) {
-        printf("\nintegrability (each velocity-level row on its own, omega = a^T dq + b dt):\n");
-        for (int r = m->nh; r < m->nr; r++) {
-            const Integrability *it = &rep->rows[r].integ;
-            printf("  %-*s  ", rw, m->rows[r].name);
-            if (!it->decided)
-                printf("undecided\n");
-            else if (it->integrable && it->law)
-                printf("integrable (holonomic): %s\n", it->law);
-            else if (it->integrable)
-                printf("integrable (holonomic); law not found in closed form\n");
-            else
-                printf("not integrable (nonholonomic)\n");
-            printf("  %-*s  %s\n", rw, "", it->note);
-        }
-        printf("  (the verdicts above are per row, on all of (q, t) space)\n");
-        printf("\nvelocity-level rows together with the holonomic rows, drivers left out:\n  %s\n",
-               rep->system.note ? rep->system.note : "not tested");
+/* Each velocity-level row's verdict, then the system's. */
+static void print_integrability(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    if (!m->nv)
+        return;
+    int rw = width(m->nr, row_name, m, 4);
+    printf("\nintegrability (each velocity-level row on its own, omega = a^T dq + b dt):\n");
+    for (int r = m->nh; r < m->nr; r++) {
+        const Integrability *it = &rep->rows[r].integ;
+        printf("  %-*s  ", rw, m->rows[r].name);
+        if (!it->decided)
+            printf("undecided\n");
+        else if (it->integrable && it->law)
+            printf("integrable (holonomic): %s\n", it->law);
+        else if (it->integrable)
+            printf("integrable (holonomic); law not found in closed form\n");
+        else
+            printf("not integrable (nonholonomic)\n");
+        printf("  %-*s  %s\n", rw, "", it->note);
     }
+    printf("  (the verdicts above are per row, on all of (q, t) space)\n");
+    printf("\nvelocity-level rows together with the holonomic rows, drivers left out:\n  %s\n",
+           rep->system.note ? rep->system.note : "not tested");
+}
 
+static void print_text(const InfoReport *rep)
+{
+    print_structure(rep);
+    print_assembly(rep);
+    print_rank(rep);
+    print_integrability(rep);
     printf("\nverdict: %s\n", rep->verdict);
 }
 
-int cmd_info(int argc, char **argv)
+/* The analysis at t and its report; exit status 1 when the assembly did not converge. */
+static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
-    Args a;
-    args_init(&a, "info", argc, argv);
-    MechLimits limits = mech_default_limits();
-    const char *opt;
-    bool json = false;
-    double t = 0.0;
-    AnalysisOptions o = analysis_default_options();
-    while (!a.failed && (opt = args_next(&a))) {
-        if (args_is_help(opt)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(&a, opt, &limits)) {
-            continue;
-        } else if (strcmp(opt, "--json") == 0) {
-            json = true;
-        } else if (strcmp(opt, "--rank-tol") == 0) {
-            if (args_double(&a, opt, &o.rank_tol) && o.rank_tol < 0) {
-                fprintf(stderr, "mechc info: error: --rank-tol needs a number >= 0\n");
-                a.failed = true;
-            }
-        } else if (strcmp(opt, "--t") == 0) {
-            args_double(&a, opt, &t);
-        } else if (strcmp(opt, "--max-dense") == 0) {
-            if (args_double(&a, opt, &o.max_dense) && o.max_dense < 0) {
-                fprintf(stderr, "mechc info: error: --max-dense needs a number >= 0\n");
-                a.failed = true;
-            }
-        } else if (strcmp(opt, "--samples") == 0) {
-            args_int(&a, opt, 1, 1000, &o.samples);
-        } else {
-            args_unknown(&a, opt);
-        }
-    }
-    Diag diag;
-    Mech *mech = cli_load(&a, &limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
+    const InfoCli *c = opts;
     InfoReport rep;
-    if (!info_analyse(mech, t, &o, &rep, &diag)) {
-        cli_error(&a, &diag);
-        pipeline_free(mech);
+    if (!info_analyse(mech, c->t, &c->analysis, &rep, diag)) {
+        cli_error(a, diag);
         return EXIT_USAGE;
     }
-    if (json)
+    if (c->json)
         print_json(&rep);
     else
         print_text(&rep);
@@ -322,13 +343,24 @@ int cmd_info(int argc, char **argv)
     if (!rep.assembled) {
         const Model *m = mech->model;
         fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
-                t, rep.assembly.residual);
+                c->t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
         fprintf(stderr, ")\n");
         status = EXIT_ANALYSIS;
     }
     info_report_free(&rep);
-    pipeline_free(mech);
     return status;
+}
+
+static const CliCommand command = {
+    .name = "info", .usage = usage, CLI_OPTIONS(options), .column = 17, .epilogue = epilogue,
+    .limits_offset = offsetof(InfoCli, limits),
+    .run = info_file,
+};
+
+int cmd_info(int argc, char **argv)
+{
+    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits()};
+    return cli_main(&command, argc, argv, &c);
 }

@@ -19,6 +19,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+enum { MAX_TRACES = CLI_LIST_MAX, MAX_PLOT_VARS = 64 };
+
+/* What the command line asked for. */
+typedef struct RunCli {
+    RunOptions ro;
+    MechLimits limits;
+    const char *csv_path, *svg_path, *plot_path, *plot_list;
+    CliList traces;         /* --trace texts */
+    double tol;             /* --tol: both Newton tolerances of ro.mechrt; 0: not given */
+    int engine, ode, digits;
+    bool json, stats;
+    bool pictures, csv_stdout;      /* worked out from the above */
+} RunCli;
+
 static const char usage[] =
     "usage: mechc run FILE.mech [--t0 T] [--t1 T] [--steps N] [--engine jit|generic|aot]\n"
     "                 [--csv OUT.csv] [--json] [options]\n"
@@ -29,37 +43,65 @@ static const char usage[] =
     "velocity drivers) have their positions integrated (GSL, adaptive step) and\n"
     "projected back onto the holonomic rows after every step. Needs as many rows\n"
     "as coordinates.\n"
-    "\n"
-    "  --t0 T, --t1 T   time interval (default 0 and 1)\n"
-    "  --steps N        intervals (default 100)\n"
-    "  --engine E       jit (default), generic or aot, as for eval\n"
-    "  --csv FILE       write the CSV to FILE ('-': stdout; the default when\n"
-    "                   there is no --json)\n"
-    "  --json           print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}\n"
-    "  --digits N       significant digits of numbers (default: the fewest that\n"
-    "                   read back exactly, at most 17)\n"
-    "  --tol X          Newton: converged when max |Phi_i| <= X and the last\n"
-    "                   step max |dq_j| <= X (default 1e-8)\n"
-    "  --max-iter N     Newton iterations per time step (default 25)\n"
-    "  --max-substeps N a step that seems to leave its assembly branch (Newton\n"
-    "                   corrects far more than the predicted motion) is redone\n"
-    "                   in 2, 4, 8 ... substeps, at most N (default 64), and\n"
-    "                   the run fails past that; substeps are not output\n"
-    "  --pivot-tol X    singular when an LU pivot <= X times the largest\n"
-    "                   Jacobian entry (default 1e-12)\n"
-    "  --cond-warn X    warn where the Jacobian's condition estimate exceeds X\n"
-    "                   (default 1e10; 0: no estimate)\n"
-    "  --ode M          integrator for velocity-level rows: rk8pd (default) or rkf45\n"
-    "  --ode-tol X      its error per step, absolute and relative (default 1e-10)\n"
-    "  --stats          print time per step, Newton iterations per step and the\n"
-    "                   step's cost in evaluations of the fused `all` kernel\n"
-    "  --svg FILE       write an animated SVG of the motion (plays in any browser)\n"
-    "  --trace B(sx,sy) draw the path of the point (sx, sy) of body B in the\n"
-    "                   animation (repeatable; a point particle: --trace m)\n"
-    "  --plot FILE      write an SVG chart of variables against time\n"
-    "  --plot-vars LIST what --plot shows: coordinate names, d(NAME) for a\n"
-    "                   velocity, dd(NAME) for an acceleration (default: every\n"
-    "                   coordinate)\n"
+    "\n";
+
+static const char *const ode_methods[] = {"rk8pd", "rkf45", NULL};
+
+#define POSITIVE CLI_POSITIVE, .what = "a positive number", .echo = true
+#define NONNEGATIVE CLI_NONNEGATIVE, .what = "a non-negative number", .echo = true
+
+static const CliOption options[] = {
+    {"--t0", CLI_REAL_AT(RunCli, ro.t0), .metavar = "T", .help = "time interval (default 0 and 1)"},
+    {"--t1", CLI_REAL_AT(RunCli, ro.t1), .metavar = "T"},
+    {"--steps", CLI_INT_AT(RunCli, ro.steps, 1, 100000000), .metavar = "N",
+     .help = "intervals (default 100)"},
+    {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
+     .help = "jit (default), generic or aot, as for eval"},
+    {"--csv", CLI_STRING_AT(RunCli, csv_path), .metavar = "FILE",
+     .help = "write the CSV to FILE ('-': stdout; the default when\n"
+             "there is no --json)"},
+    {"--json", CLI_FLAG_AT(RunCli, json),
+     .help = "print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}"},
+    {"--digits", CLI_INT_AT(RunCli, digits, 1, 17), .metavar = "N",
+     .help = "significant digits of numbers (default: the fewest that\n"
+             "read back exactly, at most 17)"},
+    {"--tol", CLI_REAL_AT(RunCli, tol), POSITIVE, .metavar = "X",
+     .help = "Newton: converged when max |Phi_i| <= X and the last\n"
+             "step max |dq_j| <= X (default 1e-8)"},
+    {"--max-iter", CLI_INT_AT(RunCli, ro.mechrt.max_iter, 1, 10000), .metavar = "N",
+     .help = "Newton iterations per time step (default 25)"},
+    {"--max-substeps", CLI_INT_AT(RunCli, ro.max_substeps, 1, 1 << 20), .metavar = "N",
+     .help = "a step that seems to leave its assembly branch (Newton\n"
+             "corrects far more than the predicted motion) is redone\n"
+             "in 2, 4, 8 ... substeps, at most N (default 64), and\n"
+             "the run fails past that; substeps are not output"},
+    {"--pivot-tol", CLI_REAL_AT(RunCli, ro.mechrt.pivot_tol), NONNEGATIVE, .metavar = "X",
+     .help = "singular when an LU pivot <= X times the largest\n"
+             "Jacobian entry (default 1e-12)"},
+    {"--cond-warn", CLI_REAL_AT(RunCli, ro.mechrt.cond_warn), NONNEGATIVE, .metavar = "X",
+     .help = "warn where the Jacobian's condition estimate exceeds X\n"
+             "(default 1e10; 0: no estimate)"},
+    {"--ode", CLI_CHOICE_AT(RunCli, ode, ode_methods), .metavar = "M",
+     .help = "integrator for velocity-level rows: rk8pd (default) or rkf45"},
+    {"--ode-tol", CLI_REAL_AT(RunCli, ro.ode.tol), POSITIVE, .metavar = "X",
+     .help = "its error per step, absolute and relative (default 1e-10)"},
+    {"--stats", CLI_FLAG_AT(RunCli, stats),
+     .help = "print time per step, Newton iterations per step and the\n"
+             "step's cost in evaluations of the fused `all` kernel"},
+    {"--svg", CLI_STRING_AT(RunCli, svg_path), .metavar = "FILE",
+     .help = "write an animated SVG of the motion (plays in any browser)"},
+    {"--trace", CLI_LIST_AT(RunCli, traces, MAX_TRACES), .what = "points", .metavar = "B(sx,sy)",
+     .help = "draw the path of the point (sx, sy) of body B in the\n"
+             "animation (repeatable; a point particle: --trace m)"},
+    {"--plot", CLI_STRING_AT(RunCli, plot_path), .metavar = "FILE",
+     .help = "write an SVG chart of variables against time"},
+    {"--plot-vars", CLI_STRING_AT(RunCli, plot_list), .metavar = "LIST",
+     .help = "what --plot shows: coordinate names, d(NAME) for a\n"
+             "velocity, dd(NAME) for an acceleration (default: every\n"
+             "coordinate)"},
+};
+
+static const char epilogue[] =
     "\n"
     "CSV columns: t, then every coordinate by name (crank.x, ...), then the\n"
     "velocities d(crank.x), ..., then the accelerations dd(crank.x), ...\n"
@@ -89,8 +131,6 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
     if (out->t1 != out->t0)
         progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
 }
-
-enum { MAX_TRACES = 16, MAX_PLOT_VARS = 64 };
 
 /* The animation and the chart, from the kept rows [t, q, qd, qdd]. */
 static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *svg_path,
@@ -137,19 +177,6 @@ static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *sv
     free(t);
     free(q);
     return ok;
-}
-
-static bool positive_option(Args *a, const char *opt, double *out, bool allow_zero)
-{
-    if (!args_double(a, opt, out))
-        return false;
-    if (*out < 0 || (!allow_zero && *out == 0)) {
-        fprintf(stderr, "mechc run: error: %s needs a %s number, not %g\n", opt,
-                allow_zero ? "non-negative" : "positive", *out);
-        a->failed = true;
-        return false;
-    }
-    return true;
 }
 
 static void print_stats(const RunResult *res, const MechrtKernels *k, const double *q,
@@ -199,102 +226,33 @@ static void on_state_keep(void *ctx, double t, const double *q, const double *qd
     memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
 }
 
-/* What the command line asked for. */
-typedef struct RunCli {
-    RunOptions ro;
-    MechLimits limits;
-    const char *csv_path, *svg_path, *plot_path, *plot_list;
-    const char *trace_text[MAX_TRACES];
-    int ntraces;
-    bool json, stats, pictures, csv_stdout;
-    int engine, digits;
-} RunCli;
-
-/* Reads the options into c. Returns -1 to go on, else the exit status
-   (--help, or bad usage already reported). */
-static int parse_options(Args *a, RunCli *c)
+/* Checks the options together and fills what they imply; false when
+   they cannot be used (reported). */
+static bool finish(Args *a, void *opts)
 {
-    const char *opt;
-    double x;
-    while (!a->failed && (opt = args_next(a))) {
-        if (args_is_help(opt)) {
-            fputs(usage, stdout);
-            fputs(args_limits_usage, stdout);
-            return EXIT_OK;
-        } else if (args_limit(a, opt, &c->limits) || args_engine(a, opt, &c->engine)) {
-            continue;
-        } else if (strcmp(opt, "--t0") == 0) {
-            args_double(a, opt, &c->ro.t0);
-        } else if (strcmp(opt, "--t1") == 0) {
-            args_double(a, opt, &c->ro.t1);
-        } else if (strcmp(opt, "--steps") == 0) {
-            args_int(a, opt, 1, 100000000, &c->ro.steps);
-        } else if (strcmp(opt, "--csv") == 0) {
-            c->csv_path = args_value(a, opt);
-        } else if (strcmp(opt, "--json") == 0) {
-            c->json = true;
-        } else if (strcmp(opt, "--svg") == 0) {
-            c->svg_path = args_value(a, opt);
-        } else if (strcmp(opt, "--trace") == 0) {
-            const char *v = args_value(a, opt);
-            if (v && c->ntraces == MAX_TRACES) {
-                fprintf(stderr, "mechc run: error: at most %d --trace points\n", MAX_TRACES);
-                a->failed = true;
-            } else if (v) {
-                c->trace_text[c->ntraces++] = v;
-            }
-        } else if (strcmp(opt, "--plot") == 0) {
-            c->plot_path = args_value(a, opt);
-        } else if (strcmp(opt, "--plot-vars") == 0) {
-            c->plot_list = args_value(a, opt);
-        } else if (strcmp(opt, "--digits") == 0) {
-            args_int(a, opt, 1, 17, &c->digits);
-        } else if (strcmp(opt, "--tol") == 0) {
-            if (positive_option(a, opt, &x, false))
-                c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = x;
-        } else if (strcmp(opt, "--max-iter") == 0) {
-            args_int(a, opt, 1, 10000, &c->ro.mechrt.max_iter);
-        } else if (strcmp(opt, "--max-substeps") == 0) {
-            args_int(a, opt, 1, 1 << 20, &c->ro.max_substeps);
-        } else if (strcmp(opt, "--pivot-tol") == 0) {
-            if (positive_option(a, opt, &x, true))
-                c->ro.mechrt.pivot_tol = x;
-        } else if (strcmp(opt, "--cond-warn") == 0) {
-            if (positive_option(a, opt, &x, true))
-                c->ro.mechrt.cond_warn = x;
-        } else if (strcmp(opt, "--ode") == 0) {
-            const char *v = args_value(a, opt);
-            if (v && !mechrt_ode_method_from_name(v, &c->ro.ode.method)) {
-                fprintf(stderr, "mechc run: error: --ode takes rk8pd or rkf45, not '%s'\n", v);
-                a->failed = true;
-            }
-        } else if (strcmp(opt, "--ode-tol") == 0) {
-            if (positive_option(a, opt, &x, false))
-                c->ro.ode.tol = x;
-        } else if (strcmp(opt, "--stats") == 0) {
-            c->stats = true;
-        } else {
-            args_unknown(a, opt);
-        }
-    }
+    RunCli *c = opts;
     if (!args_need_file(a))
-        return EXIT_USAGE;
+        return false;
+    if (c->tol > 0)
+        c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = c->tol;
+    if (c->ode >= 0)
+        mechrt_ode_method_from_name(ode_methods[c->ode], &c->ro.ode.method);
     if (c->ro.t0 == c->ro.t1) {
         fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", c->ro.t0);
-        return EXIT_USAGE;
+        return false;
     }
-    if ((c->ntraces > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
+    if ((c->traces.n > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
         fprintf(stderr, "mechc run: error: %s goes with %s\n",
-                c->ntraces ? "--trace" : "--plot-vars", c->ntraces ? "--svg FILE" : "--plot FILE");
-        return EXIT_USAGE;
+                c->traces.n ? "--trace" : "--plot-vars", c->traces.n ? "--svg FILE" : "--plot FILE");
+        return false;
     }
     c->pictures = c->svg_path || c->plot_path;
     c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0 : !c->json && !c->pictures;
     if (c->csv_stdout && c->json) {
         fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
-        return EXIT_USAGE;
+        return false;
     }
-    return -1;
+    return true;
 }
 
 /* The --trace points and --plot variables by name; false (reported) when
@@ -304,8 +262,8 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
 {
     char err[256];
     *nvars = 0;
-    for (int i = 0; i < c->ntraces; i++) {
-        if (!svg_parse_trace(m, c->trace_text[i], &traces[i], err, sizeof err)) {
+    for (int i = 0; i < c->traces.n; i++) {
+        if (!svg_parse_trace(m, c->traces.items[i], &traces[i], err, sizeof err)) {
             fprintf(stderr, "mechc run: error: %s\n", err);
             return false;
         }
@@ -323,106 +281,130 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
     return true;
 }
 
-int cmd_run(int argc, char **argv)
-{
-    Args a;
-    args_init(&a, "run", argc, argv);
-    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT};
-    int status = parse_options(&a, &c);
-    if (status >= 0)
-        return status;
-
-    Diag diag;
-    Mech *mech = cli_load(&a, &c.limits, &diag);
-    if (!mech)
-        return EXIT_USAGE;
-    const Model *m = mech->model;
-    char why[300];
+/* The --trace points and --plot variables, resolved. */
+typedef struct Pictures {
     SvgTrace traces[MAX_TRACES];
     SvgPlotVar vars[MAX_PLOT_VARS];
     int nvars;
-    if (!run_rows_match(m, why, sizeof why)) {  /* before the engine's compile */
-        diag_error(&diag, m->last_pos, "%s", why);
-        diag_print(&diag, stderr);
-        pipeline_free(mech);
-        return EXIT_USAGE;
-    }
-    if (!resolve_pictures(m, &c, traces, vars, &nvars)) {
-        pipeline_free(mech);
-        return EXIT_USAGE;
-    }
-    Engine e;
-    if (!cli_engine_open(&a, &e, (EngineKind)c.engine, mech, NULL, &diag)) {
-        pipeline_free(mech);
-        return EXIT_USAGE;
-    }
+} Pictures;
 
-    Output out = {.csv = NULL, .json = c.json || c.pictures, .digits = c.digits, .nq = m->nq,
-                  .t0 = c.ro.t0, .t1 = c.ro.t1};
-    mechrt_trace_init(&out.trace, m->nq);
-    status = EXIT_OK;
-    if (c.csv_stdout) {
-        out.csv = stdout;
-    } else if (c.csv_path) {
-        out.csv = fopen(c.csv_path, "w");
-        if (!out.csv) {
-            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c.csv_path, strerror(errno));
-            engine_close(&e);
-            pipeline_free(mech);
-            return EXIT_USAGE;
-        }
+/* Before any state: rows against coordinates (before the engine's
+   compile), the pictures' names, the engine. false when one fails
+   (reported). */
+static bool prepare(const Args *a, const RunCli *c, const Mech *mech, Pictures *pics, Engine *e,
+                    Diag *diag)
+{
+    const Model *m = mech->model;
+    char why[300];
+    if (!run_rows_match(m, why, sizeof why)) {
+        diag_error(diag, m->last_pos, "%s", why);
+        diag_print(diag, stderr);
+        return false;
     }
+    return resolve_pictures(m, c, pics->traces, pics->vars, &pics->nvars)
+           && cli_engine_open(a, e, (EngineKind)c->engine, mech, NULL, diag);
+}
 
-    MechrtKernels k = run_engine_kernels(&e);
-    RunResult res;
-    c.ro.notes = stderr;
-    if (out.csv)
-        mechrt_csv_header(out.csv, m->nq, m->coord_names);
-    LastState last = {&out, c.ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
-                      xcalloc((size_t)m->nq, sizeof(double))};
-    memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
-    progress_start(&out.progress, "run", 1000);
-    RunStatus rs = run_analysis(m, &k, &c.ro, on_state_keep, &last, &res);
-    progress_finish(&out.progress);
-
+/* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
+static int report(const RunCli *c, const Model *m, const Output *out, const Pictures *pics,
+                  RunStatus rs, const RunResult *res, const MechrtKernels *k, const LastState *last)
+{
+    int status = EXIT_OK;
     if (rs == RUN_BAD_INPUT) {
-        fprintf(stderr, "%s: error: %s\n", m->file, res.message);
-        status = EXIT_USAGE;
-    } else {
-        if (c.pictures && !write_pictures(m, &out.trace, c.svg_path, traces, c.ntraces,
-                                          c.plot_path, vars, nvars))
-            status = EXIT_USAGE;
-        if (c.json)
-            mechrt_json_write(stdout, &out.trace, m->coord_names, c.digits,
-                              rs == RUN_FAILED ? res.message : NULL, res.t_fail);
-        if (rs == RUN_FAILED) {
-            fprintf(stderr, "%s: error: %s\n", m->file, res.message);
-            if (res.states > 0)
-                fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file,
-                        res.states, res.states == 1 ? "state" : "states", res.t_fail,
-                        res.states == 1 ? "is" : "are");
-            status = EXIT_ANALYSIS;
-        }
-        if (out.trace_full) {
-            fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
-            status = EXIT_ANALYSIS;
-        }
-        if (c.stats)
-            print_stats(&res, &k, last.q, last.qd, last.t);
+        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
+        return EXIT_USAGE;
     }
-    if (out.csv && out.csv != stdout) {
-        if (fclose(out.csv) != 0) {
-            fprintf(stderr, "mechc run: error: writing '%s': %s\n", c.csv_path, strerror(errno));
+    if (c->pictures && !write_pictures(m, &out->trace, c->svg_path, pics->traces, c->traces.n,
+                                       c->plot_path, pics->vars, pics->nvars))
+        status = EXIT_USAGE;
+    if (c->json)
+        mechrt_json_write(stdout, &out->trace, m->coord_names, c->digits,
+                          rs == RUN_FAILED ? res->message : NULL, res->t_fail);
+    if (rs == RUN_FAILED) {
+        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
+        if (res->states > 0)
+            fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file,
+                    res->states, res->states == 1 ? "state" : "states", res->t_fail,
+                    res->states == 1 ? "is" : "are");
+        status = EXIT_ANALYSIS;
+    }
+    if (out->trace_full) {
+        fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
+        status = EXIT_ANALYSIS;
+    }
+    if (c->stats)
+        print_stats(res, k, last->q, last->qd, last->t);
+    return status;
+}
+
+/* Closes the CSV file or flushes stdout; status made EXIT_USAGE by a
+   write error, unless already a failure. */
+static int finish_output(const RunCli *c, FILE *csv, int status)
+{
+    if (csv && csv != stdout) {
+        if (fclose(csv) != 0) {
+            fprintf(stderr, "mechc run: error: writing '%s': %s\n", c->csv_path, strerror(errno));
             status = status == EXIT_OK ? EXIT_USAGE : status;
         }
     } else if (fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, "mechc run: error: writing the output: %s\n", strerror(errno));
         status = status == EXIT_OK ? EXIT_USAGE : status;
     }
+    return status;
+}
+
+/* Runs the analysis with the open engine, the states going where c says. */
+static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *pics)
+{
+    Output out = {.csv = NULL, .json = c->json || c->pictures, .digits = c->digits, .nq = m->nq,
+                  .t0 = c->ro.t0, .t1 = c->ro.t1};
+    if (c->csv_stdout) {
+        out.csv = stdout;
+    } else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
+        fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
+        return EXIT_USAGE;
+    }
+    mechrt_trace_init(&out.trace, m->nq);
+    MechrtKernels k = run_engine_kernels(e);
+    RunResult res;
+    c->ro.notes = stderr;
+    if (out.csv)
+        mechrt_csv_header(out.csv, m->nq, m->coord_names);
+    LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
+                      xcalloc((size_t)m->nq, sizeof(double))};
+    memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
+    progress_start(&out.progress, "run", 1000);
+    RunStatus rs = run_analysis(m, &k, &c->ro, on_state_keep, &last, &res);
+    progress_finish(&out.progress);
+    int status = report(c, m, &out, pics, rs, &res, &k, &last);
+    status = finish_output(c, out.csv, status);
     free(last.q), free(last.qd);
     mechrt_trace_free(&out.trace);
-    engine_close(&e);
-    pipeline_free(mech);
     return status;
+}
+
+/* Rows, pictures and engine ready, then the analysis. */
+static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+{
+    RunCli *c = opts;
+    Pictures pics;
+    Engine e;
+    if (!prepare(a, c, mech, &pics, &e, diag))
+        return EXIT_USAGE;
+    int status = analyse(c, mech->model, &e, &pics);
+    engine_close(&e);
+    return status;
+}
+
+static const CliCommand command = {
+    .name = "run", .usage = usage, CLI_OPTIONS(options), .column = 19, .epilogue = epilogue,
+    .limits_offset = offsetof(RunCli, limits),
+    .finish = finish, .run = run_file,
+};
+
+int cmd_run(int argc, char **argv)
+{
+    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
+                .engine = ENGINE_JIT, .ode = -1};
+    return cli_main(&command, argc, argv, &c);
 }

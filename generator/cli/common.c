@@ -1,5 +1,21 @@
-/* common.c - what the commands do alike once their options are read: load the file, open an engine, report a failure. */
+/* common.c - what the commands do alike: the order of their steps, loading the file, opening an engine, reporting a failure. */
 #include "cli.h"
+
+int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts)
+{
+    Args a;
+    if (!cli_parse(&a, cmd, argc, argv, opts))
+        return EXIT_OK;         /* --help */
+    if (cmd->finish && !cmd->finish(&a, opts))
+        return EXIT_USAGE;
+    Diag diag;      /* outlives the Mech, as cli_load wants */
+    Mech *mech = cli_load(&a, (const MechLimits *)((const char *)opts + cmd->limits_offset), &diag);
+    if (!mech)
+        return EXIT_USAGE;
+    int status = cmd->run(&a, mech, &diag, opts);
+    pipeline_free(mech);
+    return status;
+}
 
 Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag)
 {

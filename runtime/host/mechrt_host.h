@@ -174,6 +174,12 @@ bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double 
                        const double *qdd);
 void mechrt_trace_free(MechrtTrace *tr);
 
+/* A JSON string literal, quotes included (RFC 8259 section 7): a quote
+   or backslash gets a backslash before it, a control byte or DEL is
+   written as \u00XX (so none reaches a terminal), every other byte (UTF-8)
+   passes through. mechc's one JSON escaper: the CLI's JSON uses it too. */
+void mechrt_json_string(FILE *out, const char *s);
+
 /* {"coords": [...], "t": [...], "q": [[...]...], "qd": [...], "qdd": [...],
     "ok": true|false, "error": {"t": T, "message": "..."}} - error only when
    error_message is not NULL. Non-finite numbers are null. */

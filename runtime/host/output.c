@@ -103,24 +103,16 @@ void mechrt_trace_free(MechrtTrace *tr)
     tr->rows = tr->cap = 0;
 }
 
-/* A JSON string: quotes, backslashes and control characters escaped
-   (RFC 8259 section 7); other bytes (UTF-8) pass through. */
-static void json_str(FILE *out, const char *s)
+void mechrt_json_string(FILE *out, const char *s)
 {
     fputc('"', out);
     for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        switch (*p) {
-        case '"':  fputs("\\\"", out); break;
-        case '\\': fputs("\\\\", out); break;
-        case '\n': fputs("\\n", out); break;
-        case '\t': fputs("\\t", out); break;
-        case '\r': fputs("\\r", out); break;
-        default:
-            if (*p < 0x20)
-                fprintf(out, "\\u%04x", *p);
-            else
-                fputc(*p, out);
-        }
+        if (*p == '"' || *p == '\\')
+            fprintf(out, "\\%c", *p);
+        else if (*p < 0x20 || *p == 0x7f)
+            fprintf(out, "\\u%04x", *p);
+        else
+            fputc(*p, out);
     }
     fputc('"', out);
 }
@@ -140,7 +132,7 @@ void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *name
     fputs("{\"coords\": [", out);
     for (size_t i = 0; i < n; i++) {
         fputs(i ? ", " : "", out);
-        json_str(out, names[i]);
+        mechrt_json_string(out, names[i]);
     }
     fputs("],\n \"t\": [", out);
     for (size_t r = 0; r < tr->rows; r++) {
@@ -167,7 +159,7 @@ void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *name
         fputs(",\n \"error\": {\"t\": ", out);
         json_num(out, error_t, 0);
         fputs(", \"message\": ", out);
-        json_str(out, error_message);
+        mechrt_json_string(out, error_message);
         fputs("}", out);
     }
     fputs("}\n", out);
