@@ -1,7 +1,7 @@
 /* cmd_info.c - mechc info: coordinates, rows, mobility, rank, redundant rows, singularity, integrability. */
 #include "cli.h"
 
-#include "../analysis/analysis.h"
+#include "../analysis/info.h"
 #include "../base/arena.h"
 
 #include <math.h>
@@ -148,7 +148,7 @@ static void print_json(const InfoReport *rep)
            !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
     printf(",\n \"system_note\": ");
     json_string(stdout, rep->system.note ? rep->system.note : "");
-    printf(",\n \"singularity\": \"%s\"", singularity_names[rep->singularity]);
+    printf(",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
     printf(",\n \"singular\": ");
     json_string(stdout, rep->singular);
     printf(",\n \"verdict\": ");

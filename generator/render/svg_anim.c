@@ -30,7 +30,7 @@
 #include "svg_anim.h"
 
 #include "../base/arena.h"
-#include "../diff/kinematics.h"
+#include "../dag/support.h"
 #include "../eval/interp.h"
 #include "svg_common.h"
 
