@@ -343,6 +343,28 @@ static Singularity classify_singularity(const InfoReport *rep, int nuh)
     return SING_UNKNOWN;
 }
 
+/* Marks the drivers in rep and lists the rows without drivers (undriven,
+   the first *nuh of them holonomic) and the holonomic rows (hrows);
+   returns how many are undriven. */
+static int list_rows_by_kind(const Model *m, InfoReport *rep, int *undriven, int *nuh, int *hrows)
+{
+    int nu = 0;
+    *nuh = 0;
+    for (int r = 0; r < m->nr; r++) {
+        bool driver = m->rows[r].kind == JOINT_DRIVER;
+        rep->rows[r].driver = driver;
+        if (driver)
+            *(r < m->nh ? &rep->nh_drivers : &rep->nv_drivers) += 1;
+        else {
+            undriven[nu++] = r;
+            *nuh += r < m->nh;
+        }
+        if (r < m->nh)
+            hrows[r] = r;
+    }
+    return nu;
+}
+
 bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
 {
     Model *m = mech->model;
@@ -354,19 +376,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     rep->rows = xcalloc((size_t)nr + 1, sizeof *rep->rows);
     int *undriven = xmalloc(((size_t)nr + 1) * sizeof *undriven);
     int *hrows = xmalloc(((size_t)nh + 1) * sizeof *hrows);
-    int nu = 0, nuh = 0;
-    for (int r = 0; r < nr; r++) {
-        bool driver = m->rows[r].kind == JOINT_DRIVER;
-        rep->rows[r].driver = driver;
-        if (driver)
-            *(r < nh ? &rep->nh_drivers : &rep->nv_drivers) += 1;
-        else {
-            undriven[nu++] = r;
-            nuh += r < nh;
-        }
-        if (r < nh)
-            hrows[r] = r;
-    }
+    int nuh, nu = list_rows_by_kind(m, rep, undriven, &nuh, hrows);
     rep->dof = nq - nh - m->nv;
     rep->mobility = nq - nu;
     rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
