@@ -31,8 +31,9 @@ typedef struct Dag {
                                limit's error; -1: none */
     /* Sticky, like ferror: set when a node past max_nodes is asked for.
        From then on every new node comes back as DAG_ZERO (existing ones are
-       still found), so a phase runs to its end on harmless nodes and checks
-       once with dag_check_limit; no builder ever jumps out. */
+       still found), which every rule folds away: a phase goes on to its end
+       on harmless nodes (long loops test the flag to stop early) and checks
+       once with dag_check_limit. No dag_* call ever jumps out. */
     bool overflow;
     int32_t overflow_where; /* where at the first overflow */
 } Dag;

@@ -228,6 +228,7 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
     diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
 }
 
+/* A whole expression, the node limit checked once it is built. */
 static NodeId lower(Builder *b, const Ast *ast, ExprContext ctx)
 {
     NodeId id = lower_expr(b, ast, ctx);
