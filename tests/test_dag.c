@@ -10,14 +10,18 @@
 #include "testutil.h"
 
 #include "../generator/base/diag.h"
+#include "../generator/base/realfmt.h"
 #include "../generator/base/strbuf.h"
 #include "../generator/dag/dag.h"
+#include "../runtime/host/mechrt_host.h"
+
+#include <float.h>
+#include <math.h>
 
 #include <stdlib.h>
 #include <string.h>
 
 typedef struct Fixture {
-    Diag diag;
     Dag dag;
     NodeId x, y;
 } Fixture;
@@ -25,8 +29,7 @@ typedef struct Fixture {
 static int setup(void **state)
 {
     Fixture *f = calloc(1, sizeof *f);
-    diag_init(&f->diag, "test", "", 0);
-    dag_init(&f->dag, 1000000, &f->diag);
+    dag_init(&f->dag, 1000000);
     f->x = dag_var(&f->dag, 0);
     f->y = dag_var(&f->dag, 1);
     *state = f;
@@ -482,28 +485,114 @@ static void test_format(void **state)
     sb_free(&sb);
 }
 
+/* Numbers print as the shortest text that reads back; a malloc'd string. */
+static void test_format_shortest_numbers(void **state)
+{
+    Fixture *f = *state;
+    Dag *d = &f->dag;
+    const char *names[] = {"a.x", "a.phi"};
+    NodeId e = dag_add(d, f->x, dag_mul(d, dag_const(d, 0.3), f->y));
+    char *s = dag_format_string(d, e, names);
+    assert_string_equal(s, "a.x + 0.3*a.phi");
+    free(s);
+    e = dag_sub(d, f->x, dag_mul(d, dag_const(d, -2.5), dag_time(d)));
+    s = dag_format_string(d, e, names);
+    assert_string_equal(s, "a.x + 2.5*t");
+    free(s);
+    s = dag_format_string(d, dag_const(d, 0.1 + 0.2), NULL);
+    assert_string_equal(s, "0.30000000000000004");
+    free(s);
+}
+
+/* The graph's formatter and the host runtime's are two copies (runtime/
+   must not depend on generator/): the same text for every kind of value. */
+static void test_realfmt_matches_host(void **state)
+{
+    (void)state;
+    double fixed[] = {0.0, -0.0, 0.3, 0.1 + 0.2, M_PI, -M_PI, 1e-300, -4.9e-324, DBL_MAX, DBL_MIN,
+                      1e21, 123456789012345678.0, 2.5, -1.0 / 3.0, INFINITY, -INFINITY, NAN};
+    char a[40], b[40];
+    int nfixed = (int)(sizeof fixed / sizeof fixed[0]);
+    uint64_t state_bits = 0x9E3779B97F4A7C15ull;
+    for (int i = 0; i < nfixed + 2000; i++) {
+        double v;
+        if (i < nfixed) {
+            v = fixed[i];
+        } else {            /* random bit patterns: every exponent and mantissa */
+            state_bits = state_bits * 6364136223846793005ull + 1442695040888963407ull;
+            memcpy(&v, &state_bits, sizeof v);
+        }
+        int na = realfmt_shortest(a, sizeof a, v), nb = mechrt_format_real(b, sizeof b, v, 0);
+        assert_string_equal(a, b);
+        assert_int_equal(na, nb);
+        if (isfinite(v))
+            assert_true(strtod(a, NULL) == v);
+    }
+    realfmt_shortest(a, sizeof a, -0.0);
+    assert_string_equal(a, "0");
+    realfmt_shortest(a, sizeof a, 0.3);
+    assert_string_equal(a, "0.3");
+}
+
+/* Past the limit the graph makes no node: a new one comes back as
+   DAG_ZERO and sets the sticky overflow flag, existing ones are still
+   found, and dag_check_limit reports it (the ferror idiom). */
 static void test_node_limit(void **state)
 {
     (void)state;
+    Dag d;
+    dag_init(&d, 10);
     Diag diag;
     diag_init(&diag, "test", "", 0);
-    Dag d;
-    dag_init(&d, 10, &diag);
-    jmp_buf escape;
-    diag.escape = &escape;
-    volatile int made = 0;
-    if (setjmp(escape) == 0) {
-        for (int i = 0; i < 100; i++) {
-            dag_var(&d, i);
-            made++;
-        }
-        dag_free(&d);
-        fail_msg("the graph passed its limit of 10 nodes without an error");
-    }
-    assert_true(diag.failed);
-    assert_int_equal(made, 8);                  /* 0 and 1 are the first two */
+    assert_true(dag_check_limit(&d, &diag));
+    assert_false(diag.failed);
+    NodeId v[100];
+    for (int i = 0; i < 100; i++)
+        v[i] = dag_var(&d, i);
     assert_int_equal(d.count, 10);
-    assert_non_null(strstr(diag.message, "limit of 10 nodes"));
+    assert_true(d.overflow);
+    for (int i = 0; i < 8; i++)                 /* 0 and 1 are the first two */
+        assert_int_equal(v[i], i + 2);
+    for (int i = 8; i < 100; i++)
+        assert_int_equal(v[i], DAG_ZERO);
+    assert_int_equal(dag_var(&d, 3), v[3]);
+    /* the zero folds away in every rule: no node, no x/0 left behind */
+    assert_int_equal(dag_div(&d, v[0], dag_const(&d, 7.0)), DAG_ZERO);
+    assert_int_equal(dag_add(&d, v[0], dag_call(&d, OP_SIN, v[1], DAG_NONE)), v[0]);
+    assert_int_equal(dag_mul(&d, v[0], v[1]), DAG_ZERO);
+    assert_int_equal(d.count, 10);
+    assert_false(dag_check_limit(&d, &diag));
+    assert_true(diag.failed);
+    assert_false(diag.has_pos);
+    assert_string_equal(diag.message, "the expression graph passed its limit of 10 nodes "
+                                      "(the mechanism is too large; see --max-nodes)");
+    dag_free(&d);
+}
+
+/* With a statement being built, the error points at the statement where
+   the limit was first passed, not where the phase noticed it. */
+static void test_node_limit_names_statement(void **state)
+{
+    (void)state;
+    const char *text = "first\nsecond\nthird\n";
+    Dag d;
+    dag_init(&d, 4);
+    d.where = 0;
+    dag_var(&d, 0);
+    dag_var(&d, 1);
+    d.where = 6;                                /* "second" */
+    assert_int_equal(dag_var(&d, 2), DAG_ZERO);
+    d.where = 13;                               /* later work does not move it */
+    assert_int_equal(dag_var(&d, 3), DAG_ZERO);
+    Diag diag;
+    diag_init(&diag, "x.mech", text, (int)strlen(text));
+    assert_false(dag_check_limit(&d, &diag));
+    assert_true(diag.has_pos);
+    assert_int_equal(diag.line, 2);
+    assert_int_equal(diag.col, 1);
+    assert_string_equal(diag.message, "the expression graph passed its limit of 4 nodes at this "
+                                      "statement (its rows or their derivatives are too large; "
+                                      "see --max-nodes)");
     dag_free(&d);
 }
 
@@ -524,7 +613,10 @@ int main(void)
         cmocka_unit_test(test_op_table),
         cmocka_unit_test_setup_teardown(test_mark_reachable, setup, teardown),
         cmocka_unit_test_setup_teardown(test_format, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_format_shortest_numbers, setup, teardown),
+        cmocka_unit_test(test_realfmt_matches_host),
         cmocka_unit_test(test_node_limit),
+        cmocka_unit_test(test_node_limit_names_statement),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

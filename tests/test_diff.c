@@ -12,7 +12,6 @@
  */
 #include "testutil.h"
 
-#include "../generator/base/diag.h"
 #include "../generator/dag/dag.h"
 #include "../generator/diff/diff.h"
 
@@ -88,7 +87,6 @@ static double fd2_path(const Dag *d, NodeId e, const State *s)
 /* ---- fixture ---- */
 
 typedef struct Fixture {
-    Diag diag;
     Dag dag;
     Differ df;
     NodeId x, y, t, xd, yd;
@@ -97,8 +95,7 @@ typedef struct Fixture {
 static int setup(void **state)
 {
     Fixture *f = calloc(1, sizeof *f);
-    diag_init(&f->diag, "test", "", 0);
-    dag_init(&f->dag, 1000000, &f->diag);
+    dag_init(&f->dag, 1000000);
     differ_init(&f->df, &f->dag, NQ);
     f->x = dag_var(&f->dag, 0);
     f->y = dag_var(&f->dag, 1);

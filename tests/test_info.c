@@ -2,7 +2,9 @@
    minimum-norm assembly, singular positions, integrability and the laws. */
 #include "testutil.h"
 
-#include "../generator/analysis/analysis.h"
+#include "../generator/analysis/info.h"
+#include "../generator/analysis/mech_eval.h"
+#include "../generator/analysis/svd.h"
 #include "../generator/base/limits.h"
 
 #include <float.h>
@@ -292,10 +294,8 @@ static void test_redundant_rows_incremental(void **state)
 static void test_node_values_many_roots(void **state)
 {
     (void)state;
-    Diag diag;
-    memset(&diag, 0, sizeof diag);
     Dag d;
-    dag_init(&d, 1000, &diag);
+    dag_init(&d, 1000);
     NodeId x = dag_var(&d, 0), y = dag_var(&d, 1), t = dag_time(&d);
     NodeId s = dag_call(&d, OP_SIN, dag_mul(&d, x, y), DAG_NONE);     /* shared */
     NodeId roots[5] = {
@@ -720,27 +720,6 @@ static void test_system_of_rows(void **state)
     unload(l);
 }
 
-static void test_format_shortest_numbers(void **state)
-{
-    (void)state;
-    Dag dag;
-    Diag diag;
-    diag_init(&diag, "x", NULL, 0);
-    dag_init(&dag, 1000, &diag);
-    const char *names[] = {"a.x", "a.phi"};
-    NodeId x = dag_var(&dag, 0), phi = dag_var(&dag, 1);
-    NodeId e = dag_add(&dag, x, dag_mul(&dag, dag_const(&dag, 0.3), phi));
-    char *s = analysis_format(&dag, e, names);
-    assert_string_equal(s, "a.x + 0.3*a.phi");
-    free(s);
-    e = dag_sub(&dag, dag_var(&dag, 0), dag_mul(&dag, dag_const(&dag, -2.5), dag_time(&dag)));
-    s = analysis_format(&dag, e, names);
-    assert_contains(s, "2.5");
-    assert_contains(s, "t");
-    free(s);
-    dag_free(&dag);
-}
-
 /* ---- counts ---- */
 
 static void test_textbook_table_and_counts(void **state)
@@ -797,7 +776,6 @@ int main(void)
         cmocka_unit_test(test_rolling_statement_is_integrable),
         cmocka_unit_test(test_integrability_cases),
         cmocka_unit_test(test_system_of_rows),
-        cmocka_unit_test(test_format_shortest_numbers),
         cmocka_unit_test(test_textbook_table_and_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

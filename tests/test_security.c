@@ -25,6 +25,7 @@
 #include "../generator/base/arena.h"
 #include "../generator/base/diag.h"
 #include "../generator/base/limits.h"
+#include "../generator/analysis/info.h"
 #include "../generator/base/strbuf.h"
 #include "../generator/emit/emit.h"
 #include "../generator/pipeline/pipeline.h"
@@ -735,6 +736,149 @@ static void test_node_limit_trips(void **state)
     free(text);
 }
 
+/* ---- the node limit in each phase that builds nodes ---- */
+
+/* The graph's size once the model is built (before any derivative). */
+static int nodes_after_model(const char *text)
+{
+    MechLimits l = mech_default_limits();
+    Diag diag;
+    diag_init(&diag, "m.mech", NULL, 0);
+    Model *m = model_load(text, (int)strlen(text), "m.mech", "m", &l, &diag);
+    assert_non_null(m);
+    int count = m->dag.count;
+    model_free(m);
+    return count;
+}
+
+static const char *const two_rows =
+    "body a x = 1  y = 2  phi = 0.5\n"
+    "distance d: ground(0, 0) a(0.5, 0) length = 2\n"
+    "revolute r: ground(1, 2) a(0, 0.25)\n";
+
+/* Differentiation past the limit: the model builds within it, then the
+   first row whose derivatives need a node is named, as before. */
+static void test_node_limit_in_differentiation(void **state)
+{
+    (void)state;
+    MechLimits l = mech_default_limits();
+    l.max_nodes = nodes_after_model(two_rows);
+    Diag diag;
+    Mech *mech = load(two_rows, "d.mech", &l, &diag);
+    if (mech)
+        pipeline_free(mech);
+    assert_null(mech);
+    assert_true(diag.has_pos);
+    assert_int_equal(diag.line, 2);             /* the distance row, the first one */
+    assert_int_equal(diag.col, 1);
+    char want[160];
+    snprintf(want, sizeof want, "the expression graph passed its limit of %d nodes at this statement "
+             "(its rows or their derivatives are too large; see --max-nodes)", l.max_nodes);
+    assert_string_equal(diag.message, want);
+    /* one node fewer: the model builder trips, at the last statement */
+    l.max_nodes--;
+    assert_null(load(two_rows, "d.mech", &l, &diag));
+    assert_int_equal(diag.line, 3);
+    snprintf(want, sizeof want, "limit of %d nodes at this statement", l.max_nodes);
+    assert_non_null(strstr(diag.message, want));
+}
+
+/* A statement that passes the limit and has an input error after that
+   point: the node limit is the error, as when the graph jumped out at once
+   (the builder checks before each operand and after each expression). */
+static void test_node_limit_is_the_first_error(void **state)
+{
+    (void)state;
+    MechLimits l = mech_default_limits();
+    l.max_nodes = 3;        /* 0, 1 and x: sin(x) is refused, then 'nosuch' is looked up */
+    load_fails("coord x = 1\nconstraint k: atan2(sin(x), nosuch) = 0\n", &l,
+               "limit of 3 nodes at this statement", true);
+    l.max_nodes = 2;        /* cos(1) is refused: the axis would read as zero */
+    load_fails("param a = 1\nbody b\nprismatic p: ground b axis(cos(a), 0)\n", &l,
+               "limit of 2 nodes at this statement", true);
+    load_fails("param a = 1\nbody b\nweld w: nosuch(1, cos(a)) b\n", &l,     /* then the lookup */
+               "limit of 2 nodes at this statement", true);
+}
+
+/* Past the limit, differentiation stops at the row where it happened
+   instead of running on over the remaining rows with refused nodes. */
+static void test_node_limit_stops_differentiation(void **state)
+{
+    (void)state;
+    enum { N = 1000 };      /* coords, and N - 1 small rows of about 20 new nodes each */
+    StrBuf sb;
+    sb_init(&sb);
+    char a[8], b[8];
+    for (int i = 0; i < N; i++)
+        sb_printf(&sb, "coord %s = 0.%d\n", short_name(i, a), i % 9 + 1);
+    for (int r = 0; r + 1 < N; r++)
+        sb_printf(&sb, "constraint k%d: %s*%s + sin(%s) = %d\n", r, short_name(r, a),
+                  short_name(r + 1, b), a, r);
+    MechLimits l = mech_default_limits();
+    Diag diag;
+    diag_init(&diag, "c.mech", NULL, 0);
+    Model *m = model_load(sb.data, (int)sb.len, "c.mech", "c", &l, &diag);
+    assert_non_null(m);
+    m->dag.max_nodes = m->dag.count + 1000;     /* passed after some rows, long before the last */
+    Kinematics kin;
+    assert_false(kinematics_build(m, &kin, &diag));
+    assert_int_equal(m->dag.count, m->dag.max_nodes);
+    assert_non_null(strstr(diag.message, "at this statement"));
+    assert_true(diag.line > N + 1 && diag.line < N + N / 2);
+    assert_true(kin.nnz > 0);                   /* the rows before the limit */
+    assert_int_equal(kin.row_start[m->nr - 1], 0);     /* the last rows never started */
+    model_free(m);
+    sb_free(&sb);
+}
+
+static const char *const knife =
+    "body cart x = 1  y = 0  phi = 0.7\n"
+    "knife blade: cart axis(1, 0)\n"
+    "velocity roll: der(cart.x)*cart.y - der(cart.y)*cart.x = sin(cart.phi)*t\n";
+
+/* The integrability test and the involutivity test of `info` past the
+   limit: the message has no statement (the mechanism as a whole). */
+static void test_node_limit_in_info(void **state)
+{
+    (void)state;
+    MechLimits l = mech_default_limits();
+    Diag diag;
+    Mech *mech = load_ok(knife, "k.mech", &l, &diag);
+    Model *m = mech->model;
+    m->dag.max_nodes = m->dag.count;            /* nothing new from here on */
+    char want[160];
+    snprintf(want, sizeof want, "the expression graph passed its limit of %d nodes "
+             "(the mechanism is too large; see --max-nodes)", m->dag.count);
+    AnalysisOptions opt = analysis_default_options();
+    Integrability it;
+    assert_false(integrability_analyse(m, m->nh + 1, m->q0, &opt, &it, &diag));
+    assert_false(diag.has_pos);
+    assert_string_equal(diag.message, want);
+    assert_null(it.note);                       /* no verdict on refused nodes */
+    integrability_free(&it);
+
+    diag_init(&diag, "k.mech", NULL, 0);
+    int rows[3] = {0, 1, 2};
+    double t = 0.0;
+    Involutivity inv;
+    assert_false(involutivity_analyse(m, rows, m->nr, m->q0, &t, 1, &inv, &diag));
+    assert_string_equal(diag.message, want);
+    involutivity_free(&inv);
+
+    diag_init(&diag, "k.mech", NULL, 0);
+    InfoReport rep;
+    assert_false(info_analyse(mech, 0.0, &opt, &rep, &diag));
+    assert_string_equal(diag.message, want);
+    /* with room, the same mechanism analyses */
+    m->dag.max_nodes = 1000000;
+    m->dag.overflow = false;
+    diag_init(&diag, "k.mech", NULL, 0);
+    assert_true(info_analyse(mech, 0.0, &opt, &rep, &diag));
+    assert_false(rep.system.involutive);
+    info_report_free(&rep);
+    pipeline_free(mech);
+}
+
 /* Outputs sharing long chains: few graph nodes, but the code would
    recompute the chains in every part of a long function. */
 static void test_code_limit_trips(void **state)
@@ -786,6 +930,10 @@ int main(void)
         cmocka_unit_test(test_each_limit),
         cmocka_unit_test(test_one_huge_statement),
         cmocka_unit_test(test_node_limit_trips),
+        cmocka_unit_test(test_node_limit_in_differentiation),
+        cmocka_unit_test(test_node_limit_is_the_first_error),
+        cmocka_unit_test(test_node_limit_stops_differentiation),
+        cmocka_unit_test(test_node_limit_in_info),
         cmocka_unit_test(test_code_limit_trips),
         cmocka_unit_test(test_dense_limit_trips),
     };

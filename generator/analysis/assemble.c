@@ -1,10 +1,6 @@
-/* assemble.c - Phi and Phi_q from the graph, and minimum-norm Newton assembly on any set of holonomic rows.
+/* assemble.c - minimum-norm Newton assembly on any set of holonomic rows.
  *
- * Phi and the Jacobian's nonzeros are the roots of one program of the graph
- * interpreter (generator/eval/interp.h), compiled once: each evaluation is
- * one loop over the reachable nodes in id order. It needs no code
- * generation and works on the same graph as the rest of `info` (the
- * integrability test evaluates nodes it builds itself the same way).
+ * Phi and Phi_q come from the graph interpreter (mech_eval.c).
  *
  * Minimum-norm Newton (Gauss-Newton through the pseudo-inverse; Ben-Israel
  * 1966, Deuflhard, Newton Methods for Nonlinear Problems, 4.4):
@@ -17,81 +13,14 @@
  * redundant rows the dropped singular values are the dependent directions.
  * alpha is halved (at most 12 times) until the residual's 2-norm decreases.
  */
-#include "analysis.h"
+#include "assemble.h"
 
 #include "../base/arena.h"
+#include "sparse.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-AnalysisOptions analysis_default_options(void)
-{
-    return (AnalysisOptions){
-        .tol_phi = 1e-10,
-        .tol_dq = 1e-10,
-        .max_iter = 60,
-        .rank_tol = -1.0,
-        .samples = 8,
-        .seed = 20240605u,
-        .generic_samples = 3,
-        .max_dense = 5e5,
-    };
-}
-
-/* ---- Phi and Phi_q of a mechanism ---- */
-
-void mech_eval_init(MechEval *me, const Kinematics *kin)
-{
-    const Model *m = kin->model;
-    me->kin = kin;
-    me->nq = m->nq;
-    me->nh = m->nh;
-    me->nr = m->nr;
-    int nroots = m->nh + kin->nnz;
-    NodeId *roots = xmalloc(((size_t)nroots + 1) * sizeof *roots);
-    for (int i = 0; i < m->nh; i++)
-        roots[i] = kin->phi[i];
-    for (int e = 0; e < kin->nnz; e++)
-        roots[m->nh + e] = kin->jac[e].value;
-    node_values_init(&me->values, &m->dag, roots, nroots);
-    free(roots);
-}
-
-void mech_eval_free(MechEval *me)
-{
-    node_values_free(&me->values);
-    memset(me, 0, sizeof *me);
-}
-
-/* Runs the program at (q, t) and copies Phi out (phi may be NULL). */
-static void eval_phi(MechEval *me, const double *q, double t, double *phi)
-{
-    node_values_run(&me->values, q, NULL, t);
-    if (phi)
-        for (int i = 0; i < me->nh; i++)
-            phi[i] = node_values_get(&me->values, i);
-}
-
-void mech_eval(MechEval *me, const double *q, double t, double *phi, double *jac)
-{
-    const Kinematics *kin = me->kin;
-    eval_phi(me, q, t, phi);
-    if (jac) {
-        memset(jac, 0, (size_t)me->nr * (size_t)me->nq * sizeof *jac);
-        for (int e = 0; e < kin->nnz; e++)
-            jac[(size_t)kin->jac[e].row * (size_t)me->nq + (size_t)kin->jac[e].col] =
-                node_values_get(&me->values, me->nh + e);
-    }
-}
-
-void mech_eval_nz(MechEval *me, const double *q, double t, double *phi, double *vals)
-{
-    eval_phi(me, q, t, phi);
-    if (vals)
-        for (int e = 0; e < me->kin->nnz; e++)
-            vals[e] = node_values_get(&me->values, me->nh + e);
-}
 
 /* ---- minimum-norm Newton ---- */
 
@@ -217,7 +146,7 @@ static bool dense_direction(void *ctx, double *dq, int *rank)
     return true;
 }
 
-bool analysis_assemble(MechEval *me, const int *rows, int nrows, double t, double *q,
+bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, double *q,
                        const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res)
 {
     size_t nq = (size_t)me->nq;
@@ -286,8 +215,8 @@ static bool sparse_direction(void *ctx, double *dq, int *rank)
     /* factor J^T row by row (its rows are J's columns) */
     double tol = opt->rank_tol >= 0
                      ? opt->rank_tol
-                     : mechrt_svd_default_tol(nrows, nq,
-                                              sparse_sigma_max(kin, s->vals, s->all, nrows, opt->seed));
+                     : mechrt_svd_default_tol(nrows, nq, sparse_rank_sigma_max(kin, s->vals, s->all,
+                                                                               nrows, opt->seed));
     SparseRank *qr = sparse_rank_new(nrows, tol, fill_max);
     bool good = true;
     for (int i = 0; i < nq && good; i++) {
@@ -313,8 +242,8 @@ static bool sparse_direction(void *ctx, double *dq, int *rank)
     return true;
 }
 
-bool analysis_assemble_sparse(MechEval *me, int nrows, double t, double *q,
-                              const AnalysisOptions *opt, AssembleResult *res)
+bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
+                     const AnalysisOptions *opt, AssembleResult *res)
 {
     const Kinematics *kin = me->kin;
     int nq = me->nq;

@@ -29,13 +29,14 @@
  * result is accepted when d_k h = mu a_k for every k (symbolically or at
  * every sample).
  */
-#include "analysis.h"
-
-#include "../base/rng.h"
+#include "integrability.h"
 
 #include "../base/arena.h"
+#include "../base/rng.h"
 #include "../base/strbuf.h"
+#include "../dag/support.h"
 #include "../diff/diff.h"
+#include "../eval/interp.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -57,16 +58,6 @@ static double sample_state(uint64_t *s, const double *center, int nq, double *q)
     for (int i = 0; i < nq; i++)
         q[i] = center[i] + rng_symmetric(s) * (0.5 + 0.25 * fabs(center[i]));
     return rng_symmetric(s);
-}
-
-/* ---- formatting ---- */
-
-char *analysis_format(const Dag *dag, NodeId id, const char *const *coord_names)
-{
-    StrBuf sb;
-    sb_init(&sb);
-    dag_format(dag, id, coord_names, &sb);
-    return sb_take(&sb);
 }
 
 /* ---- the form omega on (q, t) space ---- */
@@ -346,7 +337,7 @@ static void find_law(Form *f, Sampler *smp, int samples, Integrability *out)
     bool symbolic = false;
     NodeId h = try_law(f, -1, smp, samples, &symbolic);
     int factor = -1;
-    for (int p = 0; p < f->nv && h == DAG_NONE; p++) {
+    for (int p = 0; p < f->nv && h == DAG_NONE && !d->overflow; p++) {
         if (dag_is_zero(d, f->coef[p]) || dag_is_const(d, f->coef[p], NULL))
             continue;
         h = try_law(f, p, smp, samples, &symbolic);
@@ -361,14 +352,14 @@ static void find_law(Form *f, Sampler *smp, int samples, Integrability *out)
         out->note = sb_take(&sb);
         return;
     }
-    char *text = analysis_format(d, h, f->m->coord_names);
+    char *text = dag_format_string(d, h, f->m->coord_names);
     size_t len = strlen(text);
     out->law = xmalloc(len + sizeof " = const");
     memcpy(out->law, text, len);
     memcpy(out->law + len, " = const", sizeof " = const");
     free(text);
     if (factor >= 0) {
-        char *fac = analysis_format(d, f->coef[factor], f->m->coord_names);
+        char *fac = dag_format_string(d, f->coef[factor], f->m->coord_names);
         sb_printf(&sb, "; law with the integrating factor 1/(%s)", fac);
         free(fac);
     }
@@ -410,7 +401,72 @@ static NodeId wedge_node(Form *f, int i, int j, int k)
     return dag_add(g, dag_add(g, t1, t2), t3);
 }
 
-/* Fills out for the form f (everything except the law). */
+/* The partials d[k*nv + l] = d coef[k] / d var[l]. */
+static void form_partials(Form *f)
+{
+    int nv = f->nv;
+    f->d = xmalloc((size_t)nv * (size_t)nv * sizeof *f->d);
+    for (int k = 0; k < nv; k++)
+        for (int l = 0; l < nv; l++)
+            f->d[k * nv + l] = deriv(f, f->coef[k], f->var[l]);
+}
+
+/* Components of omega ^ d omega that do not simplify to 0 (stops early
+   past the node limit, which the caller reports). */
+static long symbolic_nonzero(Form *f)
+{
+    int nv = f->nv;
+    long nonzero = 0;
+    for (int i = 0; i < nv && !f->dag->overflow; i++)
+        for (int j = i + 1; j < nv; j++)
+            for (int k = j + 1; k < nv; k++)
+                if (!dag_is_zero(f->dag, wedge_node(f, i, j, k)))
+                    nonzero++;
+    return nonzero;
+}
+
+/* The largest component of omega ^ d omega over the samples, relative to
+   the size of its terms. */
+typedef struct WedgeSample {
+    int good;               /* samples evaluated */
+    double worst, value;    /* largest |w| / scale, and that w */
+    int i, j, k;            /* its triple (indices into var) */
+} WedgeSample;
+
+static WedgeSample sample_wedges(Form *f, Sampler *smp, int samples)
+{
+    int nv = f->nv, nn = nv + nv * nv;
+    WedgeSample ws = {.i = -1, .j = -1, .k = -1};
+    NodeId *nodes = xmalloc((size_t)nn * sizeof *nodes);
+    double *val = xmalloc((size_t)nn * sizeof *val);
+    memcpy(nodes, f->coef, (size_t)nv * sizeof *nodes);
+    memcpy(nodes + nv, f->d, (size_t)nv * (size_t)nv * sizeof *nodes);
+    NodeValues ev;
+    node_values_init(&ev, f->dag, nodes, nn);
+    for (int s = 0; s < samples; s++) {
+        if (!sample(smp, &ev, nn, val))
+            continue;
+        ws.good++;
+        for (int i = 0; i < nv; i++)
+            for (int j = i + 1; j < nv; j++)
+                for (int k = j + 1; k < nv; k++) {
+                    double scale, w = wedge(val, val + nv, nv, i, j, k, &scale);
+                    double ratio = scale > 0 ? fabs(w) / scale : 0.0;
+                    if (ratio > ws.worst) {
+                        ws.worst = ratio;
+                        ws.value = w;
+                        ws.i = i, ws.j = j, ws.k = k;
+                    }
+                }
+    }
+    node_values_free(&ev);
+    free(nodes);
+    free(val);
+    return ws;
+}
+
+/* Fills out for the form f (everything except the law). Past the node
+   limit it leaves out->note unset: the caller reports the limit. */
 static void test_form(Form *f, Sampler *smp, int samples, Integrability *out)
 {
     int nv = f->nv;
@@ -432,146 +488,94 @@ static void test_form(Form *f, Sampler *smp, int samples, Integrability *out)
         out->note = sb_take(&sb);
         return;
     }
-    /* partials */
-    f->d = xmalloc((size_t)nv * (size_t)nv * sizeof *f->d);
-    for (int k = 0; k < nv; k++)
-        for (int l = 0; l < nv; l++)
-            f->d[k * nv + l] = deriv(f, f->coef[k], f->var[l]);
-    /* symbolic */
-    long nonzero = -1;
-    int wi = -1, wj = -1, wk = -1;
-    if (nv <= SYMBOLIC_MAX_VARS) {
-        nonzero = 0;
-        for (int i = 0; i < nv; i++)
-            for (int j = i + 1; j < nv; j++)
-                for (int k = j + 1; k < nv; k++)
-                    if (!dag_is_zero(f->dag, wedge_node(f, i, j, k)))
-                        nonzero++;
-        if (nonzero == 0) {
-            out->integrable = out->symbolic = out->decided = true;
-            sb_printf(&sb, "omega ^ d omega simplifies to 0 (%ld component%s over %d coordinates): "
-                      "a symbolic proof", triples, triples == 1 ? "" : "s", nv);
-            out->note = sb_take(&sb);
-            return;
-        }
+    form_partials(f);
+    long nonzero = nv <= SYMBOLIC_MAX_VARS ? symbolic_nonzero(f) : -1;
+    if (f->dag->overflow) {
+        sb_free(&sb);
+        return;
     }
-    /* numeric */
-    int nn = nv + nv * nv;
-    NodeId *nodes = xmalloc((size_t)nn * sizeof *nodes);
-    double *val = xmalloc((size_t)nn * sizeof *val);
-    memcpy(nodes, f->coef, (size_t)nv * sizeof *nodes);
-    memcpy(nodes + nv, f->d, (size_t)nv * (size_t)nv * sizeof *nodes);
-    NodeValues ev;
-    node_values_init(&ev, f->dag, nodes, nn);
-    double worst = 0.0, worst_value = 0.0;
-    int good = 0;
-    for (int s = 0; s < samples; s++) {
-        if (!sample(smp, &ev, nn, val))
-            continue;
-        good++;
-        for (int i = 0; i < nv; i++)
-            for (int j = i + 1; j < nv; j++)
-                for (int k = j + 1; k < nv; k++) {
-                    double scale, w = wedge(val, val + nv, nv, i, j, k, &scale);
-                    double ratio = scale > 0 ? fabs(w) / scale : 0.0;
-                    if (ratio > worst) {
-                        worst = ratio;
-                        worst_value = w;
-                        wi = i, wj = j, wk = k;
-                    }
-                }
+    if (nonzero == 0) {
+        out->integrable = out->symbolic = out->decided = true;
+        sb_printf(&sb, "omega ^ d omega simplifies to 0 (%ld component%s over %d coordinates): "
+                  "a symbolic proof", triples, triples == 1 ? "" : "s", nv);
+        out->note = sb_take(&sb);
+        return;
     }
-    node_values_free(&ev);
-    free(nodes);
-    free(val);
-    out->samples = good;
-    if (good == 0) {
-        out->decided = false;
+    WedgeSample ws = sample_wedges(f, smp, samples);
+    out->samples = ws.good;
+    out->decided = ws.good > 0;
+    out->integrable = ws.good > 0 && ws.worst <= ZERO_RTOL;
+    if (ws.good == 0)
         sb_printf(&sb, "undecided: omega ^ d omega has nonzero terms and could not be evaluated at "
                   "any of %d sample states", samples);
-    } else if (worst > ZERO_RTOL) {
-        out->decided = true;
-        out->integrable = false;
+    else if (!out->integrable)
         sb_printf(&sb, "omega ^ d omega != 0: its (%s, %s, %s) component is %.6g at a sample state "
-                  "(nonholonomic)", var_name(f, f->var[wi]), var_name(f, f->var[wj]),
-                  var_name(f, f->var[wk]), worst_value);
-    } else {
-        out->decided = true;
-        out->integrable = true;
+                  "(nonholonomic)", var_name(f, f->var[ws.i]), var_name(f, f->var[ws.j]),
+                  var_name(f, f->var[ws.k]), ws.value);
+    else
         sb_printf(&sb, "omega ^ d omega vanishes at %d random states (%ld component%s over %d "
-                  "coordinates; %s): numerical evidence", good, triples, triples == 1 ? "" : "s", nv,
-                  nonzero < 0 ? "too many to simplify" : "not simplified to 0 symbolically");
-    }
+                  "coordinates; %s): numerical evidence", ws.good, triples, triples == 1 ? "" : "s",
+                  nv, nonzero < 0 ? "too many to simplify" : "not simplified to 0 symbolically");
     out->note = sb_take(&sb);
 }
 
-bool analysis_integrability(Model *m, int row, const double *q_center,
-                            const AnalysisOptions *opt, Integrability *out, Diag *diag)
+/* omega's variables and coefficients: a_i = dPsi/dqd_i, b = Psi(qd = 0)
+   for dt, and every variable a nonzero coefficient depends on. */
+static void collect_form(Form *f, NodeId psi)
+{
+    int nq = f->nq;
+    NodeId *a = xmalloc(((size_t)nq + 1) * sizeof *a);
+    bool *used = xcalloc((size_t)nq + 1, sizeof *used);
+    for (int i = 0; i < nq; i++)
+        a[i] = DAG_ZERO;
+    int ns = support_collect(&f->scan, f->dag, psi, OP_VARD, f->buf);
+    int *s = xmalloc(((size_t)ns + 1) * sizeof *s);
+    memcpy(s, f->buf, (size_t)ns * sizeof *s);
+    for (int k = 0; k < ns; k++) {
+        a[s[k]] = diff_by_qd(&f->df, psi, s[k]);
+        if (!dag_is_zero(f->dag, a[s[k]]))
+            used[s[k]] = true;
+    }
+    free(s);
+    a[nq] = diff_without_velocities(&f->df, psi);   /* b, the dt coefficient */
+    if (!dag_is_zero(f->dag, a[nq]))
+        used[nq] = true;
+    for (int i = 0; i <= nq; i++)
+        if (!dag_is_zero(f->dag, a[i]))
+            add_vars(f, used, a[i]);
+    for (int i = 0; i <= nq; i++)
+        if (used[i]) {
+            f->var[f->nv] = i;
+            f->coef[f->nv++] = a[i];
+        }
+    free(a), free(used);
+}
+
+bool integrability_analyse(Model *m, int row, const double *q_center,
+                           const AnalysisOptions *opt, Integrability *out, Diag *diag)
 {
     memset(out, 0, sizeof *out);
-    Form *f = xcalloc(1, sizeof *f);
-    Sampler *smp = xcalloc(1, sizeof *smp);
-    f->m = m;
-    f->dag = &m->dag;
-    f->nq = m->nq;
-    differ_init(&f->df, f->dag, m->nq);
-    support_init(&f->scan);
-    f->buf = xmalloc(((size_t)m->nq + 2) * sizeof *f->buf);
-    f->var = xmalloc(((size_t)m->nq + 1) * sizeof *f->var);
-    f->coef = xmalloc(((size_t)m->nq + 1) * sizeof *f->coef);
-    bool *used = xcalloc((size_t)m->nq + 1, sizeof *used);
-    NodeId *a = xmalloc(((size_t)m->nq + 1) * sizeof *a);
-    smp->state = opt->seed ^ (0x51ed2701u * (uint64_t)(row + 1));
-    smp->center = q_center;
-    smp->nq = m->nq;
-    smp->q = xmalloc((size_t)m->nq * sizeof *smp->q);
+    Form f = {.m = m, .dag = &m->dag, .nq = m->nq};
+    differ_init(&f.df, f.dag, m->nq);
+    support_init(&f.scan);
+    f.buf = xmalloc(((size_t)m->nq + 2) * sizeof *f.buf);
+    f.var = xmalloc(((size_t)m->nq + 1) * sizeof *f.var);
+    f.coef = xmalloc(((size_t)m->nq + 1) * sizeof *f.coef);
+    Sampler smp = {.state = opt->seed ^ (0x51ed2701u * (uint64_t)(row + 1)), .center = q_center,
+                   .nq = m->nq};
+    smp.q = xmalloc((size_t)m->nq * sizeof *smp.q);
 
-    Diag *dd = f->dag->diag;
-    jmp_buf escape, *saved = dd->escape;
-    dd->escape = &escape;
-    bool ok = true;
-    if (setjmp(escape) != 0) {
-        ok = false;
-        if (diag != dd)
-            *diag = *dd;
-        goto done;
-    }
-    {
-        NodeId psi = m->rows[row].expr;
-        for (int i = 0; i < m->nq; i++)
-            a[i] = DAG_ZERO;
-        int ns = support_collect(&f->scan, f->dag, psi, OP_VARD, f->buf);
-        int *s = xmalloc(((size_t)ns + 1) * sizeof *s);
-        memcpy(s, f->buf, (size_t)ns * sizeof *s);
-        for (int k = 0; k < ns; k++) {
-            a[s[k]] = diff_by_qd(&f->df, psi, s[k]);
-            if (!dag_is_zero(f->dag, a[s[k]]))
-                used[s[k]] = true;
-        }
-        free(s);
-        a[m->nq] = diff_without_velocities(&f->df, psi);    /* b, the dt coefficient */
-        if (!dag_is_zero(f->dag, a[m->nq]))
-            used[m->nq] = true;
-        for (int i = 0; i <= m->nq; i++)
-            if (!dag_is_zero(f->dag, a[i]))
-                add_vars(f, used, a[i]);
-        for (int i = 0; i <= m->nq; i++)
-            if (used[i]) {
-                f->var[f->nv] = i;
-                f->coef[f->nv++] = a[i];
-            }
-        test_form(f, smp, opt->samples, out);
-        if (out->integrable)
-            find_law(f, smp, opt->samples, out);
-    }
-done:
-    dd->escape = saved;
-    free(used), free(a);
-    free(smp->q), free(smp);
-    free(f->buf), free(f->var), free(f->coef), free(f->d);
-    support_free(&f->scan);
-    differ_free(&f->df);
-    free(f);
+    collect_form(&f, m->rows[row].expr);
+    if (!f.dag->overflow)
+        test_form(&f, &smp, opt->samples, out);
+    if (out->integrable && !f.dag->overflow)
+        find_law(&f, &smp, opt->samples, out);
+    bool ok = dag_check_limit(f.dag, diag);     /* the node limit, once for the whole test */
+
+    free(smp.q);
+    free(f.buf), free(f.var), free(f.coef), free(f.d);
+    support_free(&f.scan);
+    differ_free(&f.df);
     return ok;
 }
 

@@ -17,11 +17,14 @@
  * This catches what the per-row test cannot: a knife edge whose heading is
  * fixed by a holonomic row is integrable on that row's manifold.
  */
-#include "analysis.h"
+#include "involutive.h"
 
 #include "../base/arena.h"
 #include "../base/strbuf.h"
+#include "../dag/support.h"
 #include "../diff/diff.h"
+#include "../eval/interp.h"
+#include "svd.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -89,147 +92,202 @@ static void project(int n, int r, const double *B, const double *W, double *out,
         }
 }
 
-bool analysis_involutivity(Model *m, const int *rows, int nrows, const double *points,
-                           const double *times, int npoints, Involutivity *out, Diag *diag)
-{
-    memset(out, 0, sizeof *out);
-    int nq = m->nq, n = nq + 1;
-    Dag *dag = &m->dag;
-    Entries *coef = xcalloc(1, sizeof *coef), *part = xcalloc(1, sizeof *part);
-    Differ *df = xcalloc(1, sizeof *df);
-    SupportScan *scan = xcalloc(1, sizeof *scan);
-    int *buf = xmalloc(((size_t)n + 1) * sizeof *buf);
-    int *vel = xmalloc(((size_t)nrows + 1) * sizeof *vel);     /* rows[k] for velocity k */
-    differ_init(df, dag, nq);
-    support_init(scan);
-    int nvel = 0;
+/* The rows' forms as graph nodes: coef holds the coefficients of every
+   row (C: row k, column j; t is column nq), part the partials d a_kj / d x_l
+   of the velocity rows' coefficients. */
+typedef struct Forms {
+    Entries coef, part;
+    int *vel;           /* index k into rows[] of each velocity row */
+    int nvel;
+} Forms;
 
-    Diag *dd = dag->diag;
-    jmp_buf escape, *saved = dd->escape;
-    dd->escape = &escape;
-    bool ok = true;
-    if (setjmp(escape) != 0) {
-        ok = false;
-        if (diag != dd)
-            *diag = *dd;
-        goto done;
-    }
-    for (int k = 0; k < nrows; k++) {
+static void forms_free(Forms *f)
+{
+    free(f->coef.e), free(f->part.e), free(f->vel);
+    memset(f, 0, sizeof *f);
+}
+
+/* The symbolic part: every node the numeric test evaluates. Stops early
+   past the node limit (the caller reports it). */
+static void collect_forms(Model *m, const int *rows, int nrows, Forms *f)
+{
+    Dag *dag = &m->dag;
+    int nq = m->nq;
+    Differ df;
+    SupportScan scan;
+    differ_init(&df, dag, nq);
+    support_init(&scan);
+    int *buf = xmalloc(((size_t)nq + 2) * sizeof *buf);
+    f->vel = xmalloc(((size_t)nrows + 1) * sizeof *f->vel);
+    for (int k = 0; k < nrows && !dag->overflow; k++) {
         const Row *row = &m->rows[rows[k]];
         if (!row->velocity) {
-            int ns = support_collect(scan, dag, row->expr, OP_VAR, buf);
+            int ns = support_collect(&scan, dag, row->expr, OP_VAR, buf);
             for (int i = 0; i < ns; i++)
-                push(coef, k, buf[i], 0, diff_by_q(df, row->expr, buf[i]));
-            push(coef, k, nq, 0, diff_by_t(df, row->expr));
+                push(&f->coef, k, buf[i], 0, diff_by_q(&df, row->expr, buf[i]));
+            push(&f->coef, k, nq, 0, diff_by_t(&df, row->expr));
             continue;
         }
-        vel[nvel++] = k;
-        int first = coef->n;
-        int ns = support_collect(scan, dag, row->expr, OP_VARD, buf);
+        f->vel[f->nvel++] = k;
+        int first = f->coef.n;
+        int ns = support_collect(&scan, dag, row->expr, OP_VARD, buf);
         for (int i = 0; i < ns; i++)
-            push(coef, k, buf[i], 0, diff_by_qd(df, row->expr, buf[i]));
-        push(coef, k, nq, 0, diff_without_velocities(df, row->expr));
-        for (int e = first; e < coef->n; e++) {
-            NodeId c = coef->e[e].node;
-            int j = coef->e[e].j;
-            int nv = support_collect(scan, dag, c, OP_VAR, buf);
+            push(&f->coef, k, buf[i], 0, diff_by_qd(&df, row->expr, buf[i]));
+        push(&f->coef, k, nq, 0, diff_without_velocities(&df, row->expr));
+        for (int e = first; e < f->coef.n; e++) {
+            NodeId c = f->coef.e[e].node;
+            int j = f->coef.e[e].j;
+            int nv = support_collect(&scan, dag, c, OP_VAR, buf);
             for (int i = 0; i < nv; i++)
-                push(part, k, j, buf[i], diff_by_q(df, c, buf[i]));
-            if (support_collect(scan, dag, c, OP_TIME, buf) > 0)
-                push(part, k, j, nq, diff_by_t(df, c));
+                push(&f->part, k, j, buf[i], diff_by_q(&df, c, buf[i]));
+            if (support_collect(&scan, dag, c, OP_TIME, buf) > 0)
+                push(&f->part, k, j, nq, diff_by_t(&df, c));
         }
     }
-    if (nvel == 0) {
+    free(buf);
+    support_free(&scan);
+    differ_free(&df);
+}
+
+/* The numeric part's program and workspaces, sized once for all points. */
+typedef struct Curvature {
+    int n, nrows;       /* n = nq + 1 */
+    NodeValues ev;      /* value e: coef.e[e]; value coef.n + e: part.e[e] */
+    double *C, *B, *W, *M, *scratch;
+    MechrtSvd *svd;
+} Curvature;
+
+static void curvature_init(Curvature *c, const Dag *dag, const Forms *f, int nrows, int n)
+{
+    c->n = n;
+    c->nrows = nrows;
+    int nroots = f->coef.n + f->part.n;
+    NodeId *roots = xmalloc(((size_t)nroots + 1) * sizeof *roots);
+    for (int e = 0; e < f->coef.n; e++)
+        roots[e] = f->coef.e[e].node;
+    for (int e = 0; e < f->part.n; e++)
+        roots[f->coef.n + e] = f->part.e[e].node;
+    node_values_init(&c->ev, dag, roots, nroots);
+    free(roots);
+    size_t nn = (size_t)n * (size_t)n;
+    c->C = xmalloc((size_t)nrows * (size_t)n * sizeof *c->C);
+    c->B = xmalloc(nn * sizeof *c->B);
+    c->W = xmalloc(nn * sizeof *c->W);
+    c->M = xmalloc(nn * sizeof *c->M);
+    c->scratch = xmalloc(2 * nn * sizeof *c->scratch);
+    c->svd = svd_work_new(nrows, n);
+}
+
+static void curvature_free(Curvature *c)
+{
+    mechrt_svd_free(c->svd);
+    node_values_free(&c->ev);
+    free(c->C), free(c->B), free(c->W), free(c->M), free(c->scratch);
+}
+
+/* W_k of the velocity row k at the evaluated point, (W_k)_jl = d_j a_l -
+   d_l a_j; *scale = max |W_k|. False when a partial is not finite. */
+static bool curl(Curvature *c, const Forms *f, int k, double *scale)
+{
+    int n = c->n;
+    size_t nn = (size_t)n * (size_t)n;
+    bool finite = true;
+    memset(c->W, 0, nn * sizeof *c->W);
+    for (int e = 0; e < f->part.n; e++) {
+        if (f->part.e[e].k != k)
+            continue;
+        double x = node_values_get(&c->ev, f->coef.n + e);     /* d_l a_j */
+        int j = f->part.e[e].j, l = f->part.e[e].l;
+        c->W[l * n + j] += x;
+        c->W[j * n + l] -= x;
+        finite = finite && isfinite(x);
+    }
+    *scale = 0.0;
+    for (size_t i = 0; i < nn; i++)
+        *scale = fmax(*scale, fabs(c->W[i]));
+    return finite;
+}
+
+/* The worst |P W_k P| / |W_k| seen so far, with its model row and point. */
+typedef struct Worst {
+    double ratio;
+    int row, point;
+} Worst;
+
+/* Point p, configuration q at time t: updates *worst for each velocity row
+   in turn. False when the point does not count (NaN or Inf met). */
+static bool worst_curvature(Curvature *c, const Forms *f, const int *rows, const double *q,
+                            double t, int p, Worst *worst)
+{
+    int n = c->n;
+    size_t nn = (size_t)n * (size_t)n;
+    node_values_run(&c->ev, q, NULL, t);
+    memset(c->C, 0, (size_t)c->nrows * (size_t)n * sizeof *c->C);
+    for (int e = 0; e < f->coef.n; e++)
+        c->C[(size_t)f->coef.e[e].k * (size_t)n + (size_t)f->coef.e[e].j] = node_values_get(&c->ev, e);
+    MechrtSvdResult sv;
+    if (!mechrt_svd(c->svd, c->C, c->nrows, n, n, -1.0, &sv))
+        return false;
+    int r = sv.rank;
+    for (int j = 0; j < n; j++)
+        for (int col = 0; col < r; col++)
+            c->B[j * r + col] = mechrt_svd_row_basis(c->svd, j, col);
+    for (int v = 0; v < f->nvel; v++) {
+        double scale;
+        if (!curl(c, f, f->vel[v], &scale))
+            return false;
+        if (scale == 0.0)
+            continue;
+        project(n, r, c->B, c->W, c->M, c->scratch);
+        double big = 0.0;
+        for (size_t i = 0; i < nn; i++)
+            big = fmax(big, fabs(c->M[i]));
+        if (big / scale > worst->ratio)
+            *worst = (Worst){big / scale, rows[f->vel[v]], p};
+    }
+    return true;
+}
+
+/* The verdict in words, from the worst ratio over the points. */
+static void involutive_note(const Model *m, const Worst *worst, Involutivity *out)
+{
+    StrBuf sb;
+    sb_init(&sb);
+    out->tested = out->points > 0;
+    if (!out->tested) {
+        sb_puts(&sb, "not tested: no configuration could be evaluated");
+    } else if (worst->ratio > INVOLUTIVE_RTOL) {
+        out->involutive = false;
+        sb_printf(&sb, "nonholonomic: d omega of row %s does not vanish on the allowed "
+                  "velocities (%.3g of its size) at %s configuration", m->rows[worst->row].name,
+                  worst->ratio, worst->point == 0 ? "the assembled" : "a sampled");
+    } else {
+        out->involutive = true;
+        sb_printf(&sb, "holonomic: the allowed velocities form an involutive distribution at "
+                  "%d configuration%s (numerical evidence)", out->points, out->points == 1 ? "" : "s");
+    }
+    out->note = sb_take(&sb);
+}
+
+bool involutivity_analyse(Model *m, const int *rows, int nrows, const double *points,
+                          const double *times, int npoints, Involutivity *out, Diag *diag)
+{
+    memset(out, 0, sizeof *out);
+    Forms f = {0};
+    collect_forms(m, rows, nrows, &f);
+    bool ok = dag_check_limit(&m->dag, diag);   /* the node limit, once for the symbolic part */
+    if (ok && f.nvel == 0) {
         out->note = strdup("no velocity-level rows");
-        goto done;
-    }
-    {
-        int nroots = coef->n + part->n;
-        NodeId *roots = xmalloc(((size_t)nroots + 1) * sizeof *roots);
-        for (int e = 0; e < coef->n; e++)
-            roots[e] = coef->e[e].node;
-        for (int e = 0; e < part->n; e++)
-            roots[coef->n + e] = part->e[e].node;
-        NodeValues ev;          /* value e: coef->e[e], value coef->n + e: part->e[e] */
-        node_values_init(&ev, dag, roots, nroots);
-        free(roots);
-        size_t nn = (size_t)n * (size_t)n;
-        double *C = xmalloc((size_t)nrows * (size_t)n * sizeof *C);
-        double *B = xmalloc((size_t)n * (size_t)n * sizeof *B);
-        double *W = xmalloc(nn * sizeof *W), *M = xmalloc(nn * sizeof *M);
-        double *scratch = xmalloc(2 * nn * sizeof *scratch);
-        MechrtSvd *w = svd_work_new(nrows, n);
-        double worst = 0.0;
-        int worst_row = -1, worst_point = -1;
-        for (int p = 0; p < npoints; p++) {
-            node_values_run(&ev, points + (size_t)p * (size_t)nq, NULL, times[p]);
-            memset(C, 0, (size_t)nrows * (size_t)n * sizeof *C);
-            for (int e = 0; e < coef->n; e++)
-                C[(size_t)coef->e[e].k * (size_t)n + (size_t)coef->e[e].j] =
-                    node_values_get(&ev, e);
-            MechrtSvdResult sv;
-            if (!mechrt_svd(w, C, nrows, n, n, -1.0, &sv))
-                continue;               /* NaN or Inf here: skip the point */
-            int r = sv.rank;
-            for (int j = 0; j < n; j++)
-                for (int c = 0; c < r; c++)
-                    B[j * r + c] = mechrt_svd_row_basis(w, j, c);
-            bool finite = true;
-            for (int v = 0; v < nvel && finite; v++) {
-                memset(W, 0, nn * sizeof *W);
-                double scale = 0.0;
-                for (int e = 0; e < part->n; e++) {
-                    if (part->e[e].k != vel[v])
-                        continue;
-                    double x = node_values_get(&ev, coef->n + e);   /* d_l a_j */
-                    int j = part->e[e].j, l = part->e[e].l;
-                    W[l * n + j] += x;
-                    W[j * n + l] -= x;
-                    finite = finite && isfinite(x);
-                }
-                for (size_t i = 0; i < nn; i++)
-                    scale = fmax(scale, fabs(W[i]));
-                if (!finite || scale == 0.0)
-                    continue;
-                project(n, r, B, W, M, scratch);
-                double big = 0.0;
-                for (size_t i = 0; i < nn; i++)
-                    big = fmax(big, fabs(M[i]));
-                if (big / scale > worst) {
-                    worst = big / scale;
-                    worst_row = rows[vel[v]];
-                    worst_point = p;
-                }
-            }
-            if (finite)
+    } else if (ok) {
+        Curvature c;
+        curvature_init(&c, &m->dag, &f, nrows, m->nq + 1);
+        Worst worst = {0.0, -1, -1};
+        for (int p = 0; p < npoints; p++)
+            if (worst_curvature(&c, &f, rows, points + (size_t)p * (size_t)m->nq, times[p], p, &worst))
                 out->points++;
-        }
-        mechrt_svd_free(w);
-        node_values_free(&ev);
-        free(C), free(B), free(W), free(M), free(scratch);
-        StrBuf sb;
-        sb_init(&sb);
-        out->tested = out->points > 0;
-        if (!out->tested) {
-            sb_puts(&sb, "not tested: no configuration could be evaluated");
-        } else if (worst > INVOLUTIVE_RTOL) {
-            out->involutive = false;
-            sb_printf(&sb, "nonholonomic: d omega of row %s does not vanish on the allowed "
-                      "velocities (%.3g of its size) at %s configuration",
-                      m->rows[worst_row].name, worst, worst_point == 0 ? "the assembled" : "a sampled");
-        } else {
-            out->involutive = true;
-            sb_printf(&sb, "holonomic: the allowed velocities form an involutive distribution at "
-                      "%d configuration%s (numerical evidence)", out->points,
-                      out->points == 1 ? "" : "s");
-        }
-        out->note = sb_take(&sb);
+        curvature_free(&c);
+        involutive_note(m, &worst, out);
     }
-done:
-    dd->escape = saved;
-    free(coef->e), free(coef), free(part->e), free(part);
-    support_free(scan), free(scan);
-    differ_free(df), free(df);
-    free(buf), free(vel);
+    forms_free(&f);
     return ok;
 }

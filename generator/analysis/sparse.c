@@ -13,7 +13,7 @@
  * span of the rows before it: it is redundant, which is the definition of
  * the dense path, decided by distance instead of by singular values.
  */
-#include "analysis.h"
+#include "sparse.h"
 
 #include "../base/rng.h"
 
@@ -125,8 +125,8 @@ int sparse_rank_add(SparseRank *s, const int *cols, const double *vals, int n)
 
 /* sigma_max of the sparse rows by power iteration on J^T J (a lower bound,
    within a few per cent after 50 steps for the matrices met here). */
-double sparse_sigma_max(const Kinematics *kin, const double *vals, const int *rows, int nrows,
-                        unsigned seed)
+double sparse_rank_sigma_max(const Kinematics *kin, const double *vals, const int *rows,
+                             int nrows, unsigned seed)
 {
     int nq = kin->model->nq;
     double *x = xmalloc((size_t)nq * sizeof *x), *y = xcalloc((size_t)nq, sizeof *y);

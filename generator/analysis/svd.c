@@ -9,7 +9,7 @@
  * tolerance held fixed the deficiency def(k) = k - rank(first k rows) steps
  * up by 0 or 1 per row, and the rows where it steps are found by bisection.
  */
-#include "analysis.h"
+#include "svd.h"
 
 #include "../base/arena.h"
 

@@ -61,6 +61,11 @@ void diag_fail(Diag *diag, SrcPos pos, const char *fmt, ...)
     va_start(ap, fmt);
     record(diag, &pos, fmt, ap);
     va_end(ap);
+    diag_throw(diag);
+}
+
+void diag_throw(Diag *diag)
+{
     longjmp(*diag->escape, 1);
 }
 

@@ -36,6 +36,9 @@ void diag_init(Diag *diag, const char *file, const char *text, int text_len);
 _Noreturn void diag_fail(Diag *diag, SrcPos pos, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* Longjmps to diag->escape with the error already recorded (diag_error). */
+_Noreturn void diag_throw(Diag *diag);
+
 /* Records an error without longjmp (first error wins). */
 void diag_error(Diag *diag, SrcPos pos, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

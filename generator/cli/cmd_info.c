@@ -1,7 +1,7 @@
 /* cmd_info.c - mechc info: coordinates, rows, mobility, rank, redundant rows, singularity, integrability. */
 #include "cli.h"
 
-#include "../analysis/analysis.h"
+#include "../analysis/info.h"
 #include "../base/arena.h"
 
 #include <math.h>
@@ -182,7 +182,7 @@ static void print_json(const InfoReport *rep)
            !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
     printf(",\n \"system_note\": ");
     json_string(stdout, rep->system.note ? rep->system.note : "");
-    printf(",\n \"singularity\": \"%s\"", singularity_names[rep->singularity]);
+    printf(",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
     printf(",\n \"singular\": ");
     json_string(stdout, rep->singular);
     printf(",\n \"verdict\": ");
@@ -231,9 +231,8 @@ static void print_structure(const InfoReport *rep)
         const Joint *jt = &m->joints[j];
         bool vel;
         int table = info_textbook_rows(jt->kind, &vel);
-        printf("  %-*s  %-10s  %d / %d%s%s\n", jw, jt->name, joint_info[jt->kind].keyword,
-               jt->nrows, table, vel || jt->velocity ? "  velocity level" : "",
-               jt->nrows == table ? "" : "  MISMATCH");
+        printf("  %-*s  %-10s  %d / %d%s\n", jw, jt->name, joint_info[jt->kind].keyword,
+               jt->nrows, table, vel || jt->velocity ? "  velocity level" : "");
     }
 
     int drivers = rep->nh_drivers + rep->nv_drivers;

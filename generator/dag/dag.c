@@ -10,11 +10,10 @@
 #include "dag.h"
 
 #include "../base/arena.h"
+#include "../base/realfmt.h"
 #include "../base/strbuf.h"
-#include "../../runtime/host/mechrt_host.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -72,7 +71,8 @@ static void table_grow(Dag *dag)
     }
 }
 
-/* The one place nodes are created: look (op, a, b, value) up, else append. */
+/* The one place nodes are created: look (op, a, b, value) up, else append
+   (past the limit: DAG_ZERO and the sticky overflow flag). */
 static NodeId intern(Dag *dag, DagOp op, int32_t a, int32_t b, double value)
 {
     if ((uint32_t)dag->count * 2 >= dag->table_cap)
@@ -84,18 +84,10 @@ static NodeId intern(Dag *dag, DagOp op, int32_t a, int32_t b, double value)
             return dag->table[h];
     }
     if (dag->count >= dag->max_nodes) {
-        if (dag->where >= 0)
-            diag_error(dag->diag, (SrcPos){dag->where},
-                       "the expression graph passed its limit of %d nodes at this statement "
-                       "(its rows or their derivatives are too large; see --max-nodes)",
-                       (int)dag->max_nodes);
-        else
-            diag_error_nopos(dag->diag,
-                             "the expression graph passed its limit of %d nodes "
-                             "(the mechanism is too large; see --max-nodes)", (int)dag->max_nodes);
-        if (dag->diag->escape)
-            longjmp(*dag->diag->escape, 1);
-        abort();
+        if (!dag->overflow)
+            dag->overflow_where = dag->where;
+        dag->overflow = true;
+        return DAG_ZERO;        /* harmless: every rule folds it away */
     }
     if (dag->count == dag->cap) {
         dag->cap = dag->cap ? dag->cap * 2 : 1024;
@@ -118,14 +110,29 @@ NodeId dag_find(const Dag *dag, DagOp op, NodeId a, NodeId b)
     return DAG_NONE;
 }
 
-void dag_init(Dag *dag, int32_t max_nodes, Diag *diag)
+void dag_init(Dag *dag, int32_t max_nodes)
 {
     memset(dag, 0, sizeof *dag);
     dag->max_nodes = max_nodes > 2 ? max_nodes : 2;
-    dag->diag = diag;
     dag->where = -1;
+    dag->overflow_where = -1;
     NodeId zero = dag_const(dag, 0.0), one = dag_const(dag, 1.0);
     (void)zero, (void)one;      /* DAG_ZERO and DAG_ONE by construction */
+}
+
+bool dag_check_limit(const Dag *dag, Diag *diag)
+{
+    if (!dag->overflow)
+        return true;
+    if (dag->overflow_where >= 0)
+        diag_error(diag, (SrcPos){dag->overflow_where},
+                   "the expression graph passed its limit of %d nodes at this statement "
+                   "(its rows or their derivatives are too large; see --max-nodes)",
+                   (int)dag->max_nodes);
+    else
+        diag_error_nopos(diag, "the expression graph passed its limit of %d nodes "
+                         "(the mechanism is too large; see --max-nodes)", (int)dag->max_nodes);
+    return false;
 }
 
 void dag_free(Dag *dag)
@@ -518,7 +525,7 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
     switch (op) {
     case OP_CONST: {
         char buf[40];
-        mechrt_format_real(buf, sizeof buf, n->value, 0);   /* reads back exactly */
+        realfmt_shortest(buf, sizeof buf, n->value);     /* reads back exactly */
         sb_printf(out, n->value < 0 ? "(%s)" : "%s", buf);
         return;
     }
@@ -578,4 +585,12 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
 void dag_format(const Dag *dag, NodeId id, const char *const *coord_names, StrBuf *out)
 {
     format_node(dag, id, coord_names, out, 0);
+}
+
+char *dag_format_string(const Dag *dag, NodeId id, const char *const *coord_names)
+{
+    StrBuf sb;
+    sb_init(&sb);
+    format_node(dag, id, coord_names, &sb, 0);
+    return sb_take(&sb);
 }

@@ -26,14 +26,24 @@ typedef struct Dag {
     int32_t count, cap;
     int32_t *table;         /* open addressing: node id or -1 */
     uint32_t table_cap;     /* power of two */
-    int32_t max_nodes;      /* limit; passing it fails through diag */
-    Diag *diag;             /* receives the node-limit error (longjmp) */
-    int32_t where;          /* offset of the statement being built, for that
-                               error; -1: none */
+    int32_t max_nodes;      /* limit on count */
+    int32_t where;          /* offset of the statement being built, for the
+                               limit's error; -1: none */
+    /* Sticky, like ferror: set when a node past max_nodes is asked for.
+       From then on every new node comes back as DAG_ZERO (existing ones are
+       still found), which every rule folds away: a phase goes on to its end
+       on harmless nodes (long loops test the flag to stop early) and checks
+       once with dag_check_limit. No dag_* call ever jumps out. */
+    bool overflow;
+    int32_t overflow_where; /* where at the first overflow */
 } Dag;
 
-void dag_init(Dag *dag, int32_t max_nodes, Diag *diag);
+void dag_init(Dag *dag, int32_t max_nodes);
 void dag_free(Dag *dag);
+
+/* True when no node was refused. Otherwise records the node-limit error in
+   diag (at the statement that was being built, if any) and returns false. */
+bool dag_check_limit(const Dag *dag, Diag *diag);
 
 static inline const DagNode *dag_node(const Dag *dag, NodeId id) { return &dag->nodes[id]; }
 static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes[id].op; }
@@ -83,5 +93,8 @@ int dag_mark_reachable(const Dag *dag, const NodeId *roots, int nroots,
    integrability law); coord_names may be NULL (prints q[i]). */
 struct StrBuf;
 void dag_format(const Dag *dag, NodeId id, const char *const *coord_names, struct StrBuf *out);
+/* The same as a malloc'd string (numbers print as the shortest text that
+   reads back: 0.3, not 0.29999999999999999). */
+char *dag_format_string(const Dag *dag, NodeId id, const char *const *coord_names);
 
 #endif

@@ -11,63 +11,78 @@
 #include "kinematics.h"
 
 #include "../base/strbuf.h"
+#include "../dag/support.h"
 #include "diff.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-void support_init(SupportScan *scan)
+/* Scratch of one pass over the rows. */
+typedef struct Work {
+    Differ df;
+    SupportScan scan;
+    int *cols, *inner;      /* nq each */
+    JacEntry *jac;          /* grows; copied into the arena at the end */
+    int cap;
+} Work;
+
+static void push_entry(Work *w, Kinematics *kin, JacEntry entry)
 {
-    memset(scan, 0, sizeof *scan);
+    if (kin->nnz == w->cap) {
+        w->cap *= 2;
+        w->jac = xrealloc(w->jac, (size_t)w->cap, sizeof *w->jac);
+    }
+    w->jac[kin->nnz++] = entry;
 }
 
-void support_free(SupportScan *scan)
+static void not_affine(const Model *m, const Row *row, int col, NodeId coef, Diag *diag)
 {
-    free(scan->mark);
-    free(scan->stack);
-    memset(scan, 0, sizeof *scan);
+    StrBuf sb;
+    sb_init(&sb);
+    dag_format(&m->dag, coef, m->coord_names, &sb);
+    diag_error(diag, row->pos,
+               "velocity row '%s' is not affine in der(): its coefficient of "
+               "der(%s) is %s, which still contains der()",
+               row->name, m->coord_names[col], sb.data);
+    sb_free(&sb);
 }
 
-int support_collect(SupportScan *scan, const Dag *dag, NodeId e, DagOp leaf, int *out)
+/* Row r's nu, gamma and Jacobian entries (and Phi for a position row).
+   False with diag filled when a velocity row constrains no velocity or is
+   not affine in der(). Past the node limit it stops early and returns
+   true: the caller reports the limit. */
+static bool build_row(Model *m, Kinematics *kin, Work *w, int r, Diag *diag)
 {
-    /* The graph grows while derivatives are built: keep the marks in step. */
-    if (scan->cap < dag->count) {
-        int cap = dag->count * 2;
-        scan->mark = xrealloc(scan->mark, (size_t)cap, sizeof *scan->mark);
-        scan->stack = xrealloc(scan->stack, (size_t)cap, sizeof *scan->stack);
-        memset(scan->mark + scan->cap, 0, (size_t)(cap - scan->cap) * sizeof *scan->mark);
-        scan->cap = cap;
+    Dag *dag = &m->dag;
+    const Row *row = &m->rows[r];
+    int ncols = support_collect(&w->scan, dag, row->expr, row->velocity ? OP_VARD : OP_VAR, w->cols);
+    if (!row->velocity) {
+        kin->phi[r] = row->expr;
+        kin->nu[r] = dag_neg(dag, diff_by_t(&w->df, row->expr));
+        kin->gamma[r] = dag_neg(dag, diff_total(&w->df, diff_total(&w->df, row->expr)));
+    } else if (ncols == 0) {
+        diag_error(diag, row->pos,
+                   "velocity row '%s' has no der() term left once simplified: it "
+                   "constrains no velocity (write a position row as a 'constraint')", row->name);
+        return false;
+    } else {
+        kin->nu[r] = dag_neg(dag, diff_without_velocities(&w->df, row->expr));
+        kin->gamma[r] = dag_neg(dag, diff_total(&w->df, row->expr));
     }
-    if (++scan->stamp == 0) {           /* wrapped: clear and restart */
-        memset(scan->mark, 0, (size_t)scan->cap * sizeof *scan->mark);
-        scan->stamp = 1;
-    }
-    int top = 0, n = 0;
-    scan->mark[e] = scan->stamp;
-    scan->stack[top++] = e;
-    while (top > 0) {
-        const DagNode *node = dag_node(dag, scan->stack[--top]);
-        if (node->op == leaf) {
-            out[n++] = node->a;
+    for (int k = 0; k < ncols; k++) {
+        NodeId v = row->velocity ? diff_by_qd(&w->df, row->expr, w->cols[k])
+                                 : diff_by_q(&w->df, row->expr, w->cols[k]);
+        if (dag->overflow)
+            return true;
+        if (dag_is_zero(dag, v))
             continue;
+        if (row->velocity && support_collect(&w->scan, dag, v, OP_VARD, w->inner) > 0) {
+            not_affine(m, row, w->cols[k], v, diag);
+            return false;
         }
-        int arity = dag_op_info[node->op].arity;
-        NodeId kids[2] = {node->a, node->b};
-        for (int k = 0; k < arity; k++) {
-            if (scan->mark[kids[k]] != scan->stamp) {
-                scan->mark[kids[k]] = scan->stamp;
-                scan->stack[top++] = kids[k];
-            }
-        }
+        push_entry(w, kin, (JacEntry){.row = r, .col = w->cols[k], .value = v});
     }
-    /* ascending order (insertion sort: a row touches few coordinates) */
-    for (int i = 1; i < n; i++)
-        for (int k = i; k > 0 && out[k - 1] > out[k]; k--) {
-            int t = out[k];
-            out[k] = out[k - 1];
-            out[k - 1] = t;
-        }
-    return n;
+    return true;
 }
 
 bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
@@ -80,80 +95,29 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     kin->gamma = arena_alloc_array(&m->arena, (size_t)m->nr, sizeof *kin->gamma);
     kin->row_start = arena_alloc_array(&m->arena, (size_t)m->nr + 1, sizeof *kin->row_start);
 
-    jmp_buf escape, *saved = diag->escape;
-    diag->escape = &escape;         /* the graph's node limit lands here */
-    Differ df;
-    differ_init(&df, dag, m->nq);
-    SupportScan scan;
-    support_init(&scan);
-    int *cols = xmalloc((size_t)m->nq * sizeof *cols);
-    int *inner = xmalloc((size_t)m->nq * sizeof *inner);
-    int cap = 16;
-    /* volatile: reallocated between setjmp and a possible longjmp, after
-       which a register copy would be stale (C11 7.13.2.1) */
-    JacEntry *volatile jac = xmalloc((size_t)cap * sizeof *jac);
+    Work w = {.cap = 16};
+    differ_init(&w.df, dag, m->nq);
+    support_init(&w.scan);
+    w.cols = xmalloc((size_t)m->nq * sizeof *w.cols);
+    w.inner = xmalloc((size_t)m->nq * sizeof *w.inner);
+    w.jac = xmalloc((size_t)w.cap * sizeof *w.jac);
     bool ok = true;
-    if (setjmp(escape) != 0) {
-        ok = false;
-        goto done;
-    }
-    for (int r = 0; r < m->nr; r++) {
-        const Row *row = &m->rows[r];
-        dag->where = row->pos.offset;       /* a node-limit error names the row */
+    for (int r = 0; r < m->nr && ok && !dag->overflow; r++) {
+        dag->where = m->rows[r].pos.offset;     /* a node-limit error names the row */
         kin->row_start[r] = kin->nnz;
-        int ncols;
-        if (!row->velocity) {
-            kin->phi[r] = row->expr;
-            ncols = support_collect(&scan, dag, row->expr, OP_VAR, cols);
-            kin->nu[r] = dag_neg(dag, diff_by_t(&df, row->expr));
-            kin->gamma[r] = dag_neg(dag, diff_total(&df, diff_total(&df, row->expr)));
-        } else {
-            ncols = support_collect(&scan, dag, row->expr, OP_VARD, cols);
-            if (ncols == 0) {
-                diag_error(diag, row->pos,
-                           "velocity row '%s' has no der() term left once simplified: it "
-                           "constrains no velocity (write a position row as a 'constraint')",
-                           row->name);
-                ok = false;
-                goto done;
-            }
-            kin->nu[r] = dag_neg(dag, diff_without_velocities(&df, row->expr));
-            kin->gamma[r] = dag_neg(dag, diff_total(&df, row->expr));
-        }
-        for (int k = 0; k < ncols; k++) {
-            NodeId v = row->velocity ? diff_by_qd(&df, row->expr, cols[k])
-                                     : diff_by_q(&df, row->expr, cols[k]);
-            if (dag_is_zero(dag, v))
-                continue;
-            if (row->velocity && support_collect(&scan, dag, v, OP_VARD, inner) > 0) {
-                StrBuf sb;
-                sb_init(&sb);
-                dag_format(dag, v, m->coord_names, &sb);
-                diag_error(diag, row->pos,
-                           "velocity row '%s' is not affine in der(): its coefficient of "
-                           "der(%s) is %s, which still contains der()",
-                           row->name, m->coord_names[cols[k]], sb.data);
-                sb_free(&sb);
-                ok = false;
-                goto done;
-            }
-            if (kin->nnz == cap) {
-                cap *= 2;
-                jac = xrealloc(jac, (size_t)cap, sizeof *jac);
-            }
-            jac[kin->nnz++] = (JacEntry){.row = r, .col = cols[k], .value = v};
-        }
+        ok = build_row(m, kin, &w, r, diag);
     }
-    kin->row_start[m->nr] = kin->nnz;
-    kin->jac = arena_alloc_array(&m->arena, (size_t)kin->nnz + 1, sizeof *kin->jac);
-    memcpy(kin->jac, jac, (size_t)kin->nnz * sizeof *jac);
-done:
+    ok = ok && dag_check_limit(dag, diag);
     dag->where = -1;
-    diag->escape = saved;
-    free(jac);
-    free(cols);
-    free(inner);
-    support_free(&scan);
-    differ_free(&df);
+    if (ok) {
+        kin->row_start[m->nr] = kin->nnz;
+        kin->jac = arena_alloc_array(&m->arena, (size_t)kin->nnz + 1, sizeof *kin->jac);
+        memcpy(kin->jac, w.jac, (size_t)kin->nnz * sizeof *w.jac);
+    }
+    free(w.jac);
+    free(w.cols);
+    free(w.inner);
+    support_free(&w.scan);
+    differ_free(&w.df);
     return ok;
 }

@@ -26,18 +26,4 @@ typedef struct Kinematics {
    arena; the derivative nodes in its graph. */
 bool kinematics_build(Model *model, Kinematics *kin, Diag *diag);
 
-/* Finds which coordinates an expression depends on; reusable across calls. */
-typedef struct SupportScan {
-    uint32_t *mark;     /* per node: stamp of the last scan that reached it */
-    NodeId *stack;
-    int cap;
-    uint32_t stamp;
-} SupportScan;
-
-void support_init(SupportScan *scan);
-void support_free(SupportScan *scan);
-/* Indices of the leaves of kind leaf (OP_VAR: coordinates, OP_VARD:
-   velocities) that e depends on, ascending, into out (room for nq). */
-int support_collect(SupportScan *scan, const Dag *dag, NodeId e, DagOp leaf, int *out);
-
 #endif

@@ -32,6 +32,7 @@ typedef struct Builder {
     Diag *diag;
     const MechLimits *limits;
     StrMap names;
+    Arena scratch;      /* entities and rows until they are copied out */
     Entity *entities;
     int nentities, cap_entities;
     int cap_coords, cap_joints;
@@ -51,15 +52,30 @@ static const char *entity_word(EntityKind kind)
     return "a name";
 }
 
-static void grow(void **p, int *cap, int need, size_t size)
+/* Arrays grow in an arena (the model's, or the builder's scratch), so an
+   input error's escape leaves nothing to free; the old copies stay until
+   the arena goes, at most as much again. */
+static void grow(Arena *arena, void **p, int *cap, int need, size_t size)
 {
     if (need <= *cap)
         return;
     int c = *cap ? *cap * 2 : 16;
     while (c < need)
         c *= 2;
-    *p = xrealloc(*p, (size_t)c, size);
+    void *bigger = arena_alloc_array(arena, (size_t)c, size);
+    if (*cap)
+        memcpy(bigger, *p, (size_t)*cap * size);
+    *p = bigger;
     *cap = c;
+}
+
+/* The graph's node limit is sticky (dag.h): checked after each piece of
+   lowering, before anything else in the statement can fail, so the error
+   is the node limit at that statement, as when the graph jumped out. */
+static void check_nodes(Builder *b)
+{
+    if (!dag_check_limit(&b->model->dag, b->diag))
+        diag_throw(b->diag);
 }
 
 static int line_of(const Builder *b, SrcPos pos)
@@ -84,7 +100,8 @@ static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos
         diag_fail(b->diag, pos, "duplicate name '%s' (first declared as %s on line %d)",
                   name, entity_word(b->entities[index].kind),
                   line_of(b, b->entities[index].pos));
-    grow((void **)&b->entities, &b->cap_entities, b->nentities + 1, sizeof *b->entities);
+    grow(&b->scratch, (void **)&b->entities, &b->cap_entities, b->nentities + 1,
+         sizeof *b->entities);
     Entity *e = &b->entities[b->nentities];
     *e = (Entity){.kind = kind, .name = name, .pos = pos, .q = -1};
     strmap_put(&b->names, name, b->nentities++);
@@ -107,9 +124,9 @@ static int add_coord(Builder *b, const char *owner, const char *suffix, double q
     if (m->nq >= b->limits->max_coords)
         diag_fail(b->diag, pos, "too many coordinates (the limit is %d)", b->limits->max_coords);
     check_jacobian_size(b, b->npos + b->nvel, m->nq + 1, pos);
-    grow((void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
-    /* q0 shares the capacity of coord_names */
-    m->q0 = xrealloc(m->q0, (size_t)b->cap_coords, sizeof *m->q0);
+    int cap = b->cap_coords;    /* q0 shares the capacity of coord_names */
+    grow(&m->arena, (void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
+    grow(&m->arena, (void **)&m->q0, &cap, m->nq + 1, sizeof *m->q0);
     char *name = arena_alloc(&m->arena, strlen(owner) + strlen(suffix) + 1);
     strcpy(name, owner);
     strcat(name, suffix);
@@ -167,6 +184,7 @@ static int coordinate_of(Builder *b, const Ast *ast)
 static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
 {
     Dag *dag = &b->model->dag;
+    check_nodes(b);         /* before this operand's names are looked up */
     switch (ast->kind) {
     case AST_NUM:
         return dag_const(dag, ast->num);
@@ -210,11 +228,19 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
     diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
 }
 
+/* A whole expression, the node limit checked once it is built. */
+static NodeId lower(Builder *b, const Ast *ast, ExprContext ctx)
+{
+    NodeId id = lower_expr(b, ast, ctx);
+    check_nodes(b);
+    return id;
+}
+
 static double constant_value(Builder *b, const Ast *ast, const char *what)
 {
     if (!ast)
         return 0.0;
-    NodeId id = lower_expr(b, ast, EXPR_CONSTANT);
+    NodeId id = lower(b, ast, EXPR_CONSTANT);
     double v;
     if (!dag_is_const(&b->model->dag, id, &v) || !isfinite(v))
         diag_fail(b->diag, ast->pos, "%s is not a finite number", what);
@@ -312,10 +338,10 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     Row row = {.name = name, .kind = j->kind, .velocity = j->velocity, .expr = expr,
                .joint = (int)(j - m->joints), .pos = j->pos};
     if (j->velocity) {
-        grow((void **)&b->vel_rows, &b->cap_vel, b->nvel + 1, sizeof *b->vel_rows);
+        grow(&b->scratch, (void **)&b->vel_rows, &b->cap_vel, b->nvel + 1, sizeof *b->vel_rows);
         b->vel_rows[b->nvel++] = row;
     } else {
-        grow((void **)&b->pos_rows, &b->cap_pos, b->npos + 1, sizeof *b->pos_rows);
+        grow(&b->scratch, (void **)&b->pos_rows, &b->cap_pos, b->npos + 1, sizeof *b->pos_rows);
         b->pos_rows[b->npos++] = row;
     }
 }
@@ -325,7 +351,7 @@ static void build_joint(Builder *b, const Stmt *s)
     Model *m = b->model;
     const JointInfo *info = &joint_info[s->joint];
     declare(b, ENT_JOINT, s->name, s->name_pos);
-    grow((void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
+    grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
     Joint *j = &m->joints[m->njoints];
     *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
                  .option = DAG_ZERO, .expr = DAG_NONE};
@@ -350,7 +376,7 @@ static void build_joint(Builder *b, const Stmt *s)
             diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }
     if (s->option) {
-        j->option = lower_expr(b, s->option, EXPR_TIMED);
+        j->option = lower(b, s->option, EXPR_TIMED);
     }
     switch (info->level) {
     case LEVEL_POSITION: j->velocity = false; break;
@@ -362,11 +388,12 @@ static void build_joint(Builder *b, const Stmt *s)
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
         ExprContext ctx = j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC;
-        j->expr = dag_sub(&m->dag, lower_expr(b, s->lhs, ctx), lower_expr(b, s->rhs, ctx));
+        j->expr = dag_sub(&m->dag, lower(b, s->lhs, ctx), lower(b, s->rhs, ctx));
     }
     m->njoints++;
     NodeId rows[3];
     joints_lower(m, j, rows);
+    check_nodes(b);
     j->nrows = info->rows;
     for (int i = 0; i < info->rows; i++)
         push_row(b, j, i, rows[i]);
@@ -444,12 +471,28 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     }
 }
 
+/* The builder's one escape (style R3): input errors longjmp here. The
+   Builder belongs to the caller, so nothing local to this frame changes
+   between setjmp and longjmp. */
+static bool build_protected(Builder *b, const Program *prog, const char *default_name)
+{
+    jmp_buf escape, *saved = b->diag->escape;
+    b->diag->escape = &escape;
+    bool ok = false;
+    if (setjmp(escape) == 0) {
+        build(b, prog, default_name);
+        ok = true;
+    }
+    b->diag->escape = saved;
+    return ok;
+}
+
 Model *model_load(const char *text, int text_len, const char *file,
                   const char *default_name, const MechLimits *limits, Diag *diag)
 {
     Model *m = xcalloc(1, sizeof *m);
     arena_init(&m->arena);
-    dag_init(&m->dag, limits->max_nodes, diag);
+    dag_init(&m->dag, limits->max_nodes);
     m->file = arena_strdup(&m->arena, file);
     diag->file = file;
     diag->text = text;
@@ -461,41 +504,10 @@ Model *model_load(const char *text, int text_len, const char *file,
     }
     Builder b = {.model = m, .diag = diag, .limits = limits};
     strmap_init(&b.names);
-    jmp_buf escape;
-    jmp_buf *saved = diag->escape;
-    diag->escape = &escape;
-    bool ok = false;
-    if (setjmp(escape) == 0) {
-        build(&b, &prog, arena_strdup(&m->arena, default_name));
-        ok = true;
-    }
-    diag->escape = saved;
-    /* coord_names and q0 move into the arena so the model has one owner */
-    if (ok) {
-        const char **names = arena_alloc_array(&m->arena, (size_t)m->nq, sizeof *names);
-        double *q0 = arena_alloc_array(&m->arena, (size_t)m->nq, sizeof *q0);
-        memcpy(names, m->coord_names, (size_t)m->nq * sizeof *names);
-        memcpy(q0, m->q0, (size_t)m->nq * sizeof *q0);
-        Joint *joints = arena_alloc_array(&m->arena, (size_t)m->njoints, sizeof *joints);
-        memcpy(joints, m->joints, (size_t)m->njoints * sizeof *joints);
-        free(m->coord_names);
-        free(m->q0);
-        free(m->joints);
-        m->coord_names = names;
-        m->q0 = q0;
-        m->joints = joints;
-    } else {
-        free(m->coord_names);
-        free(m->q0);
-        free(m->joints);
-        m->coord_names = NULL;
-        m->q0 = NULL;
-        m->joints = NULL;
-    }
-    free(b.entities);
-    free(b.pos_rows);
-    free(b.vel_rows);
+    arena_init(&b.scratch);
+    bool ok = build_protected(&b, &prog, arena_strdup(&m->arena, default_name));
     strmap_free(&b.names);
+    arena_free(&b.scratch);
     if (!ok) {
         model_free(m);
         return NULL;

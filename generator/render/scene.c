@@ -29,7 +29,7 @@
 #include "scene.h"
 
 #include "../base/arena.h"
-#include "../diff/kinematics.h"
+#include "../dag/support.h"
 #include "../eval/interp.h"
 #include "hull.h"
 #include "svg_common.h"

@@ -1,4 +1,4 @@
-/* mobility.c - the `info` report: counts, assembly, ranks, redundant rows, singularity, integrability.
+/* info.c - the `info` report: counts, assembly, ranks, redundant rows, singularity, integrability.
  *
  * Mobility by the count (Gruebler-Kutzbach in coordinate form) is
  * nq - nh - nv; the truth is nq - rank(Phi_q), the rank taken by SVD at the
@@ -15,12 +15,12 @@
  * (minimum-norm Newton lands on nearby generic configurations) and their
  * rank there, the generic rank, is compared with the rank here.
  */
-#include "analysis.h"
-
-#include "../base/rng.h"
+#include "info.h"
 
 #include "../base/arena.h"
+#include "../base/rng.h"
 #include "../base/strbuf.h"
+#include "sparse.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -29,7 +29,7 @@
 /* A condition number above this is reported as near-singular. */
 static const double NEAR_SINGULAR_COND = 1e8;
 
-const char *const singularity_names[] = {"none", "position", "drivers", "permanent", "unknown"};
+const char *const info_singularity_names[] = {"none", "position", "drivers", "permanent", "unknown"};
 
 /* What each kind removes is its joints.def row count (revolute 2, prismatic
    2, weld 3, the others 1: the textbook table, which test_info checks), so
@@ -82,7 +82,7 @@ static int generic_rank(MechEval *me, const int *rows, int nrows, const double *
     for (int s = 0; s < opt->generic_samples; s++) {
         perturb(q, nq, &state, qs);
         AssembleResult ar;
-        if (!analysis_assemble(me, rows, nrows, t, qs, opt, w, &ar))
+        if (!assemble_min_norm(me, rows, nrows, t, qs, opt, w, &ar))
             continue;
         mech_eval(me, qs, t, NULL, jac);
         pick_rows(jac, nq, rows, nrows, sub);
@@ -118,10 +118,10 @@ static bool system_test(Model *m, MechEval *me, InfoReport *rep, const int *undr
         perturb(rep->q, nq, &state, qs);
         double ts = rep->t + 0.5 * rng_symmetric(&state);
         AssembleResult ar;
-        if (analysis_assemble(me, undriven, nuh, ts, qs, opt, w, &ar))
+        if (assemble_min_norm(me, undriven, nuh, ts, qs, opt, w, &ar))
             times[np++] = ts;
     }
-    bool ok = analysis_involutivity(m, undriven, nu, points, times, np, &rep->system, diag);
+    bool ok = involutivity_analyse(m, undriven, nu, points, times, np, &rep->system, diag);
     free(points), free(times);
     return ok;
 }
@@ -236,7 +236,7 @@ static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, c
     for (int r = 0; r < nr; r++)
         all[r] = r;
     mech_eval_nz(me, rep->q, rep->t, NULL, vals);
-    double smax = sparse_sigma_max(kin, vals, all, nr, opt->seed);
+    double smax = sparse_rank_sigma_max(kin, vals, all, nr, opt->seed);
     double tol = opt->rank_tol >= 0 ? opt->rank_tol : mechrt_svd_default_tol(nr, nq, smax);
     rep->sigma_max = smax;
     rep->sigma_min = rep->cond = NAN;
@@ -375,9 +375,9 @@ static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
-        rep->assembled = analysis_assemble(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
+        rep->assembled = assemble_min_norm(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
-        rep->assembled = analysis_assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
+        rep->assembled = assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
     }
     if (w) {
         mech_eval(me, rep->q, t, NULL, jac);
@@ -435,7 +435,7 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
        then of the rows without drivers together */
     bool ok = true;
     for (int r = nh; r < nr && ok; r++)
-        ok = analysis_integrability(m, r, rep->q, opt, &rep->rows[r].integ, diag);
+        ok = integrability_analyse(m, r, rep->q, opt, &rep->rows[r].integ, diag);
     if (ok)
         ok = system_test(m, &me, rep, undriven, nu, nuh, opt, w, diag);
 

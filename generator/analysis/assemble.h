@@ -1,0 +1,36 @@
+/* assemble.h - minimum-norm Newton assembly on any set of holonomic rows, dense or sparse. */
+#ifndef MECHC_ASSEMBLE_H
+#define MECHC_ASSEMBLE_H
+
+#include "mech_eval.h"
+#include "options.h"
+#include "svd.h"
+
+#include <stdbool.h>
+
+typedef struct AssembleResult {
+    bool converged;
+    int iterations;
+    double residual;        /* ||Phi_rows||_inf at the returned q */
+    double step;            /* ||dq||_inf of the last step, -1 if none */
+    int worst_row;          /* model row with the largest |Phi|, -1 if none */
+    int rank;               /* rank of the rows' Jacobian at the last step, -1 if none */
+} AssembleResult;
+
+/* Minimum-norm Newton on the holonomic rows listed in rows[] (model row
+   indices < nh), at time t, from q (updated in place):
+   dq = -pinv(Phi_q) Phi, with step halving when the residual grows. Works
+   for fewer rows than coordinates (the step nearest to q) and for
+   redundant rows (singular values at or below the rank tolerance are
+   dropped). w must hold nrows x nq. */
+bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, double *q,
+                       const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res);
+
+/* The same beyond the dense limit, on the first nrows holonomic rows, with
+   the sparse QR of Phi_q^T (sparse.c): dq = Phi_q^T y, Phi_q Phi_q^T y = -Phi
+   by the seminormal equations; rows that depend on earlier ones are left
+   out of the step. */
+bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
+                     const AnalysisOptions *opt, AssembleResult *res);
+
+#endif
