@@ -69,6 +69,23 @@ static int line_of(const Builder *b, SrcPos pos)
     return line;
 }
 
+/* Units textbook data is written in, as constants: 30*deg, 1500*rpm.
+   They are not reserved: a file that declares one of these names (a param
+   deg from before they existed) uses its own. */
+static bool unit_value(const char *name, double *value)
+{
+    static const struct { const char *name; double value; } units[] = {
+        {"deg", 3.14159265358979323846 / 180},   /* degree, in radians */
+        {"rpm", 3.14159265358979323846 / 30},    /* revolution per minute, in rad/s */
+    };
+    for (size_t i = 0; i < sizeof units / sizeof *units; i++)
+        if (strcmp(name, units[i].name) == 0) {
+            *value = units[i].value;
+            return true;
+        }
+    return false;
+}
+
 static Entity *lookup(Builder *b, const char *name, SrcPos pos)
 {
     int index;
@@ -175,6 +192,10 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
             diag_fail(b->diag, ast->pos, "'t' cannot appear in %s", context_what(ctx));
         return dag_time(dag);
     case AST_NAME: {
+        double unit;
+        int declared;
+        if (!strmap_get(&b->names, ast->name, &declared) && unit_value(ast->name, &unit))
+            return dag_const(dag, unit);
         Entity *e = lookup(b, ast->name, ast->pos);
         if (e->kind == ENT_PARAM)
             return dag_const(dag, e->value);
