@@ -17,13 +17,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT } EntityKind;
+typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT, ENT_OUTPUT } EntityKind;
 
 typedef struct Entity {
     EntityKind kind;
     const char *name;
     SrcPos pos;
-    int q;              /* first coordinate (body, point, coord) */
+    int q;              /* first coordinate (body, point, coord); joint: its index */
     double value;       /* param */
 } Entity;
 
@@ -37,6 +37,8 @@ typedef struct Builder {
     int cap_coords, cap_joints;
     Row *pos_rows, *vel_rows;
     int npos, nvel, cap_pos, cap_vel;
+    ModelOutput *outputs;
+    int cap_outputs;
 } Builder;
 
 static const char *entity_word(EntityKind kind)
@@ -47,6 +49,7 @@ static const char *entity_word(EntityKind kind)
     case ENT_POINT: return "a point";
     case ENT_COORD: return "a coord";
     case ENT_JOINT: return "a joint";
+    case ENT_OUTPUT: return "an output";
     }
     return "a name";
 }
@@ -227,6 +230,17 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
         NodeId y = ast->rhs ? lower_expr(b, ast->rhs, ctx) : DAG_NONE;
         return dag_apply(dag, ast->op, x, y);
     }
+    case AST_SLIDE: {
+        if (ctx <= EXPR_TIMED)
+            diag_fail(b->diag, ast->pos, "slide() depends on coordinates: it cannot appear in %s",
+                      context_what(ctx));
+        Entity *e = lookup(b, ast->name, ast->member_pos);
+        const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+        if (!j || (j->kind != JOINT_PRISMATIC && j->kind != JOINT_POINTLINE))
+            diag_fail(b->diag, ast->member_pos, "slide() takes a prismatic or pointline joint; "
+                      "'%s' is %s", e->name, j ? joint_info[j->kind].keyword : entity_word(e->kind));
+        return joints_slide(b->model, j);
+    }
     }
     diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
 }
@@ -308,7 +322,7 @@ static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
                       e->name, e->name);
         r.q = e->q;
         return r;
-    case ENT_PARAM: case ENT_COORD: case ENT_JOINT:
+    case ENT_PARAM: case ENT_COORD: case ENT_JOINT: case ENT_OUTPUT:
         break;
     }
     static const char *const takes[] = {
@@ -345,7 +359,7 @@ static void build_joint(Builder *b, const Stmt *s)
 {
     Model *m = b->model;
     const JointInfo *info = &joint_info[s->joint];
-    declare(b, ENT_JOINT, s->name, s->name_pos);
+    declare(b, ENT_JOINT, s->name, s->name_pos)->q = m->njoints;
     grow((void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
     Joint *j = &m->joints[m->njoints];
     *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
@@ -393,6 +407,32 @@ static void build_joint(Builder *b, const Stmt *s)
         push_row(b, j, i, rows[i]);
 }
 
+static void push_output(Builder *b, const char *name, const char *suffix, NodeId expr)
+{
+    Model *m = b->model;
+    grow((void **)&b->outputs, &b->cap_outputs, m->nout + 1, sizeof *b->outputs);
+    char *full = arena_alloc(&m->arena, strlen(name) + strlen(suffix) + 1);
+    strcpy(full, name);
+    strcat(full, suffix);
+    b->outputs[m->nout++] = (ModelOutput){.name = full, .expr = expr};
+}
+
+/* output NAME = e: one value; output NAME: attachment: the point's NAME.x,
+   NAME.y, P = r + A(phi) s as in a joint. Outputs add no rows. */
+static void build_output(Builder *b, const Stmt *s)
+{
+    declare(b, ENT_OUTPUT, s->name, s->name_pos);
+    if (s->value) {
+        push_output(b, s->name, "", lower_expr(b, s->value, EXPR_HOLONOMIC));
+        return;
+    }
+    Attach at = resolve_attach(b, &s->attach[0], ATTACH_ANY, "output");
+    NodeId xy[2];
+    joints_point(b->model, at, xy);
+    push_output(b, s->name, ".x", xy[0]);
+    push_output(b, s->name, ".y", xy[1]);
+}
+
 static void build(Builder *b, const Program *prog, const char *default_name)
 {
     Model *m = b->model;
@@ -415,6 +455,9 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             break;
         case STMT_JOINT:
             build_joint(b, s);
+            break;
+        case STMT_OUTPUT:
+            build_output(b, s);
             break;
         }
     }
@@ -486,6 +529,9 @@ Model *model_load(const char *text, int text_len, const char *file,
         m->coord_names = names;
         m->q0 = q0;
         m->joints = joints;
+        m->outputs = arena_alloc_array(&m->arena, (size_t)m->nout, sizeof *m->outputs);
+        if (m->nout)
+            memcpy(m->outputs, b.outputs, (size_t)m->nout * sizeof *m->outputs);
     } else {
         free(m->coord_names);
         free(m->q0);
@@ -497,6 +543,7 @@ Model *model_load(const char *text, int text_len, const char *file,
     free(b.entities);
     free(b.pos_rows);
     free(b.vel_rows);
+    free(b.outputs);
     strmap_free(&b.names);
     if (!ok) {
         model_free(m);
