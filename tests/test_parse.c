@@ -106,6 +106,9 @@ static void render(const Ast *a, char *buf, size_t size)
         }
         put(buf, size, ")");
         return;
+    case AST_SLIDE:
+        put(buf, size, "(slide %s)", a->name);
+        return;
     case AST_DER:
         put(buf, size, "(der ");
         render(a->lhs, buf, size);

@@ -18,6 +18,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "../generator/analysis/outputs.h"
 #include "../generator/analysis/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/pipeline/pipeline.h"
@@ -560,7 +561,7 @@ static void test_assembly_and_nan(void **state)
     run_with(mech, ENGINE_JIT, o, &c);
     assert_int_equal(c.status, RUN_FAILED);
     assert_int_equal(c.res.states, 0);
-    assert_non_null(strstr(c.res.message, "t = 0.125: assembly"));
+    assert_non_null(strstr(c.res.message, "t = 0.125: could not assemble"));
     collected_free(&c);
     pipeline_free(mech);
 
@@ -577,6 +578,215 @@ static void test_assembly_and_nan(void **state)
     assert_int_equal(c.res.cause, MECHRT_ENOTFINITE);
     assert_non_null(strstr(c.res.message, "t = 0.5:"));
     assert_non_null(strstr(c.res.message, "nu of row d"));
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* ---- assembly from rough guesses, one instant, outputs, units ---------- */
+
+/* A four-bar a, b, c, d (crank, coupler, rocker, ground) with the crank
+   held at th2, every initial value left at its default 0 unless
+   positions_given (then the link centres are given, every angle 0). */
+static Mech *four_bar_text(double a, double b, double c, double d, double th2,
+                           bool positions_given)
+{
+    char text[1024];
+    double ax = a * cos(th2), ay = a * sin(th2);
+    snprintf(text, sizeof text,
+             "param a = %.17g\nparam b = %.17g\nparam c = %.17g\nparam d = %.17g\n"
+             "body crank %s\nbody coupler %s\nbody rocker %s\n"
+             "revolute O2: ground(0, 0) crank(-a/2, 0)\n"
+             "revolute A: crank(a/2, 0) coupler(-b/2, 0)\n"
+             "revolute B: coupler(b/2, 0) rocker(c/2, 0)\n"
+             "revolute O4: ground(d, 0) rocker(-c/2, 0)\n"
+             "driver drive: crank.phi = %.17g\n", a, b, c, d,
+             positions_given ? "x = 0.5 y = 0" : "", positions_given ? "x = 1.5 y = 1" : "",
+             positions_given ? "x = 3 y = 1" : "", th2);
+    (void)ax, (void)ay;
+    return load_text(text, "four_bar_guess.mech");
+}
+
+/* Every four-bar configuration that exists assembles from all-zero guesses
+   (angles only, or everything), on a sweep of geometries and crank
+   angles, and satisfies Freudenstein's equation; one that does not exist
+   fails with "could not assemble", never "toggle". */
+static void test_assembly_from_zero_guesses(void **state)
+{
+    (void)state;
+    static const double shapes[][4] = {
+        {1, 3, 2.5, 3},     /* the example's crank-rocker */
+        {1, 2, 2, 2},       /* a parallelogram-like Grashof linkage */
+        {2, 3, 3.5, 4},     /* non-Grashof triple rocker */
+        {1.5, 1, 2, 2.5},   /* coupler shortest */
+    };
+    RunOptions o = run_default_options();
+    o.steps = 0;
+    int assembled = 0, refused = 0, worst_iterations = 0;
+    for (size_t g = 0; g < sizeof shapes / sizeof *shapes; g++) {
+        double a = shapes[g][0], b = shapes[g][1], c = shapes[g][2], d = shapes[g][3];
+        for (int k = 0; k < 12; k++) {
+            double th2 = 2 * M_PI * k / 12 + 0.1;
+            double e = hypot(d - a * cos(th2), a * sin(th2));   /* A to O4 */
+            bool exists = fabs(b - c) < e - 1e-3 && e < b + c - 1e-3;
+            bool near_limit = fabs(e - fabs(b - c)) < 1e-3 || fabs(e - (b + c)) < 1e-3;
+            if (near_limit)
+                continue;
+            for (int given = 0; given < 2; given++) {
+                Mech *mech = four_bar_text(a, b, c, d, th2, given);
+                Collected col;
+                run_with(mech, ENGINE_JIT, o, &col);
+                if (!exists) {
+                    assert_int_equal(col.status, RUN_FAILED);
+                    assert_non_null(strstr(col.res.message, "could not assemble"));
+                    assert_null(strstr(col.res.message, "toggle"));
+                    refused++;
+                } else {
+                    if (col.status != RUN_OK)
+                        fail_msg("shape %zu, th2 = %g, positions %d: %s", g, th2, given,
+                                 col.res.message);
+                    assert_int_equal(col.res.states, 1);
+                    const Model *m = mech->model;
+                    const double *st = state_at(&col, 0);
+                    double t2 = st[1 + coord_index(m, "crank.phi")];
+                    double t4 = st[1 + coord_index(m, "rocker.phi")];
+                    double K1 = d / a, K2 = d / c, K3 = (a * a - b * b + c * c + d * d) / (2 * a * c);
+                    assert_near(K1 * cos(t4) - K2 * cos(t2) + K3, cos(t2 - t4), 0, 1e-9);
+                    if (col.res.assembly_iterations > worst_iterations)
+                        worst_iterations = col.res.assembly_iterations;
+                    assembled++;
+                }
+                collected_free(&col);
+                pipeline_free(mech);
+            }
+        }
+    }
+    assert_true(assembled >= 60);
+    assert_true(refused >= 4);
+    assert_true(worst_iterations <= 60);
+}
+
+/* The slider-crank and every example that runs assemble with every angle
+   guess 0, to the same configuration family (slider-crank: the closed form). */
+static void test_assembly_examples_zero_angles(void **state)
+{
+    (void)state;
+    Mech *mech = load_text("param r = 0.1\nparam l = 0.3\n"
+                           "body crank\nbody rod\nbody slider\n"
+                           "revolute O: ground(0, 0) crank(-r/2, 0)\n"
+                           "revolute A: crank(r/2, 0) rod(-l/2, 0)\n"
+                           "revolute B: rod(l/2, 0) slider(0, 0)\n"
+                           "prismatic P: ground(0, 0) slider(0, 0) axis(1, 0)\n"
+                           "driver D: crank.phi = 30*deg + 1500*rpm*t\n", "sc0.mech");
+    RunOptions o = run_default_options();
+    o.steps = 0;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, 0);
+    const Model *m = mech->model;
+    const double *st = state_at(&c, 0);
+    int nq = m->nq, ix = coord_index(m, "slider.x");
+    double r = 0.1, l = 0.3, th = M_PI / 6, w = 1500 * 2 * M_PI / 60;
+    double sn = sin(th), cs = cos(th), D = sqrt(l * l - r * r * sn * sn);
+    /* the slider may assemble on either side of the crank pin: x = r c +- D */
+    double x = st[1 + ix];
+    double sign = x > r * cs ? 1 : -1;
+    assert_near(x, r * cs + sign * D, 1e-12, 1e-12);
+    assert_near(st[1 + nq + ix], -r * w * sn - sign * r * r * w * sn * cs / D, 1e-9, 1e-9);
+    assert_true(c.res.assembly_iterations <= 10);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* steps = 0: one state at t0, t1 ignored; a negative count is refused. */
+static void test_one_instant(void **state)
+{
+    (void)state;
+    Mech *mech = load_file("examples/four_bar.mech");
+    RunOptions o = run_default_options();
+    o.steps = 0;
+    o.t0 = 0.25;
+    o.t1 = 0.25;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, 0);
+    assert_near(state_at(&c, 0)[0], 0.25, 0, 0);
+    assert_near(state_at(&c, 0)[1 + coord_index(mech->model, "rocker.phi")], 1.725386, 0, 1e-6);
+    assert_int_equal(c.res.steps_done, 0);
+    collected_free(&c);
+    o.steps = -1;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_non_null(strstr(c.res.message, "at least 0"));
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* Output statements: a body point, a slide() and a plain value, with their
+   velocities and accelerations, against the slider-crank's closed form. */
+static void test_outputs_slider_crank(void **state)
+{
+    (void)state;
+    Mech *mech = load_text("param r = 0.1\nparam l = 0.3\nparam omega = 2*pi\n"
+                           "body crank x = r/2\nbody rod x = r + l/2\nbody slider x = r + l\n"
+                           "revolute O: ground(0, 0) crank(-r/2, 0)\n"
+                           "revolute A: crank(r/2, 0) rod(-l/2, 0)\n"
+                           "revolute B: rod(l/2, 0) slider(0, 0)\n"
+                           "prismatic P: ground(0.05, 0) slider(0, 0) axis(2, 0)\n"
+                           "driver D: crank.phi = omega*t\n"
+                           "output pin: rod(l/2, 0)\n"
+                           "output s = slide(P)\n"
+                           "output rod_deg = rod.phi/deg\n", "outputs.mech");
+    const Model *m = mech->model;
+    assert_int_equal(m->nout, 4);
+    assert_string_equal(m->outputs[0].name, "pin.x");
+    assert_string_equal(m->outputs[1].name, "pin.y");
+    assert_string_equal(m->outputs[2].name, "s");
+    assert_string_equal(m->outputs[3].name, "rod_deg");
+    RunOptions o = run_default_options();
+    o.steps = 16;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    expect_ok(&c, 16);
+    OutputEval oe;
+    outputs_init(&oe, m);
+    const double r = 0.1, l = 0.3, w = 2 * M_PI;
+    int nq = m->nq;
+    for (int i = 0; i <= 16; i++) {
+        const double *st = state_at(&c, (size_t)i);
+        double y[4], yd[4], ydd[4];
+        outputs_eval(&oe, st + 1, st + 1 + nq, st + 1 + 2 * nq, st[0], y, yd, ydd);
+        double th = w * st[0], sn = sin(th), cs = cos(th), D = sqrt(l * l - r * r * sn * sn);
+        double x = r * cs + D, xd = -r * w * sn - r * r * w * sn * cs / D;
+        double xdd = -r * w * w * cs - r * r * w * w * (cs * cs - sn * sn) / D
+                     - r * r * r * r * w * w * sn * sn * cs * cs / (D * D * D);
+        assert_near(y[0], x, 1e-9, 1e-9);
+        assert_near(yd[0], xd, 1e-8, 1e-8);
+        assert_near(ydd[0], xdd, 1e-7, 1e-7);
+        assert_near(y[1], 0, 0, 1e-12);
+        assert_near(y[2], x - 0.05, 1e-9, 1e-9);   /* along the axis, from (0.05, 0) */
+        assert_near(yd[2], xd, 1e-8, 1e-8);
+        assert_near(ydd[2], xdd, 1e-7, 1e-7);
+        assert_near(y[3], -asin(r * sn / l) * 180 / M_PI, 1e-9, 1e-9);
+    }
+    outputs_free(&oe);
+    collected_free(&c);
+    pipeline_free(mech);
+}
+
+/* A mechanism that cannot close: the message says so and names rows. */
+static void test_cannot_assemble(void **state)
+{
+    (void)state;
+    Mech *mech = four_bar_text(1, 1, 1, 5, 0.3, true);   /* b + c < the gap */
+    RunOptions o = run_default_options();
+    o.steps = 4;
+    Collected c;
+    run_with(mech, ENGINE_JIT, o, &c);
+    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.res.states, 0);
+    assert_non_null(strstr(c.res.message, "t = 0: could not assemble from these initial values"));
+    assert_non_null(strstr(c.res.message, "largest residual"));
+    assert_null(strstr(c.res.message, "toggle"));
     collected_free(&c);
     pipeline_free(mech);
 }
@@ -928,6 +1138,11 @@ int main(void)
         cmocka_unit_test(test_toggle),
         cmocka_unit_test(test_out_of_reach),
         cmocka_unit_test(test_assembly_and_nan),
+        cmocka_unit_test(test_assembly_from_zero_guesses),
+        cmocka_unit_test(test_assembly_examples_zero_angles),
+        cmocka_unit_test(test_one_instant),
+        cmocka_unit_test(test_outputs_slider_crank),
+        cmocka_unit_test(test_cannot_assemble),
         cmocka_unit_test(test_row_count),
         cmocka_unit_test(test_condition_episodes),
         cmocka_unit_test(test_engines_agree),

@@ -57,11 +57,19 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
     res->residual = inf;
     res->worst_row = worst;
     bool ok = false;
+    double best = norm;
+    int improved = 0;       /* the iteration that last cut the best norm by 1 % */
     for (int iter = 0; isfinite(norm); iter++) {
         if (inf <= opt->tol_phi && (res->step < 0 || res->step <= opt->tol_dq)) {
             ok = true;
             break;
         }
+        if (norm < 0.99 * best) {
+            best = norm;
+            improved = iter;
+        }
+        if (opt->stall_iter > 0 && iter - improved >= opt->stall_iter)
+            break;
         if (iter >= opt->max_iter || !p->direction(p->ctx, dq, &res->rank))
             break;
         double step = 0.0;
@@ -275,5 +283,78 @@ bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
     bool ok = min_norm_newton(&path, nrows, nq, q, opt, res);
     free(s.cstart), free(s.crow), free(s.cidx), free(s.vals), free(s.cval), free(s.phi),
         free(s.y), free(s.all);
+    return ok;
+}
+
+/* ---- the direction from compiled kernels: SVD of Phi_q's holonomic rows ----
+ *
+ * What `run` and `check` assemble with: the same loop over the engine's
+ * kernels (jit, aot or generic), so no graph interpreter is needed there.
+ * The holonomic rows come first in the kernels' dense Jacobian, so they
+ * are its first nh rows.
+ */
+
+typedef struct KernelRows {
+    const MechrtKernels *k;
+    double t, rank_tol;
+    MechrtSvd *w;
+    double *f, *ftrial;     /* Phi at the iterate and at a trial point (nh) */
+    double *jac;            /* nr x nq at the iterate */
+} KernelRows;
+
+static double kernel_eval(void *ctx, const double *q, bool iterate, double *inf, int *worst)
+{
+    KernelRows *kr = ctx;
+    const MechrtKernels *k = kr->k;
+    double *f = iterate ? kr->f : kr->ftrial;
+    k->phi(k->ctx, q, kr->t, f);
+    if (iterate)
+        k->jac(k->ctx, q, kr->t, kr->jac);
+    double sum = 0.0;
+    *inf = 0.0;
+    *worst = -1;
+    for (int i = 0; i < k->nh; i++) {
+        if (!isfinite(f[i])) {
+            *worst = i;
+            return NAN;
+        }
+        sum += f[i] * f[i];
+        if (fabs(f[i]) > *inf || *worst < 0) {
+            *inf = fabs(f[i]);
+            *worst = i;
+        }
+    }
+    return sqrt(sum);
+}
+
+static bool kernel_direction(void *ctx, double *dq, int *rank)
+{
+    KernelRows *kr = ctx;
+    int nq = kr->k->nq;
+    MechrtSvdResult sv;
+    if (!mechrt_svd(kr->w, kr->jac, kr->k->nh, nq, nq, kr->rank_tol, &sv))
+        return false;
+    *rank = sv.rank;
+    mechrt_svd_pinv_solve(kr->w, kr->f, dq);
+    for (int j = 0; j < nq; j++)
+        dq[j] = -dq[j];
+    return true;
+}
+
+bool assemble_kernels(const MechrtKernels *k, double t, double *q,
+                      const AnalysisOptions *opt, AssembleResult *res)
+{
+    size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
+    KernelRows kr = {
+        .k = k, .t = t, .rank_tol = opt->rank_tol,
+        .w = k->nh > 0 ? mechrt_svd_new(k->nh, k->nq) : NULL,
+        .f = xcalloc((size_t)k->nh + 1, sizeof *kr.f),
+        .ftrial = xcalloc((size_t)k->nh + 1, sizeof *kr.ftrial),
+        .jac = xcalloc(nr * nq + 1, sizeof *kr.jac),
+    };
+    NewtonPath path = {kernel_eval, kernel_direction, &kr};
+    bool ok = (k->nh == 0 || kr.w) && min_norm_newton(&path, k->nh, k->nq, q, opt, res);
+    mechrt_svd_free(kr.w);
+    free(kr.f), free(kr.ftrial), free(kr.jac);
     return ok;
 }

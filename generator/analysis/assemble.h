@@ -33,4 +33,9 @@ bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, doubl
 bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
                      const AnalysisOptions *opt, AssembleResult *res);
 
+/* The same on the holonomic rows of compiled (or generic) kernels, dense:
+   what run and check assemble with. res->worst_row is a kernel row. */
+bool assemble_kernels(const MechrtKernels *k, double t, double *q,
+                      const AnalysisOptions *opt, AssembleResult *res);
+
 #endif

@@ -10,6 +10,11 @@ typedef struct AnalysisOptions {
     /* Newton iterations allowed; a singular root converges only linearly,
        so this is generous. default 60 */
     int max_iter;
+    /* Give up early when the residual's 2-norm has not fallen by 1 % in
+       this many iterations (a stationary point that is no solution, e.g.
+       a guess symmetric about a line the mechanism cannot lie on); 0:
+       never. default 0 */
+    int stall_iter;
     /* Absolute tolerance on singular values: sigma > rank_tol counts toward
        the rank. Negative: the default max(m, n) * eps * sigma_max (the rule
        of LAPACK's and Matlab's rank). default -1 */

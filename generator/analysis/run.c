@@ -39,6 +39,8 @@
 #include "run.h"
 
 #include "../base/arena.h"
+#include "../base/rng.h"
+#include "assemble.h"
 #include "../pipeline/pipeline.h"
 
 #include <math.h>
@@ -65,6 +67,13 @@
 /* Two subdivision levels agree when their positions at the end of the
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
+/* Robust assembly (assemble_robustly): a minimum-norm Newton attempt that
+   has not cut the residual by 1 % in RUN_ASSEMBLY_STALL iterations is
+   restarted from a jittered guess, at most RUN_ASSEMBLY_RESTARTS times,
+   with jitter from a fixed seed so that runs repeat exactly. */
+#define RUN_ASSEMBLY_STALL 8
+#define RUN_ASSEMBLY_RESTARTS 6
+#define RUN_ASSEMBLY_SEED 20261125u
 
 RunOptions run_default_options(void)
 {
@@ -76,6 +85,7 @@ RunOptions run_default_options(void)
     o.mechrt = mechrt_default_options();
     o.ode = mechrt_ode_default_options();
     o.move_note = 1e-3;
+    o.assembly_max_iter = 100;
     o.notes = NULL;
     return o;
 }
@@ -275,6 +285,90 @@ static void fail(Run *r, MechrtStatus st, double t, const double *q, const Mechr
         if (rows > 0)
             describe_dependency(r, q, t, rows, st == MECHRT_ESING);
     }
+}
+
+/* Minimum-norm Newton with step halving over the holonomic rows, from the
+ * initial values in r->q (assemble_kernels, what `info` uses):
+ * unlike Newton with LU it starts from any guess, including one where the
+ * Jacobian is singular because two links are merely parallel (all angles
+ * 0). False, with the message filled, when even it finds no configuration
+ * near the initial values: the rows it could not satisfy are named. */
+static bool assemble_robustly(Run *r)
+{
+    const RunOptions *o = r->o;
+    AnalysisOptions ao = analysis_default_options();
+    ao.tol_phi = o->mechrt.tol_phi;
+    ao.tol_dq = o->mechrt.tol_dq;
+    ao.max_iter = o->assembly_max_iter;
+    ao.stall_iter = RUN_ASSEMBLY_STALL;
+    size_t nq = (size_t)r->nq;
+    double *q0 = xmalloc(nq * sizeof *q0), *best = xmalloc(nq * sizeof *best);
+    memcpy(q0, r->q, nq * sizeof *q0);
+    /* the scale of a restart's jitter: the guess's largest residual or value */
+    double scale = 1e-3;
+    {
+        double *phi = xcalloc((size_t)r->k->nh + 1, sizeof *phi);
+        r->k->phi(r->k->ctx, q0, o->t0, phi);
+        for (int i = 0; i < r->k->nh; i++)
+            if (isfinite(phi[i]))
+                scale = fmax(scale, fabs(phi[i]));
+        for (size_t j = 0; j < nq; j++)
+            scale = fmax(scale, fabs(q0[j]));
+        free(phi);
+    }
+    uint64_t seed = RUN_ASSEMBLY_SEED;
+    AssembleResult ar, best_ar = {0};
+    bool ok = false;
+    r->res->assembled_robustly = true;
+    for (int attempt = 0; attempt <= RUN_ASSEMBLY_RESTARTS && !ok; attempt++) {
+        /* a stall is a stationary point that is no solution, most often a
+           guess symmetric about a line (every link on the x axis): restart
+           from the guess jittered by 5 %, 10 %, 20 % ... of the scale */
+        double jitter = attempt == 0 ? 0 : 0.05 * scale * (double)(1 << (attempt - 1));
+        for (size_t j = 0; j < nq; j++)
+            r->q[j] = q0[j] + jitter * rng_symmetric(&seed);
+        ok = assemble_kernels(r->k, o->t0, r->q, &ao, &ar);
+        r->res->assembly_iterations += ar.iterations;
+        if (ok || attempt == 0 || !(ar.residual >= best_ar.residual)) {
+            best_ar = ar;
+            memcpy(best, r->q, nq * sizeof *best);
+        }
+    }
+    memcpy(r->q, best, nq * sizeof *best);
+    ar = best_ar;
+    free(q0), free(best);
+    if (ok)
+        return true;
+    RunResult *res = r->res;
+    res->status = RUN_FAILED;
+    res->cause = MECHRT_EMAXITER;
+    res->t_fail = o->t0;
+    res->message[0] = '\0';
+    msgf(r, "t = %.10g: could not assemble from these initial values: ", o->t0);
+    size_t nh = (size_t)r->k->nh;
+    double *phi = xcalloc(nh + 1, sizeof *phi);
+    const char **names = xcalloc(nh + 1, sizeof *names);
+    r->k->phi(r->k->ctx, r->q, o->t0, phi);
+    bool finite = true;
+    for (size_t i = 0; i < nh; i++) {
+        finite = finite && isfinite(phi[i]);
+        phi[i] = fabs(phi[i]);
+        names[i] = r->m->rows[i].name;
+    }
+    if (!finite) {
+        msgf(r, "minimum-norm Newton reached NaN or infinity after %d %s", ar.iterations,
+             plural(ar.iterations, "iteration", "iterations"));
+    } else {
+        msgf(r, "after %d %s of minimum-norm Newton the largest residual is %.3g in row %s; "
+             "rows left unsatisfied: ", ar.iterations,
+             plural(ar.iterations, "iteration", "iterations"), ar.residual,
+             ar.worst_row >= 0 ? names[ar.worst_row] : "?");
+        name_list(r, names, phi, (int)nh);
+    }
+    msgf(r, " (the mechanism may not close with these lengths, or the guess is nearer "
+         "a configuration that does not exist; try other initial values)");
+    free(phi), free(names);
+    return false;
 }
 
 /* A note when assembly moved the initial values much. */
@@ -538,6 +632,18 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     MechrtStatus st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work,
                                   r->lwork, &rep);
     r->res->assembly_iterations = rep.iterations;
+    if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
+        /* a guess Newton cannot start from: assemble robustly, then
+           Newton again for the velocities and accelerations there */
+        memcpy(r->q, q0, nq * sizeof *q0);
+        if (!assemble_robustly(r)) {
+            status = RUN_FAILED;
+            goto out;
+        }
+        st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work, r->lwork,
+                         &rep);
+        r->res->assembly_iterations += rep.iterations;
+    }
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
         status = RUN_FAILED;
@@ -589,6 +695,15 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
     r->res->assembly_iterations = rep.iterations;
+    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
+        memcpy(r->q, q0, (size_t)r->nq * sizeof *q0);
+        if (!assemble_robustly(r)) {
+            status = RUN_FAILED;
+            goto out;
+        }
+        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
+        r->res->assembly_iterations += rep.iterations;
+    }
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, &rep, "assembly (minimum-norm Newton)");
         status = RUN_FAILED;
@@ -604,7 +719,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     }
     put_state(r, o->t0, &rep, state, ctx);
 
-    double t = o->t0, hstep = (o->t1 - o->t0) / o->steps;
+    double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i), c0 = pipeline_now();
         long it0 = mechrt_host_stats(host)->project_iterations;
@@ -677,11 +792,13 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
-    if (!(isfinite(o->t0) && isfinite(o->t1)) || o->t0 == o->t1)
+    if (o->steps < 0)
+        return bad_input(res, "the number of steps must be at least 0, not %d", o->steps);
+    /* steps = 0 is the analysis at one instant, t0: t1 plays no part */
+    if (!(isfinite(o->t0) && (o->steps == 0 || isfinite(o->t1)))
+        || (o->steps > 0 && o->t0 == o->t1))
         return bad_input(res, "the time interval must be finite and not empty (t0 = %g, t1 = %g)",
                          o->t0, o->t1);
-    if (o->steps < 1)
-        return bad_input(res, "the number of steps must be at least 1, not %d", o->steps);
     if (o->max_substeps < 1)
         return bad_input(res, "the number of substeps must be at least 1, not %d",
                          o->max_substeps);

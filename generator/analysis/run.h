@@ -21,7 +21,8 @@
 /* What a run does; fill with run_default_options(), then change fields. */
 typedef struct RunOptions {
     double t0, t1;           /* time interval, t1 != t0 (t1 < t0 runs backwards); 0, 1 */
-    int steps;               /* equal intervals, >= 1: steps + 1 states; 100 */
+    int steps;               /* equal intervals, >= 0: steps + 1 states (0: the
+                                analysis at t0 alone, t1 unused); 100 */
     /* Holonomic stepping: an interval whose step looks as if it left its
        assembly branch (see run.c) is redone internally in 2, 4, 8 ...
        predictor-corrector substeps, at most this many, >= 1 (1: never
@@ -33,6 +34,10 @@ typedef struct RunOptions {
     /* a note when assembly moves q by more than move_note * ||q0||_inf
        (dimensionless); default 1e-3 */
     double move_note;
+    /* iterations of the minimum-norm Newton that assembles at t0 when
+       Newton from the initial values fails (a singular Jacobian at the
+       guess, no convergence); default 100 */
+    int assembly_max_iter;
     FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
 } RunOptions;
 
@@ -58,6 +63,8 @@ typedef struct RunResult {
     int warnings;                /* nearly singular episodes warned about */
     double assembly_move;        /* ||q(t0) - q0||_inf */
     int assembly_iterations;     /* Newton (or Gauss-Newton) iterations at t0 */
+    bool assembled_robustly;     /* Newton from the initial values failed and
+                                    minimum-norm Newton assembled instead */
     /* per-step statistics, over the steps after t0 */
     int steps_done;
     long newton_iterations;      /* Newton iterations (velocity rows: projection

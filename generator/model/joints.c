@@ -6,6 +6,8 @@
  */
 #include "model.h"
 
+#include <math.h>
+
 typedef struct Vec {
     NodeId x, y;
 } Vec;
@@ -114,4 +116,23 @@ void joints_lower(Model *model, const Joint *j, NodeId rows[3])
     case JOINT_KIND_COUNT:
         break;
     }
+}
+
+void joints_point(Model *model, Attach at, NodeId xy[2])
+{
+    Vec p = position(&model->dag, at);
+    xy[0] = p.x;
+    xy[1] = p.y;
+}
+
+/* slide(J) = u_A . (P_B - P_A) / |u|, u_A = A(phi_A) u: how far B's point
+   has moved along A's axis, in length units whatever the axis' length. */
+NodeId joints_slide(Model *model, const Joint *j)
+{
+    Dag *d = &model->dag;
+    double len = sqrt(j->ux * j->ux + j->uy * j->uy);
+    Vec u = vec_const(d, j->ux / len, j->uy / len);
+    if (j->a.has_phi)
+        u = rotate(d, angle_of(d, j->a), u);
+    return dot(d, u, vec_sub(d, position(d, j->b), position(d, j->a)));
 }

@@ -17,13 +17,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT } EntityKind;
+typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT, ENT_OUTPUT } EntityKind;
 
 typedef struct Entity {
     EntityKind kind;
     const char *name;
     SrcPos pos;
-    int q;              /* first coordinate (body, point, coord) */
+    int q;              /* first coordinate (body, point, coord); joint: its index */
     double value;       /* param */
 } Entity;
 
@@ -38,6 +38,7 @@ typedef struct Builder {
     int cap_coords, cap_joints;
     Row *pos_rows, *vel_rows;
     int npos, nvel, cap_pos, cap_vel;
+    int cap_outputs;
 } Builder;
 
 static const char *entity_word(EntityKind kind)
@@ -48,6 +49,7 @@ static const char *entity_word(EntityKind kind)
     case ENT_POINT: return "a point";
     case ENT_COORD: return "a coord";
     case ENT_JOINT: return "a joint";
+    case ENT_OUTPUT: return "an output";
     }
     return "a name";
 }
@@ -83,6 +85,23 @@ static int line_of(const Builder *b, SrcPos pos)
     int line, col;
     diag_locate(b->diag, pos.offset, &line, &col);
     return line;
+}
+
+/* Units textbook data is written in, as constants: 30*deg, 1500*rpm.
+   They are not reserved: a file that declares one of these names (a param
+   deg from before they existed) uses its own. */
+static bool unit_value(const char *name, double *value)
+{
+    static const struct { const char *name; double value; } units[] = {
+        {"deg", 3.14159265358979323846 / 180},   /* degree, in radians */
+        {"rpm", 3.14159265358979323846 / 30},    /* revolution per minute, in rad/s */
+    };
+    for (size_t i = 0; i < sizeof units / sizeof *units; i++)
+        if (strcmp(name, units[i].name) == 0) {
+            *value = units[i].value;
+            return true;
+        }
+    return false;
 }
 
 static Entity *lookup(Builder *b, const char *name, SrcPos pos)
@@ -193,6 +212,10 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
             diag_fail(b->diag, ast->pos, "'t' cannot appear in %s", context_what(ctx));
         return dag_time(dag);
     case AST_NAME: {
+        double unit;
+        int declared;
+        if (!strmap_get(&b->names, ast->name, &declared) && unit_value(ast->name, &unit))
+            return dag_const(dag, unit);
         Entity *e = lookup(b, ast->name, ast->pos);
         if (e->kind == ENT_PARAM)
             return dag_const(dag, e->value);
@@ -223,6 +246,17 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
         NodeId x = lower_expr(b, ast->lhs, ctx);
         NodeId y = ast->rhs ? lower_expr(b, ast->rhs, ctx) : DAG_NONE;
         return dag_apply(dag, ast->op, x, y);
+    }
+    case AST_SLIDE: {
+        if (ctx <= EXPR_TIMED)
+            diag_fail(b->diag, ast->pos, "slide() depends on coordinates: it cannot appear in %s",
+                      context_what(ctx));
+        Entity *e = lookup(b, ast->name, ast->member_pos);
+        const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+        if (!j || (j->kind != JOINT_PRISMATIC && j->kind != JOINT_POINTLINE))
+            diag_fail(b->diag, ast->member_pos, "slide() takes a prismatic or pointline joint; "
+                      "'%s' is %s", e->name, j ? joint_info[j->kind].keyword : entity_word(e->kind));
+        return joints_slide(b->model, j);
     }
     }
     diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
@@ -313,7 +347,7 @@ static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
                       e->name, e->name);
         r.q = e->q;
         return r;
-    case ENT_PARAM: case ENT_COORD: case ENT_JOINT:
+    case ENT_PARAM: case ENT_COORD: case ENT_JOINT: case ENT_OUTPUT:
         break;
     }
     static const char *const takes[] = {
@@ -350,7 +384,7 @@ static void build_joint(Builder *b, const Stmt *s)
 {
     Model *m = b->model;
     const JointInfo *info = &joint_info[s->joint];
-    declare(b, ENT_JOINT, s->name, s->name_pos);
+    declare(b, ENT_JOINT, s->name, s->name_pos)->q = m->njoints;
     grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
     Joint *j = &m->joints[m->njoints];
     *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
@@ -417,6 +451,32 @@ static void collect_bodies(Builder *b)
     }
 }
 
+static void push_output(Builder *b, const char *name, const char *suffix, NodeId expr)
+{
+    Model *m = b->model;
+    grow(&m->arena, (void **)&m->outputs, &b->cap_outputs, m->nout + 1, sizeof *m->outputs);
+    char *full = arena_alloc(&m->arena, strlen(name) + strlen(suffix) + 1);
+    strcpy(full, name);
+    strcat(full, suffix);
+    m->outputs[m->nout++] = (ModelOutput){.name = full, .expr = expr};
+}
+
+/* output NAME = e: one value; output NAME: attachment: the point's NAME.x,
+   NAME.y, P = r + A(phi) s as in a joint. Outputs add no rows. */
+static void build_output(Builder *b, const Stmt *s)
+{
+    declare(b, ENT_OUTPUT, s->name, s->name_pos);
+    if (s->value) {
+        push_output(b, s->name, "", lower_expr(b, s->value, EXPR_HOLONOMIC));
+        return;
+    }
+    Attach at = resolve_attach(b, &s->attach[0], ATTACH_ANY, "output");
+    NodeId xy[2];
+    joints_point(b->model, at, xy);
+    push_output(b, s->name, ".x", xy[0]);
+    push_output(b, s->name, ".y", xy[1]);
+}
+
 static void build(Builder *b, const Program *prog, const char *default_name)
 {
     Model *m = b->model;
@@ -439,6 +499,9 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             break;
         case STMT_JOINT:
             build_joint(b, s);
+            break;
+        case STMT_OUTPUT:
+            build_output(b, s);
             break;
         }
     }

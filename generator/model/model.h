@@ -48,6 +48,14 @@ typedef struct Body {
                            particle) has none (as Attach.has_phi) */
 } Body;
 
+/* A value reported beside the coordinates (an `output` statement): an
+   expression of q and t; its velocity and acceleration come from its
+   derivatives along the motion (generator/analysis/outputs.h). */
+typedef struct ModelOutput {
+    const char *name;   /* NAME, or NAME.x and NAME.y for a point */
+    NodeId expr;
+} ModelOutput;
+
 typedef struct Model {
     Arena arena;        /* owns every string and array below */
     Dag dag;            /* owns the expression graph (rows and derivatives) */
@@ -63,6 +71,8 @@ typedef struct Model {
     int nbodies;
     Body *bodies;       /* bodies and points in declaration order (which is
                            also the order of their coordinates) */
+    int nout;
+    ModelOutput *outputs;   /* in statement order */
     SrcPos last_pos;    /* the last statement: where diagnostics about the
                            mechanism as a whole point */
 } Model;
@@ -87,5 +97,10 @@ char *model_file_stem(Arena *arena, const char *path);
 
 /* Lowers one joint's rows into the graph (generator/model/joints.c). */
 void joints_lower(Model *model, const Joint *joint, NodeId rows_out[3]);
+/* The global position P = r + A(phi) s of an attachment: xy_out[0], [1]. */
+void joints_point(Model *model, Attach at, NodeId xy_out[2]);
+/* The sliding of a prismatic or pointline joint: the displacement of B's
+   point from A's along A's axis, u_A . (P_B - P_A) / |u|. */
+NodeId joints_slide(Model *model, const Joint *joint);
 
 #endif

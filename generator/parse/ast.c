@@ -39,6 +39,7 @@ const char *ast_describe(const Ast *ast)
         }
     case AST_CALL:   return "a function call";
     case AST_DER:    return "der()";
+    case AST_SLIDE:  return "slide()";
     }
     return "an expression";
 }

@@ -54,6 +54,7 @@ typedef enum AstKind {
     AST_BINARY,     /* lhs op rhs, op one of OP_ADD OP_SUB OP_MUL OP_DIV OP_POW */
     AST_CALL,       /* op(lhs) or op(lhs, rhs) for a function op (OP_SIN ...) */
     AST_DER,        /* der(lhs): lhs is AST_NAME or AST_MEMBER */
+    AST_SLIDE,      /* slide(name): the sliding of a prismatic or pointline joint */
 } AstKind;
 
 typedef struct Ast {
@@ -77,6 +78,7 @@ typedef enum StmtKind {
     STMT_POINT,         /* point NAME [x = e] [y = e] */
     STMT_COORD,         /* coord NAME [= value] */
     STMT_JOINT,         /* KIND NAME: operands [axis(ux, uy)] [option = e] */
+    STMT_OUTPUT,        /* output NAME = e  |  output NAME: attachment */
 } StmtKind;
 
 typedef struct AstAttach {
@@ -92,12 +94,13 @@ typedef struct Stmt {
     const char *name;       /* declared name (NULL for none) */
     SrcPos name_pos;
 
-    Ast *value;             /* PARAM, COORD (NULL: coord defaults to 0) */
+    Ast *value;             /* PARAM, COORD (NULL: coord defaults to 0), OUTPUT
+                               (NULL: a point, attach[0]) */
     Ast *init[3];           /* BODY x, y, phi; POINT x, y (NULL: 0) */
     SrcPos init_pos[3];
 
     JointKind joint;        /* JOINT */
-    AstAttach attach[2];    /* JOINT: joint_info[joint].attachments used */
+    AstAttach attach[2];    /* JOINT: joint_info[joint].attachments used; OUTPUT: [0] */
     Ast *axis[2];           /* JOINT with axis: ux, uy */
     SrcPos axis_pos;
     Ast *option;            /* JOINT: angle, length or radius (NULL: absent) */

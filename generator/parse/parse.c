@@ -193,6 +193,24 @@ static Ast *coordinate(Parser *p)
     return ast;
 }
 
+
+/* slide = 'slide' '(' NAME ')'   (NAME: a prismatic or pointline joint,
+   resolved by the model; slide is no reserved word, only this form is) */
+static Ast *slide(Parser *p, const Token *word)
+{
+    Ast *ast = new_ast(p, AST_SLIDE, word->pos);
+    advance(p);
+    if (p->tok.kind != TOK_IDENT)
+        expected(p, "a joint name in slide(...)");
+    ast->name = token_text(p, &p->tok);
+    ast->member_pos = p->tok.pos;
+    advance(p);
+    if (p->tok.kind != TOK_RPAREN)
+        expected(p, "')' after the joint name in slide(%s", ast->name);
+    advance(p);
+    return ast;
+}
+
 /* der = 'der' '(' coordinate ')' */
 static Ast *derivative(Parser *p)
 {
@@ -280,6 +298,8 @@ static Ast *primary(Parser *p)
     if (lex_is_word(&tok, "der"))
         return derivative(p);
     advance(p);
+    if (p->tok.kind == TOK_LPAREN && lex_is_word(&tok, "slide"))
+        return slide(p, &tok);
     if (p->tok.kind == TOK_LPAREN)
         diag_fail(p->diag, tok.pos, "'%.*s' is not a function", tok.len, tok.start);
     Ast *ast;
@@ -533,10 +553,35 @@ static void initial_values(Parser *p, Stmt *s, int nkeys)
     }
 }
 
+/* output = 'output' NAME '=' expr                 (a value of q and t)
+          | 'output' NAME ':' NAME [pair]           (a point: body, point or ground) */
+static void output(Parser *p, Stmt *s)
+{
+    s->name = declared_name(p, "output", &s->name_pos);
+    if (p->tok.kind == TOK_EQ) {
+        advance(p);
+        s->value = expr(p);
+        return;
+    }
+    if (p->tok.kind != TOK_COLON)
+        expected(p, "'=' (a value) or ':' (a point) after 'output %s'", s->name);
+    advance(p);
+    AstAttach *at = &s->attach[0];
+    if (p->tok.kind != TOK_IDENT || (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
+        expected(p, "a body, point or ground after 'output %s:'", s->name);
+    at->name = token_text(p, &p->tok);
+    at->pos = p->tok.pos;
+    advance(p);
+    if (p->tok.kind == TOK_LPAREN) {
+        at->has_offset = true;
+        pair(p, "the point's offset", &at->sx, &at->sy);
+    }
+}
+
 /* Appends the statement keywords to buf, for the unknown-statement message. */
 static void list_keywords(char *buf, size_t size)
 {
-    int n = snprintf(buf, size, "mechanism, param, body, point, coord");
+    int n = snprintf(buf, size, "mechanism, param, body, point, coord, output");
     for (int k = 0; k < JOINT_KIND_COUNT && n > 0 && (size_t)n < size; k++)
         n += snprintf(buf + n, size - (size_t)n, "%s %s",
                       k == JOINT_KIND_COUNT - 1 ? " or" : ",", joint_info[k].keyword);
@@ -546,6 +591,7 @@ static void list_keywords(char *buf, size_t size)
              | 'param' NAME '=' expr
              | body | point
              | 'coord' NAME ['=' expr]
+             | output
              | joint */
 static Stmt *statement(Parser *p)
 {
@@ -589,6 +635,10 @@ static Stmt *statement(Parser *p)
             advance(p);
             s->value = expr(p);
         }
+    } else if (lex_is_word(&kw, "output")) {
+        s->kind = STMT_OUTPUT;
+        advance(p);
+        output(p, s);
     } else if (kind >= 0) {
         s->kind = STMT_JOINT;
         s->joint = (JointKind)kind;
