@@ -52,8 +52,8 @@ check "--plot-vars with an unknown name: exit 2" status_is 2
 check "--plot-vars with an unknown name: names it" err_has "nothing"
 run "$ex/slider_crank.mech" --svg "$tmp/a2.svg" --trace 'ghost(0,0)'
 check "--trace of an unknown body: exit 2" status_is 2
-run "$ex/slider_crank.mech" --steps 0
-check "--steps 0: exit 2" status_is 2
+run "$ex/slider_crank.mech" --steps -1
+check "--steps -1: exit 2" status_is 2
 run "$ex/slider_crank.mech" --engine warp
 check "--engine warp: exit 2" status_is 2
 run "$ex/slider_crank.mech" --t0 1 --t1 1
@@ -208,6 +208,52 @@ for f in "$ex"/*.mech; do
     run "$f" --csv /dev/null
     check "example $name: exit $want" status_is "$want"
 done
+
+# ---- one instant, outputs, rough guesses (textbook problems) ---------------
+# The value of CSV column NAME in the first data row of $tmp/out.
+col() {
+    awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i }
+                          NR == 2 { print $c }' "$tmp/out"
+}
+run "$ex/textbook_slider_crank.mech" --steps 0 --csv -
+check "textbook slider-crank --steps 0 --csv: exit 0" status_is 0
+check "textbook slider-crank: one row" out_lines 2
+check "textbook slider-crank: omega_BD = 62.0 rad/s ccw" near "$(col 'd(rod.phi)')" 61.99292234 1e-6
+check "textbook slider-crank: v_P = 523.4 in./s" near "$(col 'd(piston.x)')" 523.4202136 1e-6
+check "textbook slider-crank: alpha_BD = 9940 rad/s^2" near "$(col 'dd(rod.phi)')" 9940.162671 1e-6
+check "textbook slider-crank: a_P = -9290 ft/s^2" near "$(col 'dd(piston.x)')" -111477.5962 1e-3
+check "textbook slider-crank: v_B = 628.3 in./s (output B_pin)" \
+    near "$(awk -v x="$(col 'd(B_pin.x)')" -v y="$(col 'd(B_pin.y)')" 'BEGIN { printf "%.12g\n", sqrt(x * x + y * y) }')" 628.3185307 1e-6
+check "textbook slider-crank: beta = 13.95 deg (output)" near "$(col beta_deg)" 13.94824618 1e-6
+run "$ex/textbook_four_bar.mech" --steps 0
+check "textbook four-bar --steps 0: exit 0" status_is 0
+check "textbook four-bar: a table, not CSV" out_has "coordinate             position           velocity       acceleration"
+check "textbook four-bar: omega_BD = -88/3" out_has "coupler.phi        0.2449786631       -29.33333333       -645.3960784"
+check "textbook four-bar: omega_DE = 192/17, alpha_DE = 809" out_has "11.29411765         809.271511   (135 deg)"
+check "textbook four-bar: v_D = (-192, -192) (output D_pin)" out_has "D_pin.y                      17               -192       -15926.08627"
+check "textbook four-bar: assembled from angle guesses 0" out_has "(assembled from rough initial values in"
+run "$ex/textbook_geneva.mech" --at 0 --json
+check "textbook geneva --at 0 --json: exit 0" status_is 0
+check "textbook geneva: outputs listed" out_has '"outputs": ["slot_r", "pin.x", "pin.y"]'
+check "textbook geneva: r = 37.1 mm, sliding 476.5 mm/s toward C" \
+    out_has '"y": [[37.0981892'
+check "textbook geneva: omega_S = -4.08 rad/s" out_has ', -4.082482904638'
+check "textbook geneva: alpha_S = -233 rad/s^2" out_has ', -233.32118403'
+printf 'param a = 1\nbody crank\nbody coupler\nbody rocker\nrevolute O2: ground(0, 0) crank(-0.5, 0)\nrevolute A: crank(0.5, 0) coupler(-1.5, 0)\nrevolute B: coupler(1.5, 0) rocker(1.25, 0)\nrevolute O4: ground(3, 0) rocker(-1.25, 0)\ndriver d: crank.phi = 30*deg + 60*rpm*t\n' > "$tmp/zero.mech"
+run "$tmp/zero.mech" --steps 8 --csv "$tmp/zero.csv"
+check "four-bar with every guess 0: runs (exit 0)" status_is 0
+check "four-bar with every guess 0: the note says how it assembled" err_has "minimum-norm Newton assembled the mechanism at t = 0"
+printf 'body crank\nbody coupler\nbody rocker\nrevolute O2: ground(0, 0) crank(-0.5, 0)\nrevolute A: crank(0.5, 0) coupler(-1.5, 0)\nrevolute B: coupler(1.5, 0) rocker(1.25, 0)\nrevolute O4: ground(9, 0) rocker(-1.25, 0)\ndriver d: crank.phi = 0\n' > "$tmp/open.mech"
+run "$tmp/open.mech" --steps 0
+check "lengths that cannot close: exit 1" status_is 1
+check "lengths that cannot close: 'could not assemble', no toggle" sh -c "grep -q 'could not assemble from these initial values' '$tmp/err' && ! grep -q toggle '$tmp/err'"
+printf 'body c\nrevolute O: ground c\ndriver d: c.phi = t\noutput tip: c(1, 0)\noutput deg_angle = c.phi/deg\n' > "$tmp/out.mech"
+run "$tmp/out.mech" --steps 2 --t1 0.5
+check "outputs in the CSV header, beside the coordinates" out_has "t,c.x,c.y,c.phi,tip.x,tip.y,deg_angle,d(c.x),d(c.y),d(c.phi),d(tip.x),d(tip.y),d(deg_angle),dd(c.x)"
+run "$tmp/out.mech" --steps 2 --t1 0.5 --plot "$tmp/o.svg" --plot-vars 'tip.y,d(deg_angle)'
+check "--plot-vars takes output names" status_is 0
+run "$tmp/out.mech" --steps 2 --t1 0.5 --svg "$tmp/o2.svg"
+check "--svg: a point output's path is drawn" sh -c "grep -q 'tip' '$tmp/o2.svg'"
 
 # ---- velocity-level rows: integrated positions ----------------------------
 run "$ex/knife_cart.mech" --steps 20

@@ -16,6 +16,7 @@
 #include "assemble.h"
 
 #include "../base/arena.h"
+#include "../base/rng.h"
 #include "sparse.h"
 
 #include <math.h>
@@ -356,5 +357,53 @@ bool assemble_kernels(const MechrtKernels *k, double t, double *q,
     bool ok = (k->nh == 0 || kr.w) && min_norm_newton(&path, k->nh, k->nq, q, opt, res);
     mechrt_svd_free(kr.w);
     free(kr.f), free(kr.ftrial), free(kr.jac);
+    return ok;
+}
+
+/* ---- restarts from jittered guesses ----
+ *
+ * A stall (opt->stall_iter) is a stationary point of ||Phi|| that is no
+ * solution, most often a guess symmetric about a line the mechanism cannot
+ * lie on (every link on the x axis): the Gauss-Newton step keeps the
+ * symmetry. Restarting from the guess jittered by 5 %, 10 %, 20 % ... of
+ * its scale (its largest residual or value) breaks it; the jitter comes
+ * from a fixed seed, so that every run repeats exactly.
+ */
+#define ASSEMBLE_RESTARTS 6
+#define ASSEMBLE_SEED 20261125u
+
+bool assemble_restarting(const MechrtKernels *k, double t, double *q,
+                         const AnalysisOptions *opt, AssembleResult *res)
+{
+    size_t nq = (size_t)k->nq;
+    double *q0 = xmalloc(nq * sizeof *q0), *best = xmalloc(nq * sizeof *best);
+    double *phi = xcalloc((size_t)k->nh + 1, sizeof *phi);
+    memcpy(q0, q, nq * sizeof *q0);
+    double scale = 1e-3;
+    k->phi(k->ctx, q0, t, phi);
+    for (int i = 0; i < k->nh; i++)
+        if (isfinite(phi[i]))
+            scale = fmax(scale, fabs(phi[i]));
+    for (size_t j = 0; j < nq; j++)
+        scale = fmax(scale, fabs(q0[j]));
+    uint64_t seed = ASSEMBLE_SEED;
+    AssembleResult ar, best_ar = {0};
+    int iterations = 0;
+    bool ok = false;
+    for (int attempt = 0; attempt <= ASSEMBLE_RESTARTS && !ok; attempt++) {
+        double jitter = attempt == 0 ? 0 : 0.05 * scale * (double)(1 << (attempt - 1));
+        for (size_t j = 0; j < nq; j++)
+            q[j] = q0[j] + jitter * rng_symmetric(&seed);
+        ok = assemble_kernels(k, t, q, opt, &ar);
+        iterations += ar.iterations;
+        if (ok || attempt == 0 || !(ar.residual >= best_ar.residual)) {
+            best_ar = ar;
+            memcpy(best, q, nq * sizeof *best);
+        }
+    }
+    memcpy(q, best, nq * sizeof *best);
+    *res = best_ar;
+    res->iterations = iterations;
+    free(q0), free(best), free(phi);
     return ok;
 }

@@ -38,4 +38,12 @@ bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
 bool assemble_kernels(const MechrtKernels *k, double t, double *q,
                       const AnalysisOptions *opt, AssembleResult *res);
 
+/* assemble_kernels from q, restarted from jittered guesses (a fixed seed)
+   while it stalls (give opt->stall_iter > 0): what assembles a mechanism
+   from rough initial values, all angles 0 included. res->iterations
+   counts every attempt's; on failure q is the attempt with the smallest
+   residual. */
+bool assemble_restarting(const MechrtKernels *k, double t, double *q,
+                         const AnalysisOptions *opt, AssembleResult *res);
+
 #endif

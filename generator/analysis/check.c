@@ -47,6 +47,7 @@
 #include "check.h"
 
 #include "../../runtime/mechrt.h"
+#include "assemble.h"
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../engine/aot.h"
@@ -631,7 +632,9 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
 /* ---- the run ---- */
 
 /* The base state: Newton from the initial values at t = 0 when the
-   holonomic rows are square, else the initial values. */
+   holonomic rows are square (minimum-norm Newton with restarts from rough
+   ones), else the initial values. */
+#define CHECK_ASSEMBLY_STALL 8
 static bool assemble(Checker *c, double *q)
 {
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
@@ -643,6 +646,16 @@ static bool assemble(Checker *c, double *q)
     size_t lwork = mechrt_workspace_size(c->nq, c->nr);
     double *work = xmalloc(lwork * sizeof *work);
     MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
+    if (st != MECHRT_OK) {
+        /* rough initial values: as run assembles them (run.c) */
+        AnalysisOptions ao = analysis_default_options();
+        ao.stall_iter = CHECK_ASSEMBLY_STALL;
+        AssembleResult ar;
+        memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
+        if (assemble_restarting(&k, 0.0, q, &ao, &ar)
+            && mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL) == MECHRT_OK)
+            st = MECHRT_OK;
+    }
     free(work);
     if (st != MECHRT_OK)
         memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);

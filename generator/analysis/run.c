@@ -39,7 +39,6 @@
 #include "run.h"
 
 #include "../base/arena.h"
-#include "../base/rng.h"
 #include "assemble.h"
 #include "../pipeline/pipeline.h"
 
@@ -68,12 +67,9 @@
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
 /* Robust assembly (assemble_robustly): a minimum-norm Newton attempt that
-   has not cut the residual by 1 % in RUN_ASSEMBLY_STALL iterations is
-   restarted from a jittered guess, at most RUN_ASSEMBLY_RESTARTS times,
-   with jitter from a fixed seed so that runs repeat exactly. */
+   has not cut the residual by 1 % in this many iterations is restarted
+   from a jittered guess (assemble_restarting). */
 #define RUN_ASSEMBLY_STALL 8
-#define RUN_ASSEMBLY_RESTARTS 6
-#define RUN_ASSEMBLY_SEED 20261125u
 
 RunOptions run_default_options(void)
 {
@@ -301,42 +297,10 @@ static bool assemble_robustly(Run *r)
     ao.tol_dq = o->mechrt.tol_dq;
     ao.max_iter = o->assembly_max_iter;
     ao.stall_iter = RUN_ASSEMBLY_STALL;
-    size_t nq = (size_t)r->nq;
-    double *q0 = xmalloc(nq * sizeof *q0), *best = xmalloc(nq * sizeof *best);
-    memcpy(q0, r->q, nq * sizeof *q0);
-    /* the scale of a restart's jitter: the guess's largest residual or value */
-    double scale = 1e-3;
-    {
-        double *phi = xcalloc((size_t)r->k->nh + 1, sizeof *phi);
-        r->k->phi(r->k->ctx, q0, o->t0, phi);
-        for (int i = 0; i < r->k->nh; i++)
-            if (isfinite(phi[i]))
-                scale = fmax(scale, fabs(phi[i]));
-        for (size_t j = 0; j < nq; j++)
-            scale = fmax(scale, fabs(q0[j]));
-        free(phi);
-    }
-    uint64_t seed = RUN_ASSEMBLY_SEED;
-    AssembleResult ar, best_ar = {0};
-    bool ok = false;
+    AssembleResult ar;
+    bool ok = assemble_restarting(r->k, o->t0, r->q, &ao, &ar);
+    r->res->assembly_iterations += ar.iterations;
     r->res->assembled_robustly = true;
-    for (int attempt = 0; attempt <= RUN_ASSEMBLY_RESTARTS && !ok; attempt++) {
-        /* a stall is a stationary point that is no solution, most often a
-           guess symmetric about a line (every link on the x axis): restart
-           from the guess jittered by 5 %, 10 %, 20 % ... of the scale */
-        double jitter = attempt == 0 ? 0 : 0.05 * scale * (double)(1 << (attempt - 1));
-        for (size_t j = 0; j < nq; j++)
-            r->q[j] = q0[j] + jitter * rng_symmetric(&seed);
-        ok = assemble_kernels(r->k, o->t0, r->q, &ao, &ar);
-        r->res->assembly_iterations += ar.iterations;
-        if (ok || attempt == 0 || !(ar.residual >= best_ar.residual)) {
-            best_ar = ar;
-            memcpy(best, r->q, nq * sizeof *best);
-        }
-    }
-    memcpy(r->q, best, nq * sizeof *best);
-    ar = best_ar;
-    free(q0), free(best);
     if (ok)
         return true;
     RunResult *res = r->res;
@@ -386,7 +350,12 @@ static void note_move(Run *r, const double *q0)
             scale = fabs(q0[i]);
     }
     r->res->assembly_move = moved;
-    if (moved > r->o->move_note * (scale > 0 ? scale : 1))
+    if (r->res->assembled_robustly)
+        notef(r, "note", "Newton could not start from the file's initial values; minimum-norm "
+              "Newton assembled the mechanism at t = %.10g in %d iterations (initial values "
+              "near the configuration you mean choose its assembly branch)", r->o->t0,
+              r->res->assembly_iterations);
+    else if (moved > r->o->move_note * (scale > 0 ? scale : 1))
         notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
               "(%s: %.6g -> %.6g); the file's values are only Newton's starting point",
               r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at]);

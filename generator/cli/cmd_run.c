@@ -8,11 +8,13 @@
  */
 #include "cli.h"
 
+#include "../analysis/outputs.h"
 #include "../analysis/run.h"
 #include "../base/arena.h"
 #include "../render/progress.h"
 #include "../render/svg_anim.h"
 #include "../render/svg_plot.h"
+#include "run_table.h"
 
 #include <errno.h>
 #include <math.h>
@@ -28,21 +30,24 @@ typedef struct RunCli {
     const char *csv_path, *svg_path, *plot_path, *plot_list;
     CliList traces;         /* --trace texts */
     double tol;             /* --tol: both Newton tolerances of ro.mechrt; 0: not given */
+    double at;              /* --at: one instant, t0 = at and no steps; NaN: not given */
     int engine, ode, digits;
     bool json, stats;
-    bool pictures, csv_stdout;      /* worked out from the above */
+    bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
 
 static const char usage[] =
     "usage: mechc run FILE.mech [--t0 T] [--t1 T] [--steps N] [--engine jit|generic|aot]\n"
     "                 [--csv OUT.csv] [--json] [options]\n"
     "\n"
-    "Assembles the mechanism at t0 (Newton from the file's initial values), then\n"
-    "does position, velocity and acceleration analysis on N equal intervals up to\n"
-    "t1: N + 1 states. Mechanisms with velocity-level rows (rolling, knife,\n"
-    "velocity drivers) have their positions integrated (GSL, adaptive step) and\n"
-    "projected back onto the holonomic rows after every step. Needs as many rows\n"
-    "as coordinates.\n"
+    "Assembles the mechanism at t0 (Newton from the file's initial values; from\n"
+    "rough ones, minimum-norm Newton), then does position, velocity and\n"
+    "acceleration analysis on N equal intervals up to t1: N + 1 states. With\n"
+    "--steps 0 (or --at T) it analyses the one instant t0 and prints a table.\n"
+    "Mechanisms with velocity-level rows (rolling, knife, velocity drivers) have\n"
+    "their positions integrated (GSL, adaptive step) and projected back onto the\n"
+    "holonomic rows after every step. Needs as many rows as coordinates. The\n"
+    "file's `output` statements are reported beside the coordinates.\n"
     "\n";
 
 static const char *const ode_methods[] = {"rk8pd", "rkf45", NULL};
@@ -53,15 +58,19 @@ static const char *const ode_methods[] = {"rk8pd", "rkf45", NULL};
 static const CliOption options[] = {
     {"--t0", CLI_REAL_AT(RunCli, ro.t0), .metavar = "T", .help = "time interval (default 0 and 1)"},
     {"--t1", CLI_REAL_AT(RunCli, ro.t1), .metavar = "T"},
-    {"--steps", CLI_INT_AT(RunCli, ro.steps, 1, 100000000), .metavar = "N",
-     .help = "intervals (default 100)"},
+    {"--steps", CLI_INT_AT(RunCli, ro.steps, 0, 100000000), .metavar = "N",
+     .help = "intervals (default 100); 0: the instant t0 alone, printed\n"
+             "as a table unless --csv or --json is given"},
+    {"--at", CLI_REAL_AT(RunCli, at), .metavar = "T",
+     .help = "the instant T alone: --t0 T --steps 0"},
     {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--csv", CLI_STRING_AT(RunCli, csv_path), .metavar = "FILE",
      .help = "write the CSV to FILE ('-': stdout; the default when\n"
              "there is no --json)"},
     {"--json", CLI_FLAG_AT(RunCli, json),
-     .help = "print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}"},
+     .help = "print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}\n"
+             "(with output statements also \"outputs\", \"y\", \"yd\", \"ydd\")"},
     {"--digits", CLI_INT_AT(RunCli, digits, 1, 17), .metavar = "N",
      .help = "significant digits of numbers (default: the fewest that\n"
              "read back exactly, at most 17)"},
@@ -96,15 +105,16 @@ static const CliOption options[] = {
     {"--plot", CLI_STRING_AT(RunCli, plot_path), .metavar = "FILE",
      .help = "write an SVG chart of variables against time"},
     {"--plot-vars", CLI_STRING_AT(RunCli, plot_list), .metavar = "LIST",
-     .help = "what --plot shows: coordinate names, d(NAME) for a\n"
-             "velocity, dd(NAME) for an acceleration (default: every\n"
-             "coordinate)"},
+     .help = "what --plot shows: coordinate or output names, d(NAME)\n"
+             "for a velocity, dd(NAME) for an acceleration (default:\n"
+             "every coordinate and output)"},
 };
 
 static const char epilogue[] =
     "\n"
-    "CSV columns: t, then every coordinate by name (crank.x, ...), then the\n"
-    "velocities d(crank.x), ..., then the accelerations dd(crank.x), ...\n"
+    "CSV columns: t, then every coordinate by name (crank.x, ...) and every\n"
+    "output, then the velocities d(crank.x), ..., then the accelerations\n"
+    "dd(crank.x), ...\n"
     "Exit status: 0 done; 1 the analysis failed (the message names t = VALUE,\n"
     "the cause and the rows and coordinates involved; the states before the\n"
     "failure are written); 2 bad usage or input, or not as many rows as\n"
@@ -118,14 +128,71 @@ typedef struct Output {
     Progress progress;
     double t0, t1;
     int digits;
-    int nq;
+    int nq;                 /* coordinates */
+    int nv;                 /* reported variables: the coordinates, then the outputs */
+    OutputEval outputs;
+    double *v;              /* a state's variables: v | vd | vdd, 3 nv */
+    const char **names;     /* the variables' names, nv */
 } Output;
+
+/* Sets up out for m's coordinates and outputs; output_close frees it. */
+static void output_open(Output *out, const Model *m)
+{
+    out->nq = m->nq;
+    out->nv = m->nq + m->nout;
+    outputs_init(&out->outputs, m);
+    out->v = xcalloc(3 * (size_t)out->nv, sizeof *out->v);
+    out->names = xcalloc((size_t)out->nv, sizeof *out->names);
+    for (int i = 0; i < out->nv; i++)
+        out->names[i] = i < m->nq ? m->coord_names[i] : m->outputs[i - m->nq].name;
+    mechrt_trace_init(&out->trace, out->nv);
+}
+
+static void output_close(Output *out)
+{
+    outputs_free(&out->outputs);
+    free(out->v);
+    free(out->names);
+    mechrt_trace_free(&out->trace);
+}
+
+/* --steps 0 without --csv or --json: the one state as a table. */
+static void print_table(const Model *m, const Output *out, const RunResult *res, int digits)
+{
+    const double *row = out->trace.data;
+    size_t nv = (size_t)out->nv, nq = (size_t)out->nq;
+    bool outputs = nv > nq;
+    RunInstant s = {
+        .t = row[0], .q = row + 1, .qd = row + 1 + nv, .qdd = row + 1 + 2 * nv,
+        .y = outputs ? row + 1 + nq : NULL, .yd = outputs ? row + 1 + nv + nq : NULL,
+        .ydd = outputs ? row + 1 + 2 * nv + nq : NULL,
+        .assembly_iterations = res->assembly_iterations,
+        .assembled_robustly = res->assembled_robustly,
+    };
+    run_table_print(stdout, m, &s, digits);
+}
+
+/* The state's coordinates followed by the outputs' values, in out->v. */
+static void fill_variables(Output *out, double t, const double *q, const double *qd,
+                           const double *qdd)
+{
+    size_t nq = (size_t)out->nq, nv = (size_t)out->nv;
+    const double *src[3] = {q, qd, qdd};
+    for (size_t k = 0; k < 3; k++)
+        memcpy(out->v + k * nv, src[k], nq * sizeof *out->v);
+    outputs_eval(&out->outputs, q, qd, qdd, t, out->v + nq, out->v + nv + nq,
+                 out->v + 2 * nv + nq);
+}
 
 static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
 {
     Output *out = ctx;
+    if (out->nv > out->nq) {
+        fill_variables(out, t, q, qd, qdd);
+        q = out->v, qd = out->v + out->nv, qdd = out->v + 2 * out->nv;
+    }
     if (out->csv)
-        mechrt_csv_row(out->csv, out->nq, t, q, qd, qdd, out->digits);
+        mechrt_csv_row(out->csv, out->nv, t, q, qd, qdd, out->digits);
     if (out->json && !mechrt_trace_push(&out->trace, t, q, qd, qdd))
         out->trace_full = true;
     if (out->t1 != out->t0)
@@ -137,7 +204,7 @@ static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *sv
                            const SvgTrace *traces, int ntraces, const char *plot_path,
                            const SvgPlotVar *vars, int nvars)
 {
-    size_t n = tr->rows, nq = (size_t)m->nq, w = 1 + 3 * nq;
+    size_t n = tr->rows, nq = (size_t)m->nq, nv = (size_t)tr->nq, w = 1 + 3 * nv;
     bool ok = true;
     if (n == 0)
         return true;
@@ -164,7 +231,7 @@ static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *sv
             char names[MAX_PLOT_VARS][96];
             for (int i = 0; i < nvars; i++) {
                 svg_plot_var_name(m, vars[i], names[i], sizeof names[i]);
-                series[i] = (SvgSeries){names[i], tr->data + 1 + (size_t)vars[i].order * nq
+                series[i] = (SvgSeries){names[i], tr->data + 1 + (size_t)vars[i].order * nv
                                                   + (size_t)vars[i].coord, (int)w};
             }
             wrote = svg_write_plot(f, m->name, t, (int)n, series, nvars);
@@ -237,7 +304,11 @@ static bool finish(Args *a, void *opts)
         c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = c->tol;
     if (c->ode >= 0)
         mechrt_ode_method_from_name(ode_methods[c->ode], &c->ro.ode.method);
-    if (c->ro.t0 == c->ro.t1) {
+    if (!isnan(c->at)) {
+        c->ro.t0 = c->at;
+        c->ro.steps = 0;
+    }
+    if (c->ro.steps > 0 && c->ro.t0 == c->ro.t1) {
         fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", c->ro.t0);
         return false;
     }
@@ -247,7 +318,9 @@ static bool finish(Args *a, void *opts)
         return false;
     }
     c->pictures = c->svg_path || c->plot_path;
-    c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0 : !c->json && !c->pictures;
+    c->table = c->ro.steps == 0 && !c->csv_path && !c->json && !c->pictures;
+    c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0
+                                : !c->json && !c->pictures && !c->table;
     if (c->csv_stdout && c->json) {
         fprintf(stderr, "mechc run: error: --csv - and --json would both write to stdout\n");
         return false;
@@ -257,7 +330,7 @@ static bool finish(Args *a, void *opts)
 
 /* The --trace points and --plot variables by name; false (reported) when
    one is unknown. */
-static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
+static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, int *ntraces,
                              SvgPlotVar *vars, int *nvars)
 {
     char err[256];
@@ -268,6 +341,12 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
             return false;
         }
     }
+    *ntraces = c->traces.n;
+    for (int k = 0; k < m->nout && *ntraces < MAX_TRACES; k++) {
+        const ModelOutput *o = &m->outputs[k];
+        if (o->point && o->at.q >= 0)    /* a point output's path; ground's stays put */
+            traces[(*ntraces)++] = (SvgTrace){o->at.q, o->at.has_phi, o->at.sx, o->at.sy, o->point};
+    }
     if (c->plot_path && c->plot_list) {
         *nvars = svg_plot_resolve(m, c->plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
         if (*nvars <= 0) {
@@ -275,7 +354,7 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
             return false;
         }
     } else if (c->plot_path) {
-        for (int i = 0; i < m->nq && *nvars < MAX_PLOT_VARS; i++)
+        for (int i = 0; i < m->nq + m->nout && *nvars < MAX_PLOT_VARS; i++)
             vars[(*nvars)++] = (SvgPlotVar){i, 0};
     }
     return true;
@@ -284,6 +363,7 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces,
 /* The --trace points and --plot variables, resolved. */
 typedef struct Pictures {
     SvgTrace traces[MAX_TRACES];
+    int ntraces;            /* --trace points, then point outputs */
     SvgPlotVar vars[MAX_PLOT_VARS];
     int nvars;
 } Pictures;
@@ -301,7 +381,7 @@ static bool prepare(const Args *a, const RunCli *c, const Mech *mech, Pictures *
         diag_print(diag, stderr);
         return false;
     }
-    return resolve_pictures(m, c, pics->traces, pics->vars, &pics->nvars)
+    return resolve_pictures(m, c, pics->traces, &pics->ntraces, pics->vars, &pics->nvars)
            && cli_engine_open(a, e, (EngineKind)c->engine, mech, NULL, diag);
 }
 
@@ -314,12 +394,14 @@ static int report(const RunCli *c, const Model *m, const Output *out, const Pict
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         return EXIT_USAGE;
     }
-    if (c->pictures && !write_pictures(m, &out->trace, c->svg_path, pics->traces, c->traces.n,
+    if (c->pictures && !write_pictures(m, &out->trace, c->svg_path, pics->traces, pics->ntraces,
                                        c->plot_path, pics->vars, pics->nvars))
         status = EXIT_USAGE;
     if (c->json)
-        mechrt_json_write(stdout, &out->trace, m->coord_names, c->digits,
-                          rs == RUN_FAILED ? res->message : NULL, res->t_fail);
+        mechrt_json_write_outputs(stdout, &out->trace, m->nq, out->names, c->digits,
+                                  rs == RUN_FAILED ? res->message : NULL, res->t_fail);
+    if (c->table && rs == RUN_OK && out->trace.rows == 1)
+        print_table(m, out, res, c->digits);
     if (rs == RUN_FAILED) {
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         if (res->states > 0)
@@ -356,7 +438,7 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
 /* Runs the analysis with the open engine, the states going where c says. */
 static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *pics)
 {
-    Output out = {.csv = NULL, .json = c->json || c->pictures, .digits = c->digits, .nq = m->nq,
+    Output out = {.csv = NULL, .json = c->json || c->pictures || c->table, .digits = c->digits,
                   .t0 = c->ro.t0, .t1 = c->ro.t1};
     if (c->csv_stdout) {
         out.csv = stdout;
@@ -364,12 +446,12 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
         fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
         return EXIT_USAGE;
     }
-    mechrt_trace_init(&out.trace, m->nq);
+    output_open(&out, m);
     MechrtKernels k = run_engine_kernels(e);
     RunResult res;
     c->ro.notes = stderr;
     if (out.csv)
-        mechrt_csv_header(out.csv, m->nq, m->coord_names);
+        mechrt_csv_header(out.csv, out.nv, out.names);
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
@@ -379,7 +461,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
     int status = report(c, m, &out, pics, rs, &res, &k, &last);
     status = finish_output(c, out.csv, status);
     free(last.q), free(last.qd);
-    mechrt_trace_free(&out.trace);
+    output_close(&out);
     return status;
 }
 
@@ -405,6 +487,6 @@ static const CliCommand command = {
 int cmd_run(int argc, char **argv)
 {
     RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT, .ode = -1};
+                .engine = ENGINE_JIT, .ode = -1, .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

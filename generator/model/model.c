@@ -461,6 +461,11 @@ static void push_output(Builder *b, const char *name, const char *suffix, NodeId
     m->outputs[m->nout++] = (ModelOutput){.name = full, .expr = expr};
 }
 
+static ModelOutput *last_output(Builder *b)
+{
+    return &b->model->outputs[b->model->nout - 1];
+}
+
 /* output NAME = e: one value; output NAME: attachment: the point's NAME.x,
    NAME.y, P = r + A(phi) s as in a joint. Outputs add no rows. */
 static void build_output(Builder *b, const Stmt *s)
@@ -474,6 +479,8 @@ static void build_output(Builder *b, const Stmt *s)
     NodeId xy[2];
     joints_point(b->model, at, xy);
     push_output(b, s->name, ".x", xy[0]);
+    last_output(b)->point = s->name;
+    last_output(b)->at = at;
     push_output(b, s->name, ".y", xy[1]);
 }
 

@@ -54,6 +54,9 @@ typedef struct Body {
 typedef struct ModelOutput {
     const char *name;   /* NAME, or NAME.x and NAME.y for a point */
     NodeId expr;
+    const char *point;  /* NAME.x of a point: NAME, the point in at (the
+                           animation draws its path); otherwise NULL */
+    Attach at;
 } ModelOutput;
 
 typedef struct Model {

@@ -356,11 +356,14 @@ bool svg_write_plot(FILE *out, const char *title, const double *t, int n,
 
 /* ---- --plot-vars NAME,d(NAME),dd(NAME) ---- */
 
+/* A coordinate's index, or nq + k for the model's output k; -1 when none. */
 static int find_coord(const Model *m, const char *name, size_t len)
 {
-    for (int i = 0; i < m->nq; i++)
-        if (strlen(m->coord_names[i]) == len && strncmp(m->coord_names[i], name, len) == 0)
+    for (int i = 0; i < m->nq + m->nout; i++) {
+        const char *have = svg_plot_var_label(m, i);
+        if (strlen(have) == len && strncmp(have, name, len) == 0)
             return i;
+    }
     return -1;
 }
 
@@ -451,9 +454,18 @@ int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
     return count;
 }
 
+const char *svg_plot_var_label(const Model *m, int coord)
+{
+    if (coord >= 0 && coord < m->nq)
+        return m->coord_names[coord];
+    if (coord >= m->nq && coord < m->nq + m->nout)
+        return m->outputs[coord - m->nq].name;
+    return "?";
+}
+
 void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len)
 {
-    const char *name = v.coord >= 0 && v.coord < m->nq ? m->coord_names[v.coord] : "?";
+    const char *name = svg_plot_var_label(m, v.coord);
     if (v.order == 1)
         snprintf(buf, len, "d(%s)", name);
     else if (v.order == 2)

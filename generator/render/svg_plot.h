@@ -34,19 +34,23 @@ bool svg_write_plot(FILE *out, const char *title, const double *t, int n,
 bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
                         const SvgSeries *series, int nseries, const SvgPlotOptions *opt);
 
-/* A quantity to plot: coordinate coord, derivative order 0 (q), 1 (qd) or 2 (qdd). */
+/* A quantity to plot: coordinate coord (nq + k: the model's output k),
+   derivative order 0 (q), 1 (qd) or 2 (qdd). */
 typedef struct SvgPlotVar {
     int coord;
     int order;
 } SvgPlotVar;
 
-/* Parses a --plot-vars list: comma-separated NAME (a coordinate), d(NAME)
+/* Parses a --plot-vars list: comma-separated NAME (a coordinate or an output), d(NAME)
    (its velocity) or dd(NAME) (its acceleration), blanks allowed around
    items. Fills out[0..max) and returns the count; on error returns -1 with
    a one-line reason in err (an unknown name is reported with the
    coordinates that exist). */
 int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
                      char *err, size_t errlen);
+
+/* The name of coordinate coord, or of output coord - nq. */
+const char *svg_plot_var_label(const Model *m, int coord);
 
 /* The display name of a variable: "crank.phi", "d(crank.phi)", "dd(crank.phi)". */
 void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len);

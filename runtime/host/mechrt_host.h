@@ -186,4 +186,11 @@ void mechrt_json_string(FILE *out, const char *s);
 void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *names, int digits,
                        const char *error_message, double error_t);
 
+/* The same for a trace whose first ncoords columns are coordinates and the
+   rest reported values (mechc's `output` statements): those go under
+   "outputs" (their names), "y", "yd" and "ydd", after "qdd". */
+void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
+                               const char *const *names, int digits,
+                               const char *error_message, double error_t);
+
 #endif

@@ -125,26 +125,24 @@ static void json_num(FILE *out, double v, int digits)
         fputs("null", out);
 }
 
-void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *names, int digits,
-                       const char *error_message, double error_t)
+/* One group of columns [first, first + n) of the trace's q | qd | qdd as
+   the JSON keys names_key (NULL: the names are not written) and keys[0..2]. */
+static void json_group(FILE *out, const MechrtTrace *tr, const char *const *names, size_t first,
+                       size_t n, const char *names_key, const char *const keys[3], int digits)
 {
-    size_t n = (size_t)tr->nq, w = 1 + 3 * n;
-    fputs("{\"coords\": [", out);
-    for (size_t i = 0; i < n; i++) {
-        fputs(i ? ", " : "", out);
-        mechrt_json_string(out, names[i]);
+    size_t nq = (size_t)tr->nq, w = 1 + 3 * nq;
+    if (names_key) {
+        fprintf(out, ",\n \"%s\": [", names_key);
+        for (size_t i = 0; i < n; i++) {
+            fputs(i ? ", " : "", out);
+            mechrt_json_string(out, names[first + i]);
+        }
+        fputs("]", out);
     }
-    fputs("],\n \"t\": [", out);
-    for (size_t r = 0; r < tr->rows; r++) {
-        fputs(r ? ", " : "", out);
-        json_num(out, tr->data[r * w], digits);
-    }
-    fputs("]", out);
-    static const char *const keys[3] = {"q", "qd", "qdd"};
     for (size_t k = 0; k < 3; k++) {
         fprintf(out, ",\n \"%s\": [", keys[k]);
         for (size_t r = 0; r < tr->rows; r++) {
-            const double *v = tr->data + r * w + 1 + k * n;
+            const double *v = tr->data + r * w + 1 + k * nq + first;
             fputs(r ? ",\n   [" : "[", out);
             for (size_t i = 0; i < n; i++) {
                 fputs(i ? ", " : "", out);
@@ -154,6 +152,29 @@ void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *name
         }
         fputs("]", out);
     }
+}
+
+void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
+                               const char *const *names, int digits,
+                               const char *error_message, double error_t)
+{
+    static const char *const qkeys[3] = {"q", "qd", "qdd"}, *const ykeys[3] = {"y", "yd", "ydd"};
+    size_t w = 1 + 3 * (size_t)tr->nq, nc = (size_t)ncoords;
+    fputs("{\"coords\": [", out);
+    for (size_t i = 0; i < nc; i++) {
+        fputs(i ? ", " : "", out);
+        mechrt_json_string(out, names[i]);
+    }
+    fputs("],\n \"t\": [", out);
+    for (size_t r = 0; r < tr->rows; r++) {
+        fputs(r ? ", " : "", out);
+        json_num(out, tr->data[r * w], digits);
+    }
+    fputs("]", out);
+    size_t nq = (size_t)tr->nq;
+    json_group(out, tr, names, 0, nc, NULL, qkeys, digits);
+    if (nq > nc)
+        json_group(out, tr, names, nc, nq - nc, "outputs", ykeys, digits);
     fprintf(out, ",\n \"ok\": %s", error_message ? "false" : "true");
     if (error_message) {
         fputs(",\n \"error\": {\"t\": ", out);
@@ -163,4 +184,10 @@ void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *name
         fputs("}", out);
     }
     fputs("}\n", out);
+}
+
+void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *names, int digits,
+                       const char *error_message, double error_t)
+{
+    mechrt_json_write_outputs(out, tr, tr->nq, names, digits, error_message, error_t);
 }

@@ -1,0 +1,92 @@
+/* run_table.c - the state of a mechanism at one instant as a table people read (mechc run --steps 0).
+ *
+ * What a textbook problem asks for: every coordinate's position, velocity
+ * and acceleration, then the outputs', in aligned columns; angles also in
+ * degrees. Entries smaller than 1e-12 of their column's largest are
+ * round-off of an exact zero and are shown as 0, so that a pin's fixed
+ * coordinates read 0, not 1e-17.
+ */
+#include "run_table.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { COLUMN = 17 };
+
+/* Largest magnitude among v[0..n) (0 when none). */
+static double column_scale(const double *v, int n)
+{
+    double big = 0;
+    for (int i = 0; i < n; i++)
+        if (isfinite(v[i]) && fabs(v[i]) > big)
+            big = fabs(v[i]);
+    return big;
+}
+
+static void put_value(FILE *out, double v, double scale, int digits)
+{
+    if (fabs(v) < 1e-12 * scale)
+        v = 0;
+    fprintf(out, "  %*.*g", COLUMN, digits, v);
+}
+
+/* Whether coordinate i is a body's angle. */
+static bool is_angle(const Model *m, int i)
+{
+    for (int b = 0; b < m->nbodies; b++)
+        if (m->bodies[b].has_phi && m->bodies[b].q + 2 == i)
+            return true;
+    return false;
+}
+
+static int name_width(const Model *m)
+{
+    int w = 10;
+    for (int i = 0; i < m->nq; i++)
+        w = (int)fmax(w, (double)strlen(m->coord_names[i]));
+    for (int k = 0; k < m->nout; k++)
+        w = (int)fmax(w, (double)strlen(m->outputs[k].name));
+    return w;
+}
+
+/* One block: a heading, then a row per name with value, rate and rate of rate. */
+static void put_block(FILE *out, const Model *m, const char *heading, const char *const *names,
+                      int n, const double *const v[3], bool angles, int width, int digits)
+{
+    double scale[3];
+    for (int k = 0; k < 3; k++)
+        scale[k] = column_scale(v[k], n);
+    fprintf(out, "%-*s  %*s  %*s  %*s\n", width, heading, COLUMN, "position", COLUMN, "velocity",
+            COLUMN, "acceleration");
+    for (int i = 0; i < n; i++) {
+        fprintf(out, "%-*s", width, names[i]);
+        for (int k = 0; k < 3; k++)
+            put_value(out, v[k][i], scale[k], digits);
+        if (angles && is_angle(m, i))
+            fprintf(out, "   (%.*g deg)", digits < 8 ? digits : 8, v[0][i] * 180 / M_PI);
+        fputc('\n', out);
+    }
+}
+
+void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
+{
+    digits = digits > 0 ? digits : 10;
+    int width = name_width(m);
+    fprintf(out, "%s at t = %.10g", m->name, s->t);
+    if (s->assembled_robustly)
+        fprintf(out, " (assembled from rough initial values in %d iterations)", s->assembly_iterations);
+    fputs("\n\n", out);
+    const double *const qv[3] = {s->q, s->qd, s->qdd};
+    put_block(out, m, "coordinate", m->coord_names, m->nq, qv, true, width, digits);
+    if (m->nout > 0 && s->y) {
+        const char **names = malloc((size_t)m->nout * sizeof *names);
+        for (int k = 0; k < m->nout; k++)
+            names[k] = m->outputs[k].name;
+        const double *const yv[3] = {s->y, s->yd, s->ydd};
+        fputc('\n', out);
+        put_block(out, m, "output", names, m->nout, yv, false, width, digits);
+        free(names);
+    }
+    fputs("\nunits as in the file; angles in rad (velocity rad/s, acceleration rad/s^2)\n", out);
+}

@@ -1,0 +1,22 @@
+/* run_table.h - the state of a mechanism at one instant as a table people read (mechc run --steps 0). */
+#ifndef MECHC_RUN_TABLE_H
+#define MECHC_RUN_TABLE_H
+
+#include <stdio.h>
+
+#include "../model/model.h"
+
+/* One state: the coordinates (q, qd, qdd: nq each) and the outputs' values
+   (y, yd, ydd: m->nout each, NULL when there are none), with how assembly
+   went. digits: significant digits, 0 for 10. */
+typedef struct RunInstant {
+    double t;
+    const double *q, *qd, *qdd;
+    const double *y, *yd, *ydd;
+    int assembly_iterations;
+    bool assembled_robustly;
+} RunInstant;
+
+void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits);
+
+#endif
