@@ -330,7 +330,7 @@ static bool assemble_robustly(Run *r)
         name_list(r, names, phi, (int)nh);
     }
     msgf(r, " (the mechanism may not close with these lengths, or the guess is nearer "
-         "a configuration that does not exist; try other initial values)");
+         "a configuration that does not exist; try other initial values, or more --assembly-iter)");
     free(phi), free(names);
     return false;
 }

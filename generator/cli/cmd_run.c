@@ -79,6 +79,9 @@ static const CliOption options[] = {
              "step max |dq_j| <= X (default 1e-8)"},
     {"--max-iter", CLI_INT_AT(RunCli, ro.mechrt.max_iter, 1, 10000), .metavar = "N",
      .help = "Newton iterations per time step (default 25)"},
+    {"--assembly-iter", CLI_INT_AT(RunCli, ro.assembly_max_iter, 1, 100000), .metavar = "N",
+     .help = "minimum-norm Newton iterations per attempt when Newton\n"
+             "cannot start from the initial values (default 100)"},
     {"--max-substeps", CLI_INT_AT(RunCli, ro.max_substeps, 1, 1 << 20), .metavar = "N",
      .help = "a step that seems to leave its assembly branch (Newton\n"
              "corrects far more than the predicted motion) is redone\n"
