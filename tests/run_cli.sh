@@ -255,6 +255,20 @@ check "--plot-vars takes output names" status_is 0
 run "$tmp/out.mech" --steps 2 --t1 0.5 --svg "$tmp/o2.svg"
 check "--svg: a point output's path is drawn" sh -c "grep -q 'tip' '$tmp/o2.svg'"
 
+# every example that assembles as written also assembles with every angle
+# guess 0, and with every initial value left out
+for f in "$ex"/*.mech; do
+    name=$(basename "$f" .mech)
+    run "$f" --steps 0 --csv /dev/null
+    [ "$rc" = 0 ] || continue
+    sed -E '/^body/ s/phi *= *[^ ]+/phi = 0/' "$f" > "$tmp/angles0.mech"
+    sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/; s/^(point +[A-Za-z_0-9]+).*/\1/' "$f" > "$tmp/all0.mech"
+    run "$tmp/angles0.mech" --steps 0 --csv /dev/null
+    check "$name with angle guesses 0 assembles" status_is 0
+    run "$tmp/all0.mech" --steps 0 --csv /dev/null
+    check "$name with every guess 0 assembles" status_is 0
+done
+
 # ---- velocity-level rows: integrated positions ----------------------------
 run "$ex/knife_cart.mech" --steps 20
 check "knife_cart: exit 0" status_is 0
