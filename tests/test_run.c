@@ -88,7 +88,7 @@ static bool run_with(Mech *mech, EngineKind kind, RunOptions o, Collected *c)
             fail_msg("jit engine: %s", diag.message);
         return false;
     }
-    MechrtKernels k = run_engine_kernels(&e);
+    MechrtKernels k = e.k;
     FILE *notes = fmemopen(c->notes, sizeof c->notes - 1, "w");
     assert_non_null(notes);
     o.notes = notes;

@@ -86,13 +86,6 @@ RunOptions run_default_options(void)
     return o;
 }
 
-/* ---- the engine as runtime kernels ------------------------------------- */
-
-MechrtKernels run_engine_kernels(const Engine *e)
-{
-    return e->k;
-}
-
 /* ---- the state of one run ---------------------------------------------- */
 
 typedef struct Run {
@@ -289,6 +282,8 @@ static void fail(Run *r, MechrtStatus st, double t, const double *q, const Mechr
  * Jacobian is singular because two links are merely parallel (all angles
  * 0). False, with the message filled, when even it finds no configuration
  * near the initial values: the rows it could not satisfy are named. */
+static void fail_assembly(Run *r, const AssembleResult *ar);
+
 static bool assemble_robustly(Run *r)
 {
     const RunOptions *o = r->o;
@@ -301,8 +296,16 @@ static bool assemble_robustly(Run *r)
     bool ok = assemble_restarting(r->k, o->t0, r->q, &ao, &ar);
     r->res->assembly_iterations += ar.iterations;
     r->res->assembled_robustly = true;
-    if (ok)
-        return true;
+    if (!ok)
+        fail_assembly(r, &ar);
+    return ok;
+}
+
+/* The message of an assembly that found no configuration: the rows left
+   unsatisfied at the attempt that came closest. */
+static void fail_assembly(Run *r, const AssembleResult *ar)
+{
+    const RunOptions *o = r->o;
     RunResult *res = r->res;
     res->status = RUN_FAILED;
     res->cause = MECHRT_EMAXITER;
@@ -320,19 +323,18 @@ static bool assemble_robustly(Run *r)
         names[i] = r->m->rows[i].name;
     }
     if (!finite) {
-        msgf(r, "minimum-norm Newton reached NaN or infinity after %d %s", ar.iterations,
-             plural(ar.iterations, "iteration", "iterations"));
+        msgf(r, "minimum-norm Newton reached NaN or infinity after %d %s", ar->iterations,
+             plural(ar->iterations, "iteration", "iterations"));
     } else {
         msgf(r, "after %d %s of minimum-norm Newton the largest residual is %.3g in row %s; "
-             "rows left unsatisfied: ", ar.iterations,
-             plural(ar.iterations, "iteration", "iterations"), ar.residual,
-             ar.worst_row >= 0 ? names[ar.worst_row] : "?");
+             "rows left unsatisfied: ", ar->iterations,
+             plural(ar->iterations, "iteration", "iterations"), ar->residual,
+             ar->worst_row >= 0 ? names[ar->worst_row] : "?");
         name_list(r, names, phi, (int)nh);
     }
     msgf(r, " (the mechanism may not close with these lengths, or the guess is nearer "
          "a configuration that does not exist; try other initial values, or more --assembly-iter)");
     free(phi), free(names);
-    return false;
 }
 
 /* A note when assembly moved the initial values much. */

@@ -83,10 +83,6 @@ typedef struct RunResult {
 typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *qd,
                            const double *qdd);
 
-/* The runtime's view of an open engine: its kernels, engine->k. Valid
-   until engine_close. */
-MechrtKernels run_engine_kernels(const Engine *engine);
-
 /* True when m has one row per coordinate, as a run needs; otherwise false
    with why (size bytes) saying how many degrees of freedom are not driven
    or how many rows are too many. */

@@ -450,7 +450,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
         return EXIT_USAGE;
     }
     output_open(&out, m);
-    MechrtKernels k = run_engine_kernels(e);
+    MechrtKernels k = e->k;
     RunResult res;
     c->ro.notes = stderr;
     if (out.csv)
