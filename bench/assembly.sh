@@ -9,7 +9,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 iterations() {
     "$mechc" run "$1" --steps 0 --csv /dev/null --stats 2>&1 >/dev/null \
-        | sed -n 's/.*(\([0-9]*\) Newton iterations* at t0).*/\1/p' | head -1
+        | sed -n 's/.*assembly at t0 in \([0-9]*\) Newton.*/\1/p' | head -1
 }
 echo "| example | as written | angle guesses 0 | every guess 0 |"
 echo "|---|---|---|---|"

@@ -149,4 +149,8 @@ else
     skip "python3 not found: JSON parse checks"
 fi
 
+# rough initial values (every guess 0): info assembles them as run does
+sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/' "$ex/four_bar.mech" > "$tmp/fb0.mech"
+run info "$tmp/fb0.mech" --json
+check "info from every guess 0: assembled" out_has '"assembled": true'
 suite_end

@@ -255,6 +255,26 @@ check "--plot-vars takes output names" status_is 0
 run "$tmp/out.mech" --steps 2 --t1 0.5 --svg "$tmp/o2.svg"
 check "--svg: a point output's path is drawn" sh -c "grep -q 'tip' '$tmp/o2.svg'"
 
+run "$ex/slider_crank_toggle.mech" --at 0.25
+check "a driven toggle reached from rough guesses: exit 1" status_is 1
+check "a driven toggle reached from rough guesses: said to be a toggle" err_has "assembly from the file's initial values failed: singular Jacobian: a toggle"
+run "$ex/four_bar.mech" --at 0.1 --t0 0.5
+check "--at with --t0: refused (exit 2)" status_is 2
+check "--at with --t0: says why" err_has "--at T is --t0 T --steps 0"
+run "$ex/four_bar.mech" --steps 0 --svg "$tmp/one.svg"
+check "--steps 0 with --svg: refused (exit 2)" status_is 2
+printf 'param a = 30*deg\nparam deg = 2\nbody c\nrevolute O: ground c\ndriver d: c.phi = a\n' > "$tmp/unit.mech"
+run "$tmp/unit.mech" --steps 0
+check "deg declared after its use as a unit: exit 2" status_is 2
+check "deg declared after its use as a unit: says so" err_has "unit.mech:2:7: error: 'deg' was used as the unit deg on line 1"
+printf 'body c\nrevolute O: ground c\ndriver d: c.phi = t\noutput w = der(c.phi)\n' > "$tmp/derout.mech"
+run "$tmp/derout.mech" --steps 0
+check "der() in an output: exit 2" status_is 2
+check "der() in an output: says so" err_has "output 'w' contains der()"
+printf 'body c\nrevolute O: ground c\ndriver d: c.phi = t\noutput s = sqrt(c.phi - 0.5)\n' > "$tmp/nan.mech"
+run "$tmp/nan.mech" --steps 2 --csv /dev/null
+check "an output that is NaN: warned once" err_has "warning: output 's' is not finite at t = 0"
+
 # every example that assembles as written also assembles with every angle
 # guess 0, and with every initial value left out
 for f in "$ex"/*.mech; do

@@ -366,35 +366,71 @@ bool assemble_kernels(const MechrtKernels *k, double t, double *q,
  * solution, most often a guess symmetric about a line the mechanism cannot
  * lie on (every link on the x axis): the Gauss-Newton step keeps the
  * symmetry. Restarting from the guess jittered by 5 %, 10 %, 20 % ... of
- * its scale (its largest residual or value) breaks it; the jitter comes
- * from a fixed seed, so that every run repeats exactly.
+ * its scale (its largest residual or value: one scale for lengths and
+ * angles, which is enough to break a symmetry) breaks it; the jitter comes
+ * from a fixed seed, so that every run repeats exactly. Only coordinates
+ * the rows depend on are jittered: the others (a cart's position under
+ * velocity-level rows alone) are initial values, not guesses, and the
+ * minimum-norm step would never move them back.
  */
 #define ASSEMBLE_RESTARTS 6
 #define ASSEMBLE_SEED 20261125u
 
-bool assemble_restarting(const MechrtKernels *k, double t, double *q,
-                         const AnalysisOptions *opt, AssembleResult *res)
+/* The rows being assembled, seen by the restarts. */
+typedef struct RoughRows {
+    int nq, nrows;
+    /* Phi (nrows) and the rows' Jacobian (nrows x nq) at q */
+    void (*eval)(void *ctx, const double *q, double *phi, double *jac);
+    /* one minimum-norm Newton attempt from q */
+    bool (*attempt)(void *ctx, double *q, AssembleResult *res);
+    void *ctx;
+} RoughRows;
+
+/* The scale of the jitter, and which coordinates the rows depend on (a
+   nonzero Jacobian column at q0 or at a probe point near it). */
+static double rough_scale(const RoughRows *rr, const double *q0, bool *touched)
 {
-    size_t nq = (size_t)k->nq;
-    double *q0 = xmalloc(nq * sizeof *q0), *best = xmalloc(nq * sizeof *best);
-    double *phi = xcalloc((size_t)k->nh + 1, sizeof *phi);
-    memcpy(q0, q, nq * sizeof *q0);
+    size_t nq = (size_t)rr->nq, nrows = (size_t)rr->nrows;
+    double *phi = xcalloc(nrows + 1, sizeof *phi), *jac = xcalloc(nrows * nq + 1, sizeof *jac);
+    double *probe = xmalloc(nq * sizeof *probe);
     double scale = 1e-3;
-    k->phi(k->ctx, q0, t, phi);
-    for (int i = 0; i < k->nh; i++)
+    rr->eval(rr->ctx, q0, phi, jac);
+    for (size_t i = 0; i < nrows; i++)
         if (isfinite(phi[i]))
             scale = fmax(scale, fabs(phi[i]));
     for (size_t j = 0; j < nq; j++)
         scale = fmax(scale, fabs(q0[j]));
+    uint64_t seed = ~(uint64_t)ASSEMBLE_SEED;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i < nrows; i++)
+            for (size_t j = 0; j < nq; j++)
+                touched[j] = touched[j] || jac[i * nq + j] != 0;
+        for (size_t j = 0; j < nq; j++)
+            probe[j] = q0[j] + 0.1 * scale * rng_symmetric(&seed);
+        rr->eval(rr->ctx, probe, phi, jac);
+    }
+    free(phi), free(jac), free(probe);
+    return scale;
+}
+
+static bool restart_loop(const RoughRows *rr, double *q, AssembleResult *res)
+{
+    size_t nq = (size_t)rr->nq;
+    double *q0 = xmalloc(nq * sizeof *q0), *best = xmalloc(nq * sizeof *best);
+    bool *touched = xcalloc(nq, sizeof *touched);
+    memcpy(q0, q, nq * sizeof *q0);
+    double scale = rough_scale(rr, q0, touched);
     uint64_t seed = ASSEMBLE_SEED;
     AssembleResult ar, best_ar = {0};
     int iterations = 0;
     bool ok = false;
     for (int attempt = 0; attempt <= ASSEMBLE_RESTARTS && !ok; attempt++) {
         double jitter = attempt == 0 ? 0 : 0.05 * scale * (double)(1 << (attempt - 1));
-        for (size_t j = 0; j < nq; j++)
-            q[j] = q0[j] + jitter * rng_symmetric(&seed);
-        ok = assemble_kernels(k, t, q, opt, &ar);
+        for (size_t j = 0; j < nq; j++) {
+            double u = rng_symmetric(&seed);
+            q[j] = touched[j] ? q0[j] + jitter * u : q0[j];
+        }
+        ok = rr->attempt(rr->ctx, q, &ar);
         iterations += ar.iterations;
         if (ok || attempt == 0 || !(ar.residual >= best_ar.residual)) {
             best_ar = ar;
@@ -404,6 +440,80 @@ bool assemble_restarting(const MechrtKernels *k, double t, double *q,
     memcpy(q, best, nq * sizeof *best);
     *res = best_ar;
     res->iterations = iterations;
-    free(q0), free(best), free(phi);
+    free(q0), free(best), free(touched);
+    return ok;
+}
+
+/* The kernels' holonomic rows (the first nh rows of their Jacobian). */
+typedef struct KernelAttempt {
+    const MechrtKernels *k;
+    double t;
+    const AnalysisOptions *opt;
+    double *jac;            /* nr x nq */
+} KernelAttempt;
+
+static void kernel_rough_eval(void *ctx, const double *q, double *phi, double *jac)
+{
+    KernelAttempt *ka = ctx;
+    ka->k->phi(ka->k->ctx, q, ka->t, phi);
+    ka->k->jac(ka->k->ctx, q, ka->t, ka->jac);
+    memcpy(jac, ka->jac, (size_t)ka->k->nh * (size_t)ka->k->nq * sizeof *jac);
+}
+
+static bool kernel_attempt(void *ctx, double *q, AssembleResult *res)
+{
+    KernelAttempt *ka = ctx;
+    return assemble_kernels(ka->k, ka->t, q, ka->opt, res);
+}
+
+bool assemble_restarting(const MechrtKernels *k, double t, double *q,
+                         const AnalysisOptions *opt, AssembleResult *res)
+{
+    size_t nr = (size_t)(k->nh + k->nv);
+    KernelAttempt ka = {k, t, opt, xcalloc(nr * (size_t)k->nq + 1, sizeof *ka.jac)};
+    RoughRows rr = {k->nq, k->nh, kernel_rough_eval, kernel_attempt, &ka};
+    bool ok = restart_loop(&rr, q, res);
+    free(ka.jac);
+    return ok;
+}
+
+/* Chosen rows of a MechEval (what info assembles). */
+typedef struct EvalAttempt {
+    MechEval *me;
+    const int *rows;
+    int nrows;
+    double t;
+    const AnalysisOptions *opt;
+    MechrtSvd *w;
+    double *phi_all, *jac;  /* nh, nr x nq */
+} EvalAttempt;
+
+static void eval_rough_eval(void *ctx, const double *q, double *phi, double *jac)
+{
+    EvalAttempt *ea = ctx;
+    size_t nq = (size_t)ea->me->nq;
+    mech_eval(ea->me, q, ea->t, ea->phi_all, ea->jac);
+    for (int i = 0; i < ea->nrows; i++) {
+        phi[i] = ea->phi_all[ea->rows[i]];
+        memcpy(jac + (size_t)i * nq, ea->jac + (size_t)ea->rows[i] * nq, nq * sizeof *jac);
+    }
+}
+
+static bool eval_attempt(void *ctx, double *q, AssembleResult *res)
+{
+    EvalAttempt *ea = ctx;
+    return assemble_min_norm(ea->me, ea->rows, ea->nrows, ea->t, q, ea->opt, ea->w, res);
+}
+
+bool assemble_min_norm_restarting(MechEval *me, const int *rows, int nrows, double t, double *q,
+                                  const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res)
+{
+    size_t nq = (size_t)me->nq;
+    EvalAttempt ea = {me, rows, nrows, t, opt, w,
+                      xcalloc((size_t)me->nh + 1, sizeof *ea.phi_all),
+                      xcalloc((size_t)me->nr * nq + 1, sizeof *ea.jac)};
+    RoughRows rr = {me->nq, nrows, eval_rough_eval, eval_attempt, &ea};
+    bool ok = restart_loop(&rr, q, res);
+    free(ea.phi_all), free(ea.jac);
     return ok;
 }

@@ -38,12 +38,21 @@ bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
 bool assemble_kernels(const MechrtKernels *k, double t, double *q,
                       const AnalysisOptions *opt, AssembleResult *res);
 
+/* Iterations without 1 % progress after which an assembly from rough
+   initial values gives up an attempt and restarts (AnalysisOptions.stall_iter
+   for run, check and info). */
+#define ASSEMBLE_ROUGH_STALL 8
+
 /* assemble_kernels from q, restarted from jittered guesses (a fixed seed)
    while it stalls (give opt->stall_iter > 0): what assembles a mechanism
-   from rough initial values, all angles 0 included. res->iterations
-   counts every attempt's; on failure q is the attempt with the smallest
-   residual. */
+   from rough initial values, all angles 0 included. Coordinates the rows
+   do not depend on keep their values. res->iterations counts every
+   attempt's; on failure q is the attempt with the smallest residual. */
 bool assemble_restarting(const MechrtKernels *k, double t, double *q,
                          const AnalysisOptions *opt, AssembleResult *res);
+
+/* The same with assemble_min_norm on chosen rows of a MechEval (info). */
+bool assemble_min_norm_restarting(MechEval *me, const int *rows, int nrows, double t, double *q,
+                                  const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res);
 
 #endif

@@ -634,7 +634,7 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
 /* The base state: Newton from the initial values at t = 0 when the
    holonomic rows are square (minimum-norm Newton with restarts from rough
    ones), else the initial values. */
-#define CHECK_ASSEMBLY_STALL 8
+
 static bool assemble(Checker *c, double *q)
 {
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
@@ -649,7 +649,7 @@ static bool assemble(Checker *c, double *q)
     if (st != MECHRT_OK) {
         /* rough initial values: as run assembles them (run.c) */
         AnalysisOptions ao = analysis_default_options();
-        ao.stall_iter = CHECK_ASSEMBLY_STALL;
+        ao.stall_iter = ASSEMBLE_ROUGH_STALL;
         AssembleResult ar;
         memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
         if (assemble_restarting(&k, 0.0, q, &ao, &ar)

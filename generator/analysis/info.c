@@ -376,6 +376,13 @@ static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
         rep->assembled = assemble_min_norm(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
+        if (!rep->assembled) {      /* rough initial values: restarts, as run does */
+            AnalysisOptions rough = *opt;
+            rough.stall_iter = ASSEMBLE_ROUGH_STALL;
+            memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
+            rep->assembled = assemble_min_norm_restarting(me, hrows, nh, t, rep->q, &rough, w,
+                                                          &rep->assembly);
+        }
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
         rep->assembled = assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
     }

@@ -66,10 +66,6 @@
 /* Two subdivision levels agree when their positions at the end of the
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
-/* Robust assembly (assemble_robustly): a minimum-norm Newton attempt that
-   has not cut the residual by 1 % in this many iterations is restarted
-   from a jittered guess (assemble_restarting). */
-#define RUN_ASSEMBLY_STALL 8
 
 RunOptions run_default_options(void)
 {
@@ -189,6 +185,24 @@ static double describe_dependency(Run *r, const double *q, double t, int rows, b
     return ratio;
 }
 
+/* After an assembly from rough initial values: a configuration reached
+   only approximately because the Jacobian is singular there (a driven
+   position on a toggle) passes the LU's pivot test; it must fail as the
+   toggle it is, rather than give the huge velocities of a Jacobian
+   singular to 1e-9. True when sigma_min / sigma_max < RUN_NEAR_SINGULAR. */
+static bool nearly_singular(Run *r, double t)
+{
+    if (r->nq > RUN_SVD_MAX_NQ)
+        return false;
+    size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
+    double *jac = xcalloc(nr * nq + 1, sizeof *jac);
+    double *roww = xcalloc(nr + 1, sizeof *roww), *colw = xcalloc(nq, sizeof *colw);
+    r->k->jac(r->k->ctx, r->q, t, jac);
+    double ratio = mechrt_host_singular_direction(r->nr, r->nq, jac, roww, colw);
+    free(jac), free(roww), free(colw);
+    return ratio >= 0 && ratio < RUN_NEAR_SINGULAR;
+}
+
 /* Names the first row whose Phi, Phi_q or nu is NaN or infinite at (q, t);
    false when all are finite (then the solve overflowed). */
 static bool find_nonfinite(Run *r, const double *q, double t)
@@ -276,14 +290,14 @@ static void fail(Run *r, MechrtStatus st, double t, const double *q, const Mechr
     }
 }
 
+static void fail_assembly(Run *r, const AssembleResult *ar);
+
 /* Minimum-norm Newton with step halving over the holonomic rows, from the
  * initial values in r->q (assemble_kernels, what `info` uses):
  * unlike Newton with LU it starts from any guess, including one where the
  * Jacobian is singular because two links are merely parallel (all angles
  * 0). False, with the message filled, when even it finds no configuration
  * near the initial values: the rows it could not satisfy are named. */
-static void fail_assembly(Run *r, const AssembleResult *ar);
-
 static bool assemble_robustly(Run *r)
 {
     const RunOptions *o = r->o;
@@ -291,7 +305,7 @@ static bool assemble_robustly(Run *r)
     ao.tol_phi = o->mechrt.tol_phi;
     ao.tol_dq = o->mechrt.tol_dq;
     ao.max_iter = o->assembly_max_iter;
-    ao.stall_iter = RUN_ASSEMBLY_STALL;
+    ao.stall_iter = ASSEMBLE_ROUGH_STALL;
     AssembleResult ar;
     bool ok = assemble_restarting(r->k, o->t0, r->q, &ao, &ar);
     r->res->assembly_iterations += ar.iterations;
@@ -614,6 +628,10 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work, r->lwork,
                          &rep);
         r->res->assembly_iterations += rep.iterations;
+        if (st == MECHRT_OK && nearly_singular(r, o->t0)) {
+            st = MECHRT_ESING;
+            rep.sing_index = -1;
+        }
     }
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");

@@ -136,6 +136,8 @@ typedef struct Output {
     OutputEval outputs;
     double *v;              /* a state's variables: v | vd | vdd, 3 nv */
     const char **names;     /* the variables' names, nv */
+    const char *file;       /* for warnings */
+    bool warned;            /* an output was not finite (said once) */
 } Output;
 
 /* Sets up out for m's coordinates and outputs; output_close frees it. */
@@ -187,12 +189,27 @@ static void fill_variables(Output *out, double t, const double *q, const double 
                  out->v + 2 * nv + nq);
 }
 
+/* An output that is NaN or infinite (sqrt of a negative, ...) is written
+   as such; the first one is said on stderr, with its time. */
+static void warn_nonfinite(Output *out, double t)
+{
+    for (int k = 0; k < 3 * out->nv && !out->warned; k++) {
+        int i = k % out->nv;
+        if (i >= out->nq && !isfinite(out->v[k])) {
+            fprintf(stderr, "%s: warning: output '%s' is not finite at t = %.10g (later ones "
+                    "are not reported)\n", out->file, out->names[i], t);
+            out->warned = true;
+        }
+    }
+}
+
 static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
 {
     Output *out = ctx;
     if (out->nv > out->nq) {
         fill_variables(out, t, q, qd, qdd);
         q = out->v, qd = out->v + out->nv, qdd = out->v + 2 * out->nv;
+        warn_nonfinite(out, t);
     }
     if (out->csv)
         mechrt_csv_row(out->csv, out->nv, t, q, qd, qdd, out->digits);
@@ -253,6 +270,12 @@ static void print_stats(const RunResult *res, const MechrtKernels *k, const doub
                         const double *qd, double t)
 {
     int n = res->steps_done;
+    if (n == 0) {           /* one instant: only the assembly */
+        fprintf(stderr, "mechc run: stats: assembly at t0 in %d Newton %s%s\n",
+                res->assembly_iterations, res->assembly_iterations == 1 ? "iteration" : "iterations",
+                res->assembled_robustly ? " (minimum-norm Newton from rough initial values)" : "");
+        return;
+    }
     double ns_step = n > 0 ? 1e9 * res->step_seconds / n : 0;
     fprintf(stderr, "mechc run: stats: %d %s after assembly (%d Newton %s at t0), %.6g ms "
             "of analysis: %.0f ns per step\n", n, n == 1 ? "step" : "steps",
@@ -308,6 +331,12 @@ static bool finish(Args *a, void *opts)
     if (c->ode >= 0)
         mechrt_ode_method_from_name(ode_methods[c->ode], &c->ro.ode.method);
     if (!isnan(c->at)) {
+        RunOptions d = run_default_options();
+        if (c->ro.t0 != d.t0 || c->ro.t1 != d.t1 || c->ro.steps != d.steps) {
+            fprintf(stderr, "mechc run: error: --at T is --t0 T --steps 0: give it alone, "
+                    "without --t0, --t1 or --steps\n");
+            return false;
+        }
         c->ro.t0 = c->at;
         c->ro.steps = 0;
     }
@@ -321,6 +350,11 @@ static bool finish(Args *a, void *opts)
         return false;
     }
     c->pictures = c->svg_path || c->plot_path;
+    if (c->pictures && c->ro.steps == 0) {
+        fprintf(stderr, "mechc run: error: %s needs a motion: one instant (--steps 0 or --at) "
+                "has nothing to draw\n", c->svg_path ? "--svg" : "--plot");
+        return false;
+    }
     c->table = c->ro.steps == 0 && !c->csv_path && !c->json && !c->pictures;
     c->csv_stdout = c->csv_path ? strcmp(c->csv_path, "-") == 0
                                 : !c->json && !c->pictures && !c->table;
@@ -345,11 +379,19 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, 
         }
     }
     *ntraces = c->traces.n;
-    for (int k = 0; k < m->nout && *ntraces < MAX_TRACES; k++) {
+    int dropped = 0;
+    for (int k = 0; k < m->nout; k++) {
         const ModelOutput *o = &m->outputs[k];
-        if (o->point && o->at.q >= 0)    /* a point output's path; ground's stays put */
+        if (!o->point || o->at.q < 0)    /* a point output's path; ground's stays put */
+            continue;
+        if (*ntraces < MAX_TRACES)
             traces[(*ntraces)++] = (SvgTrace){o->at.q, o->at.has_phi, o->at.sx, o->at.sy, o->point};
+        else
+            dropped++;
     }
+    if (dropped > 0 && c->svg_path)
+        fprintf(stderr, "%s: note: the paths of %d point output%s are not drawn (at most %d "
+                "paths)\n", m->file, dropped, dropped == 1 ? "" : "s", MAX_TRACES);
     if (c->plot_path && c->plot_list) {
         *nvars = svg_plot_resolve(m, c->plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
         if (*nvars <= 0) {
@@ -359,6 +401,9 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, 
     } else if (c->plot_path) {
         for (int i = 0; i < m->nq + m->nout && *nvars < MAX_PLOT_VARS; i++)
             vars[(*nvars)++] = (SvgPlotVar){i, 0};
+        if (m->nq + m->nout > MAX_PLOT_VARS)
+            fprintf(stderr, "%s: note: --plot shows the first %d of %d variables; choose "
+                    "them with --plot-vars\n", m->file, MAX_PLOT_VARS, m->nq + m->nout);
     }
     return true;
 }
@@ -442,7 +487,7 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
 static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *pics)
 {
     Output out = {.csv = NULL, .json = c->json || c->pictures || c->table, .digits = c->digits,
-                  .t0 = c->ro.t0, .t1 = c->ro.t1};
+                  .t0 = c->ro.t0, .t1 = c->ro.t1, .file = m->file};
     if (c->csv_stdout) {
         out.csv = stdout;
     } else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {

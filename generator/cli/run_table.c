@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/arena.h"
+
 enum { COLUMN = 17 };
 
 /* Largest magnitude among v[0..n) (0 when none). */
@@ -24,11 +26,15 @@ static double column_scale(const double *v, int n)
     return big;
 }
 
-static void put_value(FILE *out, double v, double scale, int digits)
+static void put_value(FILE *out, double v, double scale, int width, int digits)
 {
-    if (fabs(v) < 1e-12 * scale)
-        v = 0;
-    fprintf(out, "  %*.*g", COLUMN, digits, v);
+    if (isnan(v)) {
+        fprintf(out, "  %*s", width, "nan");
+        return;
+    }
+    if (v == 0 || fabs(v) < 1e-12 * scale)
+        v = 0;      /* and -0 too */
+    fprintf(out, "  %*.*g", width, digits, v);
 }
 
 /* Whether coordinate i is a body's angle. */
@@ -42,12 +48,12 @@ static bool is_angle(const Model *m, int i)
 
 static int name_width(const Model *m)
 {
-    int w = 10;
+    size_t w = 10;
     for (int i = 0; i < m->nq; i++)
-        w = (int)fmax(w, (double)strlen(m->coord_names[i]));
+        w = strlen(m->coord_names[i]) > w ? strlen(m->coord_names[i]) : w;
     for (int k = 0; k < m->nout; k++)
-        w = (int)fmax(w, (double)strlen(m->outputs[k].name));
-    return w;
+        w = strlen(m->outputs[k].name) > w ? strlen(m->outputs[k].name) : w;
+    return (int)w;
 }
 
 /* One block: a heading, then a row per name with value, rate and rate of rate. */
@@ -57,12 +63,13 @@ static void put_block(FILE *out, const Model *m, const char *heading, const char
     double scale[3];
     for (int k = 0; k < 3; k++)
         scale[k] = column_scale(v[k], n);
-    fprintf(out, "%-*s  %*s  %*s  %*s\n", width, heading, COLUMN, "position", COLUMN, "velocity",
-            COLUMN, "acceleration");
+    int column = digits + 7 > COLUMN ? digits + 7 : COLUMN;   /* -1.2345e-123 */
+    fprintf(out, "%-*s  %*s  %*s  %*s\n", width, heading, column, "position", column, "velocity",
+            column, "acceleration");
     for (int i = 0; i < n; i++) {
         fprintf(out, "%-*s", width, names[i]);
         for (int k = 0; k < 3; k++)
-            put_value(out, v[k][i], scale[k], digits);
+            put_value(out, v[k][i], scale[k], column, digits);
         if (angles && is_angle(m, i))
             fprintf(out, "   (%.*g deg)", digits < 8 ? digits : 8, v[0][i] * 180 / M_PI);
         fputc('\n', out);
@@ -80,7 +87,7 @@ void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
     const double *const qv[3] = {s->q, s->qd, s->qdd};
     put_block(out, m, "coordinate", m->coord_names, m->nq, qv, true, width, digits);
     if (m->nout > 0 && s->y) {
-        const char **names = malloc((size_t)m->nout * sizeof *names);
+        const char **names = xmalloc((size_t)m->nout * sizeof *names);
         for (int k = 0; k < m->nout; k++)
             names[k] = m->outputs[k].name;
         const double *const yv[3] = {s->y, s->yd, s->ydd};

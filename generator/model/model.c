@@ -39,6 +39,7 @@ typedef struct Builder {
     Row *pos_rows, *vel_rows;
     int npos, nvel, cap_pos, cap_vel;
     int cap_outputs;
+    SrcPos unit_use[2];     /* first use of deg, rpm as units (offset -1: none) */
 } Builder;
 
 static const char *entity_word(EntityKind kind)
@@ -90,18 +91,18 @@ static int line_of(const Builder *b, SrcPos pos)
 /* Units textbook data is written in, as constants: 30*deg, 1500*rpm.
    They are not reserved: a file that declares one of these names (a param
    deg from before they existed) uses its own. */
-static bool unit_value(const char *name, double *value)
+static const struct { const char *name; double value; } units[2] = {
+    {"deg", 3.14159265358979323846 / 180},   /* degree, in radians */
+    {"rpm", 3.14159265358979323846 / 30},    /* revolution per minute, in rad/s */
+};
+
+/* The index of a unit name in units[], or -1. */
+static int unit_index(const char *name)
 {
-    static const struct { const char *name; double value; } units[] = {
-        {"deg", 3.14159265358979323846 / 180},   /* degree, in radians */
-        {"rpm", 3.14159265358979323846 / 30},    /* revolution per minute, in rad/s */
-    };
-    for (size_t i = 0; i < sizeof units / sizeof *units; i++)
-        if (strcmp(name, units[i].name) == 0) {
-            *value = units[i].value;
-            return true;
-        }
-    return false;
+    for (int i = 0; i < (int)(sizeof units / sizeof *units); i++)
+        if (strcmp(name, units[i].name) == 0)
+            return i;
+    return -1;
 }
 
 static Entity *lookup(Builder *b, const char *name, SrcPos pos)
@@ -121,6 +122,11 @@ static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos
                   line_of(b, b->entities[index].pos));
     grow(&b->scratch, (void **)&b->entities, &b->cap_entities, b->nentities + 1,
          sizeof *b->entities);
+    int u = unit_index(name);
+    if (u >= 0 && b->unit_use[u].offset >= 0)     /* one name, one meaning per file */
+        diag_fail(b->diag, pos, "'%s' was used as the unit %s on line %d: declare it before "
+                  "its first use, or choose another name", name, name,
+                  line_of(b, b->unit_use[u]));
     Entity *e = &b->entities[b->nentities];
     *e = (Entity){.kind = kind, .name = name, .pos = pos, .q = -1};
     strmap_put(&b->names, name, b->nentities++);
@@ -212,10 +218,12 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
             diag_fail(b->diag, ast->pos, "'t' cannot appear in %s", context_what(ctx));
         return dag_time(dag);
     case AST_NAME: {
-        double unit;
-        int declared;
-        if (!strmap_get(&b->names, ast->name, &declared) && unit_value(ast->name, &unit))
-            return dag_const(dag, unit);
+        int declared, u = unit_index(ast->name);
+        if (u >= 0 && !strmap_get(&b->names, ast->name, &declared)) {
+            if (b->unit_use[u].offset < 0)
+                b->unit_use[u] = ast->pos;
+            return dag_const(dag, units[u].value);
+        }
         Entity *e = lookup(b, ast->name, ast->pos);
         if (e->kind == ENT_PARAM)
             return dag_const(dag, e->value);
@@ -471,6 +479,9 @@ static ModelOutput *last_output(Builder *b)
 static void build_output(Builder *b, const Stmt *s)
 {
     declare(b, ENT_OUTPUT, s->name, s->name_pos);
+    if (mentions_der(s->value))
+        diag_fail(b->diag, s->pos, "output '%s' contains der(): an output is a value of the "
+                  "coordinates and t, whose velocity run reports anyway", s->name);
     if (s->value) {
         push_output(b, s->name, "", lower_expr(b, s->value, EXPR_HOLONOMIC));
         return;
@@ -490,7 +501,8 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     m->name = default_name;
     const Stmt *last = NULL;
     for (const Stmt *s = prog->first; s; s = s->next) {
-        last = s;
+        if (s->kind != STMT_OUTPUT)     /* messages about the rows point at a row */
+            last = s;
         m->dag.where = s->pos.offset;
         switch (s->kind) {
         case STMT_MECHANISM:
@@ -572,7 +584,8 @@ Model *model_load(const char *text, int text_len, const char *file,
         model_free(m);
         return NULL;
     }
-    Builder b = {.model = m, .diag = diag, .limits = limits};
+    Builder b = {.model = m, .diag = diag, .limits = limits,
+                 .unit_use = {{.offset = -1}, {.offset = -1}}};
     strmap_init(&b.names);
     arena_init(&b.scratch);
     bool ok = build_protected(&b, &prog, arena_strdup(&m->arena, default_name));

@@ -371,12 +371,14 @@ static int find_coord(const Model *m, const char *name, size_t len)
    the list of coordinates (shortened for big mechanisms). */
 static void unknown_name(const Model *m, const char *name, size_t len, char *err, size_t errlen)
 {
+    int nv = m->nq + m->nout;
+    const char *what = m->nout ? "coordinate or output" : "coordinate";
     size_t used = 0;
-    int n = snprintf(err, errlen, "--plot-vars: unknown coordinate '%.*s'", (int)len, name);
+    int n = snprintf(err, errlen, "--plot-vars: unknown %s '%.*s'", what, (int)len, name);
     used = n > 0 ? (size_t)n : 0;
     int members = 0;
-    for (int i = 0; i < m->nq; i++) {
-        const char *c = m->coord_names[i];
+    for (int i = 0; i < nv; i++) {
+        const char *c = svg_plot_var_label(m, i);
         if (strncmp(c, name, len) == 0 && c[len] == '.') {
             n = snprintf(err + used, used < errlen ? errlen - used : 0, "%s%s", members++ ? ", " : "; did you mean ", c);
             used += n > 0 ? (size_t)n : 0;
@@ -384,14 +386,15 @@ static void unknown_name(const Model *m, const char *name, size_t len, char *err
     }
     if (members > 0)
         return;
-    n = snprintf(err + used, used < errlen ? errlen - used : 0, "; coordinates are ");
+    n = snprintf(err + used, used < errlen ? errlen - used : 0, "; %s are ",
+                 m->nout ? "coordinates and outputs" : "coordinates");
     used += n > 0 ? (size_t)n : 0;
-    for (int i = 0; i < m->nq && used + 1 < errlen; i++) {
-        if (i == 8 && m->nq > 9) {
-            snprintf(err + used, errlen - used, ", ... (%d in all)", m->nq);
+    for (int i = 0; i < nv && used + 1 < errlen; i++) {
+        if (i == 8 && nv > 9) {
+            snprintf(err + used, errlen - used, ", ... (%d in all)", nv);
             return;
         }
-        n = snprintf(err + used, errlen - used, "%s%s", i ? ", " : "", m->coord_names[i]);
+        n = snprintf(err + used, errlen - used, "%s%s", i ? ", " : "", svg_plot_var_label(m, i));
         used += n > 0 ? (size_t)n : 0;
     }
 }
