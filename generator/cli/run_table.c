@@ -8,11 +8,11 @@
  */
 #include "run_table.h"
 
+#include "../base/arena.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "../base/arena.h"
 
 enum { COLUMN = 17 };
 
