@@ -110,9 +110,14 @@ void joints_lower(Model *model, const Joint *j, NodeId rows[3])
         rows[0] = dag_add(d, dag_vard(d, j->a.q), dag_mul(d, j->option, dag_vard(d, j->a.q + 2)));
         return;
     /* knife J: n_A . d/dt(P_A) (no velocity across the blade) */
-    case JOINT_KNIFE:
-        rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), velocity(d, j->a));
+    case JOINT_KNIFE: {
+        /* v before n, in statements: node ids follow the order nodes are
+           made in, which must not be the compiler's order of arguments */
+        Vec v = velocity(d, j->a);
+        Vec n = normal(d, j->a, j->ux, j->uy);
+        rows[0] = dot(d, n, v);
         return;
+    }
     case JOINT_KIND_COUNT:
         break;
     }

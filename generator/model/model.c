@@ -248,8 +248,14 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
         return dag_vard(dag, coordinate_of(b, ast->lhs));
     case AST_NEG:
         return dag_neg(dag, lower_expr(b, ast->lhs, ctx));
-    case AST_BINARY:
-        return dag_apply(dag, ast->op, lower_expr(b, ast->lhs, ctx), lower_expr(b, ast->rhs, ctx));
+    case AST_BINARY: {
+        /* right operand first, in sequenced statements: argument order is
+           unspecified in C, and node ids (so the generated C) must not
+           depend on the compiler; gcc had been lowering the right first */
+        NodeId y = lower_expr(b, ast->rhs, ctx);
+        NodeId x = lower_expr(b, ast->lhs, ctx);
+        return dag_apply(dag, ast->op, x, y);
+    }
     case AST_CALL: {
         NodeId x = lower_expr(b, ast->lhs, ctx);
         NodeId y = ast->rhs ? lower_expr(b, ast->rhs, ctx) : DAG_NONE;
@@ -430,7 +436,9 @@ static void build_joint(Builder *b, const Stmt *s)
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
         ExprContext ctx = j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC;
-        j->expr = dag_sub(&m->dag, lower(b, s->lhs, ctx), lower(b, s->rhs, ctx));
+        NodeId rhs = lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
+        NodeId lhs = lower(b, s->lhs, ctx);
+        j->expr = dag_sub(&m->dag, lhs, rhs);
     }
     m->njoints++;
     NodeId rows[3];
