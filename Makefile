@@ -46,6 +46,7 @@ help:
 	@echo "make check      set up, build and run every test (cmocka + CLI + generated C)"
 	@echo "make check-asan the same tests under AddressSanitizer and UBSan"
 	@echo "make check-valgrind  the cmocka suites under valgrind memcheck"
+	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
 	@echo "make bench      time the engines side by side (bench/run)"
@@ -124,6 +125,15 @@ check-valgrind: deps
 
 # An example's animated SVG rendered in headless Chromium at two instants
 # (tests/browser/run); installs Debian's chromium first when missing.
+# The output must not depend on the compiler that built mechc: a clang
+# build prints byte for byte what the gcc build does on every example.
+.PHONY: check-compilers
+check-compilers: deps
+	$(Q)sh .ci/deps fuzz
+	$(Q)$(MAKE) --no-print-directory $(MECHC)
+	$(Q)$(MAKE) --no-print-directory BUILD=build-clang CC=clang build-clang/mechc
+	$(Q)sh tests/same_outputs $(MECHC) build-clang/mechc
+
 .PHONY: check-browser
 check-browser: deps
 	$(Q)sh .ci/deps browser
@@ -182,6 +192,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/share/mechc $(DESTDIR)$(PREFIX)/include/mechc
 
 clean:
-	rm -rf build build-asan $(FUZZ_BUILD)
+	rm -rf build build-asan build-clang $(FUZZ_BUILD)
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

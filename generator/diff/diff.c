@@ -58,6 +58,18 @@ static NodeId leaf_rule(const Differ *df, const DagNode *n, NodeId e, int code)
 
 static NodeId derive(Differ *df, NodeId e, int code);
 
+/* a'b + ab'. Node ids follow the order nodes are made in and name the
+   generated C's temporaries, and C leaves the order of evaluating a call's
+   arguments unspecified: where a rule makes two nodes for one call, they
+   are made in statements of their own (the right one first, the order gcc
+   used), so the output does not depend on the compiler that built mechc. */
+static NodeId product_rule(Dag *d, NodeId a, NodeId da, NodeId b, NodeId db)
+{
+    NodeId adb = dag_mul(d, a, db);
+    NodeId dab = dag_mul(d, da, b);
+    return dag_add(d, dab, adb);
+}
+
 /* The chain rule: d f(a, b) = f_a da + f_b db, written per operation. */
 static NodeId chain_rule(Differ *df, NodeId e, int code)
 {
@@ -73,8 +85,8 @@ static NodeId chain_rule(Differ *df, NodeId e, int code)
     case OP_NEG: return dag_neg(d, da);
     case OP_ADD: return dag_add(d, da, db);
     case OP_SUB: return dag_sub(d, da, db);
-    /* (ab)' = a'b + ab' */
-    case OP_MUL: return dag_add(d, dag_mul(d, da, b), dag_mul(d, a, db));
+    /* (ab)' = a'b + ab' (ab' made first: see product_rule) */
+    case OP_MUL: return product_rule(d, a, da, b, db);
     /* (a/b)' = (a' - (a/b) b') / b */
     case OP_DIV: return dag_div(d, dag_sub(d, da, dag_mul(d, e, db)), b);
     case OP_POW: {
@@ -82,8 +94,9 @@ static NodeId chain_rule(Differ *df, NodeId e, int code)
         if (dag_is_const(d, b, &c))      /* (a^c)' = c a^(c-1) a' */
             return dag_mul(d, dag_mul(d, b, dag_pow(d, a, dag_const(d, c - 1.0))), da);
         /* (a^b)' = a^b (b' log a + b a'/a) */
-        return dag_mul(d, e, dag_add(d, dag_mul(d, db, dag_call(d, OP_LOG, a, DAG_NONE)),
-                                     dag_div(d, dag_mul(d, b, da), a)));
+        NodeId ratio = dag_div(d, dag_mul(d, b, da), a);
+        NodeId logs = dag_mul(d, db, dag_call(d, OP_LOG, a, DAG_NONE));
+        return dag_mul(d, e, dag_add(d, logs, ratio));
     }
     case OP_SIN:  return dag_mul(d, dag_call(d, OP_COS, a, DAG_NONE), da);
     case OP_COS:  return dag_neg(d, dag_mul(d, dag_call(d, OP_SIN, a, DAG_NONE), da));
@@ -97,9 +110,12 @@ static NodeId chain_rule(Differ *df, NodeId e, int code)
     }
     case OP_ATAN: return dag_div(d, da, dag_add(d, DAG_ONE, dag_mul(d, a, a)));
     /* atan2(y, x)' = (x y' - y x') / (x^2 + y^2) */
-    case OP_ATAN2:
-        return dag_div(d, dag_sub(d, dag_mul(d, b, da), dag_mul(d, a, db)),
-                       dag_add(d, dag_mul(d, a, a), dag_mul(d, b, b)));
+    case OP_ATAN2: {
+        NodeId bb = dag_mul(d, b, b), aa = dag_mul(d, a, a);
+        NodeId r2 = dag_add(d, aa, bb);
+        NodeId adb = dag_mul(d, a, db), bda = dag_mul(d, b, da);
+        return dag_div(d, dag_sub(d, bda, adb), r2);
+    }
     /* sqrt' = a' / (2 sqrt a) */
     case OP_SQRT: return dag_div(d, dag_mul(d, dag_const(d, 0.5), da), e);
     case OP_EXP:  return dag_mul(d, e, da);

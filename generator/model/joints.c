@@ -3,6 +3,12 @@
  * Planar helpers over node ids (vec_add, rotate, dot, ...) keep every
  * builder a transcription of spec section 2: P = r + A(phi) s,
  * n_A = A(phi_A) (-uy, ux).
+ *
+ * Node ids follow the order nodes are made in, and they name the
+ * temporaries of the generated C; C leaves the order of evaluating a
+ * call's arguments unspecified, so every node here is made in a statement
+ * of its own (in the order gcc used to pick: a call's arguments right to
+ * left), and the output is the same whichever compiler built mechc.
  */
 #include "model.h"
 
@@ -12,16 +18,37 @@ typedef struct Vec {
     NodeId x, y;
 } Vec;
 
-static Vec vec_sub(Dag *d, Vec a, Vec b) { return (Vec){dag_sub(d, a.x, b.x), dag_sub(d, a.y, b.y)}; }
-static NodeId dot(Dag *d, Vec a, Vec b) { return dag_add(d, dag_mul(d, a.x, b.x), dag_mul(d, a.y, b.y)); }
-static Vec vec_const(Dag *d, double x, double y) { return (Vec){dag_const(d, x), dag_const(d, y)}; }
+static Vec vec_sub(Dag *d, Vec a, Vec b)
+{
+    NodeId x = dag_sub(d, a.x, b.x);
+    NodeId y = dag_sub(d, a.y, b.y);
+    return (Vec){x, y};
+}
+
+static NodeId dot(Dag *d, Vec a, Vec b)
+{
+    NodeId yy = dag_mul(d, a.y, b.y);
+    NodeId xx = dag_mul(d, a.x, b.x);
+    return dag_add(d, xx, yy);
+}
+
+static Vec vec_const(Dag *d, double x, double y)
+{
+    NodeId cx = dag_const(d, x);
+    NodeId cy = dag_const(d, y);
+    return (Vec){cx, cy};
+}
 
 /* A(phi) v = (cos phi vx - sin phi vy, sin phi vx + cos phi vy) */
 static Vec rotate(Dag *d, NodeId phi, Vec v)
 {
-    NodeId c = dag_call(d, OP_COS, phi, DAG_NONE), s = dag_call(d, OP_SIN, phi, DAG_NONE);
-    return (Vec){dag_sub(d, dag_mul(d, c, v.x), dag_mul(d, s, v.y)),
-                 dag_add(d, dag_mul(d, s, v.x), dag_mul(d, c, v.y))};
+    NodeId c = dag_call(d, OP_COS, phi, DAG_NONE);
+    NodeId s = dag_call(d, OP_SIN, phi, DAG_NONE);
+    NodeId sy = dag_mul(d, s, v.y), cx = dag_mul(d, c, v.x);
+    NodeId x = dag_sub(d, cx, sy);
+    NodeId cy = dag_mul(d, c, v.y), sx = dag_mul(d, s, v.x);
+    NodeId y = dag_add(d, sx, cy);
+    return (Vec){x, y};
 }
 
 static NodeId angle_of(Dag *d, Attach at)
@@ -34,11 +61,15 @@ static Vec position(Dag *d, Attach at)
 {
     if (at.q < 0)
         return vec_const(d, at.sx, at.sy);
-    Vec r = {dag_var(d, at.q), dag_var(d, at.q + 1)};
+    NodeId rx = dag_var(d, at.q);
+    NodeId ry = dag_var(d, at.q + 1);
     if (!at.has_phi)
-        return r;
-    Vec s = rotate(d, angle_of(d, at), vec_const(d, at.sx, at.sy));
-    return (Vec){dag_add(d, r.x, s.x), dag_add(d, r.y, s.y)};
+        return (Vec){rx, ry};
+    Vec local = vec_const(d, at.sx, at.sy);
+    Vec s = rotate(d, angle_of(d, at), local);
+    NodeId x = dag_add(d, rx, s.x);
+    NodeId y = dag_add(d, ry, s.y);
+    return (Vec){x, y};
 }
 
 /* dP/dt = r' + phi' * (-(A s)_y, (A s)_x): the velocity of a body-fixed point. */
@@ -46,12 +77,18 @@ static Vec velocity(Dag *d, Attach at)
 {
     if (at.q < 0)
         return vec_const(d, 0.0, 0.0);
-    Vec v = {dag_vard(d, at.q), dag_vard(d, at.q + 1)};
+    NodeId vx = dag_vard(d, at.q);
+    NodeId vy = dag_vard(d, at.q + 1);
     if (!at.has_phi)
-        return v;
+        return (Vec){vx, vy};
     NodeId w = dag_vard(d, at.q + 2);
-    Vec s = rotate(d, angle_of(d, at), vec_const(d, at.sx, at.sy));
-    return (Vec){dag_sub(d, v.x, dag_mul(d, w, s.y)), dag_add(d, v.y, dag_mul(d, w, s.x))};
+    Vec local = vec_const(d, at.sx, at.sy);
+    Vec s = rotate(d, angle_of(d, at), local);
+    NodeId wy = dag_mul(d, w, s.y);
+    NodeId x = dag_sub(d, vx, wy);
+    NodeId wx = dag_mul(d, w, s.x);
+    NodeId y = dag_add(d, vy, wx);
+    return (Vec){x, y};
 }
 
 /* n_A = A(phi_A) (-uy, ux): the body-fixed normal of the axis. */
@@ -61,42 +98,59 @@ static Vec normal(Dag *d, Attach at, double ux, double uy)
     return at.has_phi ? rotate(d, angle_of(d, at), n) : n;
 }
 
+/* P_p - P_q (P_q's nodes made first) */
+static Vec difference(Dag *d, Attach p, Attach q)
+{
+    Vec pq = position(d, q);
+    Vec pp = position(d, p);
+    return vec_sub(d, pp, pq);
+}
+
+/* phi_b - phi_a - theta */
+static NodeId relative_angle(Dag *d, Attach b, Attach a, NodeId theta)
+{
+    NodeId pa = angle_of(d, a);
+    NodeId pb = angle_of(d, b);
+    return dag_sub(d, dag_sub(d, pb, pa), theta);
+}
+
 void joints_lower(Model *model, const Joint *j, NodeId rows[3])
 {
     Dag *d = &model->dag;
     switch (j->kind) {
     /* revolute J: J.x, J.y = P_A - P_B */
     case JOINT_REVOLUTE: {
-        Vec e = vec_sub(d, position(d, j->a), position(d, j->b));
+        Vec e = difference(d, j->a, j->b);
         rows[0] = e.x;
         rows[1] = e.y;
         return;
     }
     /* prismatic J: J.n = n_A . (P_B - P_A); J.phi = phi_B - phi_A - theta */
     case JOINT_PRISMATIC: {
-        Vec e = vec_sub(d, position(d, j->b), position(d, j->a));
+        Vec e = difference(d, j->b, j->a);
         rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
-        rows[1] = dag_sub(d, dag_sub(d, angle_of(d, j->b), angle_of(d, j->a)), j->option);
+        rows[1] = relative_angle(d, j->b, j->a, j->option);
         return;
     }
     /* distance J: (P_B - P_A).(P_B - P_A) - L^2 */
     case JOINT_DISTANCE: {
-        Vec e = vec_sub(d, position(d, j->b), position(d, j->a));
-        rows[0] = dag_sub(d, dot(d, e, e), dag_mul(d, j->option, j->option));
+        Vec e = difference(d, j->b, j->a);
+        NodeId l2 = dag_mul(d, j->option, j->option);
+        rows[0] = dag_sub(d, dot(d, e, e), l2);
         return;
     }
     /* pointline J: n_A . (P_B - P_A) */
     case JOINT_POINTLINE: {
-        Vec e = vec_sub(d, position(d, j->b), position(d, j->a));
+        Vec e = difference(d, j->b, j->a);
         rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
         return;
     }
     /* weld J: J.x, J.y = P_A - P_B; J.phi = phi_B - phi_A - theta */
     case JOINT_WELD: {
-        Vec e = vec_sub(d, position(d, j->a), position(d, j->b));
+        Vec e = difference(d, j->a, j->b);
         rows[0] = e.x;
         rows[1] = e.y;
-        rows[2] = dag_sub(d, dag_sub(d, angle_of(d, j->b), angle_of(d, j->a)), j->option);
+        rows[2] = relative_angle(d, j->b, j->a, j->option);
         return;
     }
     /* constraint, driver, velocity J: lhs - rhs */
@@ -106,13 +160,13 @@ void joints_lower(Model *model, const Joint *j, NodeId rows[3])
         rows[0] = j->expr;
         return;
     /* rolling J: der(B.x) + R der(B.phi) (no slip on the ground line) */
-    case JOINT_ROLLING:
-        rows[0] = dag_add(d, dag_vard(d, j->a.q), dag_mul(d, j->option, dag_vard(d, j->a.q + 2)));
+    case JOINT_ROLLING: {
+        NodeId roll = dag_mul(d, j->option, dag_vard(d, j->a.q + 2));
+        rows[0] = dag_add(d, dag_vard(d, j->a.q), roll);
         return;
+    }
     /* knife J: n_A . d/dt(P_A) (no velocity across the blade) */
     case JOINT_KNIFE: {
-        /* v before n, in statements: node ids follow the order nodes are
-           made in, which must not be the compiler's order of arguments */
         Vec v = velocity(d, j->a);
         Vec n = normal(d, j->a, j->ux, j->uy);
         rows[0] = dot(d, n, v);
@@ -139,5 +193,6 @@ NodeId joints_slide(Model *model, const Joint *j)
     Vec u = vec_const(d, j->ux / len, j->uy / len);
     if (j->a.has_phi)
         u = rotate(d, angle_of(d, j->a), u);
-    return dot(d, u, vec_sub(d, position(d, j->b), position(d, j->a)));
+    Vec e = difference(d, j->b, j->a);
+    return dot(d, u, e);
 }
