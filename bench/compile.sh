@@ -2,12 +2,13 @@
 # bench/compile.sh MECHC - how compile times grow with the mechanism: chains
 # of N four-bar loops (examples/chain.sh), N = 10, 100, 1000.
 #
-# Columns: coordinates; operations of the fused `all`; seconds from the file
-# to machine code in process (read, derive, emit, libtcc; median of 5 runs
-# of `mechc gen --stats`), its ratio to N = 100; peak memory of that run;
-# then the CPU time (user + system, so that other load on the machine does
-# not count) of `gcc -O2 -c` on the written C (one run; GCC=... to choose
-# the compiler, GCC_O2=0 to skip). POSIX sh and awk only.
+# Columns: coordinates; operations of the fused `all`; CPU seconds (user +
+# system, so that other load on the machine does not count) of `mechc gen
+# --stats`, which goes from the file to machine code in process (read,
+# derive, emit the written C and the JIT's, libtcc; median of 5 runs), its
+# ratio to N = 100; peak memory; then the CPU time of `gcc -O2 -c` on the
+# written C (one run; GCC=... to choose the compiler, GCC_O2=0 to skip).
+# Needs /usr/bin/time. POSIX sh and awk only.
 set -u
 mechc=${1:-build/mechc}
 gcc=${GCC:-gcc}
@@ -17,14 +18,15 @@ tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc-compile.XXXXXX") || exit 1
 trap 'rm -rf "$tmp"' EXIT
 trap 'exit 1' INT TERM
 
-median5() {     # median5 FILE.mech: median of 5 "from the file to machine code" times
+median5() {     # median5 FILE.mech: median of 5 CPU times of mechc gen --stats
     for i in 1 2 3 4 5; do
-        "$mechc" gen "$1" --stats -o "$tmp/out.c" 2>&1 | sed -n 's/.*machine code \([0-9.]*\) s.*/\1/p'
+        /usr/bin/time -f '%U %S' "$mechc" gen "$1" --stats -o "$tmp/out.c" 2>&1 >/dev/null \
+            | tail -1 | awk '{ printf "%.3f\n", $1 + $2 }'
     done | sort -n | sed -n 3p
 }
 
 printf 'compile times, chains of N four-bar loops\n\n'
-printf '%6s %7s %8s | %9s %9s %9s | %9s\n' N nq "all ops" "to code s" "x N=100" "peak MB" "gcc cpu s"
+printf '%6s %7s %8s | %9s %9s %9s | %9s\n' N nq "all ops" "code cpu" "x N=100" "peak MB" "gcc cpu s"
 base=""
 for n in $chains; do
     f=$tmp/chain_$n.mech
@@ -32,7 +34,8 @@ for n in $chains; do
     stats=$("$mechc" gen "$f" --stats -o "$tmp/out.c" 2>&1)
     nq=$(echo "$stats" | sed -n 's/.*: \([0-9]*\) coordinates.*/\1/p')
     ops=$(echo "$stats" | sed -n 's/.*all \([0-9]*\).*/\1/p')
-    secs=$(median5 "$f")
+    secs=-
+    [ -x /usr/bin/time ] && secs=$(median5 "$f")
     [ "$n" = 100 ] && base=$secs
     ratio=$(awk -v s="$secs" -v b="$base" 'BEGIN { if (b > 0) printf "%.1f", s / b; else print "-" }')
     peak=-
