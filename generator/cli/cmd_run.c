@@ -171,6 +171,7 @@ static void print_table(const Model *m, const Output *out, const RunResult *res,
         .t = row[0], .q = row + 1, .qd = row + 1 + nv, .qdd = row + 1 + 2 * nv,
         .y = outputs ? row + 1 + nq : NULL, .yd = outputs ? row + 1 + nv + nq : NULL,
         .ydd = outputs ? row + 1 + 2 * nv + nq : NULL,
+        .ynames = out->names + nq,
         .assembly_iterations = res->assembly_iterations,
         .assembled_robustly = res->assembled_robustly,
     };
@@ -193,14 +194,13 @@ static void fill_variables(Output *out, double t, const double *q, const double 
    as such; the first one is said on stderr, with its time. */
 static void warn_nonfinite(Output *out, double t)
 {
-    for (int k = 0; k < 3 * out->nv && !out->warned; k++) {
-        int i = k % out->nv;
-        if (i >= out->nq && !isfinite(out->v[k])) {
-            fprintf(stderr, "%s: warning: output '%s' is not finite at t = %.10g (later ones "
-                    "are not reported)\n", out->file, out->names[i], t);
-            out->warned = true;
-        }
-    }
+    for (int k = 0; k < 3 && !out->warned; k++)
+        for (int i = out->nq; i < out->nv && !out->warned; i++)
+            if (!isfinite(out->v[k * out->nv + i])) {
+                fprintf(stderr, "%s: warning: output '%s' is not finite at t = %.10g (later "
+                        "ones are not reported)\n", out->file, out->names[i], t);
+                out->warned = true;
+            }
 }
 
 static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)

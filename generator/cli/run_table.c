@@ -8,10 +8,7 @@
  */
 #include "run_table.h"
 
-#include "../base/arena.h"
-
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 enum { COLUMN = 17 };
@@ -87,13 +84,9 @@ void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
     const double *const qv[3] = {s->q, s->qd, s->qdd};
     put_block(out, m, "coordinate", m->coord_names, m->nq, qv, true, width, digits);
     if (m->nout > 0 && s->y) {
-        const char **names = xmalloc((size_t)m->nout * sizeof *names);
-        for (int k = 0; k < m->nout; k++)
-            names[k] = m->outputs[k].name;
         const double *const yv[3] = {s->y, s->yd, s->ydd};
         fputc('\n', out);
-        put_block(out, m, "output", names, m->nout, yv, false, width, digits);
-        free(names);
+        put_block(out, m, "output", s->ynames, m->nout, yv, false, width, digits);
     }
     fputs("\nunits as in the file; angles in rad (velocity rad/s, acceleration rad/s^2)\n", out);
 }

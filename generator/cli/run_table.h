@@ -7,12 +7,13 @@
 #include "../model/model.h"
 
 /* One state: the coordinates (q, qd, qdd: nq each) and the outputs' values
-   (y, yd, ydd: m->nout each, NULL when there are none), with how assembly
+   (y, yd, ydd: m->nout each, named ynames; NULL when there are none), with how assembly
    went. digits: significant digits, 0 for 10. */
 typedef struct RunInstant {
     double t;
     const double *q, *qd, *qdd;
     const double *y, *yd, *ydd;
+    const char *const *ynames;  /* the outputs' names (m->nout) */
     int assembly_iterations;
     bool assembled_robustly;
 } RunInstant;
