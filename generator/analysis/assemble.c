@@ -61,7 +61,10 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
     double best = norm;
     int improved = 0;       /* the iteration that last cut the best norm by 1 % */
     for (int iter = 0; isfinite(norm); iter++) {
-        if (inf <= opt->tol_phi && (res->step < 0 || res->step <= opt->tol_dq)) {
+        /* at least one step: a start that satisfies the rows only to
+           tol_phi (placed by construction on a toggle, where rows vary
+           quadratically) is polished until the step is small too */
+        if (inf <= opt->tol_phi && res->step >= 0 && res->step <= opt->tol_dq) {
             ok = true;
             break;
         }

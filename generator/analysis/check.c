@@ -48,6 +48,7 @@
 
 #include "../../runtime/mechrt.h"
 #include "assemble.h"
+#include "construct.h"
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../engine/aot.h"
@@ -645,6 +646,7 @@ static bool assemble(Checker *c, double *q)
     k.all = NULL;
     size_t lwork = mechrt_workspace_size(c->nq, c->nr);
     double *work = xmalloc(lwork * sizeof *work);
+    construct_with_kernels(c->m, &k, 0.0, q);
     MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
     if (st != MECHRT_OK) {
         /* rough initial values: as run assembles them (run.c) */
@@ -652,6 +654,7 @@ static bool assemble(Checker *c, double *q)
         ao.stall_iter = ASSEMBLE_ROUGH_STALL;
         AssembleResult ar;
         memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
+        construct_with_kernels(c->m, &k, 0.0, q);
         if (assemble_restarting(&k, 0.0, q, &ao, &ar)
             && mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL) == MECHRT_OK)
             st = MECHRT_OK;

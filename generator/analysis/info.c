@@ -20,6 +20,7 @@
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../base/strbuf.h"
+#include "construct.h"
 #include "sparse.h"
 
 #include <math.h>
@@ -375,11 +376,13 @@ static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
+        rep->constructed = construct_with_eval(m, me, t, rep->q);
         rep->assembled = assemble_min_norm(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
         if (!rep->assembled) {      /* rough initial values: restarts, as run does */
             AnalysisOptions rough = *opt;
             rough.stall_iter = ASSEMBLE_ROUGH_STALL;
             memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
+            construct_with_eval(m, me, t, rep->q);
             rep->assembled = assemble_min_norm_restarting(me, hrows, nh, t, rep->q, &rough, w,
                                                           &rep->assembly);
         }

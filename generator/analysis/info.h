@@ -39,6 +39,8 @@ typedef struct InfoReport {
     double *q;              /* the assembled configuration (nq, malloc'd) */
     AssembleResult assembly;
     bool assembled;         /* converged, or nothing to assemble */
+    int constructed;        /* coordinates placed by construction before
+                               Newton (construct.h) */
     /* rank of the holonomic rows at q */
     bool dense;             /* rank computed (size within max_dense) */
     double rank_tol;

@@ -40,6 +40,7 @@
 
 #include "../base/arena.h"
 #include "assemble.h"
+#include "construct.h"
 #include "../pipeline/pipeline.h"
 
 #include <math.h>
@@ -185,11 +186,12 @@ static double describe_dependency(Run *r, const double *q, double t, int rows, b
     return ratio;
 }
 
-/* After an assembly from rough initial values: a configuration reached
-   only approximately because the Jacobian is singular there (a driven
-   position on a toggle) passes the LU's pivot test; it must fail as the
-   toggle it is, rather than give the huge velocities of a Jacobian
-   singular to 1e-9. True when sigma_min / sigma_max < RUN_NEAR_SINGULAR. */
+/* After the assembly at t0: a configuration reached only approximately
+   because the Jacobian is singular there (a driven position on a toggle,
+   which the construction or Newton approaches only linearly) passes the
+   LU's pivot test; it must fail as the toggle it is, rather than give the
+   huge velocities of a Jacobian singular to 1e-9. True when
+   sigma_min / sigma_max < RUN_NEAR_SINGULAR. */
 static bool nearly_singular(Run *r, double t)
 {
     if (r->nq > RUN_SVD_MAX_NQ)
@@ -301,6 +303,7 @@ static void fail_assembly(Run *r, const AssembleResult *ar);
 static bool assemble_robustly(Run *r)
 {
     const RunOptions *o = r->o;
+    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
     AnalysisOptions ao = analysis_default_options();
     ao.tol_phi = o->mechrt.tol_phi;
     ao.tol_dq = o->mechrt.tol_dq;
@@ -366,11 +369,23 @@ static void note_move(Run *r, const double *q0)
             scale = fabs(q0[i]);
     }
     r->res->assembly_move = moved;
-    if (r->res->assembled_robustly)
+    int it = r->res->assembly_iterations;
+    const char *its = it == 1 ? "iteration" : "iterations";
+    if (r->res->assembled_robustly && r->res->constructed > 0)
+        notef(r, "note", "Newton could not start from the file's initial values; %d of the %d "
+              "coordinates were placed by construction (drivers, pins, dyads: of two closures "
+              "the one nearer the initial values), then Newton assembled the mechanism at "
+              "t = %.10g in %d %s", r->res->constructed, r->nq, r->o->t0, it, its);
+    else if (r->res->assembled_robustly)
         notef(r, "note", "Newton could not start from the file's initial values; minimum-norm "
-              "Newton assembled the mechanism at t = %.10g in %d iterations (initial values "
-              "near the configuration you mean choose its assembly branch)", r->o->t0,
-              r->res->assembly_iterations);
+              "Newton assembled the mechanism at t = %.10g in %d %s (initial values "
+              "near the configuration you mean choose its assembly branch)", r->o->t0, it, its);
+    else if (moved > r->o->move_note * (scale > 0 ? scale : 1) && r->res->constructed > 0)
+        notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
+              "(%s: %.6g -> %.6g): %d of the %d coordinates were placed by construction "
+              "(drivers, pins, dyads: of two closures the one nearer the initial values), "
+              "then Newton took %d %s", r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at],
+              r->res->constructed, r->nq, it, its);
     else if (moved > r->o->move_note * (scale > 0 ? scale : 1))
         notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
               "(%s: %.6g -> %.6g); the file's values are only Newton's starting point",
@@ -614,6 +629,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
     memcpy(q0, r->q, nq * sizeof *q0);
+    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
     MechrtStatus st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work,
                                   r->lwork, &rep);
     r->res->assembly_iterations = rep.iterations;
@@ -628,10 +644,10 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work, r->lwork,
                          &rep);
         r->res->assembly_iterations += rep.iterations;
-        if (st == MECHRT_OK && nearly_singular(r, o->t0)) {
-            st = MECHRT_ESING;
-            rep.sing_index = -1;
-        }
+    }
+    if (st == MECHRT_OK && nearly_singular(r, o->t0)) {
+        st = MECHRT_ESING;
+        rep.sing_index = -1;
     }
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
@@ -682,6 +698,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     r->res->integrated = true;
     double *q0 = xmalloc((size_t)r->nq * sizeof *q0);
     memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
+    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
     r->res->assembly_iterations = rep.iterations;
     if (st != MECHRT_OK && st != MECHRT_EINVAL) {

@@ -63,6 +63,8 @@ typedef struct RunResult {
     int warnings;                /* nearly singular episodes warned about */
     double assembly_move;        /* ||q(t0) - q0||_inf */
     int assembly_iterations;     /* Newton (or Gauss-Newton) iterations at t0 */
+    int constructed;             /* coordinates placed by construction at t0
+                                    (construct.h), before Newton */
     bool assembled_robustly;     /* Newton from the initial values failed and
                                     minimum-norm Newton assembled instead */
     /* per-step statistics, over the steps after t0 */

@@ -248,15 +248,19 @@ static void print_assembly(const InfoReport *rep)
     const Model *m = rep->model;
     printf("\nassembly at t = %g (minimum-norm Newton on the holonomic rows%s):\n  ", rep->t,
            rep->dense ? "" : ", sparse QR");
-    if (rep->nh == 0)
+    if (rep->nh == 0) {
         printf("nothing to assemble (no holonomic rows)\n");
-    else
-        printf("%s after %d iteration%s, residual %.3g%s%s\n",
-               rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
-               rep->assembly.iterations == 1 ? "" : "s", rep->assembly.residual,
-               rep->assembly.worst_row >= 0 && !rep->assembled ? ", worst row " : "",
-               rep->assembly.worst_row >= 0 && !rep->assembled
-                   ? m->rows[rep->assembly.worst_row].name : "");
+        return;
+    }
+    if (rep->constructed > 0)
+        printf("%d of %d coordinates placed by construction (drivers, pins, dyads), then\n  ",
+               rep->constructed, m->nq);
+    printf("%s after %d iteration%s, residual %.3g%s%s\n",
+           rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
+           rep->assembly.iterations == 1 ? "" : "s", rep->assembly.residual,
+           rep->assembly.worst_row >= 0 && !rep->assembled ? ", worst row " : "",
+           rep->assembly.worst_row >= 0 && !rep->assembled
+               ? m->rows[rep->assembly.worst_row].name : "");
 }
 
 /* Rank, singular values, the configuration's verdict and the redundant rows. */

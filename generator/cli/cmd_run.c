@@ -174,6 +174,7 @@ static void print_table(const Model *m, const Output *out, const RunResult *res,
         .ynames = out->names + nq,
         .assembly_iterations = res->assembly_iterations,
         .assembled_robustly = res->assembled_robustly,
+        .constructed = res->constructed,
     };
     run_table_print(stdout, m, &s, digits);
 }
@@ -273,7 +274,10 @@ static void print_stats(const RunResult *res, const MechrtKernels *k, const doub
     if (n == 0) {           /* one instant: only the assembly */
         fprintf(stderr, "mechc run: stats: assembly at t0 in %d Newton %s%s\n",
                 res->assembly_iterations, res->assembly_iterations == 1 ? "iteration" : "iterations",
-                res->assembled_robustly ? " (minimum-norm Newton from rough initial values)" : "");
+                res->assembled_robustly ? " (from rough initial values)" : "");
+        if (res->constructed > 0)
+            fprintf(stderr, "mechc run: stats: %d %s placed by construction before Newton\n",
+                    res->constructed, res->constructed == 1 ? "coordinate" : "coordinates");
         return;
     }
     double ns_step = n > 0 ? 1e9 * res->step_seconds / n : 0;

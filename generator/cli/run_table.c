@@ -78,8 +78,13 @@ void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
     digits = digits > 0 ? digits : 10;
     int width = name_width(m);
     fprintf(out, "%s at t = %.10g", m->name, s->t);
-    if (s->assembled_robustly)
-        fprintf(out, " (assembled from rough initial values in %d iterations)", s->assembly_iterations);
+    int it = s->assembly_iterations;
+    const char *its = it == 1 ? "iteration" : "iterations";
+    if (s->constructed > 0)
+        fprintf(out, " (%d of %d coordinates placed by construction, then %d Newton %s%s)",
+                s->constructed, m->nq, it, its, s->assembled_robustly ? " from rough values" : "");
+    else if (s->assembled_robustly)
+        fprintf(out, " (assembled from rough initial values in %d %s)", it, its);
     fputs("\n\n", out);
     const double *const qv[3] = {s->q, s->qd, s->qdd};
     put_block(out, m, "coordinate", m->coord_names, m->nq, qv, true, width, digits);

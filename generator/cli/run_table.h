@@ -16,6 +16,7 @@ typedef struct RunInstant {
     const char *const *ynames;  /* the outputs' names (m->nout) */
     int assembly_iterations;
     bool assembled_robustly;
+    int constructed;        /* coordinates placed by construction first */
 } RunInstant;
 
 void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits);
