@@ -700,6 +700,44 @@ static void test_assembly_examples_zero_angles(void **state)
     pipeline_free(mech);
 }
 
+/* Offset slider-cranks of several proportions at 12 crank angles, every
+   guess 0: the slider where the closed form puts it (ahead of the crank
+   pin: the closure nearer the rod's guessed angle 0), in at most twice the
+   1 iteration of exact guesses. */
+static void test_slider_crank_sweep_zero_guesses(void **state)
+{
+    (void)state;
+    static const double shapes[][3] = {{0.1, 0.3, 0}, {0.1, 0.3, 0.05}, {0.2, 0.5, -0.1}, {1, 4, 0.5}};
+    RunOptions o = run_default_options();
+    o.steps = 0;
+    for (size_t g = 0; g < sizeof shapes / sizeof *shapes; g++) {
+        double r = shapes[g][0], l = shapes[g][1], e = shapes[g][2];
+        for (int k = 0; k < 12; k++) {
+            double th = 2 * M_PI * k / 12 + 0.05;
+            char text[512];
+            snprintf(text, sizeof text, "body crank\nbody rod\nbody slider\n"
+                     "revolute O: ground(0, 0) crank(-%.17g, 0)\n"
+                     "revolute A: crank(%.17g, 0) rod(-%.17g, 0)\n"
+                     "revolute B: rod(%.17g, 0) slider(0, 0)\n"
+                     "prismatic P: ground(0, %.17g) slider(0, 0) axis(1, 0)\n"
+                     "driver D: crank.phi = %.17g\n", r / 2, r / 2, l / 2, l / 2, e, th);
+            Mech *mech = load_text(text, "sc_sweep.mech");
+            Collected c;
+            run_with(mech, ENGINE_JIT, o, &c);
+            expect_ok(&c, 0);
+            const Model *m = mech->model;
+            const double *st = state_at(&c, 0);
+            double h = e - r * sin(th);
+            assert_near(st[1 + coord_index(m, "slider.x")], r * cos(th) + sqrt(l * l - h * h), 1e-12,
+                        1e-12);
+            assert_near(st[1 + coord_index(m, "slider.y")], e, 1e-12, 1e-12);
+            assert_true(c.res.assembly_iterations <= 2);
+            collected_free(&c);
+            pipeline_free(mech);
+        }
+    }
+}
+
 /* The four-bar from rough guesses: the construction closes the dyad on the
    side of the guesses (the rocker's angle below the ground line gives the
    crossed branch), and with every guess 0 on the left of the line from the
@@ -1222,6 +1260,7 @@ int main(void)
         cmocka_unit_test(test_assembly_from_zero_guesses),
         cmocka_unit_test(test_assembly_examples_zero_angles),
         cmocka_unit_test(test_construction_picks_branch),
+        cmocka_unit_test(test_slider_crank_sweep_zero_guesses),
         cmocka_unit_test(test_one_instant),
         cmocka_unit_test(test_outputs_slider_crank),
         cmocka_unit_test(test_rough_assembly_keeps_free_coordinates),

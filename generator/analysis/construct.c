@@ -159,11 +159,16 @@ static void set_link(Place *p, int q, P2 K, double sx, double sy, P2 P, double s
     p->q[q + 2] = phi;
 }
 
-static double distance_sq(const double *a, const double *b, int n)
+/* How far two placements of a dyad's links (x, y, phi each) are apart:
+   angles in radians, positions in units of the dyad's size, so that the
+   choice does not depend on the file's length unit. */
+static double distance_sq(const double *a, const double *b, double size)
 {
     double sum = 0.0;
-    for (int i = 0; i < n; i++)
-        sum += (a[i] - b[i]) * (a[i] - b[i]);
+    for (int i = 0; i < 6; i++) {
+        double d = (a[i] - b[i]) / (i % 3 == 2 ? 1.0 : size);
+        sum += d * d;
+    }
     return sum;
 }
 
@@ -202,7 +207,7 @@ static void close_dyad(Place *p, const Side *a, const Side *b, const P2 cand[2],
         }
         memcpy(trial, p->q + a->q, 3 * sizeof *trial);
         memcpy(trial + 3, p->q + b->q, 3 * sizeof *trial);
-        double d = distance_sq(trial, guess, 6);
+        double d = distance_sq(trial, guess, side_length(a) + side_length(b));
         if (d < best_d * (1.0 - 1e-9)) {
             best_d = d;
             memcpy(best, trial, sizeof best);
@@ -336,7 +341,7 @@ static bool place_dyad(Place *p, int j)
             double c = n.x * (pa.x - off.x) + n.y * (pa.y - off.y);
             if (!(side_length(&a) > 0.0) || circle_line(a.K, side_length(&a), n, c, cand) == 0)
                 continue;
-            Side b = {mb->q, {0, 0}, 0, 0, mb->sx, mb->sy};
+            Side b = {mb->q, {0, 0}, mb->sx, mb->sy, mb->sx, mb->sy};   /* no length */
             close_dyad(p, &a, &b, cand, 2, phi_b);
             return true;
         }

@@ -19,7 +19,8 @@ typedef struct ConstructRows {
  * two placed points is placed; an RRR dyad (two links pinned to each other
  * and each to a placed point) is closed by intersecting two circles, an
  * RRP dyad (the second link slides on a placed line) by a circle and a
- * line. Of the two closures the one nearer the initial values in q is
+ * line. Of the two closures the one nearer the initial values in q (angles
+ * in radians, positions relative to the dyad's size) is
  * taken (the left one, seen from the first pin to the second, when both
  * are as near: all angles 0). Rounds repeat until nothing more is placed.
  * q is updated in place; coordinates nothing fixes keep their values.
