@@ -29,6 +29,32 @@ static const BadInput bad_inputs[] = {
     {"coord c\nrolling R: c radius = 1\n", 2, 12, "rolling attaches to a body"},
     {"coord c\nbody b\nprismatic P: c b axis(1,0)\n", 3, 14, "prismatic attaches to bodies or ground"},
     {"param k = 1\nbody b\nrevolute R: k b\n", 3, 13, "revolute attaches to bodies, points or ground"},
+    /* spatial files (issue 14): the `spatial` statement, the dimension of
+       every statement, axes and orientations */
+    {"body b\nspatial\n", 2, 1, "'spatial' must be the first statement"},
+    {"mechanism m\nspatial\nspatial\n", 3, 1, "a second 'spatial' statement (the first is on line 2)"},
+    {"body b\nspherical S: ground b\n", 2, 1, "'spherical' is a spatial joint: a spatial mechanism says 'spatial'"},
+    {"spatial\nbody b\nprismatic P: ground b axis(1,0)\n", 3, 1, "'prismatic' is a planar joint, and this file is spatial ('spatial' on line 1)"},
+    {"spatial\nbody b\nknife K: b axis(1, 0, 0)\n", 3, 1, "'knife' is a planar joint"},
+    {"body b z = 1\n", 1, 8, "'z' is for spatial files"},
+    {"body b orient = axis(0, 0, 1, 1)\n", 1, 8, "'orient' is for spatial files"},
+    {"spatial\nbody b phi = 1\n", 2, 8, "a spatial body has no 'phi'"},
+    {"spatial\nbody b orient = axis(0, 0, 0, 1)\n", 2, 8, "cannot be normalised: its axis is zero"},
+    {"spatial\nbody b orient = axis(0, 0, 1)\n", 2, 29, "orient = axis(ux, uy, uz, angle) has four components, found three"},
+    {"spatial\nbody b orient = abc(0, 0, 1)\n", 2, 17, "axis(ux, uy, uz, angle), xyz(a, b, c) or zyx(a, b, c)"},
+    {"spatial\nbody b\nspherical S: ground(1, 2) b\n", 3, 25, "has three components, found two"},
+    {"spatial\nbody b\nspherical S: ground(1, 2, 3, 4) b\n", 3, 30, "has three components, found more"},
+    {"spatial\nbody b\nrevolute R: ground b axis(0, 0, 0)\n", 3, 22, "the axis of revolute 'R' is zero"},
+    {"spatial\nbody b\nrevolute R: ground b axis(1, 0)\n", 3, 31, "has three components, found two"},
+    {"spatial\nbody b\nrevolute R: ground b\n", 3, 21, "'axis(ux, uy, uz)' after the attachments of revolute 'R'"},
+    {"spatial\nbody b\nuniversal U: ground b axis(1, 0, 0)\n", 3, 36, "B's axis: universal 'U' takes two axes"},
+    {"spatial\nbody b\nrevolute R: ground b axis(0, 0, 1) axis(0, 0, 1) axis(1, 0, 0)\n", 3, 50, "at most two axes"},
+    {"spatial\nbody b\nspherical S: ground b axis(0, 0, 1)\n", 3, 23, "spherical joints take no 'axis'"},
+    {"spatial\nbody b\nspherical S: ground b\ndriver D: angle(S) = t\n", 4, 17, "angle() takes a revolute or cylindrical joint; 'S' is spherical"},
+    {"spatial\nbody b\nrevolute R: ground b axis(0, 0, 1)\ndriver D: slide(R) = t\n", 4, 17, "slide() takes a translational or cylindrical joint; 'R' is revolute"},
+    {"spatial\nbody b\nconstraint C: b.phi = 0\n", 3, 17, "body 'b' has no coordinate 'phi' (it has x, y, z, e0, e1, e2 and e3)"},
+    {"spatial\npoint p\nconstraint C: p.e0 = 0\n", 3, 17, "point 'p' has no coordinate 'e0' (it has x, y and z)"},
+    {"spatial\nbody b\nrolling R: b radius = 1\n", 3, 24, "'axis(ux, uy, uz)' after the attachments of rolling 'R'"},
 };
 
 static void test_bad_inputs(void **state)

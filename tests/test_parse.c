@@ -109,6 +109,9 @@ static void render(const Ast *a, char *buf, size_t size)
     case AST_SLIDE:
         put(buf, size, "(slide %s)", a->name);
         return;
+    case AST_ANGLE:
+        put(buf, size, "(angle %s)", a->name);
+        return;
     case AST_DER:
         put(buf, size, "(der ");
         render(a->lhs, buf, size);
@@ -785,8 +788,25 @@ static void test_joint_table(void **state)
     assert_int_equal(joint_info[JOINT_DRIVER].level, LEVEL_EITHER);
     for (int k = 0; k < JOINT_KIND_COUNT; k++) {
         const char *kw = joint_info[k].keyword;
-        assert_int_equal(joint_kind_from_keyword(kw, (int)strlen(kw)), k);
+        if (joint_info[k].dim == DIM_INTERNAL) {     /* rows the model adds: no statement */
+            assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), false), -1);
+            assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), true), -1);
+            continue;
+        }
+        bool spatial = joint_info[k].dim == DIM_SPATIAL;
+        assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), spatial), k);
+        assert_true(joint_info[k].rows <= JOINT_MAX_ROWS);
+        assert_non_null(joint_info[k].suffix[joint_info[k].rows - 1]);
     }
+    /* one keyword, two kinds: the file's dimension picks */
+    assert_int_equal(joint_kind_lookup("revolute", 8, true), JOINT_S_REVOLUTE);
+    assert_int_equal(joint_kind_lookup("weld", 4, true), JOINT_S_WELD);
+    assert_int_equal(joint_kind_lookup("driver", 6, true), JOINT_DRIVER);
+    assert_int_equal(joint_kind_lookup("prismatic", 9, true), -1);
+    assert_int_equal(joint_kind_lookup("spherical", 9, false), -1);
+    assert_int_equal(joint_info[JOINT_S_REVOLUTE].rows, 5);
+    assert_string_equal(joint_info[JOINT_S_WELD].suffix[5], ".zx");
+    assert_int_equal(joint_info[JOINT_S_UNIVERSAL].axis, 2);
 }
 
 /* Reads a file of the repository (from the root or from tests/) into buf. */
@@ -807,14 +827,18 @@ static void read_repo_file(const char *path, char *buf, size_t size)
     buf[n] = '\0';
 }
 
-/* Every joints.def kind is used in all_statements.mech, the file the
-   jit/generic/aot and finite-difference agreement tests compile (and in
-   its copy among the fuzz seeds), so a new kind cannot go untested. */
+/* Every joints.def kind is used in all_statements.mech (planar) or
+   all_spatial.mech (spatial), the files the jit/generic/aot and
+   finite-difference agreement tests compile (and in their copies among
+   the fuzz seeds), so a new kind cannot go untested. Rows the model adds
+   itself (DIM_INTERNAL) come with every spatial body and rolling disk. */
 static void test_all_statements_has_every_kind(void **state)
 {
     Parsed *r = *state;
     static const char *const files[] = {"examples/all_statements.mech",
-                                        "tests/fuzz/corpus/all_statements.mech"};
+                                        "tests/fuzz/corpus/all_statements.mech",
+                                        "examples/all_spatial.mech",
+                                        "tests/fuzz/corpus/all_spatial.mech"};
     static char text[1 << 16];
     for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
         read_repo_file(files[f], text, sizeof text);
@@ -824,7 +848,7 @@ static void test_all_statements_has_every_kind(void **state)
             if (st->kind == STMT_JOINT)
                 seen[st->joint] = true;
         for (int k = 0; k < JOINT_KIND_COUNT; k++)
-            if (!seen[k])
+            if (!seen[k] && joint_kind_in((JointKind)k, prog->spatial))
                 fail_msg("%s has no '%s' statement", files[f], joint_info[k].keyword);
     }
 }
