@@ -771,6 +771,48 @@ static void test_long_flat_expression(void **state)
     free(text);
 }
 
+/* A spatial file: the flag, bodies with z and orient, three-component
+   offsets, two axes in any order with the option, angle() in expressions. */
+static void test_spatial(void **state)
+{
+    Parsed *r = *state;
+    const Program *prog = parse_ok(r,
+        "mechanism m\n"
+        "spatial\n"                                                      /* 1 */
+        "body b x = 1 z = -2 orient = zyx(0.1, 0.2, pi)\n"               /* 2 */
+        "point p y = 3 z = 4\n"                                          /* 3 */
+        "revolute R: ground(1, 2, 3) b(0, 0, 1) axis(0, 0, 1) axis(1, 0, 0)\n" /* 4 */
+        "rolling D: b radius = 0.5 axis(0, 1, 0)\n"                      /* 5 */
+        "driver A: angle(R) = 2*t\n");                                   /* 6 */
+    assert_true(prog->spatial);
+    assert_int_equal(nth_stmt(prog, 1)->kind, STMT_SPATIAL);
+    const Stmt *b = nth_stmt(prog, 2);
+    assert_string_equal(show(r, b->init[0]), "1");
+    assert_null(b->init[1]);
+    assert_string_equal(show(r, b->init[2]), "(neg 2)");
+    assert_int_equal(b->orient, ORIENT_ZYX);
+    assert_string_equal(show(r, b->orient_arg[2]), "3.1415926535897931");
+    assert_pos(r, b->orient_pos, 3, 21);
+    assert_string_equal(show(r, nth_stmt(prog, 3)->init[2]), "4");
+    const Stmt *j = nth_stmt(prog, 4);
+    assert_int_equal(j->joint, JOINT_S_REVOLUTE);
+    assert_string_equal(show(r, j->attach[0].sz), "3");
+    assert_string_equal(show(r, j->attach[1].sz), "1");
+    assert_string_equal(show(r, j->axis[2]), "1");
+    assert_string_equal(show(r, j->axis_b[0]), "1");
+    assert_pos(r, j->axis_b_pos, 5, 54);
+    const Stmt *d = nth_stmt(prog, 5);
+    assert_int_equal(d->joint, JOINT_S_ROLLING);
+    assert_string_equal(show(r, d->option), "0.5");
+    assert_string_equal(show(r, d->axis[1]), "1");
+    assert_string_equal(show(r, nth_stmt(prog, 6)->lhs), "(angle R)");
+    /* without `spatial`, angle(...) is no construct and revolute is planar */
+    arena_free(&r->arena);
+    prog = parse_ok(r, "revolute R: ground(1, 2) b\n");
+    assert_false(prog->spatial);
+    assert_int_equal(prog->first->joint, JOINT_REVOLUTE);
+}
+
 static void test_joint_table(void **state)
 {
     (void)state;
@@ -868,6 +910,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_bad_inputs, setup, teardown),
         cmocka_unit_test_setup_teardown(test_deep_nesting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_long_flat_expression, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_spatial, setup, teardown),
         cmocka_unit_test(test_joint_table),
         cmocka_unit_test_setup_teardown(test_all_statements_has_every_kind, setup, teardown),
     };

@@ -51,10 +51,6 @@ int joint_kind_from_keyword(const char *word, int len);
 int joint_kind_lookup(const char *word, int len, bool spatial);
 /* Whether kind may be written in a file of that dimension. */
 bool joint_kind_in(JointKind kind, bool spatial);
-static inline bool joint_kind_is_spatial(JointKind kind)
-{
-    return kind >= JOINT_S_SPHERICAL;
-}
 
 /* ---- expressions ---- */
 
