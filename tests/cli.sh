@@ -258,4 +258,23 @@ check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
 check "gen --prefix int (a C keyword) exits 2" status_is 2
 
+# ---- spatial mechanisms (issue 14): gen, eval, check and bench work on them
+for f in rssr all_spatial slider_crank_spatial rolling_disk; do
+    run check "$ex/$f.mech" --samples 4
+    check "check $f (spatial): derivatives, engines agree (exit 0)" status_is 0
+    check "check $f (spatial): the last line says so" out_has "ok: every comparison is within its tolerance"
+done
+run eval "$ex/rssr.mech" --engine generic --json
+check "eval --engine generic on a spatial file: exit 0" status_is 0
+check "eval: the .norm rows are rows like any other" out_has '{"name": "crank.norm", "kind": "body", "level": "position", "joint": "crank"}'
+run eval "$ex/rssr.mech" --json
+cp "$tmp/out" "$tmp/rssr_jit.json"
+run eval "$ex/rssr.mech" --json --engine generic
+check "eval: generic (interpreted spatial rows) prints what jit prints" cmp -s "$tmp/out" "$tmp/rssr_jit.json"
+run gen "$ex/rssr.mech" --real float -o "$tmp/rssr_float.c"
+check "gen --real float on a spatial file: exit 0" status_is 0
+check "gen: the driven angle's row needs sin and cos of t only" grep -q "sinf\|P_sincos" "$tmp/rssr_float.c"
+run info "$ex/all_spatial.mech" --json
+check "info --json: rolling's contact row is kind contact" out_has '"name": "roll.h", "kind": "contact"'
+
 suite_end

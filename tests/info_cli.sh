@@ -149,6 +149,34 @@ else
     skip "python3 not found: JSON parse checks"
 fi
 
+# ---- spatial mechanisms (issue 14) ----------------------------------------
+# Bricard: the count says it cannot move, the rank finds one redundant row
+# and 1 DOF (examples/bricard.mech's header)
+run info "$ex/bricard.mech"
+check "bricard: exit 0" status_is 0
+check "bricard: the count says 0 DOF" out_has "35 coordinates - 35 holonomic - 0 velocity-level rows = 0 DOF"
+check "bricard: rank deficiency 34 of 35" out_has "holonomic rows: rank 34 of 35"
+check "bricard: permanent, not a singular pose" out_has "a permanent redundancy"
+check "bricard: names the redundant row" out_has "redundant rows: J6.g (joint J6)"
+check "bricard: 1 DOF by the rank" out_has "DOF by the rank: 1 with drivers, 1 without"
+check "bricard: the verdict" out_has "the mechanism moves with 1 DOF, row J6.g is redundant"
+# the rolling disk: its no-slip rows are nonholonomic (Frobenius test)
+run info "$ex/rolling_disk.mech"
+check "rolling disk: exit 0" status_is 0
+check "rolling disk: roll.x not integrable" grep -q "^  roll.x  *not integrable (nonholonomic)" "$tmp/out"
+check "rolling disk: roll.y not integrable" grep -q "^  roll.y  *not integrable (nonholonomic)" "$tmp/out"
+check "rolling disk: the rows together, drivers left out: nonholonomic" \
+    grep -A1 -q "drivers left out" "$tmp/out"
+check "rolling disk: ... and the verdict there is nonholonomic" \
+    sh -c "grep -A1 'drivers left out' '$tmp/out' | grep -q '^  nonholonomic'"
+check "rolling disk: the contact row is holonomic" out_has "roll.h"
+check "rolling disk: 3 DOF without the drivers" out_has "without its 3 drivers: 3 DOF by the count, 3 by the rank"
+# every spatial body's normalisation row is a row like any other
+run info "$ex/rssr.mech"
+check "rssr: counts the .norm rows" out_has "14 coordinates, 14 rows (14 holonomic, 0 velocity level)"
+check "rssr: crank.norm listed" grep -q "^  crank.norm  *crank  *body  *position" "$tmp/out"
+check "rssr: 1 DOF without its driver" out_has "without its 1 driver: 1 DOF by the count, 1 by the rank"
+
 # rough initial values (every guess 0): info assembles them as run does
 sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/' "$ex/four_bar.mech" > "$tmp/fb0.mech"
 run info "$tmp/fb0.mech" --json

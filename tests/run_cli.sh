@@ -35,6 +35,93 @@ near() {
     awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= tol) }'
 }
 
+# ---- spatial mechanisms (issue 14) ----------------------------------------
+# slider_crank_spatial.mech equals slider_crank.mech: x, y of every body,
+# phi = 2 atan2(e3, e0) (mod 2 pi), d(phi) = 2 (e0 e3' - e3 e0') = wz and
+# dd(phi) = 2 (e0 e3'' - e3 e0''), every step, to 1e-12
+run "$ex/slider_crank.mech" --csv "$tmp/sc2.csv"
+run "$ex/slider_crank_spatial.mech" --csv "$tmp/sc3.csv"
+check "spatial slider-crank: exit 0" status_is 0
+check "spatial slider-crank: as many rows as the planar run" \
+    test "$(wc -l < "$tmp/sc2.csv")" = "$(wc -l < "$tmp/sc3.csv")"
+check "spatial slider-crank: the wz columns follow the d() columns" \
+    sh -c "head -1 '$tmp/sc3.csv' | grep -q ',d(slider.e3),crank.wx,crank.wy,crank.wz,rod.wx,'"
+# spatial_vs_planar: the largest difference over every body, quantity and step
+spatial_vs_planar() {
+    paste -d, "$tmp/sc2.csv" "$tmp/sc3.csv" | awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) if (!($i in c)) c[$i] = i; else c2[$i] = i; next }
+    function col(name) { return (name in c2) ? c2[name] : c[name] }
+    function v(name) { return $(col(name)) }
+    function wrap(a) { while (a > pi) a -= 2 * pi; while (a < -pi) a += 2 * pi; return a }
+    function put(d) { if (d < 0) d = -d; if (d > worst) worst = d }
+    BEGIN { pi = atan2(0, -1); worst = 0 }
+    {
+        split("crank rod slider", b, " ")
+        for (k = 1; k <= 3; k++) {
+            n = b[k]
+            put(v(n ".x") - $(c[n ".x"])); put(v(n ".y") - $(c[n ".y"]))
+            put(v("d(" n ".x)") - $(c["d(" n ".x)"])); put(v("d(" n ".y)") - $(c["d(" n ".y)"]))
+            put(v("dd(" n ".x)") - $(c["dd(" n ".x)"])); put(v("dd(" n ".y)") - $(c["dd(" n ".y)"]))
+            e0 = v(n ".e0"); e3 = v(n ".e3")
+            put(wrap(2 * atan2(e3, e0) - $(c[n ".phi"])))
+            put(2 * (e0 * v("d(" n ".e3)") - e3 * v("d(" n ".e0)")) - $(c["d(" n ".phi)"]))
+            put(v(n ".wz") - $(c["d(" n ".phi)"]))
+            put(2 * (e0 * v("dd(" n ".e3)") - e3 * v("dd(" n ".e0)")) - $(c["dd(" n ".phi)"]))
+            put(v(n ".z")); put(v(n ".e1")); put(v(n ".e2"))
+        }
+    }
+    END { printf "largest difference %.3g\n", worst > "/dev/stderr"; exit !(NR > 100 && worst <= 1e-12) }'
+}
+check "spatial slider-crank: x, y, phi and their rates equal the planar file's to 1e-12" spatial_vs_planar
+# the RSSR's output angle against its closed form (examples/rssr.mech)
+run "$ex/rssr.mech" --steps 8 --csv "$tmp/rssr.csv"
+check "rssr: exit 0" status_is 0
+rssr_closed_form() {
+    awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    function acos(x) { return atan2(sqrt(1 - x * x), x) }
+    BEGIN { pi = atan2(0, -1); worst = 0 }
+    {
+        th = 2 * pi * $1
+        P = 6 * (2 - cos(th)); Q = -3 * sqrt(2) * sin(th); R = 4 * cos(th) - 4
+        psi = atan2(Q, P) + acos(R / sqrt(P * P + Q * Q))
+        d = $(c["psi"]) - psi
+        while (d > pi) d -= 2 * pi; while (d < -pi) d += 2 * pi
+        if (d < 0) d = -d; if (d > worst) worst = d
+    }
+    END { exit !(NR == 10 && worst <= 1e-9) }' "$tmp/rssr.csv"
+}
+check "rssr: psi = atan2(Q, P) + acos(R / sqrt(P^2 + Q^2)) at 9 crank angles, to 1e-9" rssr_closed_form
+check "rssr: psi(0.25) = 1.5506466765" near "$(value_at 0.25 psi "$tmp/rssr.csv")" 1.5506466764710545 1e-9
+# omega in JSON, beside the Euler-parameter rates
+run "$ex/rolling_disk.mech" --steps 2 --json
+check "rolling disk: runs (integrated, projected)" status_is 0
+check "rolling disk JSON: omega_names" out_has '"omega_names": ["disk.wx", "disk.wy", "disk.wz"]'
+check "rolling disk JSON: wz = 0.4 at t = 0 (its Turn driver), wy = V/R = 1" out_has '"omega": [[0, 1, 0.4]'
+run "$ex/slider_crank.mech" --steps 2 --json
+check "planar JSON: no omega key" sh -c "! grep -q omega '$tmp/out'"
+# pictures: refused for now, --plot works
+run "$ex/rssr.mech" --svg "$tmp/rssr.svg"
+check "spatial --svg: exit 2" status_is 2
+check "spatial --svg: says why" err_has "--svg draws planar mechanisms only, and this one is spatial"
+run "$ex/rssr.mech" --plot "$tmp/rssr_plot.svg" --plot-vars 'psi,d(psi)'
+check "spatial --plot: exit 0" status_is 0
+check "spatial --plot: a chart" grep -q "d(psi)" "$tmp/rssr_plot.svg"
+# bad spatial input: FILE:LINE:COL, the line and a caret, exit 2
+printf 'spatial\nbody b\nrevolute R: ground b axis(0, 0, 0)\n' > "$tmp/zero_axis.mech"
+run "$tmp/zero_axis.mech"
+check "zero axis: exit 2" status_is 2
+check "zero axis: FILE:LINE:COL" err_has "zero_axis.mech:3:22: error: the axis of revolute 'R' is zero"
+check "zero axis: the caret under the axis" err_matches '^ *\^'
+printf 'body b\nspherical S: ground b\n' > "$tmp/not_spatial.mech"
+run "$tmp/not_spatial.mech"
+check "spatial joint in a planar file: exit 2" status_is 2
+check "spatial joint in a planar file: says to write spatial" err_has "not_spatial.mech:2:1: error: 'spherical' is a spatial joint"
+printf 'spatial\nbody b\npointline L: ground b axis(1, 0)\n' > "$tmp/planar_in_spatial.mech"
+run "$tmp/planar_in_spatial.mech"
+check "planar joint in a spatial file: exit 2" status_is 2
+check "planar joint in a spatial file: names it" err_has "planar_in_spatial.mech:3:1: error: 'pointline' is a planar joint"
+
 # ---- help and usage ------------------------------------------------------
 run --help
 check "run --help exits 0" status_is 0
@@ -202,7 +289,7 @@ for f in "$ex"/*.mech; do
     name=$(basename "$f" .mech)
     case $name in
         pendulum_distance|pendulum_constraint) want=2 ;;
-        parallelogram_redundant|slider_crank_toggle) want=1 ;;
+        parallelogram_redundant|slider_crank_toggle|bricard) want=1 ;;
         *) want=0 ;;
     esac
     run "$f" --csv /dev/null

@@ -198,6 +198,14 @@ static void test_kernels_velocity_rows(void **s)
     check_kernels("all_statements.mech");
 }
 
+/* Every spatial kind, the rows of bodies and rolling disks the model adds,
+   and both levels: generic (interpreted spatial rows), jit and aot agree. */
+static void test_kernels_spatial_rows(void **s)
+{
+    (void)s;
+    check_kernels("all_spatial.mech");
+}
+
 /* A copy of k, taken before the Engine is moved and the old place
    poisoned, still evaluates, and gives what it gave before. */
 static void test_kernels_survive_a_moved_engine(void **s)
@@ -271,6 +279,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kernels_position_rows),
         cmocka_unit_test(test_kernels_velocity_rows),
+        cmocka_unit_test(test_kernels_spatial_rows),
         cmocka_unit_test(test_kernels_survive_a_moved_engine),
         cmocka_unit_test(test_runtime_assembles_through_k),
     };

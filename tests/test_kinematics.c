@@ -792,6 +792,7 @@ static void test_examples_consistency(void **state)
     static const char *const files[] = {
         "four_bar", "slider_crank", "five_bar", "elliptical_trammel", "all_statements",
         "knife_cart", "rolling_wheel", "skate_velocity", "parallelogram_redundant",
+        "slider_crank_spatial",
     };
     for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
         char path[256];

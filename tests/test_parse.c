@@ -109,6 +109,9 @@ static void render(const Ast *a, char *buf, size_t size)
     case AST_SLIDE:
         put(buf, size, "(slide %s)", a->name);
         return;
+    case AST_ANGLE:
+        put(buf, size, "(angle %s)", a->name);
+        return;
     case AST_DER:
         put(buf, size, "(der ");
         render(a->lhs, buf, size);
@@ -768,6 +771,48 @@ static void test_long_flat_expression(void **state)
     free(text);
 }
 
+/* A spatial file: the flag, bodies with z and orient, three-component
+   offsets, two axes in any order with the option, angle() in expressions. */
+static void test_spatial(void **state)
+{
+    Parsed *r = *state;
+    const Program *prog = parse_ok(r,
+        "mechanism m\n"
+        "spatial\n"                                                      /* 1 */
+        "body b x = 1 z = -2 orient = zyx(0.1, 0.2, pi)\n"               /* 2 */
+        "point p y = 3 z = 4\n"                                          /* 3 */
+        "revolute R: ground(1, 2, 3) b(0, 0, 1) axis(0, 0, 1) axis(1, 0, 0)\n" /* 4 */
+        "rolling D: b radius = 0.5 axis(0, 1, 0)\n"                      /* 5 */
+        "driver A: angle(R) = 2*t\n");                                   /* 6 */
+    assert_true(prog->spatial);
+    assert_int_equal(nth_stmt(prog, 1)->kind, STMT_SPATIAL);
+    const Stmt *b = nth_stmt(prog, 2);
+    assert_string_equal(show(r, b->init[0]), "1");
+    assert_null(b->init[1]);
+    assert_string_equal(show(r, b->init[2]), "(neg 2)");
+    assert_int_equal(b->orient, ORIENT_ZYX);
+    assert_string_equal(show(r, b->orient_arg[2]), "3.1415926535897931");
+    assert_pos(r, b->orient_pos, 3, 21);
+    assert_string_equal(show(r, nth_stmt(prog, 3)->init[2]), "4");
+    const Stmt *j = nth_stmt(prog, 4);
+    assert_int_equal(j->joint, JOINT_S_REVOLUTE);
+    assert_string_equal(show(r, j->attach[0].sz), "3");
+    assert_string_equal(show(r, j->attach[1].sz), "1");
+    assert_string_equal(show(r, j->axis[2]), "1");
+    assert_string_equal(show(r, j->axis_b[0]), "1");
+    assert_pos(r, j->axis_b_pos, 5, 54);
+    const Stmt *d = nth_stmt(prog, 5);
+    assert_int_equal(d->joint, JOINT_S_ROLLING);
+    assert_string_equal(show(r, d->option), "0.5");
+    assert_string_equal(show(r, d->axis[1]), "1");
+    assert_string_equal(show(r, nth_stmt(prog, 6)->lhs), "(angle R)");
+    /* without `spatial`, angle(...) is no construct and revolute is planar */
+    arena_free(&r->arena);
+    prog = parse_ok(r, "revolute R: ground(1, 2) b\n");
+    assert_false(prog->spatial);
+    assert_int_equal(prog->first->joint, JOINT_REVOLUTE);
+}
+
 static void test_joint_table(void **state)
 {
     (void)state;
@@ -785,8 +830,25 @@ static void test_joint_table(void **state)
     assert_int_equal(joint_info[JOINT_DRIVER].level, LEVEL_EITHER);
     for (int k = 0; k < JOINT_KIND_COUNT; k++) {
         const char *kw = joint_info[k].keyword;
-        assert_int_equal(joint_kind_from_keyword(kw, (int)strlen(kw)), k);
+        if (joint_info[k].dim == DIM_INTERNAL) {     /* rows the model adds: no statement */
+            assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), false), -1);
+            assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), true), -1);
+            continue;
+        }
+        bool spatial = joint_info[k].dim == DIM_SPATIAL;
+        assert_int_equal(joint_kind_lookup(kw, (int)strlen(kw), spatial), k);
+        assert_true(joint_info[k].rows <= JOINT_MAX_ROWS);
+        assert_non_null(joint_info[k].suffix[joint_info[k].rows - 1]);
     }
+    /* one keyword, two kinds: the file's dimension picks */
+    assert_int_equal(joint_kind_lookup("revolute", 8, true), JOINT_S_REVOLUTE);
+    assert_int_equal(joint_kind_lookup("weld", 4, true), JOINT_S_WELD);
+    assert_int_equal(joint_kind_lookup("driver", 6, true), JOINT_DRIVER);
+    assert_int_equal(joint_kind_lookup("prismatic", 9, true), -1);
+    assert_int_equal(joint_kind_lookup("spherical", 9, false), -1);
+    assert_int_equal(joint_info[JOINT_S_REVOLUTE].rows, 5);
+    assert_string_equal(joint_info[JOINT_S_WELD].suffix[5], ".zx");
+    assert_int_equal(joint_info[JOINT_S_UNIVERSAL].axis, 2);
 }
 
 /* Reads a file of the repository (from the root or from tests/) into buf. */
@@ -807,14 +869,18 @@ static void read_repo_file(const char *path, char *buf, size_t size)
     buf[n] = '\0';
 }
 
-/* Every joints.def kind is used in all_statements.mech, the file the
-   jit/generic/aot and finite-difference agreement tests compile (and in
-   its copy among the fuzz seeds), so a new kind cannot go untested. */
+/* Every joints.def kind is used in all_statements.mech (planar) or
+   all_spatial.mech (spatial), the files the jit/generic/aot and
+   finite-difference agreement tests compile (and in their copies among
+   the fuzz seeds), so a new kind cannot go untested. Rows the model adds
+   itself (DIM_INTERNAL) come with every spatial body and rolling disk. */
 static void test_all_statements_has_every_kind(void **state)
 {
     Parsed *r = *state;
     static const char *const files[] = {"examples/all_statements.mech",
-                                        "tests/fuzz/corpus/all_statements.mech"};
+                                        "tests/fuzz/corpus/all_statements.mech",
+                                        "examples/all_spatial.mech",
+                                        "tests/fuzz/corpus/all_spatial.mech"};
     static char text[1 << 16];
     for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
         read_repo_file(files[f], text, sizeof text);
@@ -824,7 +890,7 @@ static void test_all_statements_has_every_kind(void **state)
             if (st->kind == STMT_JOINT)
                 seen[st->joint] = true;
         for (int k = 0; k < JOINT_KIND_COUNT; k++)
-            if (!seen[k])
+            if (!seen[k] && joint_kind_in((JointKind)k, prog->spatial))
                 fail_msg("%s has no '%s' statement", files[f], joint_info[k].keyword);
     }
 }
@@ -844,6 +910,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_bad_inputs, setup, teardown),
         cmocka_unit_test_setup_teardown(test_deep_nesting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_long_flat_expression, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_spatial, setup, teardown),
         cmocka_unit_test(test_joint_table),
         cmocka_unit_test_setup_teardown(test_all_statements_has_every_kind, setup, teardown),
     };

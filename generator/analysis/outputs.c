@@ -8,6 +8,10 @@
  * (eval/interp.h), no derivative nodes are built: one order-2 pass along
  * (qd, 1) gives f, D f and D(D f), one order-1 pass along (qdd, 0) gives
  * f_q qdd.
+ *
+ * A spatial body's angular velocity is not a function of q and t but of
+ * its Euler parameters and their rates: omega = 2 E(p) p' (Haug 1989,
+ * eq. 6.3.18), computed here directly, three values per body.
  */
 #include "outputs.h"
 
@@ -16,9 +20,47 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The spatial bodies' angular velocity columns and their names. */
+static void omega_init(OutputEval *oe, const Model *m)
+{
+    int n = 0;
+    for (int b = 0; b < m->nbodies; b++)
+        n += m->bodies[b].spatial && m->bodies[b].nq == 7;
+    if (n == 0)
+        return;
+    oe->nw = 3 * n;
+    oe->wq = xcalloc((size_t)n, sizeof *oe->wq);
+    oe->wnames = xcalloc((size_t)oe->nw, sizeof *oe->wnames);
+    static const char *const suffix[3] = {".wx", ".wy", ".wz"};
+    n = 0;
+    for (int b = 0; b < m->nbodies; b++) {
+        const Body *body = &m->bodies[b];
+        if (!body->spatial || body->nq != 7)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            char *name = xmalloc(strlen(body->name) + 4);
+            strcpy(name, body->name);
+            strcat(name, suffix[k]);
+            oe->wnames[3 * n + k] = name;
+        }
+        oe->wq[n++] = body->q;
+    }
+}
+
+void outputs_omega(const OutputEval *oe, const double *q, const double *qd, double *w)
+{
+    for (int i = 0; i < oe->nw / 3; i++) {
+        const double *p = q + oe->wq[i] + 3, *v = qd + oe->wq[i] + 3;
+        w[3 * i] = 2 * (-p[1] * v[0] + p[0] * v[1] - p[3] * v[2] + p[2] * v[3]);
+        w[3 * i + 1] = 2 * (-p[2] * v[0] + p[3] * v[1] + p[0] * v[2] - p[1] * v[3]);
+        w[3 * i + 2] = 2 * (-p[3] * v[0] - p[2] * v[1] + p[1] * v[2] + p[0] * v[3]);
+    }
+}
+
 void outputs_init(OutputEval *oe, const Model *m)
 {
     memset(oe, 0, sizeof *oe);
+    omega_init(oe, m);
     oe->n = m->nout;
     if (oe->n == 0)
         return;
@@ -41,6 +83,10 @@ void outputs_free(OutputEval *oe)
         tape_free(&oe->tapes[k]);
     free(oe->tapes);
     free(oe->reg);
+    for (int k = 0; k < oe->nw; k++)
+        free(oe->wnames[k]);
+    free(oe->wnames);
+    free(oe->wq);
     memset(oe, 0, sizeof *oe);
 }
 

@@ -10,6 +10,9 @@ typedef struct OutputEval {
     int n;                  /* the model's nout */
     Tape *tapes;
     Jet *reg;               /* registers for the longest program */
+    int nw;                 /* angular velocities: 3 per spatial body */
+    int *wq;                /* their bodies' x coordinates, nw / 3 */
+    char **wnames;          /* NAME.wx NAME.wy NAME.wz, nw */
 } OutputEval;
 
 void outputs_init(OutputEval *oe, const Model *m);
@@ -19,5 +22,9 @@ void outputs_free(OutputEval *oe);
    (n values each; yd, ydd may be NULL, and qd, qdd then too). */
 void outputs_eval(const OutputEval *oe, const double *q, const double *qd, const double *qdd,
                   double t, double *y, double *yd, double *ydd);
+
+/* The angular velocity omega = 2 E(p) p' (global frame), E = [-e, e~ + e0 I],
+   of every spatial body: w[3 i .. 3 i + 2] for the i-th, oe->nw values. */
+void outputs_omega(const OutputEval *oe, const double *q, const double *qd, double *w);
 
 #endif

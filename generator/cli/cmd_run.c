@@ -136,6 +136,7 @@ typedef struct Output {
     OutputEval outputs;
     double *v;              /* a state's variables: v | vd | vdd, 3 nv */
     const char **names;     /* the variables' names, nv */
+    double *w;              /* a spatial state's angular velocities, outputs.nw */
     const char *file;       /* for warnings */
     bool warned;            /* an output was not finite (said once) */
 } Output;
@@ -151,12 +152,16 @@ static void output_open(Output *out, const Model *m)
     for (int i = 0; i < out->nv; i++)
         out->names[i] = i < m->nq ? m->coord_names[i] : m->outputs[i - m->nq].name;
     mechrt_trace_init(&out->trace, out->nv);
+    out->w = xcalloc((size_t)out->outputs.nw + 1, sizeof *out->w);
+    mechrt_trace_set_omega(&out->trace, out->outputs.nw,
+                           (const char *const *)out->outputs.wnames);
 }
 
 static void output_close(Output *out)
 {
     outputs_free(&out->outputs);
     free(out->v);
+    free(out->w);
     free(out->names);
     mechrt_trace_free(&out->trace);
 }
@@ -207,14 +212,16 @@ static void warn_nonfinite(Output *out, double t)
 static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
 {
     Output *out = ctx;
+    outputs_omega(&out->outputs, q, qd, out->w);
     if (out->nv > out->nq) {
         fill_variables(out, t, q, qd, qdd);
         q = out->v, qd = out->v + out->nv, qdd = out->v + 2 * out->nv;
         warn_nonfinite(out, t);
     }
     if (out->csv)
-        mechrt_csv_row(out->csv, out->nv, t, q, qd, qdd, out->digits);
-    if (out->json && !mechrt_trace_push(&out->trace, t, q, qd, qdd))
+        mechrt_csv_row_omega(out->csv, out->nv, t, q, qd, qdd, out->outputs.nw, out->w,
+                             out->digits);
+    if (out->json && !mechrt_trace_push_omega(&out->trace, t, q, qd, qdd, out->w))
         out->trace_full = true;
     if (out->t1 != out->t0)
         progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
@@ -376,6 +383,11 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, 
 {
     char err[256];
     *nvars = 0;
+    if (m->spatial && c->svg_path) {
+        fprintf(stderr, "%s: error: --svg draws planar mechanisms only, and this one is "
+                "spatial (--plot and --csv work)\n", m->file);
+        return false;
+    }
     for (int i = 0; i < c->traces.n; i++) {
         if (!svg_parse_trace(m, c->traces.items[i], &traces[i], err, sizeof err)) {
             fprintf(stderr, "mechc run: error: %s\n", err);
@@ -503,7 +515,8 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
     RunResult res;
     c->ro.notes = stderr;
     if (out.csv)
-        mechrt_csv_header(out.csv, out.nv, out.names);
+        mechrt_csv_header_omega(out.csv, out.nv, out.names, out.outputs.nw,
+                                (const char *const *)out.outputs.wnames);
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));

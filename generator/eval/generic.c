@@ -2,8 +2,10 @@
  *
  * generic_open turns the model's joint list into plans: standard joints
  * keep their attachments and axis for the formulas of generic_joints.c;
- * `constraint`, `driver` and `velocity` rows and non-constant options
- * (length, angle, radius) are compiled to instruction lists (interp.h).
+ * `constraint`, `driver` and `velocity` rows, and for now every row of
+ * the spatial kinds (one plan per row: the model's row expression), and
+ * non-constant options (length, angle, radius) are compiled to
+ * instruction lists (interp.h).
  * A call computes cos and sin of every body angle the formulas need
  * once, then runs each plan, which writes its own rows. For an
  * interpreted row:
@@ -127,7 +129,7 @@ static void run(Call *c)
         const Plan *p = &g->plans[i];
         if (p->rows)
             p->rows(c, p);
-        else if (p->j->velocity)
+        else if (p->velocity)
             velocity_row(c, &g->progs[p->prog], p->row);
         else
             position_row(c, &g->progs[p->prog], p->row);
@@ -173,6 +175,19 @@ static int add_tape(Generic *g, const Model *m, NodeId root, CompileScratch *cs)
     return g->nprogs++;
 }
 
+/* A joint without formulas: one plan per row, each the row's program
+   (the row expression itself, options folded in). p is its first plan. */
+static void interpret_rows(Generic *g, Plan *p, CompileScratch *cs)
+{
+    const Joint *j = p->j;
+    for (int k = 0; k < j->nrows; k++) {
+        Plan *q = k == 0 ? p : &g->plans[g->nplans++];
+        *q = *p;
+        q->row = j->first_row + k;
+        q->prog = add_tape(g, g->m, g->m->rows[q->row].expr, cs);
+    }
+}
+
 Generic *generic_open(const Model *m)
 {
     Generic *g = xcalloc(1, sizeof *g);
@@ -181,9 +196,10 @@ Generic *generic_open(const Model *m)
     g->nh = m->nh;
     g->nv = m->nv;
     g->nr = m->nr;
-    g->nplans = m->njoints;
-    g->plans = xcalloc((size_t)m->njoints + 1, sizeof *g->plans);
-    g->progs = xcalloc(2 * (size_t)m->njoints + 1, sizeof *g->progs);
+    /* at most one plan per row (every joint has a row), and one program
+       per row and per joint's option */
+    g->plans = xcalloc((size_t)m->nr + 1, sizeof *g->plans);
+    g->progs = xcalloc((size_t)m->nr + (size_t)m->njoints + 1, sizeof *g->progs);
     g->cosq = xcalloc((size_t)m->nq, sizeof *g->cosq);
     g->sinq = xcalloc((size_t)m->nq, sizeof *g->sinq);
     g->angles = xcalloc((size_t)m->nq, sizeof *g->angles);
@@ -192,11 +208,14 @@ Generic *generic_open(const Model *m)
     compile_scratch_init(&cs, &m->dag);
     for (int i = 0; i < m->njoints; i++) {
         const Joint *j = &m->joints[i];
-        Plan *p = &g->plans[i];
-        *p = (Plan){.j = j, .row = j->first_row, .prog = -1, .opt = {.constant = true, .prog = -1}};
+        Plan *p = &g->plans[g->nplans++];
+        *p = (Plan){.j = j, .row = j->first_row, .velocity = j->velocity, .prog = -1,
+                    .opt = {.constant = true, .prog = -1}};
         p->rows = generic_joint_formula(j, need);
-        if (!p->rows)
-            p->prog = add_tape(g, m, j->expr, &cs);
+        if (!p->rows) {
+            interpret_rows(g, p, &cs);
+            continue;
+        }
         if (joint_info[j->kind].option != OPTION_NONE
             && !dag_is_const(&m->dag, j->option, &p->opt.value)) {
             p->opt.constant = false;

@@ -18,10 +18,11 @@ typedef struct Plan Plan;
 /* A standard joint's rows by its formulas (generic_joints.c). */
 typedef void GenericRows(const Call *c, const Plan *p);
 
-/* One joint, ready to evaluate. */
+/* One joint, ready to evaluate (a joint without formulas: one of its rows). */
 struct Plan {
     const Joint *j;
-    int row;            /* its first row */
+    int row;            /* its first row (an interpreted row: its row) */
+    bool velocity;      /* the joint's rows are velocity level */
     GenericRows *rows;  /* a standard joint's formulas; else NULL and: */
     int prog;           /* constraint, driver, velocity: the row's program; else -1 */
     Option opt;

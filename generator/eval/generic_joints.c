@@ -296,6 +296,24 @@ static Formula formula_of(JointKind kind)
     case JOINT_CONSTRAINT:
     case JOINT_DRIVER:
     case JOINT_VELOCITY:
+        break;
+    /* Spatial kinds: interpreted from the model's rows for now (generic.c
+       makes one plan per row). Step 2 of issue 14 puts their hand-derived
+       formulas (Haug ch. 9, Nikravesh ch. 7: dot-1, dot-2, spherical over
+       Euler parameters) here, one case per kind. */
+    case JOINT_S_SPHERICAL:
+    case JOINT_S_UNIVERSAL:
+    case JOINT_S_REVOLUTE:
+    case JOINT_S_CYLINDRICAL:
+    case JOINT_S_TRANSLATIONAL:
+    case JOINT_S_WELD:
+    case JOINT_S_DISTANCE:
+    case JOINT_S_POINTPLANE:
+    case JOINT_S_PARALLEL:
+    case JOINT_S_PERPENDICULAR:
+    case JOINT_S_ROLLING:
+    case JOINT_S_NORM:
+    case JOINT_S_CONTACT:
     case JOINT_KIND_COUNT:
         break;
     }

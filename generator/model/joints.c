@@ -114,7 +114,7 @@ static NodeId relative_angle(Dag *d, Attach b, Attach a, NodeId theta)
     return dag_sub(d, dag_sub(d, pb, pa), theta);
 }
 
-void joints_lower(Model *model, const Joint *j, NodeId rows[3])
+void joints_lower(Model *model, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     Dag *d = &model->dag;
     switch (j->kind) {
@@ -172,6 +172,21 @@ void joints_lower(Model *model, const Joint *j, NodeId rows[3])
         rows[0] = dot(d, n, v);
         return;
     }
+    case JOINT_S_SPHERICAL:
+    case JOINT_S_UNIVERSAL:
+    case JOINT_S_REVOLUTE:
+    case JOINT_S_CYLINDRICAL:
+    case JOINT_S_TRANSLATIONAL:
+    case JOINT_S_WELD:
+    case JOINT_S_DISTANCE:
+    case JOINT_S_POINTPLANE:
+    case JOINT_S_PARALLEL:
+    case JOINT_S_PERPENDICULAR:
+    case JOINT_S_ROLLING:
+    case JOINT_S_NORM:
+    case JOINT_S_CONTACT:
+        joints_spatial_lower(model, j, rows);
+        return;
     case JOINT_KIND_COUNT:
         break;
     }

@@ -10,6 +10,7 @@
 
 #include "../base/hashmap.h"
 #include "../parse/parse.h"
+#include "orient.h"
 
 #include <errno.h>
 #include <math.h>
@@ -40,6 +41,7 @@ typedef struct Builder {
     int npos, nvel, cap_pos, cap_vel;
     int cap_outputs;
     SrcPos unit_use[2];     /* first use of deg, rpm as units (offset -1: none) */
+    bool spatial;           /* the file says `spatial` */
 } Builder;
 
 static const char *entity_word(EntityKind kind)
@@ -177,10 +179,29 @@ static const char *context_what(ExprContext ctx)
                                 : "a holonomic row (use a 'velocity' or 'driver' statement for der())";
 }
 
+/* A spatial body's (x y z e0 e1 e2 e3) or point's (x y z) member. */
+static int spatial_member(Builder *b, const Ast *ast, const Entity *e)
+{
+    static const char *const names[7] = {"x", "y", "z", "e0", "e1", "e2", "e3"};
+    int n = e->kind == ENT_BODY ? 7 : 3;
+    for (int i = 0; i < n; i++)
+        if (strcmp(ast->member, names[i]) == 0)
+            return e->q + i;
+    diag_fail(b->diag, ast->member_pos, "%s '%s' has no coordinate '%s' (it has %s)",
+              e->kind == ENT_BODY ? "body" : "point", e->name, ast->member,
+              e->kind == ENT_BODY ? "x, y, z, e0, e1, e2 and e3" : "x, y and z");
+}
+
 /* The coordinate index an AST_NAME / AST_MEMBER names, or fails. */
 static int coordinate_of(Builder *b, const Ast *ast)
 {
     Entity *e = lookup(b, ast->name, ast->pos);
+    if (b->spatial && ast->kind == AST_NAME && (e->kind == ENT_BODY || e->kind == ENT_POINT))
+        diag_fail(b->diag, ast->pos, "'%s' is a %s: write %s.x, %s.y, %s.z%s", e->name,
+                  e->kind == ENT_BODY ? "body" : "point", e->name, e->name, e->name,
+                  e->kind == ENT_BODY ? " or its Euler parameters .e0 .. .e3" : "");
+    if (b->spatial && ast->kind == AST_MEMBER && (e->kind == ENT_BODY || e->kind == ENT_POINT))
+        return spatial_member(b, ast, e);
     if (ast->kind == AST_NAME) {
         if (e->kind == ENT_COORD)
             return e->q;
@@ -204,6 +225,19 @@ static int coordinate_of(Builder *b, const Ast *ast)
     diag_fail(b->diag, ast->member_pos, "%s '%s' has no coordinate '%s' (it has %s)",
               e->kind == ENT_BODY ? "body" : "point", e->name, ast->member,
               e->kind == ENT_BODY ? "x, y and phi" : "x and y");
+}
+
+/* The joint of slide(T) (a translational or cylindrical) or angle(R) (a
+   revolute or cylindrical) in a spatial file, or fails. */
+static const Joint *spatial_joint_of(Builder *b, const Ast *ast, const Entity *e, const Joint *j)
+{
+    bool slide = ast->kind == AST_SLIDE;
+    JointKind want = slide ? JOINT_S_TRANSLATIONAL : JOINT_S_REVOLUTE;
+    if (!j || (j->kind != want && j->kind != JOINT_S_CYLINDRICAL))
+        diag_fail(b->diag, ast->member_pos, "%s() takes a %s or cylindrical joint; '%s' is %s",
+                  slide ? "slide" : "angle", joint_info[want].keyword, e->name,
+                  j ? joint_info[j->kind].keyword : entity_word(e->kind));
+    return j;
 }
 
 static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
@@ -267,10 +301,20 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
                       context_what(ctx));
         Entity *e = lookup(b, ast->name, ast->member_pos);
         const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+        if (b->spatial)
+            return joints_spatial_slide(b->model, spatial_joint_of(b, ast, e, j));
         if (!j || (j->kind != JOINT_PRISMATIC && j->kind != JOINT_POINTLINE))
             diag_fail(b->diag, ast->member_pos, "slide() takes a prismatic or pointline joint; "
                       "'%s' is %s", e->name, j ? joint_info[j->kind].keyword : entity_word(e->kind));
         return joints_slide(b->model, j);
+    }
+    case AST_ANGLE: {
+        if (ctx <= EXPR_TIMED)
+            diag_fail(b->diag, ast->pos, "angle() depends on coordinates: it cannot appear in %s",
+                      context_what(ctx));
+        Entity *e = lookup(b, ast->name, ast->member_pos);
+        const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+        return joints_spatial_angle(b->model, spatial_joint_of(b, ast, e, j));
     }
     }
     diag_fail(b->diag, ast->pos, "internal error: unknown expression kind");
@@ -306,6 +350,51 @@ static bool mentions_der(const Ast *ast)
 
 /* ---- statements ---- */
 
+static void lower_joint(Builder *b, Joint *j);
+
+/* A new joint at the end of the model's list (not yet counted). */
+static Joint *new_joint(Builder *b)
+{
+    Model *m = b->model;
+    grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
+    return &m->joints[m->njoints];
+}
+
+/* body NAME in a spatial file: x y z and the Euler parameters e0 .. e3 of
+   its orientation (the identity unless orient = ... says otherwise), then
+   its row NAME.norm; point NAME: x y z. */
+static void declare_spatial(Builder *b, const Stmt *s)
+{
+    static const char *const suffix[7] = {".x", ".y", ".z", ".e0", ".e1", ".e2", ".e3"};
+    static const char *const word[3] = {"x", "y", "z"};
+    char what[64];
+    bool body = s->kind == STMT_BODY;
+    double v[7];
+    for (int i = 0; i < 3; i++) {
+        snprintf(what, sizeof what, "the initial %s", word[i]);
+        v[i] = constant_value(b, s->init[i], what);
+    }
+    double arg[4] = {0, 0, 0, 0};
+    int nargs = s->orient == ORIENT_AXIS ? 4 : s->orient == ORIENT_NONE ? 0 : 3;
+    for (int i = 0; i < nargs; i++)
+        arg[i] = constant_value(b, s->orient_arg[i], "an orientation component");
+    if (body && !orient_to_euler(s->orient, arg, v + 3))
+        diag_fail(b->diag, s->orient_pos, "the orientation of body '%s' cannot be normalised: "
+                  "its axis is zero", s->name);
+    Entity *e = declare(b, body ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
+    for (int i = 0; i < (body ? 7 : 3); i++) {
+        int q = add_coord(b, s->name, suffix[i], v[i], s->name_pos);
+        if (i == 0)
+            e->q = q;
+    }
+    if (!body)
+        return;
+    Joint *j = new_joint(b);
+    *j = (Joint){.kind = JOINT_S_NORM, .name = s->name, .pos = s->pos, .option = DAG_ZERO,
+                 .expr = DAG_NONE, .a = {.q = e->q, .spatial = true, .has_p = true}};
+    lower_joint(b, j);
+}
+
 static void declare_coordinates(Builder *b, const Stmt *s)
 {
     static const char *const suffix[3] = {".x", ".y", ".phi"};
@@ -315,6 +404,10 @@ static void declare_coordinates(Builder *b, const Stmt *s)
         Entity *e = declare(b, ENT_COORD, s->name, s->name_pos);
         double v = constant_value(b, s->value, "the initial value");
         e->q = add_coord(b, s->name, "", v, s->name_pos);
+        return;
+    }
+    if (b->spatial) {
+        declare_spatial(b, s);
         return;
     }
     int n = s->kind == STMT_BODY ? 3 : 2;
@@ -334,10 +427,12 @@ static void declare_coordinates(Builder *b, const Stmt *s)
 static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
                              const char *keyword)
 {
-    Attach r = {.q = -1};
+    Attach r = {.q = -1, .spatial = b->spatial};
     if (at->has_offset) {
         r.sx = constant_value(b, at->sx, "an attachment offset");
         r.sy = constant_value(b, at->sy, "an attachment offset");
+        if (b->spatial)
+            r.sz = constant_value(b, at->sz, "an attachment offset");
     }
     if (strcmp(at->name, "ground") == 0) {
         if (rule == ATTACH_BODY || rule == ATTACH_BODY_ONLY)
@@ -350,7 +445,8 @@ static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
         if (rule == ATTACH_BODY_ONLY && at->has_offset)
             diag_fail(b->diag, at->pos, "%s takes the body name alone, without an offset", keyword);
         r.q = e->q;
-        r.has_phi = true;
+        r.has_phi = !b->spatial;
+        r.has_p = b->spatial;
         return r;
     case ENT_POINT:
         if (rule != ATTACH_ANY)
@@ -394,13 +490,73 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     }
 }
 
+/* A spatial joint's axes: A's (ux, uy, uz), B's (bx, by, bz), neither zero. */
+static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
+{
+    const JointInfo *info = &joint_info[s->joint];
+    double u[2][3];
+    for (int k = 0; k < 2; k++) {
+        Ast *const *ax = k == 0 || !s->axis_b[0] ? s->axis : s->axis_b;
+        SrcPos pos = k == 0 || !s->axis_b[0] ? s->axis_pos : s->axis_b_pos;
+        for (int i = 0; i < 3; i++)
+            u[k][i] = constant_value(b, ax[i], "an axis component");
+        if (u[k][0] == 0.0 && u[k][1] == 0.0 && u[k][2] == 0.0)
+            diag_fail(b->diag, pos, "the axis of %s '%s' is zero", info->keyword, s->name);
+    }
+    j->ux = u[0][0], j->uy = u[0][1], j->uz = u[0][2];
+    j->bx = u[1][0], j->by = u[1][1], j->bz = u[1][2];
+}
+
+/* A rolling disk's holonomic companion: its contact point on the plane
+   (row J.h), a joint of its own kind after the rolling joint. */
+static void add_contact(Builder *b, int rolling)
+{
+    Joint *j = new_joint(b);
+    *j = b->model->joints[rolling];
+    j->kind = JOINT_S_CONTACT;
+    j->velocity = false;
+    lower_joint(b, j);
+}
+
+/* Counts j (the next joint) and pushes its rows. */
+static void lower_joint(Builder *b, Joint *j)
+{
+    Model *m = b->model;
+    const JointInfo *info = &joint_info[j->kind];
+    m->njoints++;
+    NodeId rows[JOINT_MAX_ROWS];
+    joints_lower(m, j, rows);
+    check_nodes(b);
+    j->nrows = info->rows;
+    for (int i = 0; i < info->rows; i++)
+        push_row(b, j, i, rows[i]);
+}
+
+/* lhs - rhs of a constraint, driver or velocity statement; in a spatial
+   file, driver D: angle(R) = theta is the branch-free row of
+   joints_spatial_angle_row. */
+static NodeId statement_row(Builder *b, const Stmt *s, ExprContext ctx)
+{
+    Model *m = b->model;
+    if (b->spatial && s->joint == JOINT_DRIVER && s->lhs->kind == AST_ANGLE && ctx != EXPR_VELOCITY) {
+        NodeId theta = lower(b, s->rhs, ctx);
+        Entity *e = lookup(b, s->lhs->name, s->lhs->member_pos);
+        const Joint *r = e->kind == ENT_JOINT ? &m->joints[e->q] : NULL;
+        NodeId row = joints_spatial_angle_row(m, spatial_joint_of(b, s->lhs, e, r), theta);
+        check_nodes(b);
+        return row;
+    }
+    NodeId rhs = lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
+    NodeId lhs = lower(b, s->lhs, ctx);
+    return dag_sub(&m->dag, lhs, rhs);
+}
+
 static void build_joint(Builder *b, const Stmt *s)
 {
     Model *m = b->model;
     const JointInfo *info = &joint_info[s->joint];
     declare(b, ENT_JOINT, s->name, s->name_pos)->q = m->njoints;
-    grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
-    Joint *j = &m->joints[m->njoints];
+    Joint *j = new_joint(b);
     *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
                  .option = DAG_ZERO, .expr = DAG_NONE};
     for (int i = 0; i < info->attachments; i++) {
@@ -417,7 +573,9 @@ static void build_joint(Builder *b, const Stmt *s)
                   ? "%s '%s' joins ground to ground: its rows depend on no coordinate"
                   : "%s '%s' joins '%s' to itself: its rows depend on no relative motion",
                   info->keyword, s->name, s->attach[0].name);
-    if (info->axis) {
+    if (info->axis && b->spatial) {
+        spatial_axes(b, s, j);
+    } else if (info->axis) {
         j->ux = constant_value(b, s->axis[0], "the axis component ux");
         j->uy = constant_value(b, s->axis[1], "the axis component uy");
         if (j->ux == 0.0 && j->uy == 0.0)
@@ -435,18 +593,11 @@ static void build_joint(Builder *b, const Stmt *s)
         if (s->joint == JOINT_VELOCITY && !mentions_der(s->lhs) && !mentions_der(s->rhs))
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
-        ExprContext ctx = j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC;
-        NodeId rhs = lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
-        NodeId lhs = lower(b, s->lhs, ctx);
-        j->expr = dag_sub(&m->dag, lhs, rhs);
+        j->expr = statement_row(b, s, j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC);
     }
-    m->njoints++;
-    NodeId rows[3];
-    joints_lower(m, j, rows);
-    check_nodes(b);
-    j->nrows = info->rows;
-    for (int i = 0; i < info->rows; i++)
-        push_row(b, j, i, rows[i]);
+    lower_joint(b, j);
+    if (s->joint == JOINT_S_ROLLING)
+        add_contact(b, m->njoints - 1);
 }
 
 /* The body table: the bodies and points among the declared names. */
@@ -462,8 +613,9 @@ static void collect_bodies(Builder *b)
         if (e->kind != ENT_BODY && e->kind != ENT_POINT)
             continue;
         bool body = e->kind == ENT_BODY;
-        m->bodies[m->nbodies++] = (Body){.name = e->name, .q = e->q, .nq = body ? 3 : 2,
-                                         .has_phi = body};
+        int nq = b->spatial ? (body ? 7 : 3) : (body ? 3 : 2);
+        m->bodies[m->nbodies++] = (Body){.name = e->name, .q = e->q, .nq = nq,
+                                         .has_phi = body && !b->spatial, .spatial = b->spatial};
     }
 }
 
@@ -495,6 +647,14 @@ static void build_output(Builder *b, const Stmt *s)
         return;
     }
     Attach at = resolve_attach(b, &s->attach[0], ATTACH_ANY, "output");
+    if (b->spatial) {
+        NodeId xyz[3];
+        joints_spatial_point(b->model, at, xyz);
+        push_output(b, s->name, ".x", xyz[0]);
+        push_output(b, s->name, ".y", xyz[1]);
+        push_output(b, s->name, ".z", xyz[2]);
+        return;
+    }
     NodeId xy[2];
     joints_point(b->model, at, xy);
     push_output(b, s->name, ".x", xy[0]);
@@ -515,6 +675,9 @@ static void build(Builder *b, const Program *prog, const char *default_name)
         switch (s->kind) {
         case STMT_MECHANISM:
             m->name = s->name;
+            break;
+        case STMT_SPATIAL:
+            m->spatial = b->spatial = true;
             break;
         case STMT_PARAM: {
             double v = constant_value(b, s->value, "the param value");

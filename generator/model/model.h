@@ -8,11 +8,16 @@
 #include "../dag/dag.h"
 #include "../parse/ast.h"
 
-/* A joint operand after name resolution: P = r + A(phi) s. */
+/* A joint operand after name resolution: P = r + A(phi) s; in a spatial
+   file P = r + A(p) s with Euler parameters p. */
 typedef struct Attach {
     int q;              /* index of the x coordinate; -1 for ground */
-    bool has_phi;       /* a body: phi is coordinate q + 2 */
+    bool has_phi;       /* a planar body: phi is coordinate q + 2 */
+    bool spatial;       /* spatial file: z is q + 2; a spatial body (has_p)
+                           has e0..e3 at q + 3 .. q + 6 */
+    bool has_p;         /* a spatial body (not a point, not ground) */
     double sx, sy;      /* body-local offset, or global point for ground */
+    double sz;          /* spatial only */
 } Attach;
 
 typedef struct Joint {
@@ -21,6 +26,8 @@ typedef struct Joint {
     SrcPos pos;
     Attach a, b;
     double ux, uy;      /* axis, as written */
+    double uz;          /* spatial: A's axis is (ux, uy, uz) in A's frame, */
+    double bx, by, bz;  /* and B's (bx, by, bz) in B's (A's vector unless given) */
     NodeId option;      /* length, angle or radius (angle absent: 0) */
     NodeId expr;        /* expression statements: lhs - rhs */
     bool velocity;      /* its rows are velocity level */
@@ -43,9 +50,11 @@ typedef struct Row {
 typedef struct Body {
     const char *name;
     int q;              /* index of its x coordinate */
-    int nq;             /* coordinates it owns: 3 (body), 2 (point) */
+    int nq;             /* coordinates it owns: 3 (body), 2 (point);
+                           spatial: 7 (x y z e0 e1 e2 e3), 3 (point) */
     bool has_phi;       /* a body: phi is coordinate q + 2; a point (a
                            particle) has none (as Attach.has_phi) */
+    bool spatial;       /* a spatial body or point (has_phi false) */
 } Body;
 
 /* A value reported beside the coordinates (an `output` statement): an
@@ -64,6 +73,7 @@ typedef struct Model {
     Dag dag;            /* owns the expression graph (rows and derivatives) */
     const char *name;   /* mechanism name */
     const char *file;   /* input file name as given */
+    bool spatial;       /* the file says `spatial` */
     int nq;
     const char **coord_names;
     double *q0;
@@ -99,7 +109,18 @@ char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag
 char *model_file_stem(Arena *arena, const char *path);
 
 /* Lowers one joint's rows into the graph (generator/model/joints.c). */
-void joints_lower(Model *model, const Joint *joint, NodeId rows_out[3]);
+void joints_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
+/* The same for the spatial kinds (generator/model/joints_spatial.c). */
+void joints_spatial_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
+/* A spatial attachment's global position P = r + A(p) s: xyz_out[0..2]. */
+void joints_spatial_point(Model *model, Attach at, NodeId xyz_out[3]);
+/* slide(T) of a spatial translational or cylindrical joint: h_A . (P_B - P_A), |h| = 1. */
+NodeId joints_spatial_slide(Model *model, const Joint *joint);
+/* angle(R) of a spatial revolute or cylindrical joint: atan2(g_A . f_B, f_A . f_B). */
+NodeId joints_spatial_angle(Model *model, const Joint *joint);
+/* The driver row angle(R) = theta, branch-free:
+   cos(theta) (g_A . f_B) - sin(theta) (f_A . f_B) = sin(angle - theta). */
+NodeId joints_spatial_angle_row(Model *model, const Joint *joint, NodeId theta);
 /* The global position P = r + A(phi) s of an attachment: xy_out[0], [1]. */
 void joints_point(Model *model, Attach at, NodeId xy_out[2]);
 /* The sliding of a prismatic or pointline joint: the displacement of B's

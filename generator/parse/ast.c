@@ -4,20 +4,32 @@
 #include <string.h>
 
 const JointInfo joint_info[JOINT_KIND_COUNT] = {
-#define X(e, kw, na, sa, sb, ax, opt, nr, lvl, s0, s1, s2) \
-    [JOINT_##e] = {kw, na, {sa, sb}, ax, opt, nr, lvl, {s0, s1, s2}},
+#define X(e, kw, dim, na, sa, sb, ax, opt, nr, lvl, ...) \
+    [JOINT_##e] = {kw, dim, na, {sa, sb}, ax, opt, nr, lvl, {__VA_ARGS__}},
 #include "joints.def"
 #undef X
 };
 
-int joint_kind_from_keyword(const char *word, int len)
+bool joint_kind_in(JointKind kind, bool spatial)
+{
+    JointDim dim = joint_info[kind].dim;
+    return dim == DIM_BOTH || dim == (spatial ? DIM_SPATIAL : DIM_PLANAR);
+}
+
+int joint_kind_lookup(const char *word, int len, bool spatial)
 {
     for (int k = 0; k < JOINT_KIND_COUNT; k++) {
         const char *kw = joint_info[k].keyword;
-        if ((int)strlen(kw) == len && memcmp(kw, word, (size_t)len) == 0)
+        if (joint_kind_in((JointKind)k, spatial) && (int)strlen(kw) == len
+            && memcmp(kw, word, (size_t)len) == 0)
             return k;
     }
     return -1;
+}
+
+int joint_kind_from_keyword(const char *word, int len)
+{
+    return joint_kind_lookup(word, len, false);
 }
 
 const char *ast_describe(const Ast *ast)
@@ -40,6 +52,7 @@ const char *ast_describe(const Ast *ast)
     case AST_CALL:   return "a function call";
     case AST_DER:    return "der()";
     case AST_SLIDE:  return "slide()";
+    case AST_ANGLE:  return "angle()";
     }
     return "an expression";
 }

@@ -19,9 +19,12 @@ typedef enum AttachRule {
 
 typedef enum JointOption { OPTION_NONE, OPTION_ANGLE, OPTION_LENGTH, OPTION_RADIUS } JointOption;
 typedef enum JointLevel { LEVEL_POSITION, LEVEL_VELOCITY, LEVEL_EITHER } JointLevel;
+typedef enum JointDim { DIM_PLANAR, DIM_SPATIAL, DIM_BOTH, DIM_INTERNAL } JointDim;
+
+enum { JOINT_MAX_ROWS = 6 };
 
 typedef enum JointKind {
-#define X(e, kw, na, sa, sb, ax, opt, nr, lvl, s0, s1, s2) JOINT_##e,
+#define X(e, kw, dim, na, sa, sb, ax, opt, nr, lvl, ...) JOINT_##e,
 #include "joints.def"
 #undef X
     JOINT_KIND_COUNT
@@ -29,19 +32,25 @@ typedef enum JointKind {
 
 typedef struct JointInfo {
     const char *keyword;
+    JointDim dim;
     int attachments;            /* 0: "lhs = rhs" statement */
     AttachRule slot[2];
-    bool axis;
+    int axis;                   /* 0 none; 1 required; 2 (spatial) both A's and B's */
     JointOption option;
     int rows;
     JointLevel level;
-    const char *suffix[3];
+    const char *suffix[JOINT_MAX_ROWS];
 } JointInfo;
 
 extern const JointInfo joint_info[JOINT_KIND_COUNT];
 
-/* Keyword lookup: the joint kind, or -1. */
+/* Keyword lookup among the planar (and both-dimension) kinds: the joint
+   kind, or -1. */
 int joint_kind_from_keyword(const char *word, int len);
+/* The same in a planar (spatial false) or spatial file. */
+int joint_kind_lookup(const char *word, int len, bool spatial);
+/* Whether kind may be written in a file of that dimension. */
+bool joint_kind_in(JointKind kind, bool spatial);
 
 /* ---- expressions ---- */
 
@@ -54,7 +63,9 @@ typedef enum AstKind {
     AST_BINARY,     /* lhs op rhs, op one of OP_ADD OP_SUB OP_MUL OP_DIV OP_POW */
     AST_CALL,       /* op(lhs) or op(lhs, rhs) for a function op (OP_SIN ...) */
     AST_DER,        /* der(lhs): lhs is AST_NAME or AST_MEMBER */
-    AST_SLIDE,      /* slide(name): the sliding of a prismatic or pointline joint */
+    AST_SLIDE,      /* slide(name): the sliding of a prismatic or pointline joint
+                       (spatial: translational or cylindrical) */
+    AST_ANGLE,      /* angle(name): the relative rotation of a spatial revolute */
 } AstKind;
 
 typedef struct Ast {
@@ -73,6 +84,7 @@ typedef struct Ast {
 
 typedef enum StmtKind {
     STMT_MECHANISM,     /* mechanism NAME */
+    STMT_SPATIAL,       /* spatial (first statement after mechanism) */
     STMT_PARAM,         /* param NAME = value */
     STMT_BODY,          /* body NAME [x = e] [y = e] [phi = e] */
     STMT_POINT,         /* point NAME [x = e] [y = e] */
@@ -81,11 +93,14 @@ typedef enum StmtKind {
     STMT_OUTPUT,        /* output NAME = e  |  output NAME: attachment */
 } StmtKind;
 
+/* A spatial body's initial orientation, as written. */
+enum { ORIENT_NONE, ORIENT_AXIS, ORIENT_XYZ, ORIENT_ZYX };
+
 typedef struct AstAttach {
     const char *name;       /* "ground" for the ground frame */
     SrcPos pos;
     bool has_offset;        /* NAME(sx, sy) rather than NAME */
-    Ast *sx, *sy;
+    Ast *sx, *sy, *sz;      /* sz: spatial files only */
 } AstAttach;
 
 typedef struct Stmt {
@@ -96,13 +111,19 @@ typedef struct Stmt {
 
     Ast *value;             /* PARAM, COORD (NULL: coord defaults to 0), OUTPUT
                                (NULL: a point, attach[0]) */
-    Ast *init[3];           /* BODY x, y, phi; POINT x, y (NULL: 0) */
+    Ast *init[3];           /* BODY x, y, phi; POINT x, y (NULL: 0);
+                               spatial BODY and POINT: x, y, z */
     SrcPos init_pos[3];
+    int orient;             /* spatial BODY: ORIENT_* */
+    Ast *orient_arg[4];     /* axis: ux, uy, uz, angle; xyz, zyx: a, b, c */
+    SrcPos orient_pos;
 
     JointKind joint;        /* JOINT */
     AstAttach attach[2];    /* JOINT: joint_info[joint].attachments used; OUTPUT: [0] */
-    Ast *axis[2];           /* JOINT with axis: ux, uy */
+    Ast *axis[3];           /* JOINT with axis: ux, uy (spatial: uz too) */
     SrcPos axis_pos;
+    Ast *axis_b[3];         /* spatial: B's axis when given (NULL: A's) */
+    SrcPos axis_b_pos;
     Ast *option;            /* JOINT: angle, length or radius (NULL: absent) */
     SrcPos option_pos;
     Ast *lhs, *rhs;         /* JOINT with attachments == 0 */
@@ -112,6 +133,7 @@ typedef struct Stmt {
 } Stmt;
 
 typedef struct Program {
+    bool spatial;           /* the file says `spatial` */
     Stmt *first;
     int count;
     int line_count;

@@ -31,6 +31,9 @@ typedef struct Parser {
     int depth;              /* expression nesting */
     int stmt_tokens;        /* tokens read in the current statement */
     int mechanism_line;     /* line of the mechanism statement, 0 if none */
+    bool spatial;           /* after a `spatial` statement */
+    int spatial_line;       /* its line, 0 if none */
+    bool begun;             /* a statement other than `mechanism` was read */
 } Parser;
 
 /* ---- tokens and errors ---- */
@@ -195,18 +198,19 @@ static Ast *coordinate(Parser *p)
 
 
 /* slide = 'slide' '(' NAME ')'   (NAME: a prismatic or pointline joint,
-   resolved by the model; slide is no reserved word, only this form is) */
+   resolved by the model; slide is no reserved word, only this form is);
+   angle = 'angle' '(' NAME ')' in a spatial file is read the same way */
 static Ast *slide(Parser *p, const Token *word)
 {
     Ast *ast = new_ast(p, AST_SLIDE, word->pos);
     advance(p);
     if (p->tok.kind != TOK_IDENT)
-        expected(p, "a joint name in slide(...)");
+        expected(p, "a joint name in %.*s(...)", word->len, word->start);
     ast->name = token_text(p, &p->tok);
     ast->member_pos = p->tok.pos;
     advance(p);
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "')' after the joint name in slide(%s", ast->name);
+        expected(p, "')' after the joint name in %.*s(%s", word->len, word->start, ast->name);
     advance(p);
     return ast;
 }
@@ -300,6 +304,11 @@ static Ast *primary(Parser *p)
     advance(p);
     if (p->tok.kind == TOK_LPAREN && lex_is_word(&tok, "slide"))
         return slide(p, &tok);
+    if (p->tok.kind == TOK_LPAREN && p->spatial && lex_is_word(&tok, "angle")) {
+        Ast *ast = slide(p, &tok);
+        ast->kind = AST_ANGLE;
+        return ast;
+    }
     if (p->tok.kind == TOK_LPAREN)
         diag_fail(p->diag, tok.pos, "'%.*s' is not a function", tok.len, tok.start);
     Ast *ast;
@@ -408,6 +417,47 @@ static void pair(Parser *p, const char *what, Ast **a, Ast **b)
     leave_level(p);
 }
 
+/* components = '(' expr {',' expr} ')'   with exactly n expressions: a
+   spatial offset, axis or orientation; what names it in messages */
+static void components(Parser *p, const char *what, int n, Ast **out)
+{
+    static const char *const count[] = {"no", "one", "two", "three", "four"};
+    if (p->tok.kind != TOK_LPAREN)
+        expected(p, "'(' after %s", what);
+    enter_level(p, p->tok.pos);
+    advance(p);
+    int i = 0;
+    for (;;) {
+        SrcPos at = p->tok.pos;
+        Ast *e = expr(p);
+        if (i == n)
+            diag_fail(p->diag, at, "%s has %s components, found more", what, count[n]);
+        out[i++] = e;
+        if (p->tok.kind != TOK_COMMA)
+            break;
+        advance(p);
+    }
+    if (p->tok.kind != TOK_RPAREN)
+        expected(p, "',' or ')' in %s", what);
+    if (i < n)
+        diag_fail(p->diag, p->tok.pos, "%s has %s components, found %s", what, count[n],
+                  count[i]);
+    advance(p);
+    leave_level(p);
+}
+
+/* An offset: (sx, sy), or (sx, sy, sz) in a spatial file. */
+static void offset(Parser *p, const char *what, AstAttach *a)
+{
+    if (!p->spatial) {
+        pair(p, what, &a->sx, &a->sy);
+        return;
+    }
+    Ast *c[3];
+    components(p, what, 3, c);
+    a->sx = c[0], a->sy = c[1], a->sz = c[2];
+}
+
 /* attachment = NAME [pair]   (NAME may be ground; a body-only slot takes no pair) */
 static void attachment(Parser *p, Stmt *s, int slot)
 {
@@ -435,7 +485,7 @@ static void attachment(Parser *p, Stmt *s, int slot)
     char what[DIAG_MESSAGE_MAX];
     snprintf(what, sizeof what, "the offset of '%s'", a->name);
     a->has_offset = true;
-    pair(p, what, &a->sx, &a->sy);
+    offset(p, what, a);
 }
 
 /* axis = 'axis' pair */
@@ -500,6 +550,42 @@ static void reject_extra_keyword(Parser *p, const Stmt *s)
               p->tok.len, p->tok.start);
 }
 
+/* A spatial joint's keywords after its attachments, in any order:
+   axis(ux, uy, uz) for A, a second axis(...) for B (default: the same
+   local vector as A's), and the kind's option. */
+static void spatial_tail(Parser *p, Stmt *s)
+{
+    const JointInfo *info = &joint_info[s->joint];
+    const char *word = option_keyword(info->option);
+    int naxes = 0;
+    while (p->tok.kind == TOK_IDENT) {
+        if (lex_is_word(&p->tok, "axis") && info->axis && naxes < 2) {
+            SrcPos *pos = naxes == 0 ? &s->axis_pos : &s->axis_b_pos;
+            *pos = p->tok.pos;
+            advance(p);
+            components(p, naxes == 0 ? "the axis (A's)" : "B's axis", 3,
+                       naxes == 0 ? s->axis : s->axis_b);
+            naxes++;
+        } else if (word && lex_is_word(&p->tok, word) && !s->option) {
+            option(p, s);
+        } else if (lex_is_word(&p->tok, "axis") && naxes == 2) {
+            diag_fail(p->diag, p->tok.pos, "%s '%s' takes at most two axes (A's, then B's)",
+                      info->keyword, s->name);
+        } else {
+            reject_extra_keyword(p, s);
+            break;
+        }
+    }
+    if (info->axis && naxes == 0)
+        expected(p, "'axis(ux, uy, uz)' after the attachments of %s '%s'", info->keyword,
+                 s->name);
+    if (info->axis == 2 && naxes == 1)
+        expected(p, "B's axis: %s '%s' takes two axes, 'axis(...) axis(...)'", info->keyword,
+                 s->name);
+    if (word && !s->option && info->option != OPTION_ANGLE)
+        expected(p, "'%s = ...' for %s '%s'", word, info->keyword, s->name);
+}
+
 /* joint = KIND NAME ':' attachment{n} [axis] [option]   (n = attachments > 0)
          | KIND NAME ':' expr '=' expr                    (n = 0) */
 static void joint(Parser *p, Stmt *s)
@@ -520,6 +606,10 @@ static void joint(Parser *p, Stmt *s)
     }
     for (int i = 0; i < info->attachments; i++)
         attachment(p, s, i);
+    if (p->spatial) {
+        spatial_tail(p, s);
+        return;
+    }
     if (info->axis)
         axis(p, s);
     option(p, s);
@@ -537,6 +627,11 @@ static void initial_values(Parser *p, Stmt *s, int nkeys)
         int i = 0;
         while (i < nkeys && !lex_is_word(&p->tok, keys[i]))
             i++;
+        if (i == nkeys && (lex_is_word(&p->tok, "z") || lex_is_word(&p->tok, "orient")))
+            diag_fail(p->diag, p->tok.pos, "unknown key %s for %s '%s': expected %s ('%.*s' "
+                      "is for spatial files, which say 'spatial' first)",
+                      lex_describe(&p->tok, buf), what, s->name,
+                      nkeys == 3 ? "x, y or phi" : "x or y", p->tok.len, p->tok.start);
         if (i == nkeys)
             diag_fail(p->diag, p->tok.pos, "unknown key %s for %s '%s': expected %s",
                       lex_describe(&p->tok, buf), what, s->name,
@@ -550,6 +645,60 @@ static void initial_values(Parser *p, Stmt *s, int nkeys)
             expected(p, "'=' after '%s'", keys[i]);
         advance(p);
         s->init[i] = expr(p);
+    }
+}
+
+/* orientation = 'axis' '(' ux ',' uy ',' uz ',' angle ')'
+               | ('xyz' | 'zyx') '(' a ',' b ',' c ')' */
+static void orientation(Parser *p, Stmt *s)
+{
+    static const char *const words[] = {"axis", "xyz", "zyx"};
+    static const int kinds[] = {ORIENT_AXIS, ORIENT_XYZ, ORIENT_ZYX};
+    int k = 0;
+    while (k < 3 && !lex_is_word(&p->tok, words[k]))
+        k++;
+    if (k == 3)
+        expected(p, "axis(ux, uy, uz, angle), xyz(a, b, c) or zyx(a, b, c) after 'orient ='");
+    s->orient = kinds[k];
+    advance(p);
+    components(p, k == 0 ? "orient = axis(ux, uy, uz, angle)" : k == 1 ? "orient = xyz(a, b, c)"
+               : "orient = zyx(a, b, c)", k == 0 ? 4 : 3, s->orient_arg);
+}
+
+/* spatial body  = 'body' NAME {('x' | 'y' | 'z') '=' expr | 'orient' '=' orientation}
+   spatial point = 'point' NAME {('x' | 'y' | 'z') '=' expr}   each key at most once */
+static void spatial_values(Parser *p, Stmt *s, bool body)
+{
+    static const char *const keys[3] = {"x", "y", "z"};
+    const char *what = body ? "body" : "point";
+    char buf[LEX_DESCRIBE_MAX];
+    while (p->tok.kind == TOK_IDENT) {
+        int i = 0;
+        while (i < 3 && !lex_is_word(&p->tok, keys[i]))
+            i++;
+        bool orient = i == 3 && body && lex_is_word(&p->tok, "orient");
+        if (i == 3 && !orient && body && lex_is_word(&p->tok, "phi"))
+            diag_fail(p->diag, p->tok.pos, "a spatial body has no 'phi': write orient = "
+                      "axis(ux, uy, uz, angle), xyz(a, b, c) or zyx(a, b, c)");
+        if (i == 3 && !orient)
+            diag_fail(p->diag, p->tok.pos, "unknown key %s for %s '%s': expected %s",
+                      lex_describe(&p->tok, buf), what, s->name,
+                      body ? "x, y, z or orient" : "x, y or z");
+        if (orient ? s->orient != ORIENT_NONE : s->init[i] != NULL)
+            diag_fail(p->diag, p->tok.pos, "'%s' given twice for %s '%s'",
+                      orient ? "orient" : keys[i], what, s->name);
+        if (!orient)
+            s->init_pos[i] = p->tok.pos;
+        else
+            s->orient_pos = p->tok.pos;
+        advance(p);
+        if (p->tok.kind != TOK_EQ)
+            expected(p, "'=' after '%s'", orient ? "orient" : keys[i]);
+        advance(p);
+        if (orient)
+            orientation(p, s);
+        else
+            s->init[i] = expr(p);
     }
 }
 
@@ -574,17 +723,50 @@ static void output(Parser *p, Stmt *s)
     advance(p);
     if (p->tok.kind == TOK_LPAREN) {
         at->has_offset = true;
-        pair(p, "the point's offset", &at->sx, &at->sy);
+        offset(p, "the point's offset", at);
     }
 }
 
-/* Appends the statement keywords to buf, for the unknown-statement message. */
-static void list_keywords(char *buf, size_t size)
+/* Appends the statement keywords of the file's dimension to buf, for the
+   unknown-statement message. */
+static void list_keywords(char *buf, size_t size, bool spatial)
 {
-    int n = snprintf(buf, size, "mechanism, param, body, point, coord, output");
-    for (int k = 0; k < JOINT_KIND_COUNT && n > 0 && (size_t)n < size; k++)
-        n += snprintf(buf + n, size - (size_t)n, "%s %s",
-                      k == JOINT_KIND_COUNT - 1 ? " or" : ",", joint_info[k].keyword);
+    int n = snprintf(buf, size, "mechanism, %sparam, body, point, coord, output",
+                     spatial ? "spatial, " : "");
+    int last = JOINT_KIND_COUNT - 1;
+    while (last > 0 && !joint_kind_in((JointKind)last, spatial))
+        last--;
+    for (int k = 0; k <= last && n > 0 && (size_t)n < size; k++)
+        if (joint_kind_in((JointKind)k, spatial))
+            n += snprintf(buf + n, size - (size_t)n, "%s %s", k == last ? " or" : ",",
+                          joint_info[k].keyword);
+}
+
+/* 'spatial': once, before every statement but `mechanism`. */
+static void spatial_statement(Parser *p, Stmt *s)
+{
+    int line, col;
+    diag_locate(p->diag, s->pos.offset, &line, &col);
+    if (p->spatial_line)
+        diag_fail(p->diag, s->pos, "a second 'spatial' statement (the first is on line %d)",
+                  p->spatial_line);
+    if (p->begun)
+        diag_fail(p->diag, s->pos, "'spatial' must be the first statement (after an "
+                  "optional 'mechanism' line): it decides how every body is read");
+    p->spatial = true;
+    p->spatial_line = line;
+    s->kind = STMT_SPATIAL;
+    advance(p);
+}
+
+/* A joint keyword of the other dimension: say which file it belongs in. */
+static _Noreturn void wrong_dimension(Parser *p, const Token *kw)
+{
+    if (p->spatial)
+        diag_fail(p->diag, kw->pos, "'%.*s' is a planar joint, and this file is spatial "
+                  "('spatial' on line %d)", kw->len, kw->start, p->spatial_line);
+    diag_fail(p->diag, kw->pos, "'%.*s' is a spatial joint: a spatial mechanism says "
+              "'spatial' as its first statement", kw->len, kw->start);
 }
 
 /* statement = 'mechanism' NAME
@@ -602,8 +784,12 @@ static Stmt *statement(Parser *p)
                   "found %s", lex_describe(&kw, buf));
     Stmt *s = arena_alloc(p->arena, sizeof *s);
     s->pos = kw.pos;
-    int kind = joint_kind_from_keyword(kw.start, kw.len);
-    if (lex_is_word(&kw, "mechanism")) {
+    int kind = joint_kind_lookup(kw.start, kw.len, p->spatial);
+    if (!lex_is_word(&kw, "mechanism") && !lex_is_word(&kw, "spatial"))
+        p->begun = true;
+    if (lex_is_word(&kw, "spatial")) {
+        spatial_statement(p, s);
+    } else if (lex_is_word(&kw, "mechanism")) {
         int line, col;
         diag_locate(p->diag, kw.pos.offset, &line, &col);
         if (p->mechanism_line)
@@ -626,7 +812,10 @@ static Stmt *statement(Parser *p)
         s->kind = body ? STMT_BODY : STMT_POINT;
         advance(p);
         s->name = declared_name(p, body ? "body" : "point", &s->name_pos);
-        initial_values(p, s, body ? 3 : 2);
+        if (p->spatial)
+            spatial_values(p, s, body);
+        else
+            initial_values(p, s, body ? 3 : 2);
     } else if (lex_is_word(&kw, "coord")) {
         s->kind = STMT_COORD;
         advance(p);
@@ -644,9 +833,11 @@ static Stmt *statement(Parser *p)
         s->joint = (JointKind)kind;
         advance(p);
         joint(p, s);
+    } else if (joint_kind_lookup(kw.start, kw.len, !p->spatial) >= 0) {
+        wrong_dimension(p, &kw);
     } else {
         char list[DIAG_MESSAGE_MAX / 2];
-        list_keywords(list, sizeof list);
+        list_keywords(list, sizeof list, p->spatial);
         diag_fail(p->diag, kw.pos, "unknown statement %s: expected %s",
                   lex_describe(&kw, buf), list);
     }
@@ -671,6 +862,7 @@ static void program(Parser *p, Program *out)
     }
     /* lines = newlines, plus one for a last line without a newline */
     out->line_count = p->lx.line - 1 + (p->lx.len > p->lx.line_start);
+    out->spatial = p->spatial;
     if (out->count == 0)
         diag_fail(p->diag, (SrcPos){0}, "the mechanism has no statements");
 }

@@ -395,7 +395,7 @@ static void draw_rolling(Scene *sc, const Joint *jt)
     double R = fabs(node_value_at(&m->dag, jt->option, q0, NULL, sc->t[sc->frames[0]]));
     if (!isfinite(R) || R <= 0)
         return;
-    Attach centre = {jt->a.q, true, 0, 0};
+    Attach centre = {.q = jt->a.q, .has_phi = true};
     Shape *s = add_shape(sc, SHAPE_CIRCLE, "disk");
     add_vtx(sc, scene_vtx_at(centre));
     s->r = R;
@@ -559,7 +559,7 @@ static void build_drive_arrows(Scene *sc)
         int i = m->bodies[b].q;
         if (!m->bodies[b].has_phi || !sc->driven[i + 2])
             continue;
-        Attach centre = {i, true, 0, 0};
+        Attach centre = {.q = i, .has_phi = true};
         for (int j = 0; j < m->njoints; j++) {
             const Joint *jt = &m->joints[j];
             if (jt->kind != JOINT_REVOLUTE)

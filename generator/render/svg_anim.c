@@ -65,7 +65,9 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
                              const char *title, const SvgAnimOptions *opt)
 {
     SvgAnimOptions o = opt ? *opt : svg_anim_default_options();
-    if (!out || !valid_input(m, t, q, nframes, traces, ntraces) || o.width < 50 || o.height < 50) {
+    /* the scene reads planar bodies (x, y, phi); spatial views come later */
+    if (!out || m->spatial || !valid_input(m, t, q, nframes, traces, ntraces) || o.width < 50
+        || o.height < 50) {
         errno = EINVAL;
         return false;
     }

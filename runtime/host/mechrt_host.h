@@ -159,6 +159,12 @@ int mechrt_format_real(char *buf, size_t size, double v, int digits);
 void mechrt_csv_header(FILE *out, int nq, const char *const *names);
 void mechrt_csv_row(FILE *out, int nq, double t, const double *q, const double *qd,
                     const double *qdd, int digits);
+/* The same with nw velocity-only columns (a spatial body's angular
+   velocity NAME.wx NAME.wy NAME.wz) after the d(NAME) columns. */
+void mechrt_csv_header_omega(FILE *out, int nq, const char *const *names, int nw,
+                             const char *const *wnames);
+void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
+                          const double *qdd, int nw, const double *w, int digits);
 
 /* The rows of a run kept for JSON (which cannot be streamed key by key):
    each row is t, q[nq], qd[nq], qdd[nq]. */
@@ -166,6 +172,9 @@ typedef struct MechrtTrace {
     int nq;
     size_t rows, cap;
     double *data;
+    int nw;                     /* velocity-only columns per row (0: none) */
+    const char *const *wnames;  /* their names (not owned) */
+    double *wdata;              /* rows x nw */
 } MechrtTrace;
 
 void mechrt_trace_init(MechrtTrace *tr, int nq);
@@ -173,6 +182,11 @@ void mechrt_trace_init(MechrtTrace *tr, int nq);
 bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double *qd,
                        const double *qdd);
 void mechrt_trace_free(MechrtTrace *tr);
+/* Keeps nw velocity-only values per row too (before the first push);
+   JSON writes them as "omega_names" and "omega", after the outputs. */
+void mechrt_trace_set_omega(MechrtTrace *tr, int nw, const char *const *wnames);
+bool mechrt_trace_push_omega(MechrtTrace *tr, double t, const double *q, const double *qd,
+                             const double *qdd, const double *w);
 
 /* A JSON string literal, quotes included (RFC 8259 section 7): a quote
    or backslash gets a backslash before it, a control byte or DEL is

@@ -42,11 +42,19 @@ static void put_real(FILE *out, double v, int digits)
 
 void mechrt_csv_header(FILE *out, int nq, const char *const *names)
 {
+    mechrt_csv_header_omega(out, nq, names, 0, NULL);
+}
+
+void mechrt_csv_header_omega(FILE *out, int nq, const char *const *names, int nw,
+                             const char *const *wnames)
+{
     fputs("t", out);
     for (int i = 0; i < nq; i++)
         fprintf(out, ",%s", names[i]);
     for (int i = 0; i < nq; i++)
         fprintf(out, ",d(%s)", names[i]);
+    for (int i = 0; i < nw; i++)
+        fprintf(out, ",%s", wnames[i]);
     for (int i = 0; i < nq; i++)
         fprintf(out, ",dd(%s)", names[i]);
     fputc('\n', out);
@@ -55,13 +63,24 @@ void mechrt_csv_header(FILE *out, int nq, const char *const *names)
 void mechrt_csv_row(FILE *out, int nq, double t, const double *q, const double *qd,
                     const double *qdd, int digits)
 {
+    mechrt_csv_row_omega(out, nq, t, q, qd, qdd, 0, NULL, digits);
+}
+
+void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
+                          const double *qdd, int nw, const double *w, int digits)
+{
     put_real(out, t, digits);
     const double *v[3] = {q, qd, qdd};
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         for (int i = 0; i < nq; i++) {
             fputc(',', out);
             put_real(out, v[k][i], digits);
         }
+        for (int i = 0; k == 1 && i < nw; i++) {
+            fputc(',', out);
+            put_real(out, w[i], digits);
+        }
+    }
     fputc('\n', out);
 }
 
@@ -70,22 +89,54 @@ void mechrt_trace_init(MechrtTrace *tr, int nq)
     tr->nq = nq;
     tr->rows = tr->cap = 0;
     tr->data = NULL;
+    tr->nw = 0;
+    tr->wnames = NULL;
+    tr->wdata = NULL;
+}
+
+void mechrt_trace_set_omega(MechrtTrace *tr, int nw, const char *const *wnames)
+{
+    tr->nw = nw;
+    tr->wnames = wnames;
+}
+
+/* Room for one more row (and its velocity-only values). */
+static bool trace_reserve(MechrtTrace *tr)
+{
+    size_t w = 1 + 3 * (size_t)tr->nq, nw = (size_t)tr->nw;
+    if (tr->rows < tr->cap)
+        return true;
+    size_t cap = tr->cap ? 2 * tr->cap : 64;
+    if (cap > ((size_t)-1 / sizeof(double)) / w)
+        return false;
+    double *p = realloc(tr->data, cap * w * sizeof *p);
+    if (!p)
+        return false;
+    tr->data = p;
+    if (nw) {
+        double *pw = realloc(tr->wdata, cap * nw * sizeof *pw);
+        if (!pw)
+            return false;
+        tr->wdata = pw;
+    }
+    tr->cap = cap;
+    return true;
 }
 
 bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double *qd,
                        const double *qdd)
 {
+    return mechrt_trace_push_omega(tr, t, q, qd, qdd, NULL);
+}
+
+bool mechrt_trace_push_omega(MechrtTrace *tr, double t, const double *q, const double *qd,
+                             const double *qdd, const double *omega)
+{
     size_t w = 1 + 3 * (size_t)tr->nq;
-    if (tr->rows == tr->cap) {
-        size_t cap = tr->cap ? 2 * tr->cap : 64;
-        if (cap > ((size_t)-1 / sizeof(double)) / w)
-            return false;
-        double *p = realloc(tr->data, cap * w * sizeof *p);
-        if (!p)
-            return false;
-        tr->data = p;
-        tr->cap = cap;
-    }
+    if (!trace_reserve(tr))
+        return false;
+    if (tr->nw)
+        memcpy(tr->wdata + tr->rows * (size_t)tr->nw, omega, (size_t)tr->nw * sizeof *omega);
     double *row = tr->data + tr->rows * w;
     size_t n = (size_t)tr->nq;
     row[0] = t;
@@ -99,7 +150,9 @@ bool mechrt_trace_push(MechrtTrace *tr, double t, const double *q, const double 
 void mechrt_trace_free(MechrtTrace *tr)
 {
     free(tr->data);
+    free(tr->wdata);
     tr->data = NULL;
+    tr->wdata = NULL;
     tr->rows = tr->cap = 0;
 }
 
@@ -154,6 +207,27 @@ static void json_group(FILE *out, const MechrtTrace *tr, const char *const *name
     }
 }
 
+/* "omega_names": [...], "omega": [[...] per row]: the velocity-only columns. */
+static void json_omega(FILE *out, const MechrtTrace *tr, int digits)
+{
+    size_t nw = (size_t)tr->nw;
+    fputs(",\n \"omega_names\": [", out);
+    for (size_t i = 0; i < nw; i++) {
+        fputs(i ? ", " : "", out);
+        mechrt_json_string(out, tr->wnames[i]);
+    }
+    fputs("],\n \"omega\": [", out);
+    for (size_t r = 0; r < tr->rows; r++) {
+        fputs(r ? ",\n   [" : "[", out);
+        for (size_t i = 0; i < nw; i++) {
+            fputs(i ? ", " : "", out);
+            json_num(out, tr->wdata[r * nw + i], digits);
+        }
+        fputs("]", out);
+    }
+    fputs("]", out);
+}
+
 void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
                                const char *const *names, int digits,
                                const char *error_message, double error_t)
@@ -175,6 +249,8 @@ void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
     json_group(out, tr, names, 0, nc, NULL, qkeys, digits);
     if (nq > nc)
         json_group(out, tr, names, nc, nq - nc, "outputs", ykeys, digits);
+    if (tr->nw)
+        json_omega(out, tr, digits);
     fprintf(out, ",\n \"ok\": %s", error_message ? "false" : "true");
     if (error_message) {
         fputs(",\n \"error\": {\"t\": ", out);
