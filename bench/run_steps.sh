@@ -1,52 +1,98 @@
 #!/bin/sh
 # bench/run_steps.sh MECHC [FILE] [STEPS] [REPEATS] - the cost of one step of
-# `mechc run`: a slider-crank revolution (examples/slider_crank.mech, t = 0..1)
-# in 10 000 steps, per engine. For each engine it reports the median over
-# REPEATS runs (default 5) of
-#   ns per step          wall time of predictor + Newton + velocity +
-#                        acceleration per step (output excluded: --csv /dev/null
-#                        is written outside the timed part)
-#   Newton it. per step  Newton iterations per step (the predictor's aim: < 2)
-#   all ns               one call of the fused kernel (Phi, Phi_q, nu, gamma)
-#   step / all           the step's cost in calls of that kernel
-# taken from `mechc run --stats`. Engines that cannot run here are skipped.
+# `mechc run` (predictor + Newton + velocity + acceleration), in calls of the
+# fused kernel, for the slider-crank, the four-bar, the five-bar and a chain
+# of N = 10 four-bar loops (examples/chain.sh), or for FILE alone; one
+# revolution (t = 0..1) in STEPS steps (default 10 000). Two measures:
+#
+# time, per engine, median over REPEATS runs (default 5) of `mechc run --stats`:
+#   ns/step        wall time of a step (output excluded: --csv /dev/null is
+#                  written outside the timed part)
+#   Newton it.     Newton iterations per step (the predictor's aim: 1)
+#   all ns         one call of the fused kernel (Phi, Phi_q, nu, gamma)
+#   step/all       the step's cost in calls of that kernel
+# instructions (AOT engine, when valgrind is installed; one run of STEPS/5
+# steps under callgrind, counting only inside mechrt_step, so deterministic
+# where wall times on a shared machine are not):
+#   Ir/step        instructions per mechrt_step call
+#   Ir/all         instructions per call of the AOT `all` kernel
+#   step/all Ir    the step's cost in kernel calls, by instructions
+# Engines that cannot run here are skipped.
 set -u
 if [ $# -lt 1 ]; then
     echo "usage: sh bench/run_steps.sh PATH/TO/mechc [FILE.mech] [STEPS] [REPEATS]" >&2
     exit 2
 fi
 mechc=$1
-file=${2:-$(dirname "$0")/../examples/slider_crank.mech}
+here=$(dirname "$0")
 steps=${3:-10000}
 repeats=${4:-5}
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_bench.XXXXXX") || exit 2
 trap 'rm -rf "$tmp"' EXIT
+if [ $# -ge 2 ] && [ -n "$2" ]; then
+    files=$2
+else
+    sh "$here/../examples/chain.sh" 10 "$tmp/chain10.mech" || exit 2
+    files="$here/../examples/slider_crank.mech $here/../examples/four_bar.mech
+           $here/../examples/five_bar.mech $tmp/chain10.mech"
+fi
 
 median() { sort -g | awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)] }'; }
 
-echo "mechc run $(basename "$file") --steps $steps: median of $repeats runs"
-printf '%-8s %12s %18s %10s %11s\n' engine "ns/step" "Newton it./step" "all ns" "step/all"
-for engine in jit aot generic; do
-    : > "$tmp/ns"; : > "$tmp/it"; : > "$tmp/all"; : > "$tmp/ratio"
-    ok=1
-    i=0
-    while [ $i -lt "$repeats" ]; do
-        if ! "$mechc" run "$file" --steps "$steps" --engine $engine --stats --csv /dev/null \
-                2> "$tmp/err"; then
-            ok=0
-            break
+# time FILE: the timed table of one mechanism
+time_file() {
+    printf '%-8s %12s %12s %10s %11s\n' engine "ns/step" "Newton it." "all ns" "step/all"
+    for engine in jit aot generic; do
+        : > "$tmp/ns"; : > "$tmp/it"; : > "$tmp/all"; : > "$tmp/ratio"
+        ok=1
+        i=0
+        while [ $i -lt "$repeats" ]; do
+            if ! "$mechc" run "$1" --steps "$steps" --engine $engine --stats --csv /dev/null \
+                    2> "$tmp/err"; then
+                ok=0
+                break
+            fi
+            sed -n 's/.*: \([0-9.]*\) ns per step.*/\1/p' "$tmp/err" >> "$tmp/ns"
+            sed -n 's/.*stats: \([0-9.e+-]*\) Newton iterations per step.*/\1/p' "$tmp/err" >> "$tmp/it"
+            sed -n 's/.*takes \([0-9.]*\) ns: a step costs \([0-9.]*\) of them.*/\1 \2/p' "$tmp/err" > "$tmp/line"
+            cut -d' ' -f1 "$tmp/line" >> "$tmp/all"
+            cut -d' ' -f2 "$tmp/line" >> "$tmp/ratio"
+            i=$((i + 1))
+        done
+        if [ $ok = 0 ]; then
+            printf '%-8s (skipped: %s)\n' $engine "$(grep -m1 error "$tmp/err" | cut -c1-60)"
+            continue
         fi
-        sed -n 's/.*: \([0-9.]*\) ns per step.*/\1/p' "$tmp/err" >> "$tmp/ns"
-        sed -n 's/.*stats: \([0-9.e+-]*\) Newton iterations per step.*/\1/p' "$tmp/err" >> "$tmp/it"
-        sed -n 's/.*takes \([0-9.]*\) ns: a step costs \([0-9.]*\) of them.*/\1 \2/p' "$tmp/err" > "$tmp/line"
-        cut -d' ' -f1 "$tmp/line" >> "$tmp/all"
-        cut -d' ' -f2 "$tmp/line" >> "$tmp/ratio"
-        i=$((i + 1))
+        printf '%-8s %12s %12s %10s %11s\n' $engine "$(median < "$tmp/ns")" "$(median < "$tmp/it")" \
+            "$(median < "$tmp/all")" "$(median < "$tmp/ratio")"
     done
-    if [ $ok = 0 ]; then
-        printf '%-8s (skipped: %s)\n' $engine "$(grep -m1 error "$tmp/err" | cut -c1-60)"
-        continue
+}
+
+# count FILE: the instruction counts of one mechanism (AOT, callgrind)
+count_file() {
+    n=$((steps / 5))
+    if ! command -v valgrind > /dev/null 2>&1; then
+        echo "instructions: skipped (no valgrind)"
+        return
     fi
-    printf '%-8s %12s %18s %10s %11s\n' $engine "$(median < "$tmp/ns")" "$(median < "$tmp/it")" \
-        "$(median < "$tmp/all")" "$(median < "$tmp/ratio")"
+    if ! valgrind --tool=callgrind --toggle-collect=mechrt_step \
+            --callgrind-out-file="$tmp/cg" "$mechc" run "$1" --steps $n --engine aot \
+            --csv /dev/null > /dev/null 2>&1; then
+        echo "instructions: skipped (the aot engine or valgrind failed)"
+        return
+    fi
+    total=$(sed -n 's/^summary: //p' "$tmp/cg")
+    set -- $(awk -v fn=mechc_aot_all -f "$here/callgrind_calls.awk" "$tmp/cg")
+    # mechrt_step runs once at t0 (h = 0) and once per step
+    awk -v total="$total" -v calls="$1" -v ir="$2" -v n="$n" 'BEGIN {
+        step = total / (n + 1); all = ir / calls
+        printf "instructions (aot, %d steps): %.0f per step, %.0f per all call (%.2f calls per step): step/all %.2f\n",
+               n, step, all, calls / (n + 1), step / all }'
+}
+
+for f in $files; do
+    echo "mechc run $(basename "$f") --steps $steps: median of $repeats runs"
+    time_file "$f"
+    count_file "$f"
+    echo
 done

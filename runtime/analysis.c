@@ -34,6 +34,7 @@ static void an_report_init(MechrtReport *r)
     r->sing_index = -1;
     r->cond = 0;
     r->cond_warning = false;
+    r->factorisations = 0;
 }
 
 static bool an_kernels_ok(const MechrtKernels *k)
@@ -99,12 +100,16 @@ static MechrtStatus an_factor(int n, const MechrtOptions *o, mechrt_real *jac,
                               mechrt_real *piv, mechrt_real *cwork, MechrtReport *r)
 {
     bool want_cond = r && o->cond_warn > 0;
-    mechrt_real anorm = want_cond ? mechrt_norm1(n, jac, n) : 0;
+    mechrt_real anorm = 0;
     int sing;
-    MechrtStatus st = mechrt_lu_factor(n, jac, n, piv, o->pivot_tol, &sing);
+    MechrtStatus st = want_cond
+        ? mechrt_lu_factor_norm1(n, jac, n, piv, o->pivot_tol, &sing, &anorm, cwork)
+        : mechrt_lu_factor(n, jac, n, piv, o->pivot_tol, &sing);
 
-    if (r)
+    if (r) {
         r->sing_index = sing;
+        r->factorisations++;
+    }
     if (st != MECHRT_OK)
         return st;
     if (want_cond && o->cond_screen > 0

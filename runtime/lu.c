@@ -85,6 +85,42 @@ mechrt_real mechrt_norm1(int n, const mechrt_real *a, int lda)
     return best;
 }
 
+/* The scan that precedes the elimination: every entry finite and the
+ * largest |a_ij| (the scale of the pivot test); when colsum is not NULL,
+ * also the column sums of |a_ij|, added in the order mechrt_norm1 adds them
+ * (so the condition estimate's norm costs no separate call and has the
+ * same bits). The branch on v > amax is predictable; NaN fails both tests. */
+static MechrtStatus lu_scan(int n, const mechrt_real *a, size_t ld, mechrt_real *amax_out,
+                            mechrt_real *colsum)
+{
+    mechrt_real amax = 0;
+    int i, j;
+
+    for (i = 0; i < n; i++) {
+        const mechrt_real *ri = a + (size_t)i * ld;
+        for (j = 0; j < n; j++) {
+            mechrt_real v = MECHRT_FABS(ri[j]);
+            if (v > amax)
+                amax = v;
+            else if (!(v <= amax))
+                return MECHRT_ENOTFINITE;
+        }
+    }
+    if (!isfinite(amax))
+        return MECHRT_ENOTFINITE;
+    if (colsum) {
+        for (j = 0; j < n; j++)
+            colsum[j] = MECHRT_FABS(a[j]);
+        for (i = 1; i < n; i++) {
+            const mechrt_real *ri = a + (size_t)i * ld;
+            for (j = 0; j < n; j++)
+                colsum[j] += MECHRT_FABS(ri[j]);
+        }
+    }
+    *amax_out = amax;
+    return MECHRT_OK;
+}
+
 /* Gaussian elimination with partial pivoting, right-looking (kij) form:
  * at step k choose the row p >= k with the largest |a_pk|, swap rows k and p,
  * store the multipliers l_ik = a_ik / a_kk below the diagonal and update the
@@ -96,33 +132,10 @@ mechrt_real mechrt_norm1(int n, const mechrt_real *a, int lda)
  * original matrix) stops the factorisation at step k; column k is then,
  * to that tolerance, a combination of columns 0..k-1.
  */
-MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
-                              mechrt_real pivot_tol, int *sing_index)
+static MechrtStatus lu_eliminate(int n, mechrt_real *a, size_t ld, mechrt_real *piv,
+                                 mechrt_real thresh, int *sing_index)
 {
-    mechrt_real amax = 0, thresh;
-    size_t ld;
     int i, j, k;
-
-    if (sing_index)
-        *sing_index = -1;
-    if (n < 0 || lda < n || (n > 0 && (!a || !piv)))
-        return MECHRT_EINVAL;
-#ifdef MECHRT_REAL_FLOAT
-    if ((long)n > 16777216L)   /* 2^24: beyond it float cannot hold piv exactly */
-        return MECHRT_EINVAL;
-#endif
-    ld = (size_t)lda;
-
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) {
-            mechrt_real v = a[(size_t)i * ld + (size_t)j];
-            if (!isfinite(v))
-                return MECHRT_ENOTFINITE;
-            if (MECHRT_FABS(v) > amax)
-                amax = MECHRT_FABS(v);
-        }
-    }
-    thresh = pivot_tol * amax;
 
     for (k = 0; k < n; k++) {
         mechrt_real *rk = a + (size_t)k * ld;
@@ -162,6 +175,51 @@ MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
         }
     }
     return MECHRT_OK;
+}
+
+static MechrtStatus lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
+                              mechrt_real pivot_tol, int *sing_index, mechrt_real *colsum)
+{
+    mechrt_real amax;
+    MechrtStatus st;
+
+    if (sing_index)
+        *sing_index = -1;
+    if (n < 0 || lda < n || (n > 0 && (!a || !piv)))
+        return MECHRT_EINVAL;
+#ifdef MECHRT_REAL_FLOAT
+    if ((long)n > 16777216L)   /* 2^24: beyond it float cannot hold piv exactly */
+        return MECHRT_EINVAL;
+#endif
+    st = lu_scan(n, a, (size_t)lda, &amax, colsum);
+    if (st != MECHRT_OK)
+        return st;
+    return lu_eliminate(n, a, (size_t)lda, piv, pivot_tol * amax, sing_index);
+}
+
+MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
+                              mechrt_real pivot_tol, int *sing_index)
+{
+    return lu_factor(n, a, lda, piv, pivot_tol, sing_index, NULL);
+}
+
+MechrtStatus mechrt_lu_factor_norm1(int n, mechrt_real *a, int lda, mechrt_real *piv,
+                                    mechrt_real pivot_tol, int *sing_index,
+                                    mechrt_real *anorm, mechrt_real *work)
+{
+    MechrtStatus st;
+    int j;
+
+    if (!anorm || (n > 0 && !work))
+        return MECHRT_EINVAL;
+    *anorm = 0;
+    st = lu_factor(n, a, lda, piv, pivot_tol, sing_index, work);
+    if (st == MECHRT_EINVAL || st == MECHRT_ENOTFINITE)
+        return st;
+    for (j = 0; j < n; j++)   /* the max as mechrt_norm1 takes it */
+        if (work[j] > *anorm || work[j] != work[j])
+            *anorm = work[j];
+    return st;
 }
 
 /* Solve A x = b from PA = LU: b <- Pb, then L y = b by forward substitution

@@ -112,6 +112,7 @@ typedef enum MechrtStatus {
 #define mechrt_workspace_size        mechrtf_workspace_size
 #define mechrt_norm1                 mechrtf_norm1
 #define mechrt_lu_factor             mechrtf_lu_factor
+#define mechrt_lu_factor_norm1       mechrtf_lu_factor_norm1
 #define mechrt_lu_solve              mechrtf_lu_solve
 #define mechrt_lu_solve_t            mechrtf_lu_solve_t
 #define mechrt_lu_cond1              mechrtf_lu_cond1
@@ -204,6 +205,8 @@ typedef struct MechrtReport {
     mechrt_real cond;      /* 1-norm condition estimate of the analysis matrix, 0 if
                               none (cond_warn == 0, or skipped by cond_screen) */
     bool cond_warning;     /* cond > cond_warn */
+    int factorisations;    /* LU factorisations the call did (Newton's and the
+                              analysis'): mechrt_step's cost in O(n^3) work */
 } MechrtReport;
 
 /* Newton state (GSL's multiroot solver, decomposed): init, then iterate and
@@ -229,6 +232,7 @@ typedef struct MechrtNewton {
     mechrt_real step;       /* ||dq||_inf of the last step, -1 before the first */
     int worst_row;          /* argmax_i |Phi_i(q)|, -1 if nh == 0 */
     int sing_index;         /* failing pivot column of the last factorisation, else -1 */
+    int factorisations;     /* LU factorisations done (one per iterate) */
 } MechrtNewton;
 
 /* Status as a short English phrase ("singular matrix"); never NULL. */
@@ -254,6 +258,14 @@ mechrt_real mechrt_norm1(int n, const mechrt_real *a, int lda);
    sing_index may be NULL; it is set to -1 on success. */
 MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
                               mechrt_real pivot_tol, int *sing_index);
+
+/* mechrt_lu_factor that also returns *anorm = mechrt_norm1(A) of the matrix
+   before factoring (the condition estimate's input), taken in the same pass
+   over the matrix as the pivot scale; work holds n reals. Same status and
+   factors as mechrt_lu_factor; *anorm is 0 on EINVAL and ENOTFINITE. */
+MechrtStatus mechrt_lu_factor_norm1(int n, mechrt_real *a, int lda, mechrt_real *piv,
+                                    mechrt_real pivot_tol, int *sing_index,
+                                    mechrt_real *anorm, mechrt_real *work);
 
 /* Solve A x = b with the factors of mechrt_lu_factor; b is overwritten by x. */
 void mechrt_lu_solve(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,

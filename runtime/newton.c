@@ -71,6 +71,7 @@ MechrtStatus mechrt_newton_init(MechrtNewton *s, const MechrtKernels *k,
     s->step = -1;
     s->worst_row = -1;
     s->sing_index = -1;
+    s->factorisations = 0;
 
     if (!k || !q || !work || k->nq < 1 || k->nh < 0 || k->nv < 0
         || (!k->all && (!k->phi || !k->jac)))
@@ -117,6 +118,7 @@ MechrtStatus mechrt_newton_iterate(MechrtNewton *s)
         return MECHRT_EINVAL;
     n = s->k->nq;
     st = mechrt_lu_factor(n, s->jac, n, s->piv, s->opts.pivot_tol, &s->sing_index);
+    s->factorisations++;
     if (st != MECHRT_OK)
         return st;
     for (i = 0; i < n; i++)
@@ -160,6 +162,7 @@ static void newton_report(const MechrtNewton *s, MechrtReport *report)
     report->sing_index = s->sing_index;
     report->cond = 0;
     report->cond_warning = false;
+    report->factorisations = s->factorisations;
 }
 
 MechrtStatus mechrt_newton_run(MechrtNewton *s, MechrtReport *report)

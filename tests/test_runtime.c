@@ -832,6 +832,129 @@ static void test_step_run(void **state)
     }
 }
 
+/* GSL's LU solve of the n x n row-major a against b (a is left alone). */
+static void ref_solve(int n, const double *a, const double *b, double *x)
+{
+    gsl_matrix *m = gsl_matrix_alloc((size_t)n, (size_t)n);
+    gsl_permutation *p = gsl_permutation_alloc((size_t)n);
+    gsl_vector_const_view bv = gsl_vector_const_view_array(b, (size_t)n);
+    gsl_vector_view xv = gsl_vector_view_array(x, (size_t)n);
+    int sign;
+
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            gsl_matrix_set(m, (size_t)i, (size_t)j, a[i * n + j]);
+    gsl_linalg_LU_decomp(m, p, &sign);
+    gsl_linalg_LU_solve(m, p, &bv.vector, &xv.vector);
+    gsl_permutation_free(p);
+    gsl_matrix_free(m);
+}
+
+/* The step written out plainly, with GSL's LU: Taylor predictor, Newton
+   until the runtime's test passes (fresh Jacobian every iteration), then
+   velocity and acceleration at the converged q. Returns the iterations. */
+static int ref_step(double *q, double *qd, double *qdd, double t, double h,
+                    const MechrtOptions *o)
+{
+    double phi[3], jac[9], nu[3], g[3], dq[3], mphi[3], step = -1, res;
+    int it = 0;
+
+    for (int i = 0; i < 3; i++)
+        q[i] += h * qd[i] + 0.5 * h * h * qdd[i];
+    for (;;) {
+        sc_phi(NULL, q, t + h, phi);
+        res = 0;
+        for (int i = 0; i < 3; i++)
+            res = fmax(res, fabs(phi[i]));
+        if (step >= 0 && res <= o->tol_phi && step <= o->tol_dq)
+            break;
+        sc_jac(NULL, q, t + h, jac);
+        for (int i = 0; i < 3; i++)
+            mphi[i] = -phi[i];
+        ref_solve(3, jac, mphi, dq);
+        step = 0;
+        for (int i = 0; i < 3; i++) {
+            q[i] += dq[i];
+            step = fmax(step, fabs(dq[i]));
+        }
+        it++;
+    }
+    sc_jac(NULL, q, t + h, jac);
+    sc_nu(NULL, q, t + h, nu);
+    ref_solve(3, jac, nu, qd);
+    sc_gamma(NULL, q, qd, t + h, g);
+    ref_solve(3, jac, g, qdd);
+    return it;
+}
+
+/* mechrt_step against the plain reference, value by value to 1e-12
+   relative, over a revolution in coarse (several Newton iterations) and
+   fine (one) steps; and its cost: one factorisation per Newton iteration
+   and one for velocity and acceleration together, so two per fine step. */
+static void test_step_reference(void **state)
+{
+    (void)state;
+    const int steps[2] = {20, 2000};
+    double work[64];
+    MechrtOptions o = mechrt_default_options();
+
+    for (int v = 0; v < 2; v++) {
+        double q[3], qd[3], qdd[3], rq[3], rqd[3], rqdd[3], t = 0, h = 1.0 / steps[v];
+        MechrtReport rep;
+        int one_iteration = 0;
+
+        sc_exact(0, q, qd, qdd);
+        for (int i = 0; i < 3; i++)
+            rq[i] = q[i], rqd[i] = qd[i], rqdd[i] = qdd[i];
+        for (int s = 0; s < steps[v]; s++, t += h) {
+            assert_int_equal(mechrt_step(&sc_kernels, &o, q, qd, qdd, t, h, work, 64, &rep),
+                             MECHRT_OK);
+            int it = ref_step(rq, rqd, rqdd, t, h, &o);
+            assert_int_equal(rep.iterations, it);
+            assert_int_equal(rep.factorisations, it + 1);
+            one_iteration += it == 1;
+            for (int i = 0; i < 3; i++) {
+                assert_near(q[i], rq[i], 1e-12, 1e-15);
+                assert_near(qd[i], rqd[i], 1e-12, 1e-15);
+                assert_near(qdd[i], rqdd[i], 1e-12, 1e-15);
+            }
+        }
+        if (v == 1)
+            assert_int_equal(one_iteration, steps[v]);   /* fine steps: 2 factorisations */
+        else
+            assert_true(one_iteration < steps[v]);       /* coarse: the test can fail */
+    }
+}
+
+/* mechrt_lu_factor_norm1: the factors of mechrt_lu_factor and the norm of
+   mechrt_norm1, bit for bit, and the same errors. */
+static void test_lu_factor_norm1(void **state)
+{
+    (void)state;
+    enum { N = 7, LDA = 9 };
+    double a[N * LDA], b[N * LDA], pa[N], pb[N], work[N], anorm;
+    uint64_t seed = 7;
+    int sa, sb;
+
+    for (int i = 0; i < N * LDA; i++)
+        a[i] = b[i] = i % 4 == 0 ? 0.0 : rnd(&seed);   /* sparse, like a Jacobian */
+    double expect = mechrt_norm1(N, a, LDA);
+    assert_int_equal(mechrt_lu_factor(N, a, LDA, pa, 1e-12, &sa), MECHRT_OK);
+    assert_int_equal(mechrt_lu_factor_norm1(N, b, LDA, pb, 1e-12, &sb, &anorm, work), MECHRT_OK);
+    assert_true(anorm == expect && anorm > 0);
+    assert_int_equal(sa, sb);
+    assert_memory_equal(a, b, sizeof a);
+    assert_memory_equal(pa, pb, sizeof pa);
+    b[LDA + 2] = NAN;
+    assert_int_equal(mechrt_lu_factor_norm1(N, b, LDA, pb, 1e-12, &sb, &anorm, work),
+                     MECHRT_ENOTFINITE);
+    b[LDA + 2] = INFINITY;
+    assert_int_equal(mechrt_lu_factor_norm1(N, b, LDA, pb, 1e-12, &sb, &anorm, work),
+                     MECHRT_ENOTFINITE);
+    assert_int_equal(mechrt_lu_factor_norm1(N, b, LDA, pb, 1e-12, &sb, NULL, work),
+                     MECHRT_EINVAL);
+}
+
 /* The double build's answer, for comparison with the float build below
    (past the float include, mechrt_* names the float functions). */
 static MechrtStatus double_lu_solve(int n, double *a, double *piv, double *b)
@@ -1099,6 +1222,8 @@ int main(void)
         cmocka_unit_test(test_analysis_not_finite),
         cmocka_unit_test(test_step_run),
         cmocka_unit_test(test_step_predictor),
+        cmocka_unit_test(test_step_reference),
+        cmocka_unit_test(test_lu_factor_norm1),
         cmocka_unit_test(test_kernel_wrappers),
         cmocka_unit_test(test_float_build),
     };

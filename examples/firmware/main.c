@@ -43,6 +43,19 @@ enum {
 #define DIGITS 17
 #endif
 
+/* Built with -DSTEP_COUNT (the `count` target of the Makefile, Cortex-M
+   only): SysTick, clocked by the core, times every mechrt_step call after
+   the first, and the program prints the mean at the end. Under QEMU with
+   -icount shift=0 every instruction takes 1 ns of virtual time and the
+   MPS2 core clock is 25 MHz, so one tick is 40 instructions, exactly and
+   on every run: an instruction count of the step on the emulated core. */
+#ifdef STEP_COUNT
+#define SYST_CSR (*(volatile unsigned long *)0xE000E010UL)
+#define SYST_RVR (*(volatile unsigned long *)0xE000E014UL)
+#define SYST_CVR (*(volatile unsigned long *)0xE000E018UL)
+#define SYST_MAX 0xFFFFFFUL /* a 24-bit down counter */
+#endif
+
 /* All the memory the loop uses, reserved at link time (.bss). */
 static mechrt_real work[MECHRT_WORKSPACE_LEN(SC_NQ, SC_NR)];
 static mechrt_real q[SC_NQ], qd[SC_NQ], qdd[SC_NQ];
@@ -84,11 +97,24 @@ int main(void)
     printf("# mechc firmware example: slider_crank, %s, %d steps\n",
            sizeof(mechrt_real) == sizeof(float) ? "float" : "double", STEPS);
     printf("# step t slider.x d(slider.x) dd(slider.x)\n");
+#ifdef STEP_COUNT
+    unsigned long ticks = 0;
+    SYST_RVR = SYST_MAX;
+    SYST_CVR = 0;
+    SYST_CSR = 5;   /* enable, core clock, no interrupt */
+#endif
     for (i = 0; i <= STEPS; i++) {
         /* Step 0 (h = 0) assembles and analyses at t = 0. */
         mechrt_real tn = PERIOD * (mechrt_real)i / (mechrt_real)STEPS;
+#ifdef STEP_COUNT
+        unsigned long c0 = SYST_CVR;
+#endif
         st = mechrt_step(&sc_kernels, &opts, q, qd, qdd, t, tn - t, work,
                          sizeof work / sizeof work[0], &report);
+#ifdef STEP_COUNT
+        if (i > 0)
+            ticks += (c0 - SYST_CVR) & SYST_MAX;
+#endif
         if (st != MECHRT_OK) {
             printf("error: t = %.*g: %s\n", DIGITS, (double)tn, mechrt_strerror(st));
             return 1;
@@ -100,5 +126,10 @@ int main(void)
                    DIGITS, (double)qd[x], DIGITS, (double)qdd[x]);
     }
     printf("# done: %d steps, %ld Newton iterations\n", STEPS, newton_iterations);
+#ifdef STEP_COUNT
+    printf("# step: %lu SysTick ticks per step (40 instructions each under -icount shift=0)\n",
+           ticks / STEPS);
+    printf("# step: about %lu instructions per step\n", 40 * ticks / STEPS);
+#endif
     return 0;
 }
