@@ -319,6 +319,12 @@ check "textbook four-bar: omega_BD = -88/3" out_has "coupler.phi        0.244978
 check "textbook four-bar: omega_DE = 192/17, alpha_DE = 809" out_has "11.29411765         809.271511   (135 deg)"
 check "textbook four-bar: v_D = (-192, -192) (output D_pin)" out_has "D_pin.y                      17               -192       -15926.08627"
 check "textbook four-bar: placed by construction from angle guesses 0" out_has "textbook_four_bar at t = 0 (9 of 9 coordinates placed by construction, then 1 Newton iteration)"
+run "$ex/slider_crank_spatial.mech" --at 0.1
+check "spatial slider-crank at one instant: exit 0" status_is 0
+check "spatial slider-crank: the rod's omega_z and alpha_z are the planar rod.phi's rates" \
+    out_has "rod.wz                              -1.727890865        7.291297119"
+check "spatial slider-crank: the angular block's heading" \
+    out_has "angular                                 velocity       acceleration"
 run "$ex/textbook_geneva.mech" --at 0 --json
 check "textbook geneva --at 0 --json: exit 0" status_is 0
 check "textbook geneva: outputs listed" out_has '"outputs": ["slot_r", "pin.x", "pin.y"]'

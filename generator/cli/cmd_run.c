@@ -181,7 +181,15 @@ static void print_table(const Model *m, const Output *out, const RunResult *res,
         .assembled_robustly = res->assembled_robustly,
         .constructed = res->constructed,
     };
+    /* alpha = 2 E(p) p'' (the term 2 E' p' vanishes: E' p' = 0) */
+    size_t nw = (size_t)out->outputs.nw;
+    double *w = xcalloc(2 * nw + 1, sizeof *w);
+    outputs_omega(&out->outputs, s.q, s.qd, w);
+    outputs_omega(&out->outputs, s.q, s.qdd, w + nw);
+    s.nw = (int)nw, s.w = w, s.wd = w + nw;
+    s.wnames = (const char *const *)out->outputs.wnames;
     run_table_print(stdout, m, &s, digits);
+    free(w);
 }
 
 /* The state's coordinates followed by the outputs' values, in out->v. */

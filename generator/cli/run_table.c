@@ -1,8 +1,9 @@
 /* run_table.c - the state of a mechanism at one instant as a table people read (mechc run --steps 0).
  *
  * What a textbook problem asks for: every coordinate's position, velocity
- * and acceleration, then the outputs', in aligned columns; angles also in
- * degrees. Entries smaller than 1e-12 of their column's largest are
+ * and acceleration, the spatial bodies' angular velocities and
+ * accelerations (global frame), then the outputs', in aligned columns;
+ * angles also in degrees. Entries smaller than 1e-12 of their column's largest are
  * round-off of an exact zero and are shown as 0, so that a pin's fixed
  * coordinates read 0, not 1e-17.
  */
@@ -73,6 +74,21 @@ static void put_block(FILE *out, const Model *m, const char *heading, const char
     }
 }
 
+/* omega and alpha of the spatial bodies (global frame): no position column. */
+static void put_angular(FILE *out, const RunInstant *s, int width, int digits)
+{
+    double scale[2] = {column_scale(s->w, s->nw), column_scale(s->wd, s->nw)};
+    int column = digits + 7 > COLUMN ? digits + 7 : COLUMN;
+    fprintf(out, "%-*s  %*s  %*s  %*s\n", width, "angular", column, "", column, "velocity", column,
+            "acceleration");
+    for (int i = 0; i < s->nw; i++) {
+        fprintf(out, "%-*s  %*s", width, s->wnames[i], column, "");
+        put_value(out, s->w[i], scale[0], column, digits);
+        put_value(out, s->wd[i], scale[1], column, digits);
+        fputc('\n', out);
+    }
+}
+
 void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
 {
     digits = digits > 0 ? digits : 10;
@@ -88,6 +104,10 @@ void run_table_print(FILE *out, const Model *m, const RunInstant *s, int digits)
     fputs("\n\n", out);
     const double *const qv[3] = {s->q, s->qd, s->qdd};
     put_block(out, m, "coordinate", m->coord_names, m->nq, qv, true, width, digits);
+    if (s->nw > 0) {
+        fputc('\n', out);
+        put_angular(out, s, width, digits);
+    }
     if (m->nout > 0 && s->y) {
         const double *const yv[3] = {s->y, s->yd, s->ydd};
         fputc('\n', out);

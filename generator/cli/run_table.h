@@ -14,6 +14,11 @@ typedef struct RunInstant {
     const double *q, *qd, *qdd;
     const double *y, *yd, *ydd;
     const char *const *ynames;  /* the outputs' names (m->nout) */
+    /* spatial bodies: angular velocity and acceleration (global frame),
+       nw values each, named wnames (NAME.wx ...); nw = 0 for planar */
+    int nw;
+    const double *w, *wd;
+    const char *const *wnames;
     int assembly_iterations;
     bool assembled_robustly;
     int constructed;        /* coordinates placed by construction first */
