@@ -281,12 +281,22 @@ static void test_coefficients_merge(void **state)
     /* 3*x - x = 2*x, x - 3*x = -2*x, 3*x + 4*x = 7*x, 3*x - 3*x = 0 */
     NodeId three_x = dag_mul(d, K(f, 3.0), x);
     assert_int_equal(dag_sub(d, three_x, x), two_x);
-    assert_node(d, dag_sub(d, x, three_x), OP_MUL, K(f, -2.0), x);
+    assert_node(d, dag_sub(d, x, three_x), OP_NEG, two_x, -1);      /* -(2*x) */
     assert_node(d, dag_add(d, three_x, dag_mul(d, K(f, 4.0), x)), OP_MUL, K(f, 7.0), x);
     assert_int_equal(dag_sub(d, three_x, three_x), DAG_ZERO);
     assert_int_equal(dag_add(d, three_x, dag_mul(d, K(f, -3.0), x)), DAG_ZERO);
-    /* -(3*x) = -3*x */
-    assert_node(d, dag_neg(d, three_x), OP_MUL, K(f, -3.0), x);
+    /* -(3*x) stays a negation of 3*x, and (-3)*x is the same node: c*x and
+       -c*x share one product, the sign goes to the parent */
+    NodeId minus_three_x = dag_neg(d, three_x);
+    assert_node(d, minus_three_x, OP_NEG, three_x, -1);
+    assert_int_equal(dag_mul(d, K(f, -3.0), x), minus_three_x);
+    assert_int_equal(dag_mul(d, x, K(f, -3.0)), minus_three_x);
+    assert_int_equal(dag_mul(d, K(f, -1.5), dag_mul(d, K(f, 2.0), x)), minus_three_x);
+    assert_int_equal(dag_neg(d, minus_three_x), three_x);
+    /* y + (-3)*x = y - 3*x; y - (-3)*x = y + 3*x; 4*x + (-3)*x = x */
+    assert_node(d, dag_add(d, y, dag_mul(d, K(f, -3.0), x)), OP_SUB, y, three_x);
+    assert_int_equal(dag_sub(d, y, dag_mul(d, K(f, -3.0), x)), dag_add(d, y, three_x));
+    assert_int_equal(dag_add(d, dag_mul(d, K(f, 4.0), x), minus_three_x), x);
     /* merging applies to compound terms: sin(y) + sin(y) = 2 sin(y) */
     NodeId sy = dag_call(d, OP_SIN, y, DAG_NONE);
     assert_node(d, dag_add(d, sy, sy), OP_MUL, K(f, 2.0), sy);
@@ -308,7 +318,7 @@ static void test_coefficients_merge(void **state)
     assert_int_equal(dag_add(d, dag_add(d, x, K(f, 3.0)), K(f, 2.0)), e5);
     /* division by a power of two is a product; by 3 it is not */
     assert_node(d, dag_div(d, x, K(f, 4.0)), OP_MUL, K(f, 0.25), x);
-    assert_node(d, dag_div(d, x, K(f, -0.5)), OP_MUL, K(f, -2.0), x);
+    assert_node(d, dag_div(d, x, K(f, -0.5)), OP_NEG, dag_mul(d, K(f, 2.0), x), -1);
     assert_node(d, dag_div(d, x, K(f, 3.0)), OP_DIV, x, K(f, 3.0));
 }
 

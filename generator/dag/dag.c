@@ -226,7 +226,12 @@ static double split_coefficient(const Dag *dag, NodeId e, NodeId *term)
         *term = n->b;
         return c;
     }
-    if (n->op == OP_NEG) {
+    if (n->op == OP_NEG) {      /* -(c y): coefficients are kept positive */
+        const DagNode *m = &dag->nodes[n->a];
+        if (m->op == OP_MUL && dag_is_const(dag, m->a, &c)) {
+            *term = m->b;
+            return -c;
+        }
         *term = n->a;
         return -1.0;
     }
@@ -254,7 +259,7 @@ NodeId dag_neg(Dag *dag, NodeId a)
         return n.a;
     if (n.op == OP_SUB)
         return dag_sub(dag, n.b, n.a);
-    if (n.op == OP_MUL && dag_is_const(dag, n.a, &c))
+    if (n.op == OP_MUL && dag_is_const(dag, n.a, &c) && c < 0.0)
         return scale(dag, -c, n.b);
     return intern(dag, OP_NEG, a, -1, 0.0);
 }
@@ -363,6 +368,12 @@ NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
         return dag_neg(dag, dag_mul(dag, a, nb.a));
     double c1, c2;
     bool a_const = dag_is_const(dag, a, &c1);
+    /* (-c) y = -(c y): one product for c y and -c y, the sign folded
+       into the parent's + or - (or a negation at the top). */
+    if (a_const && c1 < 0.0) {
+        NodeId positive = dag_const(dag, -c1);
+        return dag_neg(dag, dag_mul(dag, positive, b));
+    }
     if (nb.op == OP_MUL && dag_is_const(dag, nb.a, &c2)) {
         if (a_const && isfinite(c1 * c2))       /* c1 (c2 y) = (c1 c2) y */
             return dag_mul(dag, dag_const(dag, c1 * c2), nb.b);
