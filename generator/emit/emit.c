@@ -163,6 +163,8 @@ typedef struct Emitter {
                                    (paired with an earlier one) in this chunk */
     int chunk;                  /* the chunk being written */
     int fused;                  /* negations written into their product, this function */
+    bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
+    bool hoisting;              /* in put_calls_first */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -275,6 +277,18 @@ static NodeId sincos_leader(const Emitter *e, NodeId id)
     return partner == DAG_NONE || e->sched.pos[partner] > e->sched.pos[id] ? id : DAG_NONE;
 }
 
+/* True when id can be written at the top of its chunk: a leaf, or an
+   inline expression over leaves. */
+static bool at_hand(const Emitter *e, NodeId id)
+{
+    if (dag_is_leaf(e->dag, id))
+        return true;
+    if (e->sched.temp[id] >= 0)
+        return false;
+    const DagNode *n = dag_node(e->dag, id);
+    return at_hand(e, n->a) && (dag_op_info[n->op].arity < 2 || at_hand(e, n->b));
+}
+
 /* Stores the temporary of id into its workspace slot, if it has one (a
    later chunk of the function imports it). */
 static void put_export(const Emitter *e, StrBuf *sb, NodeId id)
@@ -300,10 +314,14 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
         if (cand == DAG_NONE)
             continue;
         NodeId cand_arg = dag_node(e->dag, cand)->a;
-        if (dag_is_leaf(e->dag, cand_arg) || e->sched.pos[cand_arg] < at)
+        if (e->hoisting ? at_hand(e, cand_arg)
+                        : dag_is_leaf(e->dag, cand_arg) || e->sched.pos[cand_arg] < at)
             other = cand;
     }
     e->sincos_used = true;      /* sincos2 needs sincos for its rare case */
+    e->written[id] = true;
+    if (sincos_partner(e, id) != DAG_NONE)
+        e->written[sincos_partner(e, id)] = true;
     if (other == DAG_NONE) {
         sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
         put_expr(e, sb, arg, false);
@@ -346,10 +364,54 @@ static void put_temporary(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, N
             put_sincos(e, sb, c, at, id);
         return;
     }
-    sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
-    put_expr(e, sb, id, true);
-    sb_puts(sb, ";\n");
+    if (e->written[id])     /* written right after its partner */
+        return;
+    NodeId partner = op == OP_SIN || op == OP_COS ? sincos_partner(e, id) : DAG_NONE;
+    for (int k = 0; k < (partner == DAG_NONE ? 1 : 2); k++) {
+        /* sin and cos of one angle side by side, with no store between
+           that could alias the argument: gcc makes them one sincos call */
+        NodeId x = k == 0 ? id : partner;
+        sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[x]);
+        put_expr(e, sb, x, true);
+        sb_puts(sb, ";\n");
+        e->written[x] = true;
+    }
     put_export(e, sb, id);
+    put_export(e, sb, partner);
+}
+
+/* Where trigonometry is a call (libm, or the tool's sincos from the JIT),
+   the chunk's sin and cos come first: the callee returns them through
+   memory anyway, and arithmetic between calls would be spilled across
+   them. Inline sincos (the written file's default) stays next to its first
+   use, where it keeps few values live, unless the chunk has so few that
+   they all stay in registers (then the evaluations overlap). */
+enum { EMIT_TRIG_IN_REGISTERS = 8 };
+
+static bool calls_first(const Emitter *e, const SchedChunk *c)
+{
+    if (e->trig_calls)
+        return true;
+    int values = 0;
+    for (int at = 0; at < c->nnodes; at++) {
+        DagOp op = dag_op(e->dag, c->nodes[at]);
+        if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
+            values++;
+    }
+    return values <= EMIT_TRIG_IN_REGISTERS;
+}
+
+static void put_calls_first(Emitter *e, StrBuf *sb, const SchedChunk *c)
+{
+    e->hoisting = true;
+    for (int at = 0; at < c->nnodes; at++) {
+        NodeId id = c->nodes[at];
+        DagOp op = dag_op(e->dag, id);
+        if ((op == OP_SIN || op == OP_COS) && e->sched.temp[id] >= 0 && !e->written[id]
+            && !sched_is_import(&e->sched, id, e->chunk) && at_hand(e, dag_node(e->dag, id)->a))
+            put_temporary(e, sb, c, at, id);
+    }
+    e->hoisting = false;
 }
 
 /* The statements of one chunk: each store right after the temporaries it
@@ -364,10 +426,12 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     for (const Param *p = function_params[which]; p->name; p++)
         sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
     sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
+    if (calls_first(e, c))
+        put_calls_first(e, sb, c);
     int at = 0;
     for (int i = 0; i < c->count; i++) {
         for (; at < c->ends[i]; at++)
-            if (e->sched.temp[c->nodes[at]] >= 0)
+            if (e->sched.temp[c->nodes[at]] >= 0 && !e->written[c->nodes[at]])
                 put_temporary(e, sb, c, at, c->nodes[at]);
         const SchedOutput *o = &fn->outputs[c->first + i];
         sb_printf(sb, "    %s[%d] = ", o->array, o->index);
@@ -375,7 +439,7 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         sb_puts(sb, ";\n");
     }
     for (; at < c->nnodes; at++)    /* trig given to this chunk by a later one */
-        if (e->sched.temp[c->nodes[at]] >= 0)
+        if (e->sched.temp[c->nodes[at]] >= 0 && !e->written[c->nodes[at]])
             put_temporary(e, sb, c, at, c->nodes[at]);
     for (int i = 0; i < c->nnodes; i++) {   /* temporaries end with their chunk */
         e->sched.temp[c->nodes[i]] = -1;
@@ -762,6 +826,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         e.sincos_name = sincos_name;
         e.sincos2_name = sincos2_name;
     }
+    e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     bool fits = put_functions(&e, parts, bodies, out);
