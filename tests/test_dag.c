@@ -322,6 +322,34 @@ static void test_coefficients_merge(void **state)
     assert_node(d, dag_div(d, x, K(f, 3.0)), OP_DIV, x, K(f, 3.0));
 }
 
+/* c t y with c a power of two and t a sin or cos is t (c y): the sin and
+   cos of an angle share c y. Other constants keep c (t y), so no result
+   changes a bit. */
+static void test_trig_products(void **state)
+{
+    Fixture *f = *state;
+    Dag *d = &f->dag;
+    NodeId x = f->x, y = f->y;
+    NodeId s = dag_call(d, OP_SIN, x, DAG_NONE), c = dag_call(d, OP_COS, x, DAG_NONE);
+    NodeId half_y = dag_mul(d, K(f, 0.5), y);
+    NodeId cy = dag_mul(d, c, half_y);
+    assert_node(d, cy, OP_MUL, c < half_y ? c : half_y, c < half_y ? half_y : c);
+    assert_int_equal(dag_mul(d, K(f, 0.5), dag_mul(d, c, y)), cy);
+    assert_int_equal(dag_mul(d, dag_mul(d, y, K(f, 0.5)), c), cy);
+    assert_int_equal(dag_mul(d, y, dag_mul(d, K(f, 0.5), c)), cy);
+    NodeId sy = dag_mul(d, K(f, 0.5), dag_mul(d, s, y));
+    const DagNode *n = dag_node(d, sy);
+    assert_true(n->a == half_y || n->b == half_y);        /* 0.5 y shared */
+    /* -0.5 (cos x) y = -(cos x (0.5 y)) */
+    assert_node(d, dag_mul(d, K(f, -0.5), dag_mul(d, c, y)), OP_NEG, cy, -1);
+    /* 1.5 is not a power of two: 1.5 (cos x y) as before */
+    NodeId cxy = dag_mul(d, c, y);
+    assert_node(d, dag_mul(d, K(f, 1.5), cxy), OP_MUL, K(f, 1.5), cxy);
+    /* sin x cos x: both trig, no rewrite */
+    NodeId sc = dag_mul(d, s, c);
+    assert_node(d, dag_mul(d, K(f, 0.5), sc), OP_MUL, K(f, 0.5), sc);
+}
+
 static void test_powers(void **state)
 {
     Fixture *f = *state;
@@ -616,6 +644,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_no_fold_to_nan_or_inf, setup, teardown),
         cmocka_unit_test_setup_teardown(test_identities, setup, teardown),
         cmocka_unit_test_setup_teardown(test_coefficients_merge, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_trig_products, setup, teardown),
         cmocka_unit_test_setup_teardown(test_powers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_even_odd_functions, setup, teardown),
         cmocka_unit_test_setup_teardown(test_canonical_order, setup, teardown),
