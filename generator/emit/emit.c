@@ -1,8 +1,9 @@
 /* emit.c - renders scheduled straight-line code into the templates.
  *
  * Each generated function is: one `const real uN = ...;` per node that
- * needs a temporary (see sched.c), the other nodes written inline, then
- * one store per output. Constants are printed with the fewest digits
+ * needs a temporary (see sched.c), the other nodes written inline, each
+ * store right after the temporaries it is first to need; a function cut
+ * into parts passes values between them in its workspace ws. Constants are printed with the fewest digits
  * that read back to the same value, so folded params round-trip exactly.
  * Text from the input reaches the output only as escaped string literals
  * (coordinate and row names) or as a sanitized identifier (the prefix).
