@@ -281,12 +281,22 @@ static void test_coefficients_merge(void **state)
     /* 3*x - x = 2*x, x - 3*x = -2*x, 3*x + 4*x = 7*x, 3*x - 3*x = 0 */
     NodeId three_x = dag_mul(d, K(f, 3.0), x);
     assert_int_equal(dag_sub(d, three_x, x), two_x);
-    assert_node(d, dag_sub(d, x, three_x), OP_MUL, K(f, -2.0), x);
+    assert_node(d, dag_sub(d, x, three_x), OP_NEG, two_x, -1);      /* -(2*x) */
     assert_node(d, dag_add(d, three_x, dag_mul(d, K(f, 4.0), x)), OP_MUL, K(f, 7.0), x);
     assert_int_equal(dag_sub(d, three_x, three_x), DAG_ZERO);
     assert_int_equal(dag_add(d, three_x, dag_mul(d, K(f, -3.0), x)), DAG_ZERO);
-    /* -(3*x) = -3*x */
-    assert_node(d, dag_neg(d, three_x), OP_MUL, K(f, -3.0), x);
+    /* -(3*x) stays a negation of 3*x, and (-3)*x is the same node: c*x and
+       -c*x share one product, the sign goes to the parent */
+    NodeId minus_three_x = dag_neg(d, three_x);
+    assert_node(d, minus_three_x, OP_NEG, three_x, -1);
+    assert_int_equal(dag_mul(d, K(f, -3.0), x), minus_three_x);
+    assert_int_equal(dag_mul(d, x, K(f, -3.0)), minus_three_x);
+    assert_int_equal(dag_mul(d, K(f, -1.5), dag_mul(d, K(f, 2.0), x)), minus_three_x);
+    assert_int_equal(dag_neg(d, minus_three_x), three_x);
+    /* y + (-3)*x = y - 3*x; y - (-3)*x = y + 3*x; 4*x + (-3)*x = x */
+    assert_node(d, dag_add(d, y, dag_mul(d, K(f, -3.0), x)), OP_SUB, y, three_x);
+    assert_int_equal(dag_sub(d, y, dag_mul(d, K(f, -3.0), x)), dag_add(d, y, three_x));
+    assert_int_equal(dag_add(d, dag_mul(d, K(f, 4.0), x), minus_three_x), x);
     /* merging applies to compound terms: sin(y) + sin(y) = 2 sin(y) */
     NodeId sy = dag_call(d, OP_SIN, y, DAG_NONE);
     assert_node(d, dag_add(d, sy, sy), OP_MUL, K(f, 2.0), sy);
@@ -308,8 +318,36 @@ static void test_coefficients_merge(void **state)
     assert_int_equal(dag_add(d, dag_add(d, x, K(f, 3.0)), K(f, 2.0)), e5);
     /* division by a power of two is a product; by 3 it is not */
     assert_node(d, dag_div(d, x, K(f, 4.0)), OP_MUL, K(f, 0.25), x);
-    assert_node(d, dag_div(d, x, K(f, -0.5)), OP_MUL, K(f, -2.0), x);
+    assert_node(d, dag_div(d, x, K(f, -0.5)), OP_NEG, dag_mul(d, K(f, 2.0), x), -1);
     assert_node(d, dag_div(d, x, K(f, 3.0)), OP_DIV, x, K(f, 3.0));
+}
+
+/* c t y with c a power of two and t a sin or cos is t (c y): the sin and
+   cos of an angle share c y. Other constants keep c (t y), so no result
+   changes a bit. */
+static void test_trig_products(void **state)
+{
+    Fixture *f = *state;
+    Dag *d = &f->dag;
+    NodeId x = f->x, y = f->y;
+    NodeId s = dag_call(d, OP_SIN, x, DAG_NONE), c = dag_call(d, OP_COS, x, DAG_NONE);
+    NodeId half_y = dag_mul(d, K(f, 0.5), y);
+    NodeId cy = dag_mul(d, c, half_y);
+    assert_node(d, cy, OP_MUL, c < half_y ? c : half_y, c < half_y ? half_y : c);
+    assert_int_equal(dag_mul(d, K(f, 0.5), dag_mul(d, c, y)), cy);
+    assert_int_equal(dag_mul(d, dag_mul(d, y, K(f, 0.5)), c), cy);
+    assert_int_equal(dag_mul(d, y, dag_mul(d, K(f, 0.5), c)), cy);
+    NodeId sy = dag_mul(d, K(f, 0.5), dag_mul(d, s, y));
+    const DagNode *n = dag_node(d, sy);
+    assert_true(n->a == half_y || n->b == half_y);        /* 0.5 y shared */
+    /* -0.5 (cos x) y = -(cos x (0.5 y)) */
+    assert_node(d, dag_mul(d, K(f, -0.5), dag_mul(d, c, y)), OP_NEG, cy, -1);
+    /* 1.5 is not a power of two: 1.5 (cos x y) as before */
+    NodeId cxy = dag_mul(d, c, y);
+    assert_node(d, dag_mul(d, K(f, 1.5), cxy), OP_MUL, K(f, 1.5), cxy);
+    /* sin x cos x: both trig, no rewrite */
+    NodeId sc = dag_mul(d, s, c);
+    assert_node(d, dag_mul(d, K(f, 0.5), sc), OP_MUL, K(f, 0.5), sc);
 }
 
 static void test_powers(void **state)
@@ -606,6 +644,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_no_fold_to_nan_or_inf, setup, teardown),
         cmocka_unit_test_setup_teardown(test_identities, setup, teardown),
         cmocka_unit_test_setup_teardown(test_coefficients_merge, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_trig_products, setup, teardown),
         cmocka_unit_test_setup_teardown(test_powers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_even_odd_functions, setup, teardown),
         cmocka_unit_test_setup_teardown(test_canonical_order, setup, teardown),

@@ -226,7 +226,12 @@ static double split_coefficient(const Dag *dag, NodeId e, NodeId *term)
         *term = n->b;
         return c;
     }
-    if (n->op == OP_NEG) {
+    if (n->op == OP_NEG) {      /* -(c y): coefficients are kept positive */
+        const DagNode *m = &dag->nodes[n->a];
+        if (m->op == OP_MUL && dag_is_const(dag, m->a, &c)) {
+            *term = m->b;
+            return -c;
+        }
         *term = n->a;
         return -1.0;
     }
@@ -254,7 +259,7 @@ NodeId dag_neg(Dag *dag, NodeId a)
         return n.a;
     if (n.op == OP_SUB)
         return dag_sub(dag, n.b, n.a);
-    if (n.op == OP_MUL && dag_is_const(dag, n.a, &c))
+    if (n.op == OP_MUL && dag_is_const(dag, n.a, &c) && c < 0.0)
         return scale(dag, -c, n.b);
     return intern(dag, OP_NEG, a, -1, 0.0);
 }
@@ -343,6 +348,32 @@ NodeId dag_sub(Dag *dag, NodeId a, NodeId b)
     return intern(dag, OP_SUB, a, b, 0.0);
 }
 
+static bool is_trig(const Dag *dag, NodeId id)
+{
+    DagOp op = dag_op(dag, id);
+    return op == OP_SIN || op == OP_COS;
+}
+
+/* c a moderate power of two: c (x y) and x (c y) are the same number
+   (scaling by 2^k is exact away from overflow and subnormals), so either
+   grouping may be chosen without changing a bit of any result. */
+static bool is_power_of_two(const Dag *dag, NodeId id)
+{
+    double c;
+    int e;
+    return dag_is_const(dag, id, &c) && c > 0.0 && frexp(c, &e) == 0.5 && e > -64 && e < 64;
+}
+
+/* t (c y), t a sin or cos, c a power of two and y neither a constant nor a
+   sin or cos: the one form of the product c t y, so that the sin and the
+   cos of an angle share c y (0.5 phid^2 in gamma). */
+static bool trig_times_scaled(const Dag *dag, NodeId t, NodeId scaled)
+{
+    const DagNode *n = &dag->nodes[scaled];
+    return is_trig(dag, t) && n->op == OP_MUL && is_power_of_two(dag, n->a)
+           && !is_trig(dag, n->b) && !dag_is_const(dag, n->b, NULL);
+}
+
 NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
 {
     NodeId r;
@@ -363,6 +394,21 @@ NodeId dag_mul(Dag *dag, NodeId a, NodeId b)
         return dag_neg(dag, dag_mul(dag, a, nb.a));
     double c1, c2;
     bool a_const = dag_is_const(dag, a, &c1);
+    /* (-c) y = -(c y): one product for c y and -c y, the sign folded
+       into the parent's + or - (or a negation at the top). */
+    if (a_const && c1 < 0.0) {
+        NodeId positive = dag_const(dag, -c1);
+        return dag_neg(dag, dag_mul(dag, positive, b));
+    }
+    if (trig_times_scaled(dag, a, b) || trig_times_scaled(dag, b, a))
+        return intern(dag, OP_MUL, a, b, 0.0);
+    /* c (t y) = t (c y) */
+    if (a_const && is_power_of_two(dag, a) && nb.op == OP_MUL && !dag_is_const(dag, nb.a, NULL)
+        && is_trig(dag, nb.a) != is_trig(dag, nb.b)) {
+        NodeId t = is_trig(dag, nb.a) ? nb.a : nb.b;
+        NodeId scaled = dag_mul(dag, a, t == nb.a ? nb.b : nb.a);
+        return dag_mul(dag, t, scaled);
+    }
     if (nb.op == OP_MUL && dag_is_const(dag, nb.a, &c2)) {
         if (a_const && isfinite(c1 * c2))       /* c1 (c2 y) = (c1 c2) y */
             return dag_mul(dag, dag_const(dag, c1 * c2), nb.b);

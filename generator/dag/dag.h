@@ -65,7 +65,9 @@ NodeId dag_time(Dag *dag);
 /* Operators, simplified as they are built: constants folded when the
    result is finite, 0/1 identities, x - x, double negation, numeric
    coefficients merged (2*(3*x) = 6*x, x + x = 2*x, 3*x - x = 2*x),
-   operands of + and * put in canonical order. */
+   operands of + and * put in canonical order, coefficients positive
+   ((-c)*x is built as -(c*x), so c*x is one node for both signs and the
+   sign goes into the parent's + or -). */
 NodeId dag_neg(Dag *dag, NodeId a);
 NodeId dag_add(Dag *dag, NodeId a, NodeId b);
 NodeId dag_sub(Dag *dag, NodeId a, NodeId b);

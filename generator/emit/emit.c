@@ -1,8 +1,9 @@
 /* emit.c - renders scheduled straight-line code into the templates.
  *
  * Each generated function is: one `const real uN = ...;` per node that
- * needs a temporary (see sched.c), the other nodes written inline, then
- * one store per output. Constants are printed with the fewest digits
+ * needs a temporary (see sched.c), the other nodes written inline, each
+ * store right after the temporaries it is first to need; a function cut
+ * into parts passes values between them in its workspace ws. Constants are printed with the fewest digits
  * that read back to the same value, so folded params round-trip exactly.
  * Text from the input reaches the output only as escaped string literals
  * (coordinate and row names) or as a sanitized identifier (the prefix).
@@ -161,6 +162,10 @@ typedef struct Emitter {
     bool sincos2_used;          /* some function called sincos2_name */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
+    int chunk;                  /* the chunk being written */
+    int fused;                  /* negations written into their product, this function */
+    bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
+    bool hoisting;              /* in put_calls_first */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -204,6 +209,13 @@ static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top)
     case OP_VARD:  sb_printf(sb, "qd[%d]", n->a); return;
     case OP_TIME:  sb_puts(sb, "t"); return;
     case OP_NEG:
+        if (sched_fused_negation(&e->sched, id)) {     /* (-c) * y */
+            const DagNode *product = dag_node(e->dag, n->a);
+            put_literal(sb, -dag_node(e->dag, product->a)->value, e->opt->real_float);
+            sb_puts(sb, " * ");
+            put_operand(e, sb, product->b, 2, true);
+            return;
+        }
         sb_putc(sb, '-');
         put_operand(e, sb, n->a, 4, false);
         return;
@@ -233,7 +245,8 @@ static NodeId sincos_partner(const Emitter *e, NodeId id)
 {
     NodeId other = dag_find(e->dag, dag_op(e->dag, id) == OP_SIN ? OP_COS : OP_SIN,
                             dag_node(e->dag, id)->a, -1);
-    return other != DAG_NONE && e->sched.temp[other] >= 0 ? other : DAG_NONE;
+    return other != DAG_NONE && e->sched.temp[other] >= 0
+           && !sched_is_import(&e->sched, other, e->chunk) ? other : DAG_NONE;
 }
 
 /* The names that receive sin and cos of a sin or cos node's argument: the
@@ -259,17 +272,38 @@ static NodeId sincos_leader(const Emitter *e, NodeId id)
 {
     DagOp op = dag_op(e->dag, id);
     if (!e->sincos_name || (op != OP_SIN && op != OP_COS) || e->sched.temp[id] < 0 ||
-        e->written[id])
+        e->written[id] || sched_is_import(&e->sched, id, e->chunk))
         return DAG_NONE;
     NodeId partner = sincos_partner(e, id);
-    return partner == DAG_NONE || partner > id ? id : DAG_NONE;
+    return partner == DAG_NONE || e->sched.pos[partner] > e->sched.pos[id] ? id : DAG_NONE;
+}
+
+/* True when id can be written at the top of its chunk: a leaf, or an
+   inline expression over leaves. */
+static bool at_hand(const Emitter *e, NodeId id)
+{
+    if (dag_is_leaf(e->dag, id))
+        return true;
+    if (e->sched.temp[id] >= 0)
+        return false;
+    const DagNode *n = dag_node(e->dag, id);
+    return at_hand(e, n->a) && (dag_op_info[n->op].arity < 2 || at_hand(e, n->b));
+}
+
+/* Stores the temporary of id into its workspace slot, if it has one (a
+   later chunk of the function imports it). */
+static void put_export(const Emitter *e, StrBuf *sb, NodeId id)
+{
+    int slot = id == DAG_NONE ? -1 : sched_slot(&e->sched, id);
+    if (slot >= 0)
+        sb_printf(sb, "    ws[%d] = u%d;\n", slot, e->sched.temp[id]);
 }
 
 /* The sin and cos temporaries of the group led by id, through one sincos
    call; with a two-angle function, a later group of the chunk whose
-   argument is already at hand (a leaf, or a node whose id is below id's:
-   ids are a topological order and temporaries are written in id order)
-   shares the call, so that both angles go through one instruction stream. */
+   argument is already at hand (a leaf, or a node written before this
+   one) shares the call, so that both angles go through one instruction
+   stream. */
 static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
     char ts[24], tc[24], ts2[24], tc2[24];
@@ -281,14 +315,20 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
         if (cand == DAG_NONE)
             continue;
         NodeId cand_arg = dag_node(e->dag, cand)->a;
-        if (dag_is_leaf(e->dag, cand_arg) || cand_arg < id)
+        if (e->hoisting ? at_hand(e, cand_arg)
+                        : dag_is_leaf(e->dag, cand_arg) || e->sched.pos[cand_arg] < at)
             other = cand;
     }
     e->sincos_used = true;      /* sincos2 needs sincos for its rare case */
+    e->written[id] = true;
+    if (sincos_partner(e, id) != DAG_NONE)
+        e->written[sincos_partner(e, id)] = true;
     if (other == DAG_NONE) {
         sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
         put_expr(e, sb, arg, false);
         sb_printf(sb, ", &%s, &%s);\n", ts, tc);
+        put_export(e, sb, id);
+        put_export(e, sb, sincos_partner(e, id));
         return;
     }
     NodeId other_partner = sincos_partner(e, other);
@@ -303,38 +343,105 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     sb_puts(sb, ", ");
     put_expr(e, sb, dag_node(e->dag, other)->a, false);
     sb_printf(sb, ", &%s, &%s, &%s, &%s);\n", ts, tc, ts2, tc2);
+    put_export(e, sb, id);
+    put_export(e, sb, sincos_partner(e, id));
+    put_export(e, sb, other);
+    put_export(e, sb, other_partner);
 }
 
-/* The statements of one chunk: temporaries in id order, then the stores. */
-static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
-                      EmitFunction which)
+/* The statement that gives node id (at position at of chunk c) its
+   temporary: an import's load, a sincos call for a group's leader, or an
+   assignment (then its export). */
+static void put_temporary(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
-    sched_prepare_chunk(&e->sched, fn, chunk);
+    int slot = sched_slot(&e->sched, id);
+    if (sched_is_import(&e->sched, id, e->chunk)) {
+        sb_printf(sb, "    const %s_real u%d = ws[%d];\n", e->prefix, e->sched.temp[id], slot);
+        return;
+    }
+    DagOp op = dag_op(e->dag, id);
+    if (e->sincos_name && (op == OP_SIN || op == OP_COS)) {
+        if (sincos_leader(e, id) != DAG_NONE)   /* else written with its partner */
+            put_sincos(e, sb, c, at, id);
+        return;
+    }
+    if (e->written[id])     /* written right after its partner */
+        return;
+    NodeId partner = op == OP_SIN || op == OP_COS ? sincos_partner(e, id) : DAG_NONE;
+    for (int k = 0; k < (partner == DAG_NONE ? 1 : 2); k++) {
+        /* sin and cos of one angle side by side, with no store between
+           that could alias the argument: gcc makes them one sincos call */
+        NodeId x = k == 0 ? id : partner;
+        sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[x]);
+        put_expr(e, sb, x, true);
+        sb_puts(sb, ";\n");
+        e->written[x] = true;
+    }
+    put_export(e, sb, id);
+    put_export(e, sb, partner);
+}
+
+/* Where trigonometry is a call (libm, or the tool's sincos from the JIT),
+   the chunk's sin and cos come first: the callee returns them through
+   memory anyway, and arithmetic between calls would be spilled across
+   them. Inline sincos (the written file's default) stays next to its first
+   use, where it keeps few values live, unless the chunk has so few that
+   they all stay in registers (then the evaluations overlap). */
+enum { EMIT_TRIG_IN_REGISTERS = 8 };
+
+static bool calls_first(const Emitter *e, const SchedChunk *c)
+{
+    if (e->trig_calls)
+        return true;
+    int values = 0;
+    for (int at = 0; at < c->nnodes; at++) {
+        DagOp op = dag_op(e->dag, c->nodes[at]);
+        if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
+            values++;
+    }
+    return values <= EMIT_TRIG_IN_REGISTERS;
+}
+
+static void put_calls_first(Emitter *e, StrBuf *sb, const SchedChunk *c)
+{
+    e->hoisting = true;
+    for (int at = 0; at < c->nnodes; at++) {
+        NodeId id = c->nodes[at];
+        DagOp op = dag_op(e->dag, id);
+        if ((op == OP_SIN || op == OP_COS) && e->sched.temp[id] >= 0 && !e->written[id]
+            && !sched_is_import(&e->sched, id, e->chunk) && at_hand(e, dag_node(e->dag, id)->a))
+            put_temporary(e, sb, c, at, id);
+    }
+    e->hoisting = false;
+}
+
+/* The statements of one chunk: each store right after the temporaries it
+   is the first to need. */
+static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
+                      EmitFunction which, bool workspace)
+{
+    e->fused += sched_prepare_chunk(&e->sched, fn, chunk);
+    e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
     sb_puts(sb, "    ");
     for (const Param *p = function_params[which]; p->name; p++)
         sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
-    sb_putc(sb, '\n');
-    for (int i = 0; i < c->nnodes; i++) {
-        NodeId id = c->nodes[i];
-        if (e->sched.temp[id] < 0)
-            continue;
-        DagOp op = dag_op(e->dag, id);
-        if (e->sincos_name && (op == OP_SIN || op == OP_COS)) {
-            if (sincos_leader(e, id) != DAG_NONE)   /* else written with its partner */
-                put_sincos(e, sb, c, i, id);
-            continue;
-        }
-        sb_printf(sb, "    const %s_real u%d = ", e->prefix, e->sched.temp[id]);
-        put_expr(e, sb, id, true);
-        sb_puts(sb, ";\n");
-    }
-    for (int i = c->first; i < c->first + c->count; i++) {
-        const SchedOutput *o = &fn->outputs[i];
+    sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
+    if (calls_first(e, c))
+        put_calls_first(e, sb, c);
+    int at = 0;
+    for (int i = 0; i < c->count; i++) {
+        for (; at < c->ends[i]; at++)
+            if (e->sched.temp[c->nodes[at]] >= 0 && !e->written[c->nodes[at]])
+                put_temporary(e, sb, c, at, c->nodes[at]);
+        const SchedOutput *o = &fn->outputs[c->first + i];
         sb_printf(sb, "    %s[%d] = ", o->array, o->index);
         put_expr(e, sb, o->value, false);
         sb_puts(sb, ";\n");
     }
+    for (; at < c->nnodes; at++)    /* trig given to this chunk by a later one */
+        if (e->sched.temp[c->nodes[at]] >= 0 && !e->written[c->nodes[at]])
+            put_temporary(e, sb, c, at, c->nodes[at]);
     for (int i = 0; i < c->nnodes; i++) {   /* temporaries end with their chunk */
         e->sched.temp[c->nodes[i]] = -1;
         e->written[c->nodes[i]] = false;
@@ -362,19 +469,24 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
                          StrBuf *parts, StrBuf *body)
 {
     if (fn->nchunks == 1) {
-        put_chunk(e, body, fn, 0, which);
+        put_chunk(e, body, fn, 0, which, false);
         return;
     }
     const char *p = e->prefix;
+    bool workspace = fn->nslots > 0;    /* values that cross parts */
+    if (workspace)
+        sb_printf(body, "    %s_real ws[%d];\n", p, fn->nslots);
     for (int c = 0; c < fn->nchunks; c++) {
         sb_printf(parts, "%s_PART void %s_%s_part%d(", e->prefix_upper, p, emit_function_names[which], c);
         put_signature(parts, p, which);
+        if (workspace)
+            sb_printf(parts, ", %s_real *ws", p);
         sb_puts(parts, ")\n{\n");
-        put_chunk(e, parts, fn, c, which);
+        put_chunk(e, parts, fn, c, which, workspace);
         sb_puts(parts, "}\n\n");
         sb_printf(body, "    %s_%s_part%d(", p, emit_function_names[which], c);
         put_arguments(body, which);
-        sb_puts(body, ");\n");
+        sb_puts(body, workspace ? ", ws);\n" : ");\n");
     }
 }
 
@@ -533,8 +645,9 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         collect_outputs(e->kin, (EmitFunction)f, &outs, &n);
         SchedFunction fn;
         if (sched_function(&e->sched, outs, n, &fn)) {
+            e->fused = 0;
             put_function(e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
-            out->ops[f] = fn.ops;
+            out->ops[f] = fn.ops - e->fused;
             out->chunks[f] = fn.nchunks;
         } else {
             fits = false;
@@ -714,6 +827,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         e.sincos_name = sincos_name;
         e.sincos2_name = sincos2_name;
     }
+    e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     bool fits = put_functions(&e, parts, bodies, out);
