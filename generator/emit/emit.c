@@ -431,37 +431,36 @@ static void put_int_list(StrBuf *sb, const Kinematics *kin, bool rows)
         sb_puts(sb, "    0\n");
 }
 
-/* The zero-fill of the dense Jacobian before its nonzeros are stored. The
-   JIT calls memset (libtcc compiles loops and stores as written, a store
-   costs it a load and a store). Compiled code stores each structural zero
-   when the matrix is small (gcc turns a short fill loop into rep stos,
-   which costs more there), else loops. */
+/* The zero-fill of the dense Jacobian before its nonzeros are stored:
+   one memset, which every compiler provides, freestanding or not (gcc and
+   clang may call it for any fill loop); a loop as written runs element by
+   element under libtcc, gcc -O0 and -O1. Optimizing compilers get a small
+   matrix's structural zeros as stores instead (P_OPTIMIZED, put_math):
+   gcc turns a short memset into rep stos, which costs more there. */
 enum { EMIT_ZERO_STORES_MAX = 256 };
 static void put_zero_fill(StrBuf *sb, const Kinematics *kin, const EmitOptions *opt,
                           const char *prefix, const char *upper)
 {
     const Model *m = kin->model;
-    if (opt->declare_math) {
-        sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
-        return;
-    }
-    if ((long)m->nr * m->nq > EMIT_ZERO_STORES_MAX) {
-        sb_printf(sb, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;", upper,
-                  upper);
-        return;
-    }
-    /* eight stores a line; the template ends the last line */
-    int k = 0, stores = 0;
-    for (int r = 0; r < m->nr; r++)
+    bool stores = !opt->declare_math && (long)m->nr * m->nq <= EMIT_ZERO_STORES_MAX;
+    if (stores)
+        sb_printf(sb, "#if %s_OPTIMIZED\n", upper);
+    /* eight stores a line */
+    for (int r = 0, k = 0, n = 0; stores && r < m->nr; r++)
         for (int c = 0; c < m->nq; c++) {
             if (k < kin->nnz && kin->jac[k].row == r && kin->jac[k].col == c) {
                 k++;
                 continue;
             }
-            const char *sep = stores == 0 ? "    " : stores % 8 == 0 ? "\n    " : " ";
+            const char *sep = n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ";
             sb_printf(sb, "%sjac[%d] = 0;", sep, r * m->nq + c);
-            stores++;
+            n++;
         }
+    if (stores)
+        sb_puts(sb, "\n#else\n");
+    sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
+    if (stores)
+        sb_puts(sb, "\n#endif");
 }
 
 /* The banner names the input by its base name, with anything that could
@@ -549,9 +548,24 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
     return fits;
 }
 
+/* Calls of name in the written functions. */
+static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *name)
+{
+    char call[170];
+    snprintf(call, sizeof call, "%s(", name);
+    long n = 0;
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        for (int b = 0; b < 2; b++)
+            for (const char *at = (b ? bodies : parts)[f].data; (at = strstr(at, call)); at++)
+                n++;
+    return n;
+}
+
 /* What the kernels call for math: libm declared (JIT) or included, and
-   the sincos functions the emitter used. */
-static void put_math(StrBuf *math, const Emitter *e)
+   the sincos functions the emitter used, for written files chosen by the
+   compiler (templates/trig.tmpl). parts and bodies: the written functions. */
+enum { EMIT_INLINE_TRIG_MAX = 64 };
+static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
 {
     const char *upper = e->prefix_upper;
     if (e->opt->declare_math) {
@@ -568,28 +582,45 @@ static void put_math(StrBuf *math, const Emitter *e)
         sb_puts(math, "void *memset(void *, int, unsigned long);\n");
         return;
     }
-    sb_puts(math, "#include <math.h>\n");
+    sb_printf(math, "#include <math.h>\n#include <string.h>\n\n"
+              "/* Chosen when the file is compiled: optimizing compilers get the file's\n"
+              "   own sin/cos and a small Jacobian's zeros as stores; libtcc and gcc -O0\n"
+              "   (firmware debug builds), which compile the sin/cos series into slow\n"
+              "   code, get sin and cos of <math.h> and memset. */\n"
+              "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
+              "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
     if (!e->sincos_used)
         return;
+    /* Inlined at every call (gcc splits the pair function at its rare-case
+       test and calls the rest out of line, through memory, unless forced),
+       the pair takes gcc -O2 several times as long as libm calls would:
+       large files call one copy. */
+    bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
+                       count_calls(parts, bodies, e->sincos2_name) <= EMIT_INLINE_TRIG_MAX;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
-    TemplateVar sv[] = {{"P", e->prefix}, {"STATIC", trig}};
-    /* gcc splits the pair function at its rare-case test and calls the rest
-       out of line, through memory, unless forced; without a vector unit,
-       inlining only multiplies the code (it doubled the Cortex-M3 kernels
-       at -O2) */
-    sb_printf(math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
-              "they inline it;\n   elsewhere one copy serves all calls */\n"
-              "#if defined(__GNUC__) && defined(__SSE2__)\n"
-              "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
-              "#define %s_TRIG static\n#endif\n", upper, upper);
-    if (template_render(math, template_sincos, sv, 2))
+    TemplateVar sv[] = {
+        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""},
+        {"TRIG_X86", inline_pair ? "static inline __attribute__((always_inline))"
+                                 : "static __attribute__((noinline))"},
+        {"TRIG_WHY", inline_pair ? "x86-64 compilers vectorize the two-angle sincos only where "
+                                   "they inline it;\n   elsewhere one copy serves all calls"
+                                 : "one copy serves all calls: inlined at each of this file's "
+                                   "many calls, the\n   pair would take gcc several times as "
+                                   "long to compile"},
+    };
+    int nsv = (int)(sizeof sv / sizeof *sv);
+    StrBuf sincos;
+    sb_init(&sincos);
+    if (template_render(&sincos, template_sincos, sv, nsv) ||
+        (e->sincos2_used && (sb_puts(&sincos, "\n"),
+                             template_render(&sincos, template_sincos2, sv, nsv))))
         abort();    /* every placeholder of the sincos templates is given */
-    if (e->sincos2_used) {
-        sb_puts(math, "\n");
-        if (template_render(math, template_sincos2, sv, 2))
-            abort();
-    }
+    template_set(sv, nsv, "SINCOS", sincos.data);
+    sb_puts(math, "\n");
+    if (template_render(math, template_trig, sv, nsv))
+        abort();
+    sb_free(&sincos);
 }
 
 /* The data section's lists: initial values, names, Jacobian structure. */
@@ -630,7 +661,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
-    put_math(&math, e);
+    put_math(&math, e, parts, bodies);
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
