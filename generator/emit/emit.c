@@ -463,6 +463,28 @@ static void put_zero_fill(StrBuf *sb, const Kinematics *kin, const EmitOptions *
         sb_puts(sb, "\n#endif");
 }
 
+/* The spread Jacobian's moves, one statement each (jac_spread.tmpl): jac[at]
+   = jac[base + k] for every entry k, in order, then a zero in each slot of
+   the packed tail that no entry moved into. Eight a line. */
+static void put_jac_moves(StrBuf *sb, const Kinematics *kin)
+{
+    const Model *m = kin->model;
+    long total = (long)m->nr * m->nq, nnz = kin->nnz > 0 ? kin->nnz : 1, base = total - nnz;
+    long n = 0, k = 0;
+    for (; k < kin->nnz; k++, n++)
+        sb_printf(sb, "%sjac[%ld] = jac[%ld];", n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ",
+                  (long)kin->jac[k].row * m->nq + kin->jac[k].col, base + k);
+    k = 0;      /* the targets increase: walk them beside the tail's slots */
+    for (long s = base; s < total; s++) {
+        while (k < kin->nnz && (long)kin->jac[k].row * m->nq + kin->jac[k].col < s)
+            k++;
+        if (k < kin->nnz && (long)kin->jac[k].row * m->nq + kin->jac[k].col == s)
+            continue;
+        sb_printf(sb, "%sjac[%ld] = 0;", n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ", s);
+        n++;
+    }
+}
+
 /* The banner names the input by its base name, with anything that could
    end the comment or confuse a reader replaced. */
 static void put_banner(StrBuf *sb, const char *source)
@@ -649,9 +671,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     const EmitOptions *opt = e->opt;
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac, &inc};
+                          &zero, &jac, &inc, &moves};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
@@ -661,6 +683,8 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
+    if (!opt->direct_jac)
+        put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
@@ -683,7 +707,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"JAC", ""},
+        {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     /* INTERFACE and JAC are rendered from the others, then filled in */
