@@ -111,7 +111,7 @@ if [ -x /usr/bin/time ] && [ -f "$tmp/chain_100/m.c" ]; then
         }
         END {
             m = median("m"); l = median("l")
-            printf "  default %.2f s, --trig libm %.2f s, ratio %.2f\n", m, l, l > 0 ? m / l : 0
+            printf "  default %.2f s, --trig libm %.2f s, ratio %.2f\n", m, l, (l > 0 ? m / l : 0)
         }'
 else
     echo "skip: gcc -O2 compile time (needs /usr/bin/time and the N = 100 chain)"

@@ -8,7 +8,8 @@
  * velocities 0.1 (i mod 7 - 3), t = 0.3: REPEAT rounds, each timing every
  * function of every LIB once (interleaved, so a change of machine speed
  * touches them alike), one batch of calls lasting about 2 ms; the median
- * per function. Also times the floor of the dense Jacobian: one memset of
+ * per function (each round starts at another function, after one round
+ * to warm up). Also times the floor of the dense Jacobian: one memset of
  * NR*NQ reals and NNZ stores at their places, built with this driver's
  * flags (gcc -O2). Prints one line per LIB: its name, then ns per call of
  * phi jac jac_nz nu gamma all; then a line "floor" with the fill and
@@ -50,7 +51,7 @@ typedef struct Work {
 static double now(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);   /* time descheduled does not count */
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -104,10 +105,12 @@ static void call_n(const Lib *l, int fn, long n, Work *w, const Lib *shape)
     }
 }
 
-/* Calls per batch so that one batch lasts about 2 ms. */
+/* Calls per batch so that one batch lasts about 2 ms; after one call, so
+   that page faults and cold caches do not count. */
 static long batch_size(const Lib *l, int fn, Work *w, const Lib *shape)
 {
     long n = 1;
+    call_n(l, fn, 1, w, shape);
     for (;;) {
         double t0 = now();
         call_n(l, fn, n, w, shape);
@@ -199,12 +202,16 @@ int main(int argc, char **argv)
     double *ns = calloc((size_t)nslots * (size_t)repeat, sizeof(double));
     for (int s = 0; s < nslots; s++)
         batch[s] = batch_size(s < nslots - 1 ? &libs[s / FN_COUNT] : NULL, s % FN_COUNT, &w, &libs[0]);
-    for (int r = 0; r < repeat; r++)
-        for (int s = 0; s < nslots; s++) {
+    /* round -1 warms up; each round starts at another slot, so that no
+       LIB always follows the floor (whose memset evicts the Jacobian) */
+    for (int r = -1; r < repeat; r++)
+        for (int i = 0; i < nslots; i++) {
+            int s = (i + (r < 0 ? 0 : r) * (FN_COUNT + 1)) % nslots;
             const Lib *l = s < nslots - 1 ? &libs[s / FN_COUNT] : NULL;
             double t0 = now();
             call_n(l, s % FN_COUNT, batch[s], &w, &libs[0]);
-            ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (now() - t0) / (double)batch[s];
+            if (r >= 0)
+                ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (now() - t0) / (double)batch[s];
         }
     for (int s = 0; s < nslots; s++) {
         double *v = &ns[(size_t)s * (size_t)repeat];
