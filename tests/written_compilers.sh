@@ -15,7 +15,8 @@
 # gamma; these must equal `mechc eval --json` (the JIT) at that state to
 # 1e-12 (relative above 1). The driver also requires jac from jac_nz,
 # all and jac to agree exactly. Checks too that the trig is the one chosen:
-# the sincos table is in the gcc -O2 object and not in the others.
+# the sincos table is in the gcc -O2 object and not in the others, and the
+# pair is always_inline in the four-bar's file, noinline in chain_12's.
 . "$(dirname "$0")/lib.sh"
 suite_begin written_compilers "${1:-build/mechc}"
 
@@ -158,6 +159,11 @@ done > "$tmp/results"
 while read -r verdict rest; do
     if [ "$verdict" = ok ]; then ok; else : > "$tmp/err"; bad "$rest"; fi
 done < "$tmp/results"
+# the pair is inlined on x86-64 in small files only (70 calls in chain_12)
+check "four_bar: the sincos pair always_inline on x86-64" \
+    grep -q '^#define M_TRIG static inline __attribute__((always_inline))$' "$tmp/four_bar/m.c"
+check "chain_12: one noinline copy of the sincos pair" \
+    grep -q '^#define M_TRIG static __attribute__((noinline))$' "$tmp/chain_12/m.c"
 # 5 cases x 3 compilers x 2 checks, and the table check for the 4 with sin/cos
 [ "$(grep -c . "$tmp/results")" -ge 30 ] && ok || bad "fewer results than expected ($(grep -c . "$tmp/results"))"
 suite_end

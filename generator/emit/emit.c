@@ -602,6 +602,7 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
                           e->sincos2_name);
         }
         sb_puts(math, "void *memset(void *, int, unsigned long);\n");
+        sb_printf(math, "#define %s_OPTIMIZED 0   /* libtcc */\n", upper);
         return;
     }
     sb_printf(math, "#include <math.h>\n#include <string.h>\n\n"
@@ -634,10 +635,14 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     int nsv = (int)(sizeof sv / sizeof *sv);
     StrBuf sincos;
     sb_init(&sincos);
-    if (template_render(&sincos, template_sincos, sv, nsv) ||
-        (e->sincos2_used && (sb_puts(&sincos, "\n"),
-                             template_render(&sincos, template_sincos2, sv, nsv))))
-        abort();    /* every placeholder of the sincos templates is given */
+    /* every placeholder of the templates is given: they render */
+    if (template_render(&sincos, template_sincos, sv, nsv))
+        abort();
+    if (e->sincos2_used) {
+        sb_puts(&sincos, "\n");
+        if (template_render(&sincos, template_sincos2, sv, nsv))
+            abort();
+    }
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");
     if (template_render(math, template_trig, sv, nsv))
