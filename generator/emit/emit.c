@@ -607,9 +607,9 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     }
     sb_printf(math, "#include <math.h>\n#include <string.h>\n\n"
               "/* Chosen when the file is compiled: optimizing compilers get the file's\n"
-              "   own sin/cos and a small Jacobian's zeros as stores; libtcc and gcc -O0\n"
-              "   (firmware debug builds), which compile the sin/cos series into slow\n"
-              "   code, get sin and cos of <math.h> and memset. */\n"
+              "   own sin/cos, and a small Jacobian's zeros as stores rather than a\n"
+              "   memset; libtcc and gcc -O0 (firmware debug builds), which compile the\n"
+              "   sin/cos series into slow code, get sin and cos of <math.h>. */\n"
               "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
     if (!e->sincos_used)
