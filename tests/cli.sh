@@ -238,8 +238,8 @@ check "gen --help documents --jac" out_has "--jac HOW"
 run gen "$ex/four_bar.mech" --jac direct --prefix fbd -o "$tmp/fbd.c"
 check "gen --jac direct exits 0" status_is 0
 check "gen --jac direct: the dense Jacobian stores its own entries" \
-    sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "fbd_jac_nz(q, t, jac);" "$1"' _ "$tmp/fbd.c"
-check "gen default: the dense Jacobian is spread from jac_nz" grep -q "fb_jac_nz(q, t, jac);" "$tmp/fb.c"
+    sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "fbd_jac_nz(q, t, packed);" "$1"' _ "$tmp/fbd.c"
+check "gen default: the dense Jacobian is spread from jac_nz" grep -q "fb_jac_nz(q, t, packed);" "$tmp/fb.c"
 if have gcc; then
     check "gcc compiles gen --jac direct output" gcc $cflags -c "$tmp/fbd.c" -o "$tmp/fbd.o"
 fi

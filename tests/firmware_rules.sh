@@ -1,7 +1,8 @@
 #!/bin/sh
 # tests/firmware_rules.sh MECHC - checks the promise of spec section 4 on the
 # compiled objects, not only on the text: generated kernels and the runtime
-# core build as freestanding C99 and need nothing but <math.h>.
+# core build as freestanding C99 and need nothing but <math.h> (and, for
+# the kernels, memset of <string.h>).
 #
 #   sh tests/firmware_rules.sh build/mechc
 #
@@ -11,7 +12,8 @@
 #     -Wall -Wextra -Wpedantic -Wconversion -Wdouble-promotion -Wvla -Werror
 #     (float code: float literals and sinf/cosf..., no promotion to double;
 #     no variable-length arrays);
-#   - the source includes only <math.h> and its own header, and names no
+#   - the source includes only <math.h>, <string.h> (memset, the Jacobian's
+#     zero fill) and its own header, and names no
 #     allocation, stdio or other library call; `static` appears only as
 #     `static const` data or in the PART macro of helper functions;
 #   - nm: every undefined symbol is a <math.h> function of the right
@@ -215,7 +217,7 @@ FORBIDDEN='\b(malloc|calloc|realloc|free|alloca|printf|fprintf|sprintf|snprintf|
 source_rules() {
     for f in "$1" "$2"; do
         code_of "$f" > "$tmp/code" || return 1
-        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|"[A-Za-z0-9_]+\.h")$/ {
+        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|<string\.h>|"[A-Za-z0-9_]+\.h")$/ {
             print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
         ! grep -n -E "$FORBIDDEN" "$tmp/code" &&
         ! grep -n -w static "$tmp/code" | grep -v -E 'static const|#define [A-Z0-9_]+_(PART|TRIG) static|static void [A-Za-z0-9_]+_sincos2_apart\(double' ||

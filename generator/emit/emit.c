@@ -543,37 +543,58 @@ static void put_int_list(StrBuf *sb, const Kinematics *kin, bool rows)
         sb_puts(sb, "    0\n");
 }
 
-/* The zero-fill of the dense Jacobian before its nonzeros are stored. The
-   JIT calls memset (libtcc compiles loops and stores as written, a store
-   costs it a load and a store). Compiled code stores each structural zero
-   when the matrix is small (gcc turns a short fill loop into rep stos,
-   which costs more there), else loops. */
+/* The zero-fill of the dense Jacobian before its nonzeros are stored:
+   one memset, which every compiler provides, freestanding or not (gcc and
+   clang may call it for any fill loop); a loop as written runs element by
+   element under libtcc, gcc -O0 and -O1. Optimizing compilers get a small
+   matrix's structural zeros as stores instead (P_OPTIMIZED, put_math):
+   gcc turns a short memset into rep stos, which costs more there. */
 enum { EMIT_ZERO_STORES_MAX = 256 };
 static void put_zero_fill(StrBuf *sb, const Kinematics *kin, const EmitOptions *opt,
                           const char *prefix, const char *upper)
 {
     const Model *m = kin->model;
-    if (opt->declare_math) {
-        sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
-        return;
-    }
-    if ((long)m->nr * m->nq > EMIT_ZERO_STORES_MAX) {
-        sb_printf(sb, "    for (int i = 0; i < %s_NR * %s_NQ; ++i)\n        jac[i] = 0;", upper,
-                  upper);
-        return;
-    }
-    /* eight stores a line; the template ends the last line */
-    int k = 0, stores = 0;
-    for (int r = 0; r < m->nr; r++)
+    bool stores = !opt->declare_math && (long)m->nr * m->nq <= EMIT_ZERO_STORES_MAX;
+    if (stores)
+        sb_printf(sb, "#if %s_OPTIMIZED\n", upper);
+    /* eight stores a line */
+    for (int r = 0, k = 0, n = 0; stores && r < m->nr; r++)
         for (int c = 0; c < m->nq; c++) {
             if (k < kin->nnz && kin->jac[k].row == r && kin->jac[k].col == c) {
                 k++;
                 continue;
             }
-            const char *sep = stores == 0 ? "    " : stores % 8 == 0 ? "\n    " : " ";
+            const char *sep = n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ";
             sb_printf(sb, "%sjac[%d] = 0;", sep, r * m->nq + c);
-            stores++;
+            n++;
         }
+    if (stores)
+        sb_puts(sb, "\n#else\n");
+    sb_printf(sb, "    memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ);", prefix, upper, upper);
+    if (stores)
+        sb_puts(sb, "\n#endif");
+}
+
+/* The spread Jacobian's moves, one statement each (jac_spread.tmpl): jac[at]
+   = jac[base + k] for every entry k, in order, then a zero in each slot of
+   the packed tail that no entry moved into. Eight a line. */
+static void put_jac_moves(StrBuf *sb, const Kinematics *kin)
+{
+    const Model *m = kin->model;
+    long total = (long)m->nr * m->nq, nnz = kin->nnz > 0 ? kin->nnz : 1, base = total - nnz;
+    long n = 0, k = 0;
+    for (; k < kin->nnz; k++, n++)
+        sb_printf(sb, "%sjac[%ld] = jac[%ld];", n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ",
+                  (long)kin->jac[k].row * m->nq + kin->jac[k].col, base + k);
+    k = 0;      /* the targets increase: walk them beside the tail's slots */
+    for (long s = base; s < total; s++) {
+        while (k < kin->nnz && (long)kin->jac[k].row * m->nq + kin->jac[k].col < s)
+            k++;
+        if (k < kin->nnz && (long)kin->jac[k].row * m->nq + kin->jac[k].col == s)
+            continue;
+        sb_printf(sb, "%sjac[%ld] = 0;", n == 0 ? "    " : n % 8 == 0 ? "\n    " : " ", s);
+        n++;
+    }
 }
 
 /* The banner names the input by its base name, with anything that could
@@ -662,9 +683,24 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
     return fits;
 }
 
+/* Calls of name in the written functions. */
+static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *name)
+{
+    char call[170];
+    snprintf(call, sizeof call, "%s(", name);
+    long n = 0;
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        for (int b = 0; b < 2; b++)
+            for (const char *at = (b ? bodies : parts)[f].data; (at = strstr(at, call)); at++)
+                n++;
+    return n;
+}
+
 /* What the kernels call for math: libm declared (JIT) or included, and
-   the sincos functions the emitter used. */
-static void put_math(StrBuf *math, const Emitter *e)
+   the sincos functions the emitter used, for written files chosen by the
+   compiler (templates/trig.tmpl). parts and bodies: the written functions. */
+enum { EMIT_INLINE_TRIG_MAX = 64 };
+static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
 {
     const char *upper = e->prefix_upper;
     if (e->opt->declare_math) {
@@ -679,30 +715,52 @@ static void put_math(StrBuf *math, const Emitter *e)
                           e->sincos2_name);
         }
         sb_puts(math, "void *memset(void *, int, unsigned long);\n");
+        sb_printf(math, "#define %s_OPTIMIZED 0   /* libtcc */\n", upper);
         return;
     }
-    sb_puts(math, "#include <math.h>\n");
+    sb_printf(math, "#include <math.h>\n#include <string.h>\n\n"
+              "/* Chosen when the file is compiled: optimizing compilers get the file's\n"
+              "   own sin/cos, and a small Jacobian's zeros as stores rather than a\n"
+              "   memset; libtcc and gcc -O0 (firmware debug builds), which compile the\n"
+              "   sin/cos series into slow code, get sin and cos of <math.h>. */\n"
+              "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
+              "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
     if (!e->sincos_used)
         return;
+    /* Inlined at every call (gcc splits the pair function at its rare-case
+       test and calls the rest out of line, through memory, unless forced),
+       the pair takes gcc -O2 several times as long as libm calls would:
+       large files call one copy. */
+    bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
+                       count_calls(parts, bodies, e->sincos2_name) <= EMIT_INLINE_TRIG_MAX;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
-    TemplateVar sv[] = {{"P", e->prefix}, {"STATIC", trig}};
-    /* gcc splits the pair function at its rare-case test and calls the rest
-       out of line, through memory, unless forced; without a vector unit,
-       inlining only multiplies the code (it doubled the Cortex-M3 kernels
-       at -O2) */
-    sb_printf(math, "\n/* x86-64 compilers vectorize the two-angle sincos only where "
-              "they inline it;\n   elsewhere one copy serves all calls */\n"
-              "#if defined(__GNUC__) && defined(__SSE2__)\n"
-              "#define %s_TRIG static inline __attribute__((always_inline))\n#else\n"
-              "#define %s_TRIG static\n#endif\n", upper, upper);
-    if (template_render(math, template_sincos, sv, 2))
-        abort();    /* every placeholder of the sincos templates is given */
+    TemplateVar sv[] = {
+        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""},
+        {"TRIG_X86", inline_pair ? "static inline __attribute__((always_inline))"
+                                 : "static __attribute__((noinline))"},
+        {"TRIG_WHY", inline_pair ? "x86-64 compilers vectorize the two-angle sincos only where "
+                                   "they inline it;\n   elsewhere one copy serves all calls"
+                                 : "one copy serves all calls: inlined at each of this file's "
+                                   "many calls, the\n   pair would take gcc several times as "
+                                   "long to compile"},
+    };
+    int nsv = (int)(sizeof sv / sizeof *sv);
+    StrBuf sincos;
+    sb_init(&sincos);
+    /* every placeholder of the templates is given: they render */
+    if (template_render(&sincos, template_sincos, sv, nsv))
+        abort();
     if (e->sincos2_used) {
-        sb_puts(math, "\n");
-        if (template_render(math, template_sincos2, sv, 2))
+        sb_puts(&sincos, "\n");
+        if (template_render(&sincos, template_sincos2, sv, nsv))
             abort();
     }
+    template_set(sv, nsv, "SINCOS", sincos.data);
+    sb_puts(math, "\n");
+    if (template_render(math, template_trig, sv, nsv))
+        abort();
+    sb_free(&sincos);
 }
 
 /* The data section's lists: initial values, names, Jacobian structure. */
@@ -731,9 +789,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     const EmitOptions *opt = e->opt;
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac, &inc};
+                          &zero, &jac, &inc, &moves};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
@@ -743,7 +801,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
-    put_math(&math, e);
+    if (!opt->direct_jac)
+        put_jac_moves(&moves, e->kin);
+    put_math(&math, e, parts, bodies);
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
@@ -765,7 +825,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"JAC", ""},
+        {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     /* INTERFACE and JAC are rendered from the others, then filled in */

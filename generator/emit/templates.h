@@ -9,5 +9,6 @@ extern const char template_mech_c[];
 extern const char template_mech_h[];
 extern const char template_sincos[];
 extern const char template_sincos2[];
+extern const char template_trig[];
 
 #endif
