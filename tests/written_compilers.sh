@@ -8,7 +8,7 @@
 # under tcc and without optimisation, its own sincos pair otherwise) and
 # zero-fills the dense Jacobian with memset (or, optimised and small, with
 # stores). For four-bar (spread and --jac direct Jacobian), slider-crank,
-# all_statements and a chain of 12 loops (a large Jacobian; a sincos pair
+# all_statements and a chain of 20 loops (a large Jacobian; a sincos pair
 # called out of line under gcc -O2), each build is linked with a driver
 # that evaluates every function at a state near q0 with velocities, the
 # Jacobian outputs first filled with NaN, and prints Phi, Phi_q, nu and
@@ -16,7 +16,7 @@
 # 1e-12 (relative above 1). The driver also requires jac from jac_nz,
 # all and jac to agree exactly. Checks too that the trig is the one chosen:
 # the sincos table is in the gcc -O2 object and not in the others, and the
-# pair is always_inline in the four-bar's file, noinline in chain_12's.
+# pair is always_inline in the four-bar's file, noinline in chain_20's.
 . "$(dirname "$0")/lib.sh"
 suite_begin written_compilers "${1:-build/mechc}"
 
@@ -93,12 +93,12 @@ same_values() {
         END { exit bad }'
 }
 
-sh "$ex/chain.sh" 12 "$tmp/chain_12.mech"
+sh "$ex/chain.sh" 20 "$tmp/chain_20.mech"
 cases="four_bar:$ex/four_bar.mech:
 four_bar_direct:$ex/four_bar.mech:--jac direct
 slider_crank:$ex/slider_crank.mech:
 all_statements:$ex/all_statements.mech:
-chain_12:$tmp/chain_12.mech:"
+chain_20:$tmp/chain_20.mech:"
 compilers="gcc_O2|gcc -std=c99 -O2 -Wall -Wextra -Wpedantic -Werror
 gcc_O0|gcc -std=c99 -O0 -Wall -Wextra -Wpedantic -Werror"
 if have tcc; then
@@ -159,11 +159,11 @@ done > "$tmp/results"
 while read -r verdict rest; do
     if [ "$verdict" = ok ]; then ok; else : > "$tmp/err"; bad "$rest"; fi
 done < "$tmp/results"
-# the pair is inlined on x86-64 in small files only (70 calls in chain_12)
+# the pair is inlined on x86-64 in small files only (96 calls in chain_20 since trig is computed once per function)
 check "four_bar: the sincos pair always_inline on x86-64" \
     grep -q '^#define M_TRIG static inline __attribute__((always_inline))$' "$tmp/four_bar/m.c"
-check "chain_12: one noinline copy of the sincos pair" \
-    grep -q '^#define M_TRIG static __attribute__((noinline))$' "$tmp/chain_12/m.c"
+check "chain_20: one noinline copy of the sincos pair" \
+    grep -q '^#define M_TRIG static __attribute__((noinline))$' "$tmp/chain_20/m.c"
 # every case and compiler gave its 3 results (all 5 cases use sin/cos)
 n=$(grep -c . "$tmp/results")
 want=$(($(echo "$compilers" | grep -c .) * 5 * 3))
