@@ -100,10 +100,43 @@ check "rolling disk JSON: omega_names" out_has '"omega_names": ["disk.wx", "disk
 check "rolling disk JSON: wz = 0.4 at t = 0 (its Turn driver), wy = V/R = 1" out_has '"omega": [[0, 1, 0.4]'
 run "$ex/slider_crank.mech" --steps 2 --json
 check "planar JSON: no omega key" sh -c "! grep -q omega '$tmp/out'"
-# pictures: refused for now, --plot works
-run "$ex/rssr.mech" --svg "$tmp/rssr.svg"
-check "spatial --svg: exit 2" status_is 2
-check "spatial --svg: says why" err_has "--svg draws planar mechanisms only, and this one is spatial"
+# pictures: the animation in an orthographic view (--view, default iso), and --plot
+run "$ex/rssr.mech" --svg "$tmp/rssr.svg" --trace 'rocker(3, 0, 0)'
+check "spatial --svg: exit 0" status_is 0
+check "spatial --svg: the iso view by default" grep -q "(the iso view, orthographic" "$tmp/rssr.svg"
+check "spatial --svg: two links that move" \
+    sh -c '[ "$(grep -c "<polyline class=\"link\".*<title>" "$1")" = 2 ] && grep -q "<animate attributeName=\"points\"" "$1"' _ "$tmp/rssr.svg"
+check "spatial --svg: the ground pivots marked" sh -c '[ "$(grep -c "class=\"pivot\"" "$1")" = 2 ]' _ "$tmp/rssr.svg"
+check "spatial --trace BODY(sx, sy, sz): its path" grep -q "path of rocker(3, 0, 0)" "$tmp/rssr.svg"
+run "$ex/all_spatial.mech" --t1 1 --svg "$tmp/all_spatial.svg"
+check "spatial --svg: a point output's path is drawn" grep -q "path of wtip" "$tmp/all_spatial.svg"
+# the crank of slider_crank_spatial at t = 0.25 points along +y from the
+# origin: the top view shows it upright (one pixel column, r tall), the front
+# view as a point, the side view lying (one pixel row)
+crank_px() {   # crank_px VIEW: the crank link's first-frame points, "X0 Y0 X1 Y1"
+    "$mechc" run "$ex/slider_crank_spatial.mech" --t0 0.25 --svg "$tmp/v_$1.svg" --view "$1" 2>/dev/null &&
+        sed -n 's/.*<polyline class="link" points="\([^"]*\)".*<title>crank<\/title>.*/\1/p' "$tmp/v_$1.svg" | tr ', ' '  '
+}
+crank_is() {   # crank_is VIEW AWK-CONDITION on x0 y0 x1 y1
+    set -- "$(crank_px "$1")" "$2"
+    [ -n "$1" ] && echo "$1" | awk "{ x0 = \$1; y0 = \$2; x1 = \$3; y1 = \$4; exit !($2) }"
+}
+check "--view top: the crank upright (x right, y up)" crank_is top 'x0 == x1 && y1 < y0 - 50'
+check "--view front: the crank end-on (x right, z up)" crank_is front 'x0 == x1 && y0 == y1'
+check "--view side: the crank lying (y right, z up)" crank_is side 'y0 == y1 && x1 > x0 + 50'
+check "--view front: said in the picture" grep -q "(the front view, orthographic" "$tmp/v_front.svg"
+run "$ex/rssr.mech" --svg "$tmp/bad.svg" --view back
+check "--view back: exit 2" status_is 2
+check "--view back: names the choices" err_has "--view takes front, top, side or iso, not 'back'"
+run "$ex/slider_crank.mech" --svg "$tmp/bad.svg" --view iso
+check "--view on a planar file: exit 2" status_is 2
+check "--view on a planar file: says why" err_has "--view chooses how a spatial mechanism is seen, and this one is planar"
+run "$ex/rssr.mech" --view top
+check "--view without --svg: exit 2" status_is 2
+check "--view without --svg: says so" err_has "--view goes with --svg FILE"
+run "$ex/rssr.mech" --svg "$tmp/bad.svg" --trace 'rocker(3, 0)'
+check "spatial --trace B(sx, sy): exit 2, sz missing" \
+    sh -c '[ "$1" = 2 ] && grep -q "expected .,. between sy and sz" "$2"' _ "$rc" "$tmp/err"
 run "$ex/rssr.mech" --plot "$tmp/rssr_plot.svg" --plot-vars 'psi,d(psi)'
 check "spatial --plot: exit 0" status_is 0
 check "spatial --plot: a chart" grep -q "d(psi)" "$tmp/rssr_plot.svg"

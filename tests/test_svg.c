@@ -580,7 +580,7 @@ static void test_anim_bad_input(void **state)
     q_nan[4] = NAN;
     assert_false(svg_write_animation(f, m, fx->t, q_nan, 1, NULL, 0, NULL));
     assert_false(svg_write_animation(f, m, fx->t, fx->q, 0, NULL, 0, NULL));
-    SvgTrace bad = {40, true, 0, 0, "x"};
+    SvgTrace bad = {.q = 40, .has_phi = true, .label = "x"};
     assert_false(svg_write_animation(f, m, fx->t, fx->q, 2, &bad, 1, NULL));
     char *s = capture_close(&c);
     assert_int_equal(strlen(s), 0);     /* nothing written on refusal */

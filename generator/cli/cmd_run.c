@@ -32,6 +32,7 @@ typedef struct RunCli {
     double tol;             /* --tol: both Newton tolerances of ro.mechrt; 0: not given */
     double at;              /* --at: one instant, t0 = at and no steps; NaN: not given */
     int engine, ode, digits;
+    int view;               /* --view: an SvgView; -1: not given (iso) */
     bool json, stats;
     bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
@@ -104,7 +105,13 @@ static const CliOption options[] = {
      .help = "write an animated SVG of the motion (plays in any browser)"},
     {"--trace", CLI_LIST_AT(RunCli, traces, MAX_TRACES), .what = "points", .metavar = "B(sx,sy)",
      .help = "draw the path of the point (sx, sy) of body B in the\n"
-             "animation (repeatable; a point particle: --trace m)"},
+             "animation (repeatable; a point particle: --trace m;\n"
+             "spatial: B(sx,sy,sz))"},
+    {"--view", CLI_CHOICE_AT(RunCli, view, svg_view_names), .metavar = "V",
+     .help = "the animation of a spatial mechanism seen from the\n"
+             "front (x right, z up), top (x right, y up), side\n"
+             "(y right, z up) or iso (default; isometric, from\n"
+             "(1, -1, 1)): orthographic"},
     {"--plot", CLI_STRING_AT(RunCli, plot_path), .metavar = "FILE",
      .help = "write an SVG chart of variables against time"},
     {"--plot-vars", CLI_STRING_AT(RunCli, plot_list), .metavar = "LIST",
@@ -237,9 +244,12 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
 
 /* The animation and the chart, from the kept rows [t, q, qd, qdd]. */
 static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *svg_path,
-                           const SvgTrace *traces, int ntraces, const char *plot_path,
+                           const SvgTrace *traces, int ntraces, int view, const char *plot_path,
                            const SvgPlotVar *vars, int nvars)
 {
+    SvgAnimOptions ao = svg_anim_default_options();
+    if (view >= 0)
+        ao.view = (SvgView)view;
     size_t n = tr->rows, nq = (size_t)m->nq, nv = (size_t)tr->nq, w = 1 + 3 * nv;
     bool ok = true;
     if (n == 0)
@@ -261,7 +271,7 @@ static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *sv
         }
         bool wrote;
         if (which == 0) {
-            wrote = svg_write_animation(f, m, t, q, (int)n, traces, ntraces, m->name);
+            wrote = svg_write_animation_opt(f, m, t, q, (int)n, traces, ntraces, m->name, &ao);
         } else {
             SvgSeries series[MAX_PLOT_VARS];
             char names[MAX_PLOT_VARS][96];
@@ -368,6 +378,10 @@ static bool finish(Args *a, void *opts)
                 c->traces.n ? "--trace" : "--plot-vars", c->traces.n ? "--svg FILE" : "--plot FILE");
         return false;
     }
+    if (c->view >= 0 && !c->svg_path) {
+        fprintf(stderr, "mechc run: error: --view goes with --svg FILE\n");
+        return false;
+    }
     c->pictures = c->svg_path || c->plot_path;
     if (c->pictures && c->ro.steps == 0) {
         fprintf(stderr, "mechc run: error: %s needs a motion: one instant (--steps 0 or --at) "
@@ -391,9 +405,9 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, 
 {
     char err[256];
     *nvars = 0;
-    if (m->spatial && c->svg_path) {
-        fprintf(stderr, "%s: error: --svg draws planar mechanisms only, and this one is "
-                "spatial (--plot and --csv work)\n", m->file);
+    if (!m->spatial && c->view >= 0) {
+        fprintf(stderr, "%s: error: --view chooses how a spatial mechanism is seen, and this "
+                "one is planar (drawn as it is, x right, y up)\n", m->file);
         return false;
     }
     for (int i = 0; i < c->traces.n; i++) {
@@ -409,7 +423,8 @@ static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, 
         if (!o->point || o->at.q < 0)    /* a point output's path; ground's stays put */
             continue;
         if (*ntraces < MAX_TRACES)
-            traces[(*ntraces)++] = (SvgTrace){o->at.q, o->at.has_phi, o->at.sx, o->at.sy, o->point};
+            traces[(*ntraces)++] = (SvgTrace){o->at.q, o->at.has_phi || o->at.has_p, o->at.sx,
+                                              o->at.sy, o->point, o->at.spatial, o->at.sz};
         else
             dropped++;
     }
@@ -467,7 +482,7 @@ static int report(const RunCli *c, const Model *m, const Output *out, const Pict
         return EXIT_USAGE;
     }
     if (c->pictures && !write_pictures(m, &out->trace, c->svg_path, pics->traces, pics->ntraces,
-                                       c->plot_path, pics->vars, pics->nvars))
+                                       c->view, c->plot_path, pics->vars, pics->nvars))
         status = EXIT_USAGE;
     if (c->json)
         mechrt_json_write_outputs(stdout, &out->trace, m->nq, out->names, c->digits,
@@ -560,6 +575,6 @@ static const CliCommand command = {
 int cmd_run(int argc, char **argv)
 {
     RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT, .ode = -1, .at = NAN};
+                .engine = ENGINE_JIT, .ode = -1, .view = -1, .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

@@ -651,6 +651,8 @@ static void build_output(Builder *b, const Stmt *s)
         NodeId xyz[3];
         joints_spatial_point(b->model, at, xyz);
         push_output(b, s->name, ".x", xyz[0]);
+        last_output(b)->point = s->name;    /* the animation draws its path */
+        last_output(b)->at = at;
         push_output(b, s->name, ".y", xyz[1]);
         push_output(b, s->name, ".z", xyz[2]);
         return;

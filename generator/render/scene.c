@@ -40,7 +40,7 @@
 
 /* ---- vertices and shapes ---- */
 
-static int add_vtx(Scene *sc, Vtx v)
+int scene_add_vtx(Scene *sc, Vtx v)
 {
     if (sc->nv == sc->vcap) {
         sc->vcap = sc->vcap ? 2 * sc->vcap : 64;
@@ -52,13 +52,14 @@ static int add_vtx(Scene *sc, Vtx v)
 
 Vtx scene_vtx_at(Attach a)
 {
-    Vtx v = {a.q, a.has_phi, a.sx, a.sy, -1, 0, 0};
+    Vtx v = {a.q, a.has_phi, a.sx, a.sy, -1, 0, 0, a.spatial, a.has_p, a.sz, 0};
     return v;
 }
 
 Vtx scene_vtx_trace(const SvgTrace *tr)
 {
-    Vtx v = {tr->q, tr->has_phi, tr->sx, tr->sy, -1, 0, 0};
+    Vtx v = {tr->q, tr->has_phi && !tr->spatial, tr->sx, tr->sy, -1, 0, 0,
+             tr->spatial, tr->has_phi && tr->spatial, tr->sz, 0};
     return v;
 }
 
@@ -66,11 +67,11 @@ Vtx scene_vtx_trace(const SvgTrace *tr)
    attachment f (ground or a particle: not turned). */
 static Vtx vtx_off(Attach a, Attach f, double ox, double oy)
 {
-    Vtx v = {a.q, a.has_phi, a.sx, a.sy, f.q >= 0 && f.has_phi ? f.q + 2 : -1, ox, oy};
+    Vtx v = {a.q, a.has_phi, a.sx, a.sy, f.q >= 0 && f.has_phi ? f.q + 2 : -1, ox, oy, false, false, 0, 0};
     return v;
 }
 
-static Shape *add_shape(Scene *sc, ShapeKind kind, const char *cls)
+Shape *scene_add_shape(Scene *sc, ShapeKind kind, const char *cls)
 {
     if (sc->nsh == sc->shcap) {
         sc->shcap = sc->shcap ? 2 * sc->shcap : 32;
@@ -85,9 +86,9 @@ static Shape *add_shape(Scene *sc, ShapeKind kind, const char *cls)
 }
 
 /* Call after adding the shape's vertices. */
-static void end_shape(Scene *sc, Shape *s) { s->nv = sc->nv - s->v0; }
+void scene_end_shape(Scene *sc, Shape *s) { s->nv = sc->nv - s->v0; }
 
-static void add_ground(Scene *sc, Ground g)
+void scene_add_ground(Scene *sc, Ground g)
 {
     if (sc->nground == sc->groundcap) {
         sc->groundcap = sc->groundcap ? 2 * sc->groundcap : 16;
@@ -96,9 +97,65 @@ static void add_ground(Scene *sc, Ground g)
     sc->ground[sc->nground++] = g;
 }
 
+/* out = A(p) s, A(p) = (2 e0^2 - 1) I + 2 (e e^T + e0 e~) for the Euler
+   parameters p[0..3] (left as they are: the run keeps them normalised). */
+static void turn3(const double *p, const double s[3], double out[3])
+{
+    const double *e = p + 1;
+    double es = e[0] * s[0] + e[1] * s[1] + e[2] * s[2], c = 2 * p[0] * p[0] - 1;
+    double ex[3] = {e[1] * s[2] - e[2] * s[1], e[2] * s[0] - e[0] * s[2], e[0] * s[1] - e[1] * s[0]};
+    for (int i = 0; i < 3; i++)
+        out[i] = c * s[i] + 2 * e[i] * es + 2 * p[0] * ex[i];
+}
+
+/* P = r + A(p) s (+ A(p_f) o) of a spatial vertex. */
+static void vtx_point3(const Vtx *v, const double *qk, double P[3])
+{
+    double s[3] = {v->sx, v->sy, v->sz}, o[3] = {v->ox, v->oy, v->oz}, w[3];
+    for (int i = 0; i < 3; i++)
+        P[i] = v->q < 0 ? s[i] : qk[v->q + i];
+    if (v->q >= 0 && v->has_p) {
+        turn3(qk + v->q + 3, s, w);
+        for (int i = 0; i < 3; i++)
+            P[i] += w[i];
+    }
+    if (v->fq >= 0)
+        turn3(qk + v->fq + 3, o, w);
+    for (int i = 0; i < 3; i++)
+        P[i] += v->fq >= 0 ? w[i] : o[i];
+}
+
+void scene_vtx_point(const Vtx *v, const double *qk, double P[3])
+{
+    if (v->spatial) {
+        vtx_point3(v, qk, P);
+        return;
+    }
+    scene_vtx_world(v, qk, &P[0], &P[1]);
+    P[2] = 0;
+}
+
+void scene_vtx_xy(const Scene *sc, const Vtx *v, const double *qk, double *x, double *y)
+{
+    if (!v->spatial) {
+        scene_vtx_world(v, qk, x, y);
+        return;
+    }
+    double P[3];
+    vtx_point3(v, qk, P);
+    svg_view_project(sc->view, P, x, y);
+}
+
 void scene_vtx_world(const Vtx *v, const double *qk, double *x, double *y)
 {
     double px, py;
+    if (v->spatial) {
+        double P[3];
+        vtx_point3(v, qk, P);
+        *x = P[0];
+        *y = P[1];
+        return;
+    }
     if (v->q < 0) {
         px = v->sx;
         py = v->sy;
@@ -128,7 +185,7 @@ const double *scene_frame_q(const Scene *sc, int k) { return sc->q + (size_t)k *
 static void attach_world(const Scene *sc, Attach a, int k, double *x, double *y)
 {
     Vtx v = scene_vtx_at(a);
-    scene_vtx_world(&v, scene_frame_q(sc, k), x, y);
+    scene_vtx_xy(sc, &v, scene_frame_q(sc, k), x, y);
 }
 
 const char *scene_trace_colour(int i) { return svg_palette[(i + 3) % (SVG_PALETTE_SIZE - 1)]; }
@@ -272,12 +329,12 @@ static int body_points(const Scene *sc, int q, HullPoint *pts)
 
 static void add_particle(Scene *sc, const Body *b)
 {
-    Shape *s = add_shape(sc, SHAPE_CIRCLE, "particle");
-    add_vtx(sc, (Vtx){b->q, false, 0, 0, -1, 0, 0});
+    Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, "particle");
+    scene_add_vtx(sc, (Vtx){b->q, false, 0, 0, -1, 0, 0, false, false, 0, 0});
     s->r = 5.5;
     s->fill = sc->colour[b->q];
     s->name = b->name;
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
 }
 
 static void build_bodies(Scene *sc)
@@ -297,13 +354,13 @@ static void build_bodies(Scene *sc)
         int h = hull_convex(pts, n, hull, 1e-9 * sc->L);
         if (h == 1 && body_has_symbol(sc, b->q))
             continue;
-        Shape *s = add_shape(sc, h >= 3 ? SHAPE_POLYGON : h == 2 ? SHAPE_POLYLINE : SHAPE_MARK, "link");
+        Shape *s = scene_add_shape(sc, h >= 3 ? SHAPE_POLYGON : h == 2 ? SHAPE_POLYLINE : SHAPE_MARK, "link");
         for (int k = 0; k < h; k++)
-            add_vtx(sc, (Vtx){b->q, true, hull[k].x, hull[k].y, -1, 0, 0});
+            scene_add_vtx(sc, (Vtx){b->q, true, hull[k].x, hull[k].y, -1, 0, 0, false, false, 0, 0});
         s->stroke = c;
         s->fill = h >= 3 ? c : h == 2 ? "none" : c;
         s->name = b->name;
-        end_shape(sc, s);
+        scene_end_shape(sc, s);
     }
     free(pts);
     free(hull);
@@ -342,11 +399,11 @@ static Shape *add_guide(Scene *sc, const Joint *jt, double pad)
     double ulen = hypot(jt->ux, jt->uy);
     double ex = jt->ux / ulen, ey = jt->uy / ulen;
     double a = lo * ulen - pad, b = hi * ulen + pad;
-    Shape *s = add_shape(sc, SHAPE_POLYLINE, "guide");
-    add_vtx(sc, vtx_off(jt->a, jt->a, a * ex, a * ey));
-    add_vtx(sc, vtx_off(jt->a, jt->a, b * ex, b * ey));
+    Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "guide");
+    scene_add_vtx(sc, vtx_off(jt->a, jt->a, a * ex, a * ey));
+    scene_add_vtx(sc, vtx_off(jt->a, jt->a, b * ex, b * ey));
     s->name = jt->name;
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
     return s;
 }
 
@@ -359,31 +416,31 @@ static void draw_prismatic(Scene *sc, const Joint *jt)
     Shape *g = add_guide(sc, jt, 0.6 * block_len);
     if (jt->a.q < 0) {
         const Vtx *v0 = &sc->v[g->v0], *v1 = &sc->v[g->v0 + 1];
-        add_ground(sc, (Ground){GROUND_LINE, v0->sx + v0->ox, v0->sy + v0->oy,
+        scene_add_ground(sc, (Ground){GROUND_LINE, v0->sx + v0->ox, v0->sy + v0->oy,
                                 v1->sx + v1->ox, v1->sy + v1->oy, 0.5 * block_h});
     }
     double ulen = hypot(jt->ux, jt->uy);
     double ex = jt->ux / ulen, ey = jt->uy / ulen;
     double nx = -ey, ny = ex;
-    Shape *s = add_shape(sc, SHAPE_POLYGON, "slider");
+    Shape *s = scene_add_shape(sc, SHAPE_POLYGON, "slider");
     static const double corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
     for (int k = 0; k < 4; k++) {
         double a = 0.5 * block_len * corner[k][0], b = 0.5 * block_h * corner[k][1];
-        add_vtx(sc, vtx_off(jt->b, jt->a, a * ex + b * nx, a * ey + b * ny));
+        scene_add_vtx(sc, vtx_off(jt->b, jt->a, a * ex + b * nx, a * ey + b * ny));
     }
     s->name = jt->name;
     if (jt->b.q >= 0)
         s->stroke = sc->colour[jt->b.q];
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
 }
 
 static void draw_distance(Scene *sc, const Joint *jt)
 {
-    Shape *s = add_shape(sc, SHAPE_POLYLINE, "distance");
-    add_vtx(sc, scene_vtx_at(jt->a));
-    add_vtx(sc, scene_vtx_at(jt->b));
+    Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "distance");
+    scene_add_vtx(sc, scene_vtx_at(jt->a));
+    scene_add_vtx(sc, scene_vtx_at(jt->b));
     s->name = jt->name;
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
 }
 
 /* rolling: a disk of the radius at the first kept frame with a spoke, on a
@@ -396,17 +453,17 @@ static void draw_rolling(Scene *sc, const Joint *jt)
     if (!isfinite(R) || R <= 0)
         return;
     Attach centre = {.q = jt->a.q, .has_phi = true};
-    Shape *s = add_shape(sc, SHAPE_CIRCLE, "disk");
-    add_vtx(sc, scene_vtx_at(centre));
+    Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, "disk");
+    scene_add_vtx(sc, scene_vtx_at(centre));
     s->r = R;
     s->r_world = true;
     s->name = jt->name;
     s->stroke = sc->colour[jt->a.q];
-    end_shape(sc, s);
-    s = add_shape(sc, SHAPE_POLYLINE, "spoke");
-    add_vtx(sc, scene_vtx_at(centre));
-    add_vtx(sc, vtx_off(centre, centre, R, 0));
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
+    s = scene_add_shape(sc, SHAPE_POLYLINE, "spoke");
+    scene_add_vtx(sc, scene_vtx_at(centre));
+    scene_add_vtx(sc, vtx_off(centre, centre, R, 0));
+    scene_end_shape(sc, s);
     double xlo = INFINITY, xhi = -INFINITY, cx, cy;
     for (int f = 0; f < sc->nf; f++) {
         attach_world(sc, centre, sc->frames[f], &cx, &cy);
@@ -414,18 +471,18 @@ static void draw_rolling(Scene *sc, const Joint *jt)
         xhi = fmax(xhi, cx);
     }
     attach_world(sc, centre, sc->frames[0], &cx, &cy);
-    add_ground(sc, (Ground){GROUND_LINE, xlo - 1.3 * R, cy - R, xhi + 1.3 * R, cy - R, 0});
+    scene_add_ground(sc, (Ground){GROUND_LINE, xlo - 1.3 * R, cy - R, xhi + 1.3 * R, cy - R, 0});
 }
 
 static void draw_knife(Scene *sc, const Joint *jt)
 {
     double ulen = hypot(jt->ux, jt->uy), h = 24 * sc->px;
     double ex = jt->ux / ulen * h, ey = jt->uy / ulen * h;
-    Shape *s = add_shape(sc, SHAPE_POLYLINE, "knife");
-    add_vtx(sc, vtx_off(jt->a, jt->a, -ex, -ey));
-    add_vtx(sc, vtx_off(jt->a, jt->a, ex, ey));
+    Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "knife");
+    scene_add_vtx(sc, vtx_off(jt->a, jt->a, -ex, -ey));
+    scene_add_vtx(sc, vtx_off(jt->a, jt->a, ex, ey));
     s->name = jt->name;
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
 }
 
 void scene_draw_generic(Scene *sc, const Joint *jt, bool over_bodies)
@@ -433,21 +490,21 @@ void scene_draw_generic(Scene *sc, const Joint *jt, bool over_bodies)
     int na = joint_info[jt->kind].attachments;
     /* no class rule in the style sheet: the colours come inline */
     if (!over_bodies && na == 2) {
-        Shape *s = add_shape(sc, SHAPE_POLYLINE, "joint");
-        add_vtx(sc, scene_vtx_at(jt->a));
-        add_vtx(sc, scene_vtx_at(jt->b));
+        Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "joint");
+        scene_add_vtx(sc, scene_vtx_at(jt->a));
+        scene_add_vtx(sc, scene_vtx_at(jt->b));
         s->stroke = "#444";
         s->fill = "none";
         s->extra = "stroke-width=\"1.5\"";
         s->name = jt->name;
-        end_shape(sc, s);
+        scene_end_shape(sc, s);
     } else if (over_bodies && na == 1) {
-        Shape *s = add_shape(sc, SHAPE_MARK, "joint");
-        add_vtx(sc, scene_vtx_at(jt->a));
+        Shape *s = scene_add_shape(sc, SHAPE_MARK, "joint");
+        scene_add_vtx(sc, scene_vtx_at(jt->a));
         s->stroke = "#444";
         s->fill = "none";
         s->name = jt->name;
-        end_shape(sc, s);
+        scene_end_shape(sc, s);
     }
 }
 
@@ -492,11 +549,11 @@ static void build_joints(Scene *sc)
 
 static void add_pin(Scene *sc, Attach a, const char *cls, double r, const char *name)
 {
-    Shape *s = add_shape(sc, SHAPE_CIRCLE, cls);
-    add_vtx(sc, scene_vtx_at(a));
+    Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, cls);
+    scene_add_vtx(sc, scene_vtx_at(a));
     s->r = r;
     s->name = name;
-    end_shape(sc, s);
+    scene_end_shape(sc, s);
 }
 
 /* revolute, weld, distance: a ground pivot at each ground side; pins on
@@ -507,7 +564,7 @@ static void draw_pins(Scene *sc, const Joint *jt)
     for (int k = 0; k < 2; k++) {
         Attach a = k ? jt->b : jt->a;
         if (a.q < 0)
-            add_ground(sc, (Ground){GROUND_PIVOT, a.sx, a.sy, 0, 0, 0});
+            scene_add_ground(sc, (Ground){GROUND_PIVOT, a.sx, a.sy, 0, 0, 0});
     }
     if (jt->kind == JOINT_DISTANCE) {
         if (jt->a.q >= 0 && jt->a.has_phi)
@@ -572,13 +629,13 @@ static void build_drive_arrows(Scene *sc)
         double rho = 26 * sc->px;
         /* the arrow points the way the angle goes over the run */
         double turn = scene_frame_q(sc, sc->frames[sc->nf - 1])[i + 2] - scene_frame_q(sc, sc->frames[0])[i + 2];
-        Shape *s = add_shape(sc, SHAPE_POLYLINE, "drive");
+        Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "drive");
         for (int k = 0; k <= 16; k++) {
             double a = (turn >= 0 ? 40.0 + 240.0 * k / 16 : 140.0 - 240.0 * k / 16) * (3.14159265358979323846 / 180);
-            add_vtx(sc, vtx_off(centre, centre, rho * cos(a), rho * sin(a)));
+            scene_add_vtx(sc, vtx_off(centre, centre, rho * cos(a), rho * sin(a)));
         }
         s->extra = "marker-end=\"url(#arrow)\"";
-        end_shape(sc, s);
+        scene_end_shape(sc, s);
     }
 }
 
@@ -586,17 +643,22 @@ static void build_trace_dots(Scene *sc)
 {
     for (int i = 0; i < sc->ntraces; i++) {
         const SvgTrace *tr = &sc->traces[i];
-        Shape *s = add_shape(sc, SHAPE_CIRCLE, "tracedot");
-        add_vtx(sc, scene_vtx_trace(tr));
+        Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, "tracedot");
+        scene_add_vtx(sc, scene_vtx_trace(tr));
         s->r = 3.5;
         s->fill = scene_trace_colour(i);
         s->name = tr->label;
-        end_shape(sc, s);
+        scene_end_shape(sc, s);
     }
 }
 
 void scene_build(Scene *sc)
 {
+    if (sc->m->spatial) {
+        scene_build_spatial(sc);
+        build_trace_dots(sc);
+        return;
+    }
     build_joints(sc);
     build_bodies(sc);
     build_drive_arrows(sc);

@@ -9,13 +9,18 @@
 #define SCENE_DRIVE_COLOUR "#d62728"
 
 /* P = r + A(phi) s of attachment (q, has_phi, sx, sy), then + A(q[fq]) o
-   (fq: a phi coordinate, or -1 for a world offset). */
+   (fq: a phi coordinate, or -1 for a world offset). A spatial vertex
+   (spatial true) is P = r + A(p) s in 3D, s = (sx, sy, sz), p the Euler
+   parameters at q + 3 when has_p, then + A(p) o with the Euler parameters
+   of the body whose x is fq (or -1: a world offset), o = (ox, oy, oz). */
 typedef struct Vtx {
     int q;
     bool has_phi;
     double sx, sy;
     int fq;
     double ox, oy;
+    bool spatial, has_p;
+    double sz, oz;
 } Vtx;
 
 typedef enum ShapeKind {
@@ -48,6 +53,7 @@ typedef struct Ground {
 
 typedef struct Scene {
     const Model *m;
+    SvgView view;           /* a spatial mechanism's projection */
     const double *t, *q;
     int n;                  /* frames given */
     const SvgTrace *traces;
@@ -89,10 +95,27 @@ void scene_build(Scene *sc);
    square at its one attachment point. Nothing for a row statement. */
 void scene_draw_generic(Scene *sc, const Joint *jt, bool over_bodies);
 
+/* The spatial part of scene_build (scene_spatial.c): bodies, joints and
+   ground points of a spatial mechanism, the links farthest first. */
+void scene_build_spatial(Scene *sc);
+
+/* Building blocks of a scene: a vertex (its index), a shape whose
+   vertices are the ones added until scene_end_shape, a ground symbol. */
+int scene_add_vtx(Scene *sc, Vtx v);
+Shape *scene_add_shape(Scene *sc, ShapeKind kind, const char *cls);
+void scene_end_shape(Scene *sc, Shape *s);
+void scene_add_ground(Scene *sc, Ground g);
+
 /* The coordinates of frame k. */
 const double *scene_frame_q(const Scene *sc, int k);
-/* The world position of vertex v given coordinates qk. */
+/* The world position of vertex v given coordinates qk (a spatial vertex:
+   its x and y). */
 void scene_vtx_world(const Vtx *v, const double *qk, double *x, double *y);
+/* The world position in 3D (a planar vertex: z = 0). */
+void scene_vtx_point(const Vtx *v, const double *qk, double P[3]);
+/* Where the drawing shows vertex v: its world position, projected by the
+   scene's view when it is spatial. */
+void scene_vtx_xy(const Scene *sc, const Vtx *v, const double *qk, double *x, double *y);
 /* The vertex at an attachment, and at a traced point. */
 Vtx scene_vtx_at(Attach a);
 Vtx scene_vtx_trace(const SvgTrace *tr);

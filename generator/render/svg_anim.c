@@ -24,6 +24,7 @@ SvgAnimOptions svg_anim_default_options(void)
         .width = 760,
         .height = 520,
         .max_bytes = 4000000,
+        .view = SVG_VIEW_ISO,
     };
     return o;
 }
@@ -41,8 +42,9 @@ static bool valid_input(const Model *m, const double *t, const double *q, int n,
                 return false;
     }
     for (int i = 0; i < ntr; i++) {
-        int need = tr[i].has_phi ? 3 : 2;
-        if (tr[i].q < 0 || tr[i].q + need > m->nq || !isfinite(tr[i].sx) || !isfinite(tr[i].sy))
+        int need = tr[i].spatial ? (tr[i].has_phi ? 7 : 3) : tr[i].has_phi ? 3 : 2;
+        if (tr[i].q < 0 || tr[i].q + need > m->nq || !isfinite(tr[i].sx) || !isfinite(tr[i].sy)
+            || (tr[i].spatial && !isfinite(tr[i].sz)) || tr[i].spatial != m->spatial)
             return false;
     }
     return true;
@@ -65,14 +67,14 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
                              const char *title, const SvgAnimOptions *opt)
 {
     SvgAnimOptions o = opt ? *opt : svg_anim_default_options();
-    /* the scene reads planar bodies (x, y, phi); spatial views come later */
-    if (!out || m->spatial || !valid_input(m, t, q, nframes, traces, ntraces) || o.width < 50
-        || o.height < 50) {
+    if (!out || !valid_input(m, t, q, nframes, traces, ntraces) || o.width < 50
+        || o.height < 50 || (unsigned)o.view > SVG_VIEW_ISO) {
         errno = EINVAL;
         return false;
     }
     Scene sc;
     scene_init(&sc, m, t, q, nframes, traces, ntraces, o.max_frames);
+    sc.view = o.view;
     SvgBox b = svg_scene_extent(&sc, false);
     sc.L = fmax(b.x1 - b.x0, b.y1 - b.y0);
     if (!(sc.L > 0))

@@ -3,18 +3,23 @@
 #define MECHC_SVG_ANIM_H
 
 #include "../model/model.h"
+#include "view.h"
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 
 /* A point whose path is drawn: P = r + A(phi) s of a body (has_phi), or a
-   particle (has_phi false, sx = sy = 0). q is the index of the x coordinate. */
+   particle (has_phi false, sx = sy = 0). q is the index of the x coordinate.
+   In a spatial mechanism (spatial true) P = r + A(p) s, s = (sx, sy, sz),
+   and has_phi says the point turns with a body (Euler parameters at q + 3). */
 typedef struct SvgTrace {
     int q;
     bool has_phi;
     double sx, sy;
     const char *label;      /* legend text (escaped on output); NULL: none */
+    bool spatial;
+    double sz;
 } SvgTrace;
 
 /* Tunables with their defaults (svg_anim_default_options). */
@@ -27,6 +32,8 @@ typedef struct SvgAnimOptions {
     int width, height;      /* largest drawing area in px; default 760 x 520 */
     long max_bytes;         /* about the largest file: a big mechanism keeps
                                fewer frames (10 at least); default 4000000 */
+    SvgView view;           /* a spatial mechanism's projection (view.h);
+                               default iso; planar ones ignore it */
 } SvgAnimOptions;
 
 SvgAnimOptions svg_anim_default_options(void);
@@ -47,7 +54,8 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
                              const char *title, const SvgAnimOptions *opt);
 
 /* Parses a --trace argument: `BODY(sx, sy)` (a point fixed to the body, in
-   its local frame), `BODY` (its reference point) or `POINT` (a particle);
+   its local frame; `BODY(sx, sy, sz)` in a spatial mechanism), `BODY` (its
+   reference point) or `POINT` (a particle);
    sx and sy are decimal numbers, signed or not (`-0.15`, `2e-3`; no
    expressions or params). Blanks are allowed between the parts. On success
    fills *out (label = text, so text must outlive the trace) and returns

@@ -51,14 +51,22 @@ static void extent_points(const Scene *sc, int k, SvgBox *b)
     const Model *m = sc->m;
     const double *qk = scene_frame_q(sc, k);
     double x, y;
-    for (int i = 0; i < m->nbodies; i++)
-        svg_box_add(b, qk[m->bodies[i].q], qk[m->bodies[i].q + 1]);
+    for (int i = 0; i < m->nbodies; i++) {
+        const Body *bd = &m->bodies[i];
+        if (bd->spatial) {
+            Vtx v = {.q = bd->q, .fq = -1, .spatial = true};
+            scene_vtx_xy(sc, &v, qk, &x, &y);
+            svg_box_add(b, x, y);
+        } else {
+            svg_box_add(b, qk[bd->q], qk[bd->q + 1]);
+        }
+    }
     for (int j = 0; j < m->njoints; j++) {
         const Joint *jt = &m->joints[j];
         const Attach *at[2] = {&jt->a, &jt->b};
         for (int a = 0; a < joint_info[jt->kind].attachments; a++) {
             Vtx v = scene_vtx_at(*at[a]);
-            scene_vtx_world(&v, qk, &x, &y);
+            scene_vtx_xy(sc, &v, qk, &x, &y);
             svg_box_add(b, x, y);
         }
     }
@@ -72,7 +80,7 @@ static void extent_shapes(const Scene *sc, int k, SvgBox *b)
     for (int s = 0; s < sc->nsh; s++) {
         const Shape *sh = &sc->sh[s];
         for (int v = sh->v0; v < sh->v0 + sh->nv; v++) {
-            scene_vtx_world(&sc->v[v], qk, &x, &y);
+            scene_vtx_xy(sc, &sc->v[v], qk, &x, &y);
             double r = sh->r_world ? sh->r : 0;
             svg_box_add(b, x - r, y - r);
             svg_box_add(b, x + r, y + r);
@@ -94,7 +102,7 @@ SvgBox svg_scene_extent(const Scene *sc, bool shapes)
     for (int i = 0; i < sc->ntraces; i++) {
         Vtx v = scene_vtx_trace(&sc->traces[i]);
         for (int j = 0; j < count; j++) {
-            scene_vtx_world(&v, scene_frame_q(sc, path_frame(sc, j, count)), &x, &y);
+            scene_vtx_xy(sc, &v, scene_frame_q(sc, path_frame(sc, j, count)), &x, &y);
             svg_box_add(&b, x, y);
         }
     }
@@ -173,7 +181,7 @@ static double *shape_pixels(const Scene *sc, const SvgPixelMap *pm, const Shape 
         const double *qk = scene_frame_q(sc, sc->frames[f]);
         for (int v = 0; v < sh->nv; v++) {
             double x, y;
-            scene_vtx_world(&sc->v[sh->v0 + v], qk, &x, &y);
+            scene_vtx_xy(sc, &sc->v[sh->v0 + v], qk, &x, &y);
             /* rounded as printed, so "moves" means a visible change */
             xy[((size_t)f * sh->nv + v) * 2] = round(px_x(pm, x) * 10) / 10;
             xy[((size_t)f * sh->nv + v) * 2 + 1] = round(px_y(pm, y) * 10) / 10;
@@ -357,7 +365,7 @@ static void write_trace_paths(FILE *out, const Scene *sc, const SvgPixelMap *pm)
         int written = 0;
         for (int j = 0; j < count; j++) {
             double x, y;
-            scene_vtx_world(&v, scene_frame_q(sc, path_frame(sc, j, count)), &x, &y);
+            scene_vtx_xy(sc, &v, scene_frame_q(sc, path_frame(sc, j, count)), &x, &y);
             x = round(px_x(pm, x) * 10) / 10;
             y = round(px_y(pm, y) * 10) / 10;
             if (x == px && y == py)
@@ -545,8 +553,11 @@ void svg_write_scene(FILE *out, const Scene *sc, const SvgPixelMap *pm, const ch
                  "viewBox=\"0 0 %d %d\">\n<title>",
             pm->width, pm->height, pm->width, pm->height);
     svg_put_escaped(out, title);
-    fputs("</title>\n<desc>Made by mechc: the mechanism at the first instant; SMIL animations play the run "
-          "(y up, equal scales).</desc>\n", out);
+    fputs("</title>\n<desc>Made by mechc: the mechanism at the first instant; SMIL animations play the run ", out);
+    if (sc->m->spatial)
+        fprintf(out, "(the %s view, orthographic, equal scales).</desc>\n", svg_view_names[sc->view]);
+    else
+        fputs("(y up, equal scales).</desc>\n", out);
     fputs(style_sheet, out);
     fputs("<defs><marker id=\"arrow\" viewBox=\"0 0 10 10\" refX=\"5\" refY=\"5\" markerWidth=\"5\" "
           "markerHeight=\"5\" orient=\"auto\"><path d=\"M0,0 L10,5 L0,10 z\" fill=\"" SCENE_DRIVE_COLOUR

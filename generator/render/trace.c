@@ -1,4 +1,4 @@
-/* trace.c - the --trace argument: a point of a body (BODY(sx, sy), BODY) or a particle (POINT). */
+/* trace.c - the --trace argument: a point of a body (BODY(sx, sy), spatial BODY(sx, sy, sz), BODY) or a particle (POINT). */
 #include "svg_anim.h"
 
 #include "../base/arena.h"
@@ -31,29 +31,29 @@ static bool parse_number(const char *s, double *v, const char **end)
     return true;
 }
 
-/* Reads "(sx, sy)" at *s, blanks allowed around its parts; on success
-   moves *s past it. */
-static bool parse_offset(const char **s, const char *text, double *sx, double *sy,
-                         char *err, size_t errlen)
+/* Reads "(sx, sy)" ("(sx, sy, sz)" when n is 3) at *s, blanks allowed
+   around its parts; on success moves *s past it. */
+static bool parse_offset(const char **s, const char *text, int n, double *v, char *err,
+                         size_t errlen)
 {
-    const char *p = skip_blank(*s + 1), *e;
-    if (!parse_number(p, sx, &e)) {
-        snprintf(err, errlen, "--trace '%s': expected a number for sx at '%s'", text, p);
-        return false;
+    static const char *const names[3] = {"sx", "sy", "sz"};
+    const char *p = *s + 1, *e;
+    for (int i = 0; i < n; i++) {
+        p = skip_blank(p);
+        if (!parse_number(p, &v[i], &e)) {
+            snprintf(err, errlen, "--trace '%s': expected a number for %s at '%s'", text, names[i], p);
+            return false;
+        }
+        p = skip_blank(e);
+        if (i + 1 < n && *p != ',') {
+            snprintf(err, errlen, "--trace '%s': expected ',' between %s and %s", text, names[i],
+                     names[i + 1]);
+            return false;
+        }
+        p += i + 1 < n;
     }
-    p = skip_blank(e);
-    if (*p != ',') {
-        snprintf(err, errlen, "--trace '%s': expected ',' between sx and sy", text);
-        return false;
-    }
-    p = skip_blank(p + 1);
-    if (!parse_number(p, sy, &e)) {
-        snprintf(err, errlen, "--trace '%s': expected a number for sy at '%s'", text, p);
-        return false;
-    }
-    p = skip_blank(e);
     if (*p != ')') {
-        snprintf(err, errlen, "--trace '%s': expected ')' after sy", text);
+        snprintf(err, errlen, "--trace '%s': expected ')' after %s", text, names[n - 1]);
         return false;
     }
     *s = skip_blank(p + 1);
@@ -105,24 +105,29 @@ bool svg_parse_trace(const Model *m, const char *text, SvgTrace *out, char *err,
     const Body *b = parse_body(m, &s, text, err, errlen);
     if (!b)
         return false;
-    double sx = 0, sy = 0;
+    bool turns = b->has_phi || (b->spatial && b->nq == 7);
+    int n = b->spatial ? 3 : 2;
+    double v[3] = {0, 0, 0};
     s = skip_blank(s);
     if (*s == '(') {
-        if (!b->has_phi) {
+        if (!turns) {
             snprintf(err, errlen, "--trace '%s': '%s' is a point; it takes no offset", text, b->name);
             return false;
         }
-        if (!parse_offset(&s, text, &sx, &sy, err, errlen))
+        if (!parse_offset(&s, text, n, v, err, errlen))
             return false;
     }
     if (*s) {
-        snprintf(err, errlen, "--trace '%s': unexpected '%s' (expected BODY(sx, sy), BODY or POINT)", text, s);
+        snprintf(err, errlen, "--trace '%s': unexpected '%s' (expected %s, BODY or POINT)", text, s,
+                 b->spatial ? "BODY(sx, sy, sz)" : "BODY(sx, sy)");
         return false;
     }
     out->q = b->q;
-    out->has_phi = b->has_phi;
-    out->sx = sx;
-    out->sy = sy;
+    out->has_phi = turns;
+    out->sx = v[0];
+    out->sy = v[1];
+    out->sz = v[2];
+    out->spatial = b->spatial;
     out->label = text;
     return true;
 }
