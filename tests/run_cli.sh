@@ -93,6 +93,42 @@ rssr_closed_form() {
 }
 check "rssr: psi = atan2(Q, P) + acos(R / sqrt(P^2 + Q^2)) at 9 crank angles, to 1e-9" rssr_closed_form
 check "rssr: psi(0.25) = 1.5506466765" near "$(value_at 0.25 psi "$tmp/rssr.csv")" 1.5506466764710545 1e-9
+# the Stewart platform: forward kinematics (Newton from the previous pose)
+# gives back the trajectory whose inverse kinematics drives the legs
+# (examples/stewart.mech): pose, rates and accelerations at every step
+run "$ex/stewart.mech" --steps 40 --csv "$tmp/stewart.csv"
+check "stewart: exit 0" status_is 0
+stewart_closed_form() {
+    awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    function put(name, want, level,   d) {
+        if (!(name in c)) { missing = name; return }
+        d = $(c[name]) - want; if (d < 0) d = -d
+        if (d > worst[level]) worst[level] = d
+    }
+    BEGIN { pi = atan2(0, -1); w = 2 * pi; amp = 0.25; u[1] = 1 / 3; u[2] = u[3] = 2 / 3 }
+    {
+        t = $1; s = sin(w * t); co = cos(w * t)
+        a = amp * s; ad = amp * w * co; add = -amp * w * w * s
+        put("top.x", 0.1 * s, 0); put("d(top.x)", 0.1 * w * co, 1); put("dd(top.x)", -0.1 * w * w * s, 2)
+        put("top.y", 0.08 * sin(2 * w * t), 0); put("d(top.y)", 0.16 * w * cos(2 * w * t), 1)
+        put("dd(top.y)", -0.32 * w * w * sin(2 * w * t), 2)
+        put("top.z", 1 + 0.1 * (1 - co), 0); put("d(top.z)", 0.1 * w * s, 1); put("dd(top.z)", 0.1 * w * w * co, 2)
+        ch = cos(a / 2); sh = sin(a / 2)
+        put("top.e0", ch, 0); put("d(top.e0)", -sh * ad / 2, 1); put("dd(top.e0)", -ch * ad * ad / 4 - sh * add / 2, 2)
+        for (k = 1; k <= 3; k++) {
+            put("top.e" k, u[k] * sh, 0); put("d(top.e" k ")", u[k] * ch * ad / 2, 1)
+            put("dd(top.e" k ")", u[k] * (-sh * ad * ad / 4 + ch * add / 2), 2)
+        }
+        n++
+    }
+    END {
+        printf "stewart: worst position %.3g, velocity %.3g, acceleration %.3g\n", worst[0], worst[1], worst[2] > "/dev/stderr"
+        exit !(n == 41 && missing == "" && worst[0] <= 1e-9 && worst[1] <= 1e-9 && worst[2] <= 1e-9)
+    }' "$tmp/stewart.csv"
+}
+check "stewart: pose, rates and accelerations equal the closed-form trajectory at 41 instants, to 1e-9" stewart_closed_form
+check "stewart: e1(0.25) = sin(0.125)/3" near "$(value_at 0.25 top.e1 "$tmp/stewart.csv")" 0.041558244461742564 1e-12
 # omega in JSON, beside the Euler-parameter rates
 run "$ex/rolling_disk.mech" --steps 2 --json
 check "rolling disk: runs (integrated, projected)" status_is 0
