@@ -131,6 +131,16 @@ stewart_closed_form() {
 }
 check "stewart: pose, rates and accelerations equal the closed-form trajectory at 41 instants, to 1e-9" stewart_closed_form
 check "stewart: e1(0.25) = 0.125/(3 sqrt(1 + 0.125^2))" near "$(value_at 0.25 top.e1 "$tmp/stewart.csv")" 0.041344911529736156 1e-12
+# the double-wishbone suspension: camber and toe against an independent
+# computation of the same geometry (tests/suspension_reference.awk)
+run "$ex/suspension.mech" --steps 20 --csv "$tmp/suspension.csv"
+check "suspension: exit 0" status_is 0
+check "suspension: camber and toe at 21 travels equal the step-by-step geometry to 1e-9 deg" \
+    awk -F, -v tol=1e-9 -f "$(dirname "$0")/suspension_reference.awk" "$tmp/suspension.csv"
+check "suspension: camber 0 at zero travel" near "$(value_at 0.5 camber_deg "$tmp/suspension.csv")" 0 1e-9
+check "suspension: toe 0 at zero travel" near "$(value_at 0.5 toe_deg "$tmp/suspension.csv")" 0 1e-9
+check "suspension: camber -2.641 deg at 80 mm of bump" near "$(value_at 1 camber_deg "$tmp/suspension.csv")" -2.641433191371 1e-9
+check "suspension: toe -0.187 deg at 80 mm of rebound" near "$(value_at 0 toe_deg "$tmp/suspension.csv")" -0.187234746379 1e-9
 # omega in JSON, beside the Euler-parameter rates
 run "$ex/rolling_disk.mech" --steps 2 --json
 check "rolling disk: runs (integrated, projected)" status_is 0
