@@ -141,6 +141,27 @@ check "suspension: camber 0 at zero travel" near "$(value_at 0.5 camber_deg "$tm
 check "suspension: toe 0 at zero travel" near "$(value_at 0.5 toe_deg "$tmp/suspension.csv")" 0 1e-9
 check "suspension: camber -2.641 deg at 80 mm of bump" near "$(value_at 1 camber_deg "$tmp/suspension.csv")" -2.641433191371 1e-9
 check "suspension: toe -0.187 deg at 80 mm of rebound" near "$(value_at 0 toe_deg "$tmp/suspension.csv")" -0.187234746379 1e-9
+# examples/chain_spatial.sh: N bodies, 7N coordinates; every rod turns with
+# the first by a = 0.5 sin(2 pi t) about y, so e2 = sin(a/2), e0 = cos(a/2)
+sh "$ex/chain_spatial.sh" 4 "$tmp/chain_spatial_4.mech"
+run "$tmp/chain_spatial_4.mech" --steps 8 --csv "$tmp/chain_spatial.csv"
+check "chain_spatial.sh 4: runs (exit 0)" status_is 0
+check "chain_spatial.sh 4: 28 coordinates" sh -c "head -1 '$tmp/chain_spatial.csv' | grep -q ',rod3.e3,' && ! grep -q rod4 '$tmp/chain_spatial.csv'"
+check "chain_spatial.sh 4: every rod at the first rod's angle, to 1e-12" awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    {
+        a = 0.5 * sin(2 * atan2(0, -1) * $1)
+        for (k = 0; k < 4; k++) {
+            d = $(c["rod" k ".e2"]) - sin(a / 2); if (d < 0) d = -d; if (d > w) w = d
+            d = $(c["rod" k ".e0"]) - cos(a / 2); if (d < 0) d = -d; if (d > w) w = d
+        }
+        n++
+    }
+    END { exit !(n == 9 && w <= 1e-12) }' "$tmp/chain_spatial.csv"
+run_mechc gen "$tmp/chain_spatial_4.mech" --stats -o /dev/null
+check "chain_spatial.sh 4: 28 rows" err_has "28 coordinates, 28 rows"
+sh "$ex/chain_spatial.sh" 0 > /dev/null 2>&1
+check "chain_spatial.sh 0: refused (exit 2)" test $? = 2
 # omega in JSON, beside the Euler-parameter rates
 run "$ex/rolling_disk.mech" --steps 2 --json
 check "rolling disk: runs (integrated, projected)" status_is 0
