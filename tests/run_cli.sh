@@ -93,6 +93,75 @@ rssr_closed_form() {
 }
 check "rssr: psi = atan2(Q, P) + acos(R / sqrt(P^2 + Q^2)) at 9 crank angles, to 1e-9" rssr_closed_form
 check "rssr: psi(0.25) = 1.5506466765" near "$(value_at 0.25 psi "$tmp/rssr.csv")" 1.5506466764710545 1e-9
+# the Stewart platform: forward kinematics (Newton from the previous pose)
+# gives back the trajectory whose inverse kinematics drives the legs
+# (examples/stewart.mech): pose, rates and accelerations at every step
+run "$ex/stewart.mech" --steps 40 --csv "$tmp/stewart.csv"
+check "stewart: exit 0" status_is 0
+stewart_closed_form() {
+    awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    function put(name, want, level,   d) {
+        if (!(name in c)) { missing = name; return }
+        d = $(c[name]) - want; if (d < 0) d = -d
+        if (d > worst[level]) worst[level] = d
+    }
+    BEGIN { pi = atan2(0, -1); w = 2 * pi; k = 0.125; u[1] = 1 / 3; u[2] = u[3] = 2 / 3 }
+    {
+        t = $1; s = sin(w * t); co = cos(w * t)
+        put("top.x", 0.1 * s, 0); put("d(top.x)", 0.1 * w * co, 1); put("dd(top.x)", -0.1 * w * w * s, 2)
+        put("top.y", 0.08 * sin(2 * w * t), 0); put("d(top.y)", 0.16 * w * cos(2 * w * t), 1)
+        put("dd(top.y)", -0.32 * w * w * sin(2 * w * t), 2)
+        put("top.z", 1 + 0.1 * (1 - co), 0); put("d(top.z)", 0.1 * w * s, 1); put("dd(top.z)", 0.1 * w * w * co, 2)
+        # e0 = (1 + g^2)^(-1/2), e = u g e0, g = k sin wt
+        g = k * s; gd = k * w * co; gdd = -k * w * w * s; m = 1 + g * g
+        e0 = m ^ -0.5; e0d = -g * gd * m ^ -1.5
+        e0dd = -(gd * gd + g * gdd) * m ^ -1.5 + 3 * g * g * gd * gd * m ^ -2.5
+        put("top.e0", e0, 0); put("d(top.e0)", e0d, 1); put("dd(top.e0)", e0dd, 2)
+        for (j = 1; j <= 3; j++) {
+            put("top.e" j, u[j] * g * e0, 0); put("d(top.e" j ")", u[j] * (gd * e0 + g * e0d), 1)
+            put("dd(top.e" j ")", u[j] * (gdd * e0 + 2 * gd * e0d + g * e0dd), 2)
+        }
+        n++
+    }
+    END {
+        printf "stewart: worst position %.3g, velocity %.3g, acceleration %.3g\n", worst[0], worst[1], worst[2] > "/dev/stderr"
+        exit !(n == 41 && missing == "" && worst[0] <= 1e-9 && worst[1] <= 1e-9 && worst[2] <= 1e-9)
+    }' "$tmp/stewart.csv"
+}
+check "stewart: pose, rates and accelerations equal the closed-form trajectory at 41 instants, to 1e-9" stewart_closed_form
+check "stewart: e1(0.25) = 0.125/(3 sqrt(1 + 0.125^2))" near "$(value_at 0.25 top.e1 "$tmp/stewart.csv")" 0.041344911529736156 1e-12
+# the double-wishbone suspension: camber and toe against an independent
+# computation of the same geometry (tests/suspension_reference.awk)
+run "$ex/suspension.mech" --steps 20 --csv "$tmp/suspension.csv"
+check "suspension: exit 0" status_is 0
+check "suspension: camber and toe at 21 travels equal the step-by-step geometry to 1e-9 deg" \
+    awk -F, -v tol=1e-9 -f "$(dirname "$0")/suspension_reference.awk" "$tmp/suspension.csv"
+check "suspension: camber 0 at zero travel" near "$(value_at 0.5 camber_deg "$tmp/suspension.csv")" 0 1e-9
+check "suspension: toe 0 at zero travel" near "$(value_at 0.5 toe_deg "$tmp/suspension.csv")" 0 1e-9
+check "suspension: camber -2.641 deg at 80 mm of bump" near "$(value_at 1 camber_deg "$tmp/suspension.csv")" -2.641433191371 1e-9
+check "suspension: toe -0.187 deg at 80 mm of rebound" near "$(value_at 0 toe_deg "$tmp/suspension.csv")" -0.187234746379 1e-9
+# examples/chain_spatial.sh: N bodies, 7N coordinates; every rod turns with
+# the first by a = 0.5 sin(2 pi t) about y, so e2 = sin(a/2), e0 = cos(a/2)
+sh "$ex/chain_spatial.sh" 4 "$tmp/chain_spatial_4.mech"
+run "$tmp/chain_spatial_4.mech" --steps 8 --csv "$tmp/chain_spatial.csv"
+check "chain_spatial.sh 4: runs (exit 0)" status_is 0
+check "chain_spatial.sh 4: 28 coordinates" sh -c "head -1 '$tmp/chain_spatial.csv' | grep -q ',rod3.e3,' && ! grep -q rod4 '$tmp/chain_spatial.csv'"
+check "chain_spatial.sh 4: every rod at the first rod's angle, to 1e-12" awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    {
+        a = 0.5 * sin(2 * atan2(0, -1) * $1)
+        for (k = 0; k < 4; k++) {
+            d = $(c["rod" k ".e2"]) - sin(a / 2); if (d < 0) d = -d; if (d > w) w = d
+            d = $(c["rod" k ".e0"]) - cos(a / 2); if (d < 0) d = -d; if (d > w) w = d
+        }
+        n++
+    }
+    END { exit !(n == 9 && w <= 1e-12) }' "$tmp/chain_spatial.csv"
+run_mechc gen "$tmp/chain_spatial_4.mech" --stats -o /dev/null
+check "chain_spatial.sh 4: 28 rows" err_has "28 coordinates, 28 rows"
+sh "$ex/chain_spatial.sh" 0 > /dev/null 2>&1
+check "chain_spatial.sh 0: refused (exit 2)" test $? = 2
 # omega in JSON, beside the Euler-parameter rates
 run "$ex/rolling_disk.mech" --steps 2 --json
 check "rolling disk: runs (integrated, projected)" status_is 0

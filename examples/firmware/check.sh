@@ -4,6 +4,9 @@
 # mps2-an386 and the Cortex-M3 image under mps2-an385, and compares each
 # target's output with the host run of the same real type (compare.awk:
 # float within 1e-4, double within 1e-12, relative to each column's size).
+# The same for the Stewart platform's forward kinematics (stewart.c, float:
+# host-stewart and m4f-stewart; each also checks itself against the
+# closed-form trajectory and exits 1 when a pose is off).
 #
 # The images print through semihosting and end with its SYS_EXIT call;
 # QEMU's exit status is the program's. Each run is bounded by a timeout
@@ -53,8 +56,11 @@ run host-double "$out/host-double"
 run host-float "$out/host-float"
 run m3 qemu-system-arm -M mps2-an385 $qemu_opts -kernel "$out/m3.elf"
 run m4f qemu-system-arm -M mps2-an386 $qemu_opts -kernel "$out/m4f.elf"
+run host-stewart "$out/host-stewart"
+run m4f-stewart qemu-system-arm -M mps2-an386 $qemu_opts -kernel "$out/m4f-stewart.elf"
 compare host-double m3 1e-12
 compare host-float m4f 1e-4
+compare host-stewart m4f-stewart 1e-4
 
 echo "firmware_check: $pass passed, $fail failed"
 [ "$fail" = 0 ]
