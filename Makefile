@@ -55,7 +55,7 @@ help:
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
-	@echo "make bench      time the engines side by side (bench/run)"
+	@echo "make bench      time the engines side by side (bench/run), and run's scaling (bench/scaling.sh)"
 	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
@@ -185,6 +185,7 @@ demo: deps
 bench: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)sh bench/run $(MECHC)
+	$(Q)sh bench/scaling.sh $(MECHC)
 
 install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/bin

@@ -56,6 +56,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* A singular value ratio below this names the dependency in a failure message. */
 #define RUN_NEAR_SINGULAR 1e-7
@@ -719,11 +720,13 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
         double c0 = pipeline_now();
+        clock_t cpu0 = clock();
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
         st = checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
         r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
             status = RUN_FAILED;
             goto out;
@@ -786,6 +789,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i), c0 = pipeline_now();
+        clock_t cpu0 = clock();
         long it0 = mechrt_host_stats(host)->project_iterations;
         st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep, &rep);
         r->res->newton_iterations += mechrt_host_stats(host)->project_iterations - it0;
@@ -801,6 +805,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
                                           r->lwork, &rep);
         r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (st != MECHRT_OK) {
             fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
             status = RUN_FAILED;

@@ -90,6 +90,7 @@ typedef struct RunResult {
     long newton_iterations;      /* Newton iterations (velocity rows: projection
                                     iterations) */
     double step_seconds;         /* wall time inside the analysis of those steps */
+    double step_cpu_seconds;     /* the process's CPU time in the same (clock()) */
     int subdivided;              /* intervals redone in substeps */
     long substeps;               /* predictor-corrector substeps taken in them
                                     (every level tried; their Newton iterations

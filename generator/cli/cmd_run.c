@@ -319,6 +319,8 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
             fprintf(stderr, "mechc run: stats: %d %s redone in substeps (%ld substeps)\n",
                     res->subdivided, res->subdivided == 1 ? "step" : "steps", res->substeps);
     }
+    fprintf(stderr, "mechc run: stats: %.6g ms of CPU time in the steps: %.0f ns per step\n",
+            1e3 * res->step_cpu_seconds, 1e9 * res->step_cpu_seconds / n);
     if (res->sparse)
         fprintf(stderr, "mechc run: stats: sparse LU (KLU): %ld factorisations with pivoting, "
                 "%ld refactorisations\n", res->fresh_factorisations, res->refactorisations);
