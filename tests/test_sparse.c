@@ -108,6 +108,42 @@ static void test_klu_singular_named(void **state)
     mechrt_host_sparse_free(s);
 }
 
+/* A refactorisation whose kept pivot order has gone bad pivots afresh:
+   [a b; c d] first pivots on a, then a becomes tiny. */
+static const int full_row[] = {0, 0, 1, 1};
+static const int full_col[] = {0, 1, 0, 1};
+
+static void fill_full(void *ctx, const double *q, double t, double *vals)
+{
+    (void)q, (void)t;
+    memcpy(vals, ctx, 4 * sizeof *vals);
+}
+
+static void test_klu_repivots(void **state)
+{
+    (void)state;
+    double v[4] = {1, 1, 1e-3, 2};
+    MechrtHostJacNz j = {4, full_row, full_col, v, fill_full};
+    MechrtHostSparse *s = mechrt_host_sparse_new(2, &j);
+    assert_non_null(s);
+    mechrt_host_sparse_eval(s, NULL, 0);
+    assert_int_equal(mechrt_host_sparse_factor(s, 1e-12), MECHRT_OK);
+    v[0] = 1e-9;
+    v[2] = 1;
+    mechrt_host_sparse_eval(s, NULL, 0);
+    assert_int_equal(mechrt_host_sparse_factor(s, 1e-12), MECHRT_OK);
+    long fresh, re;
+    mechrt_host_sparse_counts(s, &fresh, &re);
+    assert_int_equal(fresh, 2);
+    assert_int_equal(re, 0);
+    /* x = (1, 1): b = (1e-9 + 1, 1 + 2), to full accuracy */
+    double b[2] = {1 + 1e-9, 3};
+    assert_int_equal(mechrt_host_sparse_solve(s, b), MECHRT_OK);
+    assert_near(b[0], 1, 1e-15, 0);
+    assert_near(b[1], 1, 1e-15, 0);
+    mechrt_host_sparse_free(s);
+}
+
 static void test_klu_bad_pattern(void **state)
 {
     (void)state;
@@ -329,6 +365,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_klu_solve),
         cmocka_unit_test(test_klu_singular_named),
+        cmocka_unit_test(test_klu_repivots),
         cmocka_unit_test(test_klu_bad_pattern),
         cmocka_unit_test(test_examples_agree),
         cmocka_unit_test(test_chain_agrees),

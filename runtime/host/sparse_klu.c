@@ -182,7 +182,8 @@ MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol)
     double thresh = pivot_tol * amax;
     if (s->numeric) {
         if (klu_refactor(s->ap, s->ai, s->ax, s->symbolic, s->numeric, &s->common)
-            && !sparse_bad_pivot(s, thresh) && sparse_spread(s) <= SPARSE_REFRESH * s->spread_fresh) {
+            && !sparse_bad_pivot(s, thresh)
+            && sparse_spread(s) <= SPARSE_REFRESH * s->spread_fresh) {
             s->refactored++;
             return MECHRT_OK;
         }
