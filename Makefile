@@ -16,10 +16,16 @@ CFLAGS_TOOL    := -std=c11 $(OPT) $(WARN) $(SAN) -D_DEFAULT_SOURCE \
                   -DMECHC_VERSION='"$(VERSION)"' -MMD -MP
 CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) -MMD -MP
 
+# SuiteSparse's KLU, the sparse LU of large Jacobians (runtime/host/sparse_klu.c).
+# Debian 12's libsuitesparse-dev has no pkg-config file (later ones do).
+KLU_CFLAGS := $(shell pkg-config --cflags klu 2>/dev/null || echo -I/usr/include/suitesparse)
+KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig)
+CFLAGS_TOOL += $(KLU_CFLAGS)
+
 # libtcc: Debian ships only a static, non-PIC libtcc.a, so the tool links it
 # statically and is itself linked without PIE.
 LDFLAGS_TOOL := -no-pie $(SAN)
-LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic -lgsl -lgslcblas -ldl -lm -lpthread
+LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic $(KLU_LIBS) -lgsl -lgslcblas -ldl -lm -lpthread
 LDLIBS_TEST  := -lcmocka
 
 GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))
@@ -49,7 +55,7 @@ help:
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
-	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh)"
+	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh)"
 	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
@@ -180,6 +186,7 @@ bench: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)sh bench/run $(MECHC)
 	$(Q)sh bench/written.sh $(MECHC)
+	$(Q)sh bench/scaling.sh $(MECHC)
 
 install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/bin

@@ -28,6 +28,15 @@
  * iteration, passes the check for the price of saving the state it started
  * from.
  *
+ * The linear algebra is chosen once per run (RunOptions.linear): the
+ * runtime's dense LU (mechrt_step), or KLU on the Jacobian's nonzeros
+ * (mechrt_host_sparse_step, runtime/host/sparse_step.c: the same predictor,
+ * Newton and analysis); run_step is the one place the two differ, so the
+ * stepping, its checks and substeps are shared. The sparse path never forms
+ * an nr x nq matrix: its diagnostics name the failing pivot's row and
+ * coordinate instead of an SVD's, and the nearly singular test at t0 is
+ * KLU's condition estimate. Velocity-level rows stay dense for now.
+ *
  * Failures stop the run and say when, why and where: the time as
  * `t = VALUE`, the runtime's cause, the row with the largest residual or
  * the coordinate where elimination found no pivot, and, from an SVD of the
@@ -47,6 +56,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* A singular value ratio below this names the dependency in a failure message. */
 #define RUN_NEAR_SINGULAR 1e-7
@@ -68,6 +78,8 @@
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
 
+const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
+
 RunOptions run_default_options(void)
 {
     RunOptions o;
@@ -80,6 +92,8 @@ RunOptions run_default_options(void)
     o.move_note = 1e-3;
     o.assembly_max_iter = 100;
     o.notes = NULL;
+    o.linear = RUN_LINEAR_AUTO;
+    o.jac_nz = NULL;
     return o;
 }
 
@@ -94,6 +108,7 @@ typedef struct Run {
     double *q, *qd, *qdd;    /* one block of 3 nq: qd == q + nq, qdd == q + 2 nq */
     double *work;
     size_t lwork;
+    MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
@@ -159,11 +174,25 @@ static void name_list(Run *r, const char *const *names, const double *w, int n)
         msgf(r, "%s%s", c == 0 ? "" : c + 1 == count ? " and " : ", ", names[picked[c]]);
 }
 
+/* The sparse path's account of a singular factorisation: the row and the
+   coordinate of the pivot that failed (KLU's permutations undone). */
+static double describe_pivot(Run *r)
+{
+    int row, col;
+    mechrt_host_sparse_singular(r->sp, &row, &col);
+    if (row >= 0 && col >= 0)
+        msgf(r, "; the sparse LU found no pivot for %s in row %s (or after it)",
+             r->m->coord_names[col], r->m->rows[row].name);
+    return -1;
+}
+
 /* The rows and coordinates of the Jacobian's (near) dependency at (q, t),
    over the first `rows` rows; nothing when the Jacobian is well conditioned.
    Returns sigma_min / sigma_max, or -1 when it could not be computed. */
 static double describe_dependency(Run *r, const double *q, double t, int rows, bool always)
 {
+    if (r->sp)
+        return describe_pivot(r);
     if (r->nq > RUN_SVD_MAX_NQ)
         return -1;
     size_t nq = (size_t)r->nq;
@@ -194,6 +223,8 @@ static double describe_dependency(Run *r, const double *q, double t, int rows, b
    sigma_min / sigma_max < RUN_NEAR_SINGULAR. */
 static bool nearly_singular(Run *r, double t)
 {
+    if (r->sp)      /* its last factorisation is at q: the velocity analysis' */
+        return !(mechrt_host_sparse_condest(r->sp) * RUN_NEAR_SINGULAR <= 1);
     if (r->nq > RUN_SVD_MAX_NQ)
         return false;
     size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
@@ -207,29 +238,50 @@ static bool nearly_singular(Run *r, double t)
 
 /* Names the first row whose Phi, Phi_q or nu is NaN or infinite at (q, t);
    false when all are finite (then the solve overflowed). */
+/* The first row with a NaN or infinite Jacobian entry at (q, t), or -1:
+   the dense kernel's, or the sparse path's nonzeros. */
+static int nonfinite_jac_row(Run *r, const double *q, double t)
+{
+    int row = -1;
+    if (r->sp) {
+        const MechrtHostJacNz *j = r->o->jac_nz;
+        double *vals = mechrt_host_sparse_values(r->sp);
+        mechrt_host_sparse_eval(r->sp, q, t);
+        for (int e = 0; e < j->nnz && row < 0; e++)
+            if (!isfinite(vals[e]))
+                row = j->row[e];
+        return row;
+    }
+    size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
+    double *jac = xcalloc(nr * nq + 1, sizeof *jac);
+    r->k->jac(r->k->ctx, q, t, jac);
+    for (size_t i = 0; i < nr * nq && row < 0; i++)
+        if (!isfinite(jac[i]))
+            row = (int)(i / nq);
+    free(jac);
+    return row;
+}
+
 static bool find_nonfinite(Run *r, const double *q, double t)
 {
     const MechrtKernels *k = r->k;
-    size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
-    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(nr * nq + 1, sizeof *jac);
-    double *nu = xcalloc(nr + 1, sizeof *nu);
+    size_t nr = (size_t)r->nr;
+    double *phi = xcalloc(nr + 1, sizeof *phi), *nu = xcalloc(nr + 1, sizeof *nu);
     const char *what = NULL;
     int row = -1;
     k->phi(k->ctx, q, t, phi);
-    k->jac(k->ctx, q, t, jac);
     k->nu(k->ctx, q, t, nu);
     for (int i = 0; i < k->nh && !what; i++)
         if (!isfinite(phi[i]))
             what = "Phi", row = i;
-    for (size_t i = 0; i < nr * nq && !what; i++)
-        if (!isfinite(jac[i]))
-            what = "Phi_q", row = (int)(i / nq);
+    if (!what && (row = nonfinite_jac_row(r, q, t)) >= 0)
+        what = "Phi_q";
     for (int i = 0; i < r->nr && !what; i++)
         if (!isfinite(nu[i]))
             what = "nu", row = i;
     if (what)
         msgf(r, "NaN or infinity in %s of row %s", what, r->m->rows[row].name);
-    free(phi), free(jac), free(nu);
+    free(phi), free(nu);
     return what != NULL;
 }
 
@@ -496,14 +548,23 @@ static bool step_quiet(const Run *r, double h, const MechrtReport *rep, StepChec
     return false;
 }
 
+/* The one place the linear algebra differs: the runtime's dense step, or
+   the same step on the sparse Jacobian. */
+static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
+{
+    if (r->sp)
+        return mechrt_host_sparse_step(r->sp, r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h,
+                                       r->work, r->lwork, rep);
+    return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
+}
+
 /* One predictor-corrector step of the runtime from t to t + h, its start
    kept in sq, sqd, sqdd; *quiet says whether it passed the check. */
 static MechrtStatus checked_step(Run *r, double t, double h, MechrtReport *rep, bool *quiet,
                                  StepCheck *chk)
 {
     memcpy(r->sq, r->q, 3 * (size_t)r->nq * sizeof(double));   /* q | qd | qdd */
-    MechrtStatus st = mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work,
-                                  r->lwork, rep);
+    MechrtStatus st = run_step(r, t, h, rep);
     r->res->newton_iterations += rep->iterations;
     *quiet = st == MECHRT_OK && step_quiet(r, h, rep, chk);
     return st;
@@ -630,8 +691,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
     memcpy(q0, r->q, nq * sizeof *q0);
     r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
-    MechrtStatus st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work,
-                                  r->lwork, &rep);
+    MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
     r->res->assembly_iterations = rep.iterations;
     if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
         /* a guess Newton cannot start from: assemble robustly, then
@@ -641,8 +701,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
             status = RUN_FAILED;
             goto out;
         }
-        st = mechrt_step(r->k, &o->mechrt, r->q, r->qd, r->qdd, o->t0, 0.0, r->work, r->lwork,
-                         &rep);
+        st = run_step(r, o->t0, 0.0, &rep);
         r->res->assembly_iterations += rep.iterations;
     }
     if (st == MECHRT_OK && nearly_singular(r, o->t0)) {
@@ -661,11 +720,13 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
         double c0 = pipeline_now();
+        clock_t cpu0 = clock();
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
         st = checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
         r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
             status = RUN_FAILED;
             goto out;
@@ -728,6 +789,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i), c0 = pipeline_now();
+        clock_t cpu0 = clock();
         long it0 = mechrt_host_stats(host)->project_iterations;
         st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep, &rep);
         r->res->newton_iterations += mechrt_host_stats(host)->project_iterations - it0;
@@ -743,6 +805,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
                                           r->lwork, &rep);
         r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (st != MECHRT_OK) {
             fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
             status = RUN_FAILED;
@@ -770,6 +833,28 @@ static RunStatus bad_input(RunResult *res, const char *fmt, ...)
     res->status = RUN_BAD_INPUT;
     res->cause = MECHRT_EINVAL;
     return RUN_BAD_INPUT;
+}
+
+/* Dense or sparse for this run (RunOptions.linear); false with why when
+   the choice cannot be honoured. */
+static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
+                          size_t size)
+{
+    bool can = o->jac_nz && m->nv == 0;
+    *sparse = o->linear == RUN_LINEAR_SPARSE
+              || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
+    if (*sparse && m->nv > 0) {
+        snprintf(why, size, "--linear sparse does not support velocity-level rows yet (%d "
+                 "here: rolling, knife edges, velocity drivers); their integration is dense: "
+                 "use --linear dense or auto", m->nv);
+        return false;
+    }
+    if (*sparse && !o->jac_nz) {
+        snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
+                 "which the generic engine does not have: use --engine jit or aot");
+        return false;
+    }
+    return true;
 }
 
 bool run_rows_match(const Model *m, char *why, size_t size)
@@ -814,6 +899,9 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     char why[sizeof res->message];
     if (!run_rows_match(m, why, sizeof why))
         return bad_input(res, "%s", why);
+    bool sparse;
+    if (!choose_linear(m, o, &sparse, why, sizeof why))
+        return bad_input(res, "%s", why);
 
     Run r = {0};
     r.m = m;
@@ -827,12 +915,23 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     r.q = xcalloc(3 * nq, sizeof *r.q);
     r.qd = r.q + nq;
     r.qdd = r.q + 2 * nq;
-    r.lwork = mechrt_workspace_size(m->nq, m->nr);
+    if (sparse && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+        free(r.q);
+        return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
+                         "entries) is not a valid %d x %d pattern, or out of memory",
+                         o->jac_nz->nnz, m->nq, m->nq);
+    }
+    res->sparse = sparse;
+    r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
 
     RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
                                   : run_integrated(&r, state, state_ctx);
+    if (r.sp) {
+        mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
+        mechrt_host_sparse_free(r.sp);
+    }
     if (status == RUN_OK && r.episode)
         notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
@@ -841,17 +940,23 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     return status;
 }
 
-double run_time_all(const MechrtKernels *k, const double *q, const double *qd, double t,
-                    double min_seconds)
+double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const double *q,
+                    const double *qd, double t, double min_seconds)
 {
     size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
-    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(nr * nq + 1, sizeof *jac);
+    size_t njac = jnz ? (size_t)jnz->nnz : nr * nq;
+    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(njac + 1, sizeof *jac);
     double *nu = xcalloc(nr + 1, sizeof *nu), *gamma = xcalloc(nr + 1, sizeof *gamma);
     long calls = 0, batch = 64;
     double t0 = pipeline_now(), elapsed;
     do {
         for (long i = 0; i < batch; i++) {
-            if (k->all) {
+            if (jnz) {
+                k->phi(k->ctx, q, t, phi);
+                jnz->jac_nz(jnz->ctx, q, t, jac);
+                k->nu(k->ctx, q, t, nu);
+                k->gamma(k->ctx, q, qd, t, gamma);
+            } else if (k->all) {
                 k->all(k->ctx, q, qd, t, phi, jac, nu, gamma);
             } else {
                 k->phi(k->ctx, q, t, phi);
@@ -866,4 +971,20 @@ double run_time_all(const MechrtKernels *k, const double *q, const double *qd, d
     } while (elapsed < min_seconds);
     free(phi), free(jac), free(nu), free(gamma);
     return 1e9 * elapsed / (double)calls;
+}
+
+static void code_jac_nz(void *ctx, const double *q, double t, double *vals)
+{
+    ((const Kernels *)ctx)->jac_nz(q, t, vals);
+}
+
+bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
+{
+    const Kernels *code = e->k.ctx;
+    if ((e->kind != ENGINE_JIT && e->kind != ENGINE_AOT) || !code || !code->jac_nz
+        || !code->jac_row || !code->jac_col)
+        return false;
+    *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
+                             code_jac_nz};
+    return true;
 }

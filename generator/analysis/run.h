@@ -18,6 +18,20 @@
 #include "../engine/engine.h"
 #include "../model/model.h"
 
+/* The linear algebra of a holonomic run: the freestanding runtime's dense
+   LU, or KLU on the Jacobian's nonzeros (runtime/host/sparse_klu.c), or
+   whichever suits the size (RUN_DENSE_MAX_NQ). */
+typedef enum RunLinear { RUN_LINEAR_AUTO, RUN_LINEAR_DENSE, RUN_LINEAR_SPARSE } RunLinear;
+
+/* "auto", "dense", "sparse", NULL: the --linear names, in RunLinear order. */
+extern const char *const run_linear_names[];
+
+/* auto stays dense up to this many coordinates, sparse above: near the
+   crossover measured on examples/chain.sh chains (README, Performance),
+   where the dense LU's O(n^3) starts to cost more than KLU's overhead. */
+#define RUN_DENSE_MAX_NQ 100
+#define RUN_DENSE_MAX_NQ_TEXT "100"     /* the same, for --help */
+
 /* What a run does; fill with run_default_options(), then change fields. */
 typedef struct RunOptions {
     double t0, t1;           /* time interval, t1 != t0 (t1 < t0 runs backwards); 0, 1 */
@@ -39,6 +53,10 @@ typedef struct RunOptions {
        guess, no convergence); default 100 */
     int assembly_max_iter;
     FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
+    RunLinear linear;        /* RUN_LINEAR_AUTO */
+    /* the kernels' sparse Jacobian (run_jac_nz_of); NULL: none, dense only
+       (the generic engine has none); default NULL */
+    const MechrtHostJacNz *jac_nz;
 } RunOptions;
 
 RunOptions run_default_options(void);
@@ -72,12 +90,16 @@ typedef struct RunResult {
     long newton_iterations;      /* Newton iterations (velocity rows: projection
                                     iterations) */
     double step_seconds;         /* wall time inside the analysis of those steps */
+    double step_cpu_seconds;     /* the process's CPU time in the same (clock()) */
     int subdivided;              /* intervals redone in substeps */
     long substeps;               /* predictor-corrector substeps taken in them
                                     (every level tried; their Newton iterations
                                     are in newton_iterations) */
     double max_cond;             /* largest condition estimate seen (0: off) */
     bool integrated;             /* positions came from the integrator */
+    bool sparse;                 /* the sparse path (KLU) was used */
+    long fresh_factorisations;   /* sparse: KLU factorisations with pivoting... */
+    long refactorisations;       /* ... and with the pivot order kept */
     MechrtHostStats host;        /* integrator counters when integrated */
 } RunResult;
 
@@ -97,8 +119,13 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
                        RunStateFn state, void *state_ctx, RunResult *res);
 
 /* Nanoseconds per call of the fused `all` kernel (or phi + jac + nu + gamma
-   when there is none) at (q, qd, t), timed over at least min_seconds. */
-double run_time_all(const MechrtKernels *k, const double *q, const double *qd, double t,
-                    double min_seconds);
+   when there is none; with jnz, phi + jac_nz + nu + gamma, the sparse
+   path's) at (q, qd, t), timed over at least min_seconds. */
+double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const double *q,
+                    const double *qd, double t, double min_seconds);
+
+/* The sparse Jacobian of compiled kernels (jit, aot) into *out, whose
+   ctx is e's; false for the generic engine, which has none. */
+bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out);
 
 #endif

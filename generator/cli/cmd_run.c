@@ -33,6 +33,7 @@ typedef struct RunCli {
     double at;              /* --at: one instant, t0 = at and no steps; NaN: not given */
     int engine, ode, digits;
     int view;               /* --view: an SvgView; -1: not given (iso) */
+    int linear;             /* --linear, a RunLinear */
     bool json, stats;
     bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
@@ -66,6 +67,10 @@ static const CliOption options[] = {
      .help = "the instant T alone: --t0 T --steps 0"},
     {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
+    {"--linear", CLI_CHOICE_AT(RunCli, linear, run_linear_names), .metavar = "L",
+     .help = "linear algebra: dense (LU), sparse (KLU on the Jacobian's\n"
+             "nonzeros; jit and aot, holonomic rows only) or auto\n"
+             "(default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates when it can)"},
     {"--csv", CLI_STRING_AT(RunCli, csv_path), .metavar = "FILE",
      .help = "write the CSV to FILE ('-': stdout; the default when\n"
              "there is no --json)"},
@@ -292,8 +297,8 @@ static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *sv
     return ok;
 }
 
-static void print_stats(const RunResult *res, const MechrtKernels *k, const double *q,
-                        const double *qd, double t)
+static void print_stats(const RunResult *res, const MechrtKernels *k,
+                        const MechrtHostJacNz *jnz, const double *q, const double *qd, double t)
 {
     int n = res->steps_done;
     if (n == 0) {           /* one instant: only the assembly */
@@ -324,9 +329,16 @@ static void print_stats(const RunResult *res, const MechrtKernels *k, const doub
             fprintf(stderr, "mechc run: stats: %d %s redone in substeps (%ld substeps)\n",
                     res->subdivided, res->subdivided == 1 ? "step" : "steps", res->substeps);
     }
-    double ns_all = run_time_all(k, q, qd, t, 0.05);
-    fprintf(stderr, "mechc run: stats: one `all` kernel call (Phi, Phi_q, nu, gamma) takes "
-            "%.1f ns: a step costs %.2f of them\n", ns_all, ns_all > 0 ? ns_step / ns_all : 0);
+    fprintf(stderr, "mechc run: stats: %.6g ms of CPU time in the steps: %.0f ns per step\n",
+            1e3 * res->step_cpu_seconds, 1e9 * res->step_cpu_seconds / n);
+    if (res->sparse)
+        fprintf(stderr, "mechc run: stats: sparse LU (KLU): %ld factorisations with pivoting, "
+                "%ld refactorisations\n", res->fresh_factorisations, res->refactorisations);
+    double ns_all = run_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
+    fprintf(stderr, "mechc run: stats: one %s call (Phi, Phi_q, nu, gamma) takes "
+            "%.1f ns: a step costs %.2f of them\n",
+            res->sparse ? "phi + jac_nz + nu + gamma kernel" : "`all` kernel", ns_all,
+            ns_all > 0 ? ns_step / ns_all : 0);
     if (res->max_cond > 0)
         fprintf(stderr, "mechc run: stats: largest condition estimate %.3g\n", res->max_cond);
 }
@@ -474,7 +486,8 @@ static bool prepare(const Args *a, const RunCli *c, const Mech *mech, Pictures *
 
 /* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
 static int report(const RunCli *c, const Model *m, const Output *out, const Pictures *pics,
-                  RunStatus rs, const RunResult *res, const MechrtKernels *k, const LastState *last)
+                  RunStatus rs, const RunResult *res, const MechrtKernels *k,
+                  const MechrtHostJacNz *jnz, const LastState *last)
 {
     int status = EXIT_OK;
     if (rs == RUN_BAD_INPUT) {
@@ -502,7 +515,7 @@ static int report(const RunCli *c, const Model *m, const Output *out, const Pict
         status = EXIT_ANALYSIS;
     }
     if (c->stats)
-        print_stats(res, k, last->q, last->qd, last->t);
+        print_stats(res, k, jnz, last->q, last->qd, last->t);
     return status;
 }
 
@@ -535,8 +548,11 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
     }
     output_open(&out, m);
     MechrtKernels k = e->k;
+    MechrtHostJacNz jnz;
     RunResult res;
     c->ro.notes = stderr;
+    c->ro.linear = (RunLinear)c->linear;
+    c->ro.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
     if (out.csv)
         mechrt_csv_header_omega(out.csv, out.nv, out.names, out.outputs.nw,
                                 (const char *const *)out.outputs.wnames);
@@ -546,7 +562,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
     progress_start(&out.progress, "run", 1000);
     RunStatus rs = run_analysis(m, &k, &c->ro, on_state_keep, &last, &res);
     progress_finish(&out.progress);
-    int status = report(c, m, &out, pics, rs, &res, &k, &last);
+    int status = report(c, m, &out, pics, rs, &res, &k, &jnz, &last);
     status = finish_output(c, out.csv, status);
     free(last.q), free(last.qd);
     output_close(&out);

@@ -5,8 +5,9 @@
  * than coordinates, adaptive integration of the positions of mechanisms with
  * velocity-level rows (GSL's odeiv2), the dense SVD behind both the
  * projection and `info` (ranks, pseudo-inverse, the singular direction of a
- * Jacobian for error messages), and the CSV and JSON writers of `mechc run`.
- * Compiled into the tool only (double reals, C11, links GSL); the
+ * Jacobian for error messages), the sparse LU of large Jacobians (KLU), and
+ * the CSV and JSON writers of `mechc run`.
+ * Compiled into the tool only (double reals, C11, links GSL and KLU); the
  * freestanding core in runtime/ stays free of all of it.
  *
  * Ownership follows the core: a MechrtHost holds every workspace for one
@@ -145,6 +146,66 @@ void mechrt_svd_smallest(const MechrtSvd *w, double *row_w, double *col_w);
  * or memory runs out. Allocates: for error paths. */
 double mechrt_host_singular_direction(int m, int n, const double *a, double *row_w,
                                       double *col_w);
+
+/* ---- Sparse Jacobian (sparse_klu.c: KLU; sparse_step.c: a time step) ---
+   For large mechanisms: the Jacobian's structural nonzeros only, factored
+   by SuiteSparse's KLU (symbolic analysis once, numeric refactorisation
+   per call). Nothing of size nr x nq is allocated. */
+
+/* The Jacobian's nonzeros as generated code gives them (spec section 4:
+   PREFIX_jac_nz with its fixed pattern PREFIX_jac_row, PREFIX_jac_col):
+   entry e sits at (row[e], col[e]); jac_nz writes the nnz values in that
+   order. The arrays must outlive every user. */
+typedef struct MechrtHostJacNz {
+    int nnz;
+    const int *row, *col;
+    void *ctx;              /* passed unchanged to jac_nz */
+    void (*jac_nz)(void *ctx, const double *q, double t, double *vals);
+} MechrtHostJacNz;
+
+typedef struct MechrtHostSparse MechrtHostSparse;
+
+/* The n x n matrix of pattern jnz (copied; its arrays are kept by
+   pointer), analysed once. NULL when out of memory, or an index is out of
+   range or repeated. */
+MechrtHostSparse *mechrt_host_sparse_new(int n, const MechrtHostJacNz *jnz);
+void mechrt_host_sparse_free(MechrtHostSparse *s);
+int mechrt_host_sparse_nnz(const MechrtHostSparse *s);
+/* The nnz values, in the pattern's order, that the next factorisation
+   takes: jac_nz's output; mechrt_host_sparse_eval fills them at (q, t). */
+double *mechrt_host_sparse_values(MechrtHostSparse *s);
+void mechrt_host_sparse_eval(MechrtHostSparse *s, const double *q, double t);
+/* LU of the values with partial pivoting. MECHRT_ESING when a pivot
+   |u_kk| <= pivot_tol * max|a_ij| (the dense test of lu.c), naming it in
+   mechrt_host_sparse_singular; MECHRT_ENOTFINITE for NaN or Inf (its row
+   named); MECHRT_EINVAL when out of memory. */
+MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol);
+/* b = A^-1 b with the last factorisation; MECHRT_ENOTFINITE when b or the
+   solution is not finite, MECHRT_EINVAL without a factorisation. */
+MechrtStatus mechrt_host_sparse_solve(MechrtHostSparse *s, double *b);
+/* max|u_kk| / min|u_kk| of the last factorisation (the condition screen). */
+double mechrt_host_sparse_spread(const MechrtHostSparse *s);
+/* 1-norm condition estimate of the matrix factored last (KLU's Hager-Higham
+   estimate, as lu.c's); INFINITY without a factorisation. */
+double mechrt_host_sparse_condest(MechrtHostSparse *s);
+/* After MECHRT_ESING: the original row and column (coordinate) of the
+   failing pivot; after MECHRT_ENOTFINITE: the row, column -1; else -1. */
+void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col);
+/* Fresh factorisations (with pivot search) and refactorisations done. */
+void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored);
+
+/* Workspace length, in doubles, of mechrt_host_sparse_step. */
+#define MECHRT_HOST_SPARSE_WORK_LEN(nq) (2u * (size_t)(nq))
+
+/* mechrt_step (runtime/analysis.c) on the sparse Jacobian s of k's
+   mechanism: predictor, Newton with one factorisation per iteration, then
+   velocity and acceleration from one factorisation at the converged q.
+   Same statuses and report; report->sing_index is the failing pivot's
+   column (its row: mechrt_host_sparse_singular). */
+MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k,
+                                     const MechrtOptions *opts, double *q, double *qd,
+                                     double *qdd, double t, double h, double *work, size_t lwork,
+                                     MechrtReport *report);
 
 /* ---- Output (output.c) ---------------------------------------------------- */
 

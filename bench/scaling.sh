@@ -1,0 +1,119 @@
+#!/bin/sh
+# bench/scaling.sh MECHC - how `mechc run` grows with the mechanism: chains
+# of N four-bar loops (examples/chain.sh N, 6N + 3 coordinates), run with
+# the dense LU and with the sparse one (KLU), then the issue-15 target run.
+#
+#   sh bench/scaling.sh build/mechc                    (part of `make bench`)
+#   SIZES="10 100 1000 3000" STEPS=100 sh bench/scaling.sh build/mechc
+#
+# Per size and linear algebra, one `mechc run --steps STEPS --csv /dev/null
+# --stats` (the dense LU's O(n^3) steps are few at N >= DENSE_FEW_N: their
+# per-step figures are still per step; above DENSE_MAX_N, 1000, the dense
+# matrix alone would take gigabytes and the dense runs are left out):
+#   step ms        wall time of one step, inside run (--stats; output excluded)
+#   step CPU ms    the process's CPU time of one step (--stats)
+#   wall s, CPU s  the whole command: parse, generate, JIT-compile, assemble,
+#                  STEPS steps, CSV formatted to /dev/null (/usr/bin/time)
+#   max RSS MB     peak resident memory (/usr/bin/time -f %M)
+# and the ratio dense / sparse of the step CPU time. Then the target run:
+# N = TARGET_N, `run --steps 1000` (auto: sparse), CSV to a file, whole
+# command wall time and peak memory, and the same with --digits 6 (the
+# shortest round-trip printing of 18 million numbers is most of the time).
+# Without /usr/bin/time the whole-command columns say "-".
+# N = 10 000 needs the dense-Jacobian limit raised past what the generated
+# code's int indices allow (60 003^2 entries): not runnable yet.
+# POSIX sh and awk only.
+set -u
+mechc=${1:-build/mechc}
+sizes=${SIZES:-"10 100 1000"}
+steps=${STEPS:-100}
+dense_few_n=${DENSE_FEW_N:-1000}
+dense_few_steps=${DENSE_FEW_STEPS:-2}
+dense_max_n=${DENSE_MAX_N:-1000}
+target_n=${TARGET_N:-1000}
+if [ ! -x "$mechc" ]; then
+    echo "usage: sh bench/scaling.sh MECHC   ('$mechc' is not an executable; run make first)" >&2
+    exit 2
+fi
+here=$(dirname "$0")
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_scaling.XXXXXX") || exit 2
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 2' INT TERM
+timer=
+[ -x /usr/bin/time ] && timer=/usr/bin/time
+
+# timed OUT ARGS...: mechc run ARGS, stderr to OUT.err; "wall cpu maxrss_kb" in OUT.time.
+timed() {
+    out=$1
+    shift
+    if [ -n "$timer" ]; then
+        $timer -f "%e %U %S %M" -o "$out.t" "$mechc" run "$@" > /dev/null 2> "$out.err"
+        tail -1 "$out.t" > "$out.time"     # after "Command exited with ..." on failure
+    else
+        "$mechc" run "$@" > /dev/null 2> "$out.err"
+        echo "- - - -" > "$out.time"
+    fi
+}
+
+# stat FILE WHAT: the ns per step of a --stats line ("analysis" or "CPU").
+stat() {
+    case $2 in
+        analysis) sed -n 's/.*of analysis: \([0-9.]*\) ns per step.*/\1/p' "$1" ;;
+        CPU) sed -n 's/.*of CPU time in the steps: \([0-9.]*\) ns per step.*/\1/p' "$1" ;;
+    esac
+}
+
+echo "mechc run on chains of N four-bar loops (examples/chain.sh N), dense LU against KLU"
+printf '%6s %6s %-6s %5s %10s %12s %8s %8s %10s\n' \
+    N nq linear steps "step ms" "step CPU ms" "wall s" "CPU s" "max RSS MB"
+for n in $sizes; do
+    sh "$here/../examples/chain.sh" "$n" "$tmp/chain.mech" || exit 2
+    nq=$((6 * n + 3))
+    # 60 003^2 > INT_MAX: the generated dense Jacobian's limit (other work)
+    limit=$((nq * nq < 2000000000 ? nq * nq : 2000000000))
+    for lin in dense sparse; do
+        s=$steps
+        [ "$lin" = dense ] && [ "$n" -ge "$dense_few_n" ] && s=$dense_few_steps
+        if [ "$lin" = dense ] && [ "$n" -gt "$dense_max_n" ]; then
+            printf '%6s %6s %-6s %5s skipped (nq^2 doubles: %s MB)\n' "$n" "$nq" "$lin" - \
+                $((nq * nq / 131072))
+            continue
+        fi
+        timed "$tmp/r" "$tmp/chain.mech" --steps "$s" --linear "$lin" --csv /dev/null \
+            --stats --max-jac-entries "$limit"
+        a=$(stat "$tmp/r.err" analysis)
+        c=$(stat "$tmp/r.err" CPU)
+        if [ -z "$a" ]; then
+            printf '%6s %6s %-6s %5s failed: %s\n' "$n" "$nq" "$lin" "$s" "$(head -1 "$tmp/r.err")"
+            continue
+        fi
+        eval "cpu_$lin=$c"
+        read -r wall user sys rss < "$tmp/r.time"
+        awk -v n="$n" -v nq="$nq" -v l="$lin" -v s="$s" -v a="$a" -v c="$c" -v w="$wall" \
+            -v u="$user" -v y="$sys" -v r="$rss" 'BEGIN {
+            cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
+            mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
+            printf "%6d %6d %-6s %5d %10.3f %12.3f %8s %8s %10s\n", n, nq, l, s, a / 1e6, c / 1e6, w, cpu, mb }'
+    done
+    awk -v n="$n" -v d="${cpu_dense:-}" -v s="${cpu_sparse:-}" 'BEGIN {
+        if (d != "" && s != "" && s > 0) printf "%6d  dense / sparse step CPU time: %.1f\n", n, d / s }'
+    cpu_dense=
+    cpu_sparse=
+done
+
+echo
+echo "target (issue 15): chain N = $target_n, mechc run --steps 1000 (auto), whole command"
+sh "$here/../examples/chain.sh" "$target_n" "$tmp/target.mech" || exit 2
+for digits in "" 6; do
+    timed "$tmp/t" "$tmp/target.mech" --steps 1000 --csv "$tmp/target.csv" --stats \
+        ${digits:+--digits "$digits"}
+    read -r wall user sys rss < "$tmp/t.time"
+    a=$(stat "$tmp/t.err" analysis)
+    awk -v w="$wall" -v u="$user" -v y="$sys" -v r="$rss" -v a="$a" -v d="$digits" \
+        -v b="$(wc -c < "$tmp/target.csv" 2> /dev/null || echo 0)" 'BEGIN {
+        how = (d == "") ? "shortest round-trip CSV" : "CSV with --digits " d
+        cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
+        mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
+        printf "  %-24s wall %s s, CPU %s s, max RSS %s MB; steps alone %.2f s; CSV %.0f MB\n",
+               how, w, cpu, mb, a * 1000 / 1e9, b / 1e6 }'
+done

@@ -1,0 +1,141 @@
+/* sparse_step.c - one kinematic time step (predictor, Newton, velocity, acceleration) on the sparse Jacobian.
+ *
+ * mechrt_step of runtime/analysis.c with its dense LU replaced by KLU
+ * (sparse_klu.c): the same predictor, the same Newton iteration and
+ * convergence test (one factorisation per iteration: the refactorisation
+ * is cheap, and a chord iteration that kept an old one would change the
+ * iteration counts that run's branch check relies on, so the two paths
+ * step alike), then one factorisation at the converged q for the velocity
+ * and the acceleration, with the same condition screen and estimate. Phi
+ * comes from the phi kernel, the Jacobian's nonzeros from jac_nz, nu and
+ * gamma from theirs: nothing of size nr x nq is ever formed.
+ */
+#include "mechrt_host.h"
+
+#include <math.h>
+
+static void sp_report_init(MechrtReport *r)
+{
+    r->iterations = 0;
+    r->residual = 0;
+    r->step = -1;
+    r->worst_row = -1;
+    r->sing_index = -1;
+    r->cond = 0;
+    r->cond_warning = false;
+    r->factorisations = 0;
+}
+
+/* Phi and the Jacobian's nonzeros at q; the residual norm and worst row
+   into r. NaN or Inf in Phi is an error. */
+static MechrtStatus sp_eval(MechrtHostSparse *s, const MechrtKernels *k, const double *q,
+                            double t, double *phi, MechrtReport *r)
+{
+    k->phi(k->ctx, q, t, phi);
+    mechrt_host_sparse_eval(s, q, t);
+    r->residual = 0;
+    r->worst_row = k->nh > 0 ? 0 : -1;
+    for (int i = 0; i < k->nh; i++) {
+        double a = fabs(phi[i]);
+        if (!isfinite(a)) {
+            r->residual = a;
+            r->worst_row = i;
+            return MECHRT_ENOTFINITE;
+        }
+        if (a > r->residual) {
+            r->residual = a;
+            r->worst_row = i;
+        }
+    }
+    return MECHRT_OK;
+}
+
+/* A factorisation counted in r; a failing pivot's column in sing_index. */
+static MechrtStatus sp_factor(MechrtHostSparse *s, const MechrtOptions *o, MechrtReport *r)
+{
+    int row, col;
+    MechrtStatus st = mechrt_host_sparse_factor(s, o->pivot_tol);
+    r->factorisations++;
+    mechrt_host_sparse_singular(s, &row, &col);
+    r->sing_index = col;
+    return st;
+}
+
+/* Newton on Phi(q, t) = 0 from q (updated in place), stopping as
+   mechrt_newton_run does. */
+static MechrtStatus sp_newton(MechrtHostSparse *s, const MechrtKernels *k, const MechrtOptions *o,
+                              double *q, double t, double *phi, double *dq, MechrtReport *r)
+{
+    int n = k->nq;
+    MechrtStatus st = sp_eval(s, k, q, t, phi, r);
+    if (st != MECHRT_OK)
+        return st;
+    for (;;) {
+        if (r->step >= 0 && r->residual <= o->tol_phi && r->step <= o->tol_dq)
+            return MECHRT_OK;
+        if (r->iterations >= o->max_iter)
+            return MECHRT_EMAXITER;
+        if ((st = sp_factor(s, o, r)) != MECHRT_OK)
+            return st;
+        for (int i = 0; i < n; i++)
+            dq[i] = -phi[i];
+        if (mechrt_host_sparse_solve(s, dq) != MECHRT_OK)
+            return MECHRT_ENOTFINITE;   /* overflow in a nearly singular solve */
+        double step = 0;
+        for (int i = 0; i < n; i++) {
+            q[i] += dq[i];
+            step = fabs(dq[i]) > step ? fabs(dq[i]) : step;
+        }
+        r->step = step;
+        r->iterations++;
+        if ((st = sp_eval(s, k, q, t, phi, r)) != MECHRT_OK)
+            return st;
+    }
+}
+
+/* Factors the Jacobian last evaluated, with the condition estimate of
+   an_factor (runtime/analysis.c): screened by the pivot spread. */
+static MechrtStatus sp_factor_cond(MechrtHostSparse *s, const MechrtOptions *o, MechrtReport *r)
+{
+    MechrtStatus st = sp_factor(s, o, r);
+    if (st != MECHRT_OK || !(o->cond_warn > 0))
+        return st;
+    if (o->cond_screen > 0 && mechrt_host_sparse_spread(s) <= o->cond_screen * o->cond_warn)
+        return MECHRT_OK;
+    r->cond = mechrt_host_sparse_condest(s);
+    r->cond_warning = !(r->cond <= o->cond_warn);   /* NaN warns too */
+    return MECHRT_OK;
+}
+
+MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k,
+                                     const MechrtOptions *opts, double *q, double *qd,
+                                     double *qdd, double t, double h, double *work, size_t lwork,
+                                     MechrtReport *report)
+{
+    MechrtOptions o = opts ? *opts : mechrt_default_options();
+    MechrtReport dummy;
+    MechrtReport *r = report ? report : &dummy;
+    sp_report_init(r);
+    if (!s || !k || !k->phi || !k->nu || !k->gamma || !q || !qd || !qdd || !work || !isfinite(h))
+        return MECHRT_EINVAL;
+    if (k->nh != k->nq || k->nv != 0)
+        return MECHRT_ENOTSQUARE;
+    int n = k->nq;
+    if (lwork < MECHRT_HOST_SPARSE_WORK_LEN(n))
+        return MECHRT_EBADLEN;
+    double *phi = work, *rhs = work + n;
+    if (h != 0)
+        for (int i = 0; i < n; i++)
+            q[i] += h * qd[i] + 0.5 * h * h * qdd[i];
+    double tn = t + h;
+    MechrtStatus st = sp_newton(s, k, &o, q, tn, phi, rhs, r);
+    if (st != MECHRT_OK)
+        return st;
+    if ((st = sp_factor_cond(s, &o, r)) != MECHRT_OK)
+        return st;
+    k->nu(k->ctx, q, tn, qd);
+    if ((st = mechrt_host_sparse_solve(s, qd)) != MECHRT_OK)
+        return st;
+    k->gamma(k->ctx, q, qd, tn, qdd);   /* gamma needs the velocities just found */
+    return mechrt_host_sparse_solve(s, qdd);
+}
