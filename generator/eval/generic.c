@@ -275,6 +275,14 @@ Generic *generic_open(const Model *m)
     return g;
 }
 
+int generic_interpreted_rows(const Generic *g)
+{
+    int n = 0;
+    for (int i = 0; i < g->nplans; i++)
+        n += g->plans[i].rows == NULL;
+    return n;
+}
+
 void generic_free(Generic *g)
 {
     if (!g)
