@@ -4,8 +4,8 @@
  * keep their attachments and axis for the formulas of generic_joints.c
  * (planar) and generic_spatial.c (spatial, with the local frame of each
  * side's axis); `constraint`, `driver` and `velocity` rows (one plan per
- * row: the model's row expression; in a spatial file also the branch-free
- * angle(R) driver) and non-constant options (length, angle, radius) are
+ * row: the model's row expression; in a spatial file `driver D:
+ * angle(R) = E` and `slide(T) = E` have formulas over R's and T's frames) and non-constant options (length, angle, radius) are
  * compiled to instruction lists (interp.h).
  * A call computes cos and sin of every body angle, and A(p) of every
  * spatial body, the formulas need once, then runs each plan, which writes
@@ -195,15 +195,15 @@ static void interpret_rows(Generic *g, Plan *p, CompileScratch *cs)
    builder's, joints_spatial_frame); a kind without an axis has none. */
 static void spatial_frame(Generic *g, Plan *p, int joint)
 {
-    const Joint *j = p->j;
+    const Joint *j = p->of;
     double (*fr)[3] = g->frames + 6 * joint;
     if (j->ux != 0.0 || j->uy != 0.0 || j->uz != 0.0)
         joints_spatial_frame(j->ux, j->uy, j->uz, fr[0], fr[1], fr[2]);
     if (j->bx != 0.0 || j->by != 0.0 || j->bz != 0.0)
         joints_spatial_frame(j->bx, j->by, j->bz, fr[3], fr[4], fr[5]);
     p->frame = (const double (*)[3])fr;
-    if (j->kind == JOINT_S_CONTACT && !p->opt.constant)
-        g->nu_rots = true;      /* its nu = s R_t needs A */
+    if ((j->kind == JOINT_S_CONTACT || p->j->measures > 0) && !p->opt.constant)
+        g->nu_rots = true;      /* nu = s R_t, (s S + c C) theta_t need A */
 }
 
 /* The spatial bodies whose A(p) the formulas use (need[e0] == NEED_ROT). */
@@ -243,12 +243,17 @@ Generic *generic_open(const Model *m)
         Plan *p = &g->plans[g->nplans++];
         *p = (Plan){.j = j, .row = j->first_row, .velocity = j->velocity, .prog = -1,
                     .opt = {.constant = true, .prog = -1}};
+        p->of = j;
         p->rows = generic_joint_formula(j, need);
+        if (!p->rows && j->kind == JOINT_DRIVER && j->measures != 0) {
+            p->of = &m->joints[abs(j->measures) - 1];
+            p->rows = generic_measure_rows(j, p->of, need);
+        }
         if (!p->rows) {
             interpret_rows(g, p, &cs);
             continue;
         }
-        if (joint_info[j->kind].option != OPTION_NONE
+        if ((joint_info[j->kind].option != OPTION_NONE || j->measures != 0)
             && !dag_is_const(&m->dag, j->option, &p->opt.value)) {
             p->opt.constant = false;
             p->opt.prog = add_tape(g, m, j->option, &cs);

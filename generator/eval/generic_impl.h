@@ -30,7 +30,9 @@ struct Plan {
     int row;            /* its first row (an interpreted row: its row) */
     bool velocity;      /* the joint's rows are velocity level */
     GenericRows *rows;  /* a standard joint's formulas; else NULL and: */
-    const double (*frame)[3];   /* spatial: local h, f, g of side A, then of B */
+    const Joint *of;    /* the joint whose frames and sides the formulas use:
+                           j, or the one a measuring driver measures */
+    const double (*frame)[3];   /* spatial: of's local h, f, g of side A, then of B */
     int prog;           /* constraint, driver, velocity: the row's program; else -1 */
     Option opt;
 };
@@ -50,7 +52,8 @@ struct Generic {
     int *rot_q;         /* each one's x coordinate, */
     int *rot_of;        /* per x coordinate: its index into rots */
     int nrots;
-    bool nu_rots;       /* a nu-only call needs them too (a contact's R(t)) */
+    bool nu_rots;       /* a nu-only call needs them too (a contact's R(t),
+                           an angle driver's theta(t)) */
     double (*frames)[3];    /* 6 per joint (Plan.frame) */
     Jet *jreg;          /* registers for the longest program */
     double *vreg;
@@ -88,6 +91,9 @@ enum { NEED_ROT = 3 };
 
 /* The spatial kinds' formulas (generic_spatial.c), NULL for any other kind. */
 GenericRows *generic_spatial_rows(JointKind kind);
+/* A spatial `driver D: angle(R) = E` or `slide(T) = E` (driver->measures),
+   R or T being of: its formulas, marking of's bodies in need; else NULL. */
+GenericRows *generic_measure_rows(const Joint *driver, const Joint *of, char *need);
 /* A, and with qd Ad and H, of every body in g->rots, for one call. */
 void generic_spatial_rotations(const Call *c);
 

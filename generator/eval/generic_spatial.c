@@ -37,6 +37,8 @@
  */
 #include "generic_impl.h"
 
+#include "../base/sincos.h"
+
 #include <math.h>
 
 /* A vector or point of one side: value, d/dt and d2/dt2 at qdd = 0 (the
@@ -485,6 +487,84 @@ static void rolling_joint(const Call *c, const Plan *p)
         c->gamma[r] = -(w[1] * dK[2] - w[2] * dK[1]);
         c->gamma[r + 1] = -(w[2] * dK[0] - w[0] * dK[2]);
     }
+}
+
+/* driver angle(R) = theta (model.c records R and theta): the builder's
+   branch-free row phi = c S - s C, c = cos theta, s = sin theta,
+   S = gA^T fB, C = fA^T fB (two dot-1 of R's frames):
+   Jacobian c S_q - s C_q - (s S + c C) theta_q;  nu = (s S + c C) theta_t;
+   with w = D theta, gamma = -(D2(c S) - D2(s C)),
+   D2(c S) = c D2S - 2 s w DS - (c w^2 + s D2theta) S,
+   D2(s C) = s D2C + 2 c w DC + (c D2theta - s w^2) C. */
+static void angle_driver(const Call *c, const Plan *p)
+{
+    int r = p->row;
+    const Joint *j = p->of;
+    if (!c->phi && !c->jac && !c->gamma && (!c->nu || p->opt.constant)) {
+        if (c->nu)
+            c->nu[r] = 0.0;
+        return;     /* a nu-only call with theta(t) has A: generic.c's nu_rots */
+    }
+    double theta = option_value(c, &p->opt), sn, cs;
+    mechc_sincos(theta, &sn, &cs);
+    V3 fa = turned(c, &j->a, p->frame[FA]), ga = turned(c, &j->a, p->frame[GA]);
+    V3 fb = turned(c, &j->b, p->frame[FB]);
+    double S = dot3(ga.v, fb.v), C = dot3(fa.v, fb.v), k = sn * S + cs * C;
+    if (c->phi)
+        c->phi[r] = cs * S - sn * C;
+    if (c->jac) {
+        double *row = jac_row(c, r), w[3];
+        jac_turned(c, row, &j->a, p->frame[GA], fb.v, cs);
+        jac_turned(c, row, &j->a, p->frame[FA], fb.v, -sn);
+        for (int i = 0; i < 3; i++)
+            w[i] = cs * ga.v[i] - sn * fa.v[i];
+        jac_turned(c, row, &j->b, p->frame[FB], w, 1.0);
+        option_jac(c, &p->opt, -k, row);
+    }
+    if (c->nu)
+        c->nu[r] = k * option_dt(c, &p->opt);
+    if (c->gamma) {
+        Jet th = option_along(c, &p->opt, 2);
+        double w = th.d;
+        double dS = dot3(ga.d, fb.v) + dot3(ga.v, fb.d), dC = dot3(fa.d, fb.v) + dot3(fa.v, fb.d);
+        double ddS = dot3(ga.dd, fb.v) + 2.0 * dot3(ga.d, fb.d) + dot3(ga.v, fb.dd);
+        double ddC = dot3(fa.dd, fb.v) + 2.0 * dot3(fa.d, fb.d) + dot3(fa.v, fb.dd);
+        double cS = cs * ddS - 2.0 * sn * w * dS - (cs * w * w + sn * th.dd) * S;
+        double sC = sn * ddC + 2.0 * cs * w * dC + (cs * th.dd - sn * w * w) * C;
+        c->gamma[r] = -(cS - sC);
+    }
+}
+
+/* driver slide(T) = E: hA^T (P_B - P_A) - E over T's frame, a dot-2 row;
+   Jacobian - E_q, nu = E_t, gamma + D2E. */
+static void slide_driver(const Call *c, const Plan *p)
+{
+    int r = p->row;
+    const Joint *j = p->of;
+    if (c->nu)
+        c->nu[r] = option_dt(c, &p->opt);
+    if (!c->phi && !c->jac && !c->gamma)
+        return;
+    V3 pa = placed(c, &j->a), pb = placed(c, &j->b);
+    V3 d = minus(&pb, &pa);
+    dot2(c, r, j, p->frame[HA], &d);
+    if (c->phi)
+        c->phi[r] -= option_value(c, &p->opt);
+    if (c->jac)
+        option_jac(c, &p->opt, -1.0, jac_row(c, r));
+    if (c->gamma)
+        c->gamma[r] += option_along(c, &p->opt, 2).dd;
+}
+
+GenericRows *generic_measure_rows(const Joint *driver, const Joint *of, char *need)
+{
+    if (driver->kind != JOINT_DRIVER || driver->velocity || driver->measures == 0)
+        return NULL;
+    if (of->a.has_p)
+        need[of->a.q + 3] = NEED_ROT;
+    if (of->b.has_p)
+        need[of->b.q + 3] = NEED_ROT;
+    return driver->measures > 0 ? angle_driver : slide_driver;
 }
 
 GenericRows *generic_spatial_rows(JointKind kind)

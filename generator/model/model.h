@@ -28,7 +28,10 @@ typedef struct Joint {
     double ux, uy;      /* axis, as written */
     double uz;          /* spatial: A's axis is (ux, uy, uz) in A's frame, */
     double bx, by, bz;  /* and B's (bx, by, bz) in B's (A's vector unless given) */
-    NodeId option;      /* length, angle or radius (angle absent: 0) */
+    NodeId option;      /* length, angle or radius (angle absent: 0); a
+                           measuring driver's right side E (below) */
+    int measures;       /* spatial `driver D: angle(R) = E`: 1 + R's index in
+                           joints; `slide(T) = E`: -(1 + T's); 0 otherwise */
     NodeId expr;        /* expression statements: lhs - rhs */
     bool velocity;      /* its rows are velocity level */
     int first_row, nrows;
