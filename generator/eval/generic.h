@@ -1,9 +1,9 @@
 /* generic.h - the generic evaluator: Phi, Phi_q, nu and gamma from the joint list, without generated code.
  *
  * Standard joints use the textbook body-coordinate formulas (generic_joints.c;
- * spatial joints over Euler parameters: generic_spatial.c);
- * `constraint`, `driver` and `velocity` rows and joint options are
- * interpreted (interp.h). Nothing here uses the symbolic derivatives, so
+ * spatial joints, and spatial angle() and slide() drivers, over Euler
+ * parameters: generic_spatial.c); other `constraint`, `driver` and
+ * `velocity` rows and joint options are interpreted (interp.h). Nothing here uses the symbolic derivatives, so
  * the generic evaluator and the generated code check each other.
  *
  * Everything is allocated by generic_open; the evaluation calls allocate

@@ -33,7 +33,9 @@
  *     spherical  P_A - P_B:  Jacobian [I, B_A] and [-I, -B_B];  gamma = -(H_A s_A - H_B s_B)
  *
  * where a'' and d'' are the qdd-free parts (H s). nu is 0 unless an option
- * (a distance's length, a disk's radius) depends on t.
+ * (a distance's length, a disk's radius, a driver's angle or slide)
+ * depends on t. The norm row, the rolling disk's contact and no-slip rows
+ * and the angle() and slide() drivers have formulas of their own below.
  */
 #include "generic_impl.h"
 
