@@ -3,10 +3,11 @@
  * generic_open turns the model's joint list into plans: standard joints
  * keep their attachments and axis for the formulas of generic_joints.c
  * (planar) and generic_spatial.c (spatial, with the local frame of each
- * side's axis); `constraint`, `driver` and `velocity` rows (one plan per
- * row: the model's row expression; in a spatial file `driver D:
- * angle(R) = E` and `slide(T) = E` have formulas over R's and T's frames) and non-constant options (length, angle, radius) are
- * compiled to instruction lists (interp.h).
+ * side's axis, also for `driver D: angle(R) = E` and `slide(T) = E` over
+ * R's and T's frames); other `constraint`, `driver` and `velocity` rows
+ * (one plan per row: the model's row expression) and non-constant
+ * options (length, angle, radius, a driver's E) are compiled to
+ * instruction lists (interp.h).
  * A call computes cos and sin of every body angle, and A(p) of every
  * spatial body, the formulas need once, then runs each plan, which writes
  * its own rows. For an interpreted row:
