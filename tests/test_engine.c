@@ -199,11 +199,122 @@ static void test_kernels_velocity_rows(void **s)
 }
 
 /* Every spatial kind, the rows of bodies and rolling disks the model adds,
-   and both levels: generic (interpreted spatial rows), jit and aot agree. */
+   and both levels: generic (spatial formulas), jit and aot agree. */
 static void test_kernels_spatial_rows(void **s)
 {
     (void)s;
     check_kernels("all_spatial.mech");
+}
+
+/* Every spatial kind with each side a body, a point or ground, general
+   axes (B's its own where allowed), lengths and radii of t, and angle()
+   and slide() drivers of t, of q and constant: the generic engine's
+   formulas must meet each variant. */
+static const char every_spatial_text[] =
+    "spatial\n"
+    "body a x = 0.1 y = 0.2 z = 0.3 orient = axis(1, 2, 3, 0.7)\n"
+    "body b x = 1 y = 0.5 z = -0.2 orient = xyz(0.3, -0.2, 0.5)\n"
+    "body c x = -0.5 y = 1 z = 0.4 orient = zyx(0.1, 0.4, -0.3)\n"
+    "body d x = 2 y = 0 z = 0.5\n"
+    "point m x = 0.3 y = -0.4 z = 0.8\n"
+    "point n x = 1.3 y = 0.4 z = -0.8\n"
+    "spherical S1: a(0.1, -0.2, 0.3) b(-0.4, 0.2, 0.1)\n"
+    "spherical S2: m ground(1, 2, 3)\n"
+    "spherical S3: ground(0.5, 0, 0) c(0.2, 0.3, -0.1)\n"
+    "universal U: a(0.3, 0.1, -0.2) ground(0.4, 0.4, 0.1) axis(1, 1, 0) axis(0, 1, 2)\n"
+    "revolute R: b(0.2, -0.1, 0.3) c(-0.3, 0.2, 0.1) axis(0.3, -1, 0.2)\n"
+    "revolute R0: ground(0, 0, 1) a(0, 0, 0) axis(1, 0, 0)\n"
+    "cylindrical C: c(0.1, 0.2, 0.3) b(0, 0, 0) axis(1, 2, -0.5) axis(0.2, 0.1, 1)\n"
+    "translational T: a(0.2, 0.1, 0) ground(1, -1, 0.5) axis(-0.4, 0.3, 0.9)\n"
+    "weld W: c(0.3, -0.3, 0.2) b(-0.1, 0.4, 0.2)\n"
+    "weld W0: ground(0.2, 0.3, 0.4) a(0.1, 0, 0)\n"
+    "distance D1: m a(0.1, 0.2, 0.3) length = 1.2 + 0.1*sin(t)\n"
+    "distance D2: b ground(1, 1, 1) length = 2\n"
+    "distance D3: b(0.2, 0.1, -0.3) n length = 0.7*t\n"
+    "pointplane PP: b(0.1, 0.2, 0.3) n axis(0.5, -1, 2)\n"
+    "pointplane PP0: ground(0, 0, 1) c(0.2, 0.1, 0) axis(0, 0, 1)\n"
+    "parallel Pl: a c axis(1, 1, 1) axis(0.2, -1, 0.3)\n"
+    "perpendicular Pp: b a axis(0.1, 0.9, -0.2) axis(1, 0, 0.3)\n"
+    "rolling roll: d radius = 0.5 + 0.1*t + 0.02*sin(2*t) axis(0.1, 1, 0.2)\n"
+    "rolling roll2: c radius = 0.3 axis(0, 0, 1)\n"
+    "driver Da: angle(R) = t\n"
+    "driver Ds: slide(T) = 0.1*t\n"
+    "driver Dc: angle(C) = 0.3*t^2 + sin(t)\n"
+    "driver Dcs: slide(C) = 0.2*cos(t) + 0.1*m.y\n"
+    "driver Dk: angle(R0) = 0.4\n"
+    "driver Dq: angle(R) = t + 0.3*b.z*m.x\n"
+    "velocity V: der(d.e3) + d.e1*der(m.x) = 0.1*t\n";
+
+/* xorshift64*: deterministic numbers in [-1, 1) */
+static double rnd(uint64_t *s)
+{
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return (double)((*s * 2685821657736338717ULL) >> 11) / 4503599627370496.0 - 1.0;
+}
+
+/* generic (hand formulas; interpreted: the rows a `constraint`, `driver`
+   or `velocity` statement writes, except angle() and slide() drivers,
+   `interpreted` of them) against jit at 16 states whose Euler parameters
+   are off the unit sphere, to 1e-12. */
+static void check_spatial(Mech *mech, const char *name, int interpreted)
+{
+    const Model *m = mech->model;
+    assert_true(m->spatial);
+    Engine gen, jit;
+    assert_true(open_kind(&gen, ENGINE_GENERIC, mech));
+    assert_true(open_kind(&jit, ENGINE_JIT, mech));
+    if (generic_interpreted_rows(gen.generic) != interpreted)
+        fail_msg("%s: %d interpreted rows, expected %d", name,
+                 generic_interpreted_rows(gen.generic), interpreted);
+    double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd);
+    Out og, oj;
+    out_alloc(&og, m), out_alloc(&oj, m);
+    uint64_t s = 0x2545f4914f6cdd1dull;
+    char ctx[160];
+    for (int k = 0; k < 16; k++) {
+        for (int i = 0; i < m->nq; i++) {
+            q[i] = m->q0[i] + 0.3 * rnd(&s);
+            qd[i] = 1.5 * rnd(&s);
+        }
+        double t = 0.1 + 0.37 * k;
+        evaluate(&gen.k, q, qd, t, &og);
+        evaluate(&jit.k, q, qd, t, &oj);
+        snprintf(ctx, sizeof ctx, "%s state %d: generic", name, k);
+        assert_outs(ctx, m, &og, &oj, 1e-12);
+    }
+    out_free(&og), out_free(&oj);
+    free(q), free(qd);
+    engine_close(&gen);
+    engine_close(&jit);
+}
+
+static void test_generic_spatial_formulas(void **s)
+{
+    (void)s;
+    static const struct {
+        const char *file;
+        int interpreted;
+    } files[] = {
+        {"all_spatial.mech", 10},   /* Th Cx Cy Cz Up Head, Du Dv Push, Vp */
+        {"rssr.mech", 0},           /* its angle(R1) driver has a formula */
+        {"bricard.mech", 0},
+        {"rolling_disk.mech", 3},   /* three velocity-level drivers */
+        {"slider_crank_spatial.mech", 0},
+    };
+    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
+        Mech *mech = load_example(files[i].file);
+        check_spatial(mech, files[i].file, files[i].interpreted);
+        pipeline_free(mech);
+    }
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load_text(every_spatial_text, "every_spatial.mech", &limits, &diag);
+    if (!mech)
+        fail_msg("every_spatial.mech: %s", diag.message);
+    check_spatial(mech, "every_spatial.mech", 1);     /* V */
+    pipeline_free(mech);
 }
 
 /* A copy of k, taken before the Engine is moved and the old place
@@ -280,6 +391,7 @@ int main(void)
         cmocka_unit_test(test_kernels_position_rows),
         cmocka_unit_test(test_kernels_velocity_rows),
         cmocka_unit_test(test_kernels_spatial_rows),
+        cmocka_unit_test(test_generic_spatial_formulas),
         cmocka_unit_test(test_kernels_survive_a_moved_engine),
         cmocka_unit_test(test_runtime_assembles_through_k),
     };

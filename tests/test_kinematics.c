@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { MAXQ = 24, MAXR = 24 };
+enum { MAXQ = 24, MAXR = 26 };
 
 #define RTOL 1e-12
 #define ATOL 1e-13
@@ -732,6 +732,120 @@ static void test_circle_345(void **state)
     unload(L);
 }
 
+/* ---- spatial rows ---- */
+
+/* Three bodies and a point (24 coordinates), every block: spherical and
+   dot-1 (revolute R, universal U, perpendicular Pp), dot-2 (cylindrical
+   C, translational T, pointplane PP), distance D and the bodies' .norm
+   (24 rows). */
+static const char spatial_text[] =
+    "spatial\n"
+    "body a x = 0.1 y = 0.2 z = 0.3\n"
+    "body b x = 1 y = 0.5 z = -0.2\n"
+    "body c x = -0.5 y = 1 z = 0.4\n"
+    "point m x = 0.3 y = -0.4 z = 0.8\n"
+    "revolute R: ground(0.1, 0.2, 0.3) a(0.2, -0.1, 0.3) axis(0.3, -1, 0.2)\n"
+    "cylindrical C: a(0.1, 0.2, 0.3) b(-0.2, 0.1, 0) axis(1, 2, -0.5) axis(0.2, 0.1, 1)\n"
+    "universal U: b(0.3, 0.1, -0.2) c(0.1, 0.4, 0.1) axis(1, 1, 0) axis(0, 1, 2)\n"
+    "distance D: m c(0.1, 0.2, 0.3) length = 1.2\n"
+    "pointplane PP: c(0.1, 0.2, 0.3) m axis(0.5, -1, 2)\n"
+    "perpendicular Pp: a c axis(0.1, 0.9, -0.2) axis(1, 0, 0.3)\n"
+    "translational T: b(0.2, 0.1, 0) ground(1, -1, 0.5) axis(-0.4, 0.3, 0.9)\n";
+
+/* A(p) s = (2 e0^2 - 1) s + 2 e (e.s) + 2 e0 e x s, at any p */
+static void rot_p(const double *p, const double s[3], double out[3])
+{
+    const double *e = p + 1;
+    double es = e[0] * s[0] + e[1] * s[1] + e[2] * s[2];
+    double exs[3] = {e[1] * s[2] - e[2] * s[1], e[2] * s[0] - e[0] * s[2], e[0] * s[1] - e[1] * s[0]};
+    for (int i = 0; i < 3; i++)
+        out[i] = (2 * p[0] * p[0] - 1) * s[i] + 2 * e[i] * es + 2 * p[0] * exs[i];
+}
+
+/* P = r + A(p) s of the body whose x is q[k] */
+static void point_p(const double *q, int k, const double s[3], double out[3])
+{
+    rot_p(q + k + 3, s, out);
+    for (int i = 0; i < 3; i++)
+        out[i] += q[k + i];
+}
+
+/* Along a line q + h u every one of these rows is a polynomial of degree
+   at most 4 in h (A(p) s is quadratic in p, each row at most a product
+   of two such), and the five-point stencils are exact for those:
+     f'(0)  = (f(-2h) - 8 f(-h) + 8 f(h) - f(2h)) / 12h,
+     f''(0) = (-f(-2h) + 16 f(-h) - 30 f(0) + 16 f(h) - f(2h)) / 12h^2.
+   So the Jacobian (u = a unit vector) and gamma = -f''(0) along u = qd
+   (the rows have no t) come out of Phi alone, to round-off, with no
+   formula: neither the symbolic one nor a hand one. */
+static void stencil(const Loaded *L, const double *q, const double *u, double h, double d1[], double d2[])
+{
+    double f[5][MAXR], x[MAXQ];
+    for (int k = 0; k < 5; k++) {
+        for (int i = 0; i < L->nq; i++)
+            x[i] = q[i] + (k - 2) * h * u[i];
+        L->k->phi(x, 0.0, f[k]);
+    }
+    for (int r = 0; r < L->nh; r++) {
+        d1[r] = (f[0][r] - 8 * f[1][r] + 8 * f[3][r] - f[4][r]) / (12 * h);
+        d2[r] = (-f[0][r] + 16 * f[1][r] - 30 * f[2][r] + 16 * f[3][r] - f[4][r]) / (12 * h * h);
+    }
+}
+
+static void test_spatial_rows(void **state)
+{
+    (void)state;
+    Loaded *L = load(spatial_text);
+    const Model *m = L->mech->model;
+    assert_int_equal(L->nq, 24);
+    assert_int_equal(L->nh, 24);
+    Eval e;
+    evaluate(L, Q, QD, T, &e);
+    /* Phi by hand (A, C = 0, 7, 14 and m = 21): R.x .. R.z = P_ground - P_a,
+       D = |P_c - m|^2 - 1.2^2, PP = h_c . (m - P_c), the norms */
+    static const double sa[3] = {0.2, -0.1, 0.3}, sc[3] = {0.1, 0.2, 0.3}, g[3] = {0.1, 0.2, 0.3};
+    double pa[3], pc[3], d[3], hc[3];
+    point_p(Q, 0, sa, pa);
+    point_p(Q, 14, sc, pc);
+    double n = sqrt(0.25 + 1 + 4), u[3] = {0.5 / n, -1 / n, 2 / n};
+    rot_p(Q + 17, u, hc);
+    for (int i = 0; i < 3; i++)
+        d[i] = Q[21 + i] - pc[i];
+    int row = 0;
+    for (int r = 0; r < m->nr; r++)
+        if (strcmp(m->rows[r].name, "R.x") == 0)
+            row = r;
+    for (int i = 0; i < 3; i++)
+        assert_near(e.phi[row + i], g[i] - pa[i], RTOL, ATOL);
+    for (int r = 0; r < m->nr; r++) {
+        const char *name = m->rows[r].name;
+        if (strcmp(name, "D") == 0)
+            assert_near(e.phi[r], d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - 1.44, RTOL, ATOL);
+        if (strcmp(name, "PP") == 0)
+            assert_near(e.phi[r], hc[0] * d[0] + hc[1] * d[1] + hc[2] * d[2], RTOL, ATOL);
+        if (strcmp(name, "b.norm") == 0)
+            assert_near(e.phi[r], Q[10] * Q[10] + Q[11] * Q[11] + Q[12] * Q[12] + Q[13] * Q[13] - 1, RTOL, ATOL);
+        assert_near(e.nu[r], 0.0, 0, 0);
+    }
+    /* the Jacobian column by column and gamma along qd, from Phi alone */
+    double d1[MAXR], d2[MAXR], unit[MAXQ] = {0};
+    for (int c = 0; c < L->nq; c++) {
+        unit[c] = 1.0;
+        stencil(L, Q, unit, 0.5, d1, d2);
+        unit[c] = 0.0;
+        for (int r = 0; r < L->nh; r++)
+            if (!(fabs(e.jac[r * L->nq + c] - d1[r]) <= 1e-12 * (1 + fabs(d1[r]))))
+                fail_msg("%s: jac[%s] = %.17g, the stencil gives %.17g", m->rows[r].name,
+                         m->coord_names[c], e.jac[r * L->nq + c], d1[r]);
+    }
+    stencil(L, Q, QD, 0.5, d1, d2);
+    for (int r = 0; r < L->nh; r++)
+        if (!(fabs(e.gamma[r] + d2[r]) <= 1e-11 * (1 + fabs(d2[r]))))
+            fail_msg("%s: gamma = %.17g, the stencil gives %.17g", m->rows[r].name, e.gamma[r], -d2[r]);
+    check_consistency(L, Q, QD, T);
+    unload(L);
+}
+
 /* ---- rows: order, names, kinds ---- */
 
 static void test_row_order_and_names(void **state)
@@ -792,7 +906,7 @@ static void test_examples_consistency(void **state)
     static const char *const files[] = {
         "four_bar", "slider_crank", "five_bar", "elliptical_trammel", "all_statements",
         "knife_cart", "rolling_wheel", "skate_velocity", "parallelogram_redundant",
-        "slider_crank_spatial",
+        "slider_crank_spatial", "rssr", "rolling_disk",
     };
     for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
         char path[256];
@@ -881,6 +995,7 @@ int main(void)
         cmocka_unit_test(test_pendulum_constraint),
         cmocka_unit_test(test_point_on_line),
         cmocka_unit_test(test_circle_345),
+        cmocka_unit_test(test_spatial_rows),
         cmocka_unit_test(test_row_order_and_names),
         cmocka_unit_test(test_examples_consistency),
         cmocka_unit_test(test_sparse_pattern),

@@ -1,14 +1,16 @@
 /* generic.c - the generic evaluator's state, its interpreted rows and options, and its entry points.
  *
  * generic_open turns the model's joint list into plans: standard joints
- * keep their attachments and axis for the formulas of generic_joints.c;
- * `constraint`, `driver` and `velocity` rows, and for now every row of
- * the spatial kinds (one plan per row: the model's row expression), and
- * non-constant options (length, angle, radius) are compiled to
+ * keep their attachments and axis for the formulas of generic_joints.c
+ * (planar) and generic_spatial.c (spatial, with the local frame of each
+ * side's axis, also for `driver D: angle(R) = E` and `slide(T) = E` over
+ * R's and T's frames); other `constraint`, `driver` and `velocity` rows
+ * (one plan per row: the model's row expression) and non-constant
+ * options (length, angle, radius, a driver's E) are compiled to
  * instruction lists (interp.h).
- * A call computes cos and sin of every body angle the formulas need
- * once, then runs each plan, which writes its own rows. For an
- * interpreted row:
+ * A call computes cos and sin of every body angle, and A(p) of every
+ * spatial body, the formulas need once, then runs each plan, which writes
+ * its own rows. For an interpreted row:
  *
  *   position row Phi:   Jacobian dPhi/dq_j by one dual pass per column in
  *                       the row's support; nu = -dPhi/dt (dual in t);
@@ -123,6 +125,8 @@ static void run(Call *c)
            code generation, not sin and cos */
         mechc_sincos(c->q[i], &g->sinq[i], &g->cosq[i]);
     }
+    if (g->nrots && (c->phi || c->jac || c->gamma || c->psi || g->nu_rots))
+        generic_spatial_rotations(c);
     if (c->jac)
         memset(c->jac, 0, (size_t)g->nr * (size_t)g->nq * sizeof *c->jac);
     for (int i = 0; i < g->nplans; i++) {
@@ -188,6 +192,34 @@ static void interpret_rows(Generic *g, Plan *p, CompileScratch *cs)
     }
 }
 
+/* A spatial plan's local frames: h, f, g of A's axis and of B's (the
+   builder's, joints_spatial_frame); a kind without an axis has none. */
+static void spatial_frame(Generic *g, Plan *p, int joint)
+{
+    const Joint *j = p->of;
+    double (*fr)[3] = g->frames + 6 * joint;
+    if (j->ux != 0.0 || j->uy != 0.0 || j->uz != 0.0)
+        joints_spatial_frame(j->ux, j->uy, j->uz, fr[0], fr[1], fr[2]);
+    if (j->bx != 0.0 || j->by != 0.0 || j->bz != 0.0)
+        joints_spatial_frame(j->bx, j->by, j->bz, fr[3], fr[4], fr[5]);
+    p->frame = (const double (*)[3])fr;
+    if ((j->kind == JOINT_S_CONTACT || p->j->measures > 0) && !p->opt.constant)
+        g->nu_rots = true;      /* nu = s R_t, (s S + c C) theta_t need A */
+}
+
+/* The spatial bodies whose A(p) the formulas use (need[e0] == NEED_ROT). */
+static void collect_rotations(Generic *g, const char *need)
+{
+    g->rots = xcalloc((size_t)g->nq + 1, sizeof *g->rots);
+    g->rot_q = xcalloc((size_t)g->nq + 1, sizeof *g->rot_q);
+    g->rot_of = xcalloc((size_t)g->nq + 1, sizeof *g->rot_of);
+    for (int k = 3; k < g->nq; k++)
+        if (need[k] == NEED_ROT) {
+            g->rot_of[k - 3] = g->nrots;
+            g->rot_q[g->nrots++] = k - 3;
+        }
+}
+
 Generic *generic_open(const Model *m)
 {
     Generic *g = xcalloc(1, sizeof *g);
@@ -203,6 +235,7 @@ Generic *generic_open(const Model *m)
     g->cosq = xcalloc((size_t)m->nq, sizeof *g->cosq);
     g->sinq = xcalloc((size_t)m->nq, sizeof *g->sinq);
     g->angles = xcalloc((size_t)m->nq, sizeof *g->angles);
+    g->frames = xcalloc((size_t)m->njoints * 6 + 1, sizeof *g->frames);
     char *need = xcalloc((size_t)m->nq, sizeof *need);
     CompileScratch cs;
     compile_scratch_init(&cs, &m->dag);
@@ -211,18 +244,26 @@ Generic *generic_open(const Model *m)
         Plan *p = &g->plans[g->nplans++];
         *p = (Plan){.j = j, .row = j->first_row, .velocity = j->velocity, .prog = -1,
                     .opt = {.constant = true, .prog = -1}};
+        p->of = j;
         p->rows = generic_joint_formula(j, need);
+        if (!p->rows && j->kind == JOINT_DRIVER && j->measures != 0) {
+            p->of = &m->joints[abs(j->measures) - 1];
+            p->rows = generic_measure_rows(j, p->of, need);
+        }
         if (!p->rows) {
             interpret_rows(g, p, &cs);
             continue;
         }
-        if (joint_info[j->kind].option != OPTION_NONE
+        if ((joint_info[j->kind].option != OPTION_NONE || j->measures != 0)
             && !dag_is_const(&m->dag, j->option, &p->opt.value)) {
             p->opt.constant = false;
             p->opt.prog = add_tape(g, m, j->option, &cs);
         }
+        if (m->spatial)
+            spatial_frame(g, p, i);
     }
     compile_scratch_free(&cs);
+    collect_rotations(g, need);
     for (int level = 2; level >= 1; level--) {
         for (int k = 0; k < m->nq; k++)
             if (need[k] == level)
@@ -240,6 +281,14 @@ Generic *generic_open(const Model *m)
     return g;
 }
 
+int generic_interpreted_rows(const Generic *g)
+{
+    int n = 0;
+    for (int i = 0; i < g->nplans; i++)
+        n += g->plans[i].rows == NULL;
+    return n;
+}
+
 void generic_free(Generic *g)
 {
     if (!g)
@@ -251,6 +300,10 @@ void generic_free(Generic *g)
     free(g->cosq);
     free(g->sinq);
     free(g->angles);
+    free(g->frames);
+    free(g->rots);
+    free(g->rot_q);
+    free(g->rot_of);
     free(g->jreg);
     free(g->vreg);
     free(g);

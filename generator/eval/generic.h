@@ -1,8 +1,9 @@
 /* generic.h - the generic evaluator: Phi, Phi_q, nu and gamma from the joint list, without generated code.
  *
- * Standard joints use the textbook body-coordinate formulas (generic_joints.c);
- * `constraint`, `driver` and `velocity` rows and joint options are
- * interpreted (interp.h). Nothing here uses the symbolic derivatives, so
+ * Standard joints use the textbook body-coordinate formulas (generic_joints.c;
+ * spatial joints, and spatial angle() and slide() drivers, over Euler
+ * parameters: generic_spatial.c); other `constraint`, `driver` and
+ * `velocity` rows and joint options are interpreted (interp.h). Nothing here uses the symbolic derivatives, so
  * the generic evaluator and the generated code check each other.
  *
  * Everything is allocated by generic_open; the evaluation calls allocate
@@ -31,5 +32,9 @@ void generic_all(Generic *g, const double *q, const double *qd, double t,
 /* Psi(q, qd, t) of the velocity-level rows (nv values): what the rows say
    before they are split into Jacobian and nu; for finite differences. */
 void generic_psi(Generic *g, const double *q, const double *qd, double t, double *psi);
+
+/* How many rows the interpreter runs (constraint, driver and velocity
+   rows); every other row is a joint's formula. */
+int generic_interpreted_rows(const Generic *g);
 
 #endif

@@ -13,6 +13,12 @@ typedef struct Option {
 } Option;
 
 typedef struct Call Call;
+
+/* A spatial body's rotation at the current state: A(p), and when qd is
+   given dA/dt and H, the part of d2A/dt2 without p'' (generic_spatial.c). */
+typedef struct Rot {
+    double a[9], ad[9], h[9];   /* row-major */
+} Rot;
 typedef struct Plan Plan;
 
 /* A standard joint's rows by its formulas (generic_joints.c). */
@@ -24,6 +30,9 @@ struct Plan {
     int row;            /* its first row (an interpreted row: its row) */
     bool velocity;      /* the joint's rows are velocity level */
     GenericRows *rows;  /* a standard joint's formulas; else NULL and: */
+    const Joint *of;    /* the joint whose frames and sides the formulas use:
+                           j, or the one a measuring driver measures */
+    const double (*frame)[3];   /* spatial: of's local h, f, g of side A, then of B */
     int prog;           /* constraint, driver, velocity: the row's program; else -1 */
     Option opt;
 };
@@ -39,6 +48,13 @@ struct Generic {
     int nangles;        /* all of them, */
     int nangles_pos;    /* of which the first nangles_pos serve position-level joints */
     double *cosq, *sinq;    /* per coordinate; valid for angles[] during a call */
+    Rot *rots;          /* the spatial bodies the formulas turn, this call: */
+    int *rot_q;         /* each one's x coordinate, */
+    int *rot_of;        /* per x coordinate: its index into rots */
+    int nrots;
+    bool nu_rots;       /* a nu-only call needs them too (a contact's R(t),
+                           an angle driver's theta(t)) */
+    double (*frames)[3];    /* 6 per joint (Plan.frame) */
     Jet *jreg;          /* registers for the longest program */
     double *vreg;
 };
@@ -70,5 +86,15 @@ void option_jac(const Call *c, const Option *o, double coef, double *row);
    coordinate) for each angle q[k] whose A(phi) they rotate: to 2 for a
    position-level joint, to 1 for a velocity-level one. */
 GenericRows *generic_joint_formula(const Joint *j, char *need);
+/* need[k] of a spatial body's e0 (q + 3) when the formulas turn by its A(p). */
+enum { NEED_ROT = 3 };
+
+/* The spatial kinds' formulas (generic_spatial.c), NULL for any other kind. */
+GenericRows *generic_spatial_rows(JointKind kind);
+/* A spatial `driver D: angle(R) = E` or `slide(T) = E` (driver->measures),
+   R or T being of: its formulas, marking of's bodies in need; else NULL. */
+GenericRows *generic_measure_rows(const Joint *driver, const Joint *of, char *need);
+/* A, and with qd Ad and H, of every body in g->rots, for one call. */
+void generic_spatial_rotations(const Call *c);
 
 #endif

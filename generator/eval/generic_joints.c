@@ -275,6 +275,7 @@ enum {
     TURN_SA = 1,        /* A's offset: P_A = r_A + A(phi_A) s_A */
     TURN_SB = 2,        /* B's offset */
     TURN_AXIS = 4,      /* A's axis: n_A = A(phi_A) (-uy, ux) */
+    TURN_P = 8,         /* spatial: both sides' A(p) */
 };
 
 typedef struct Formula {
@@ -297,10 +298,10 @@ static Formula formula_of(JointKind kind)
     case JOINT_DRIVER:
     case JOINT_VELOCITY:
         break;
-    /* Spatial kinds: interpreted from the model's rows for now (generic.c
-       makes one plan per row). Step 2 of issue 14 puts their hand-derived
-       formulas (Haug ch. 9, Nikravesh ch. 7: dot-1, dot-2, spherical over
-       Euler parameters) here, one case per kind. */
+    /* Spatial kinds (generic_spatial.c): dot-1, dot-2 and spherical over
+       Euler parameters; the body row .norm turns nothing. */
+    case JOINT_S_NORM:
+        return (Formula){generic_spatial_rows(kind), 0};
     case JOINT_S_SPHERICAL:
     case JOINT_S_UNIVERSAL:
     case JOINT_S_REVOLUTE:
@@ -312,8 +313,8 @@ static Formula formula_of(JointKind kind)
     case JOINT_S_PARALLEL:
     case JOINT_S_PERPENDICULAR:
     case JOINT_S_ROLLING:
-    case JOINT_S_NORM:
     case JOINT_S_CONTACT:
+        return (Formula){generic_spatial_rows(kind), TURN_P};
     case JOINT_KIND_COUNT:
         break;
     }
@@ -334,7 +335,12 @@ static void need_angle(char *need, const Attach *at, bool axis, bool offset, boo
 GenericRows *generic_joint_formula(const Joint *j, char *need)
 {
     Formula f = formula_of(j->kind);
-    if (f.rows) {
+    if (f.rows && (f.turns & TURN_P)) {
+        if (j->a.has_p)
+            need[j->a.q + 3] = NEED_ROT;
+        if (j->b.has_p)
+            need[j->b.q + 3] = NEED_ROT;
+    } else if (f.rows) {
         need_angle(need, &j->a, f.turns & TURN_AXIS, f.turns & TURN_SA, j->velocity);
         need_angle(need, &j->b, false, f.turns & TURN_SB, j->velocity);
     }

@@ -149,7 +149,7 @@ static Vec3 difference3(Dag *d, Attach p, Attach q)
 }
 
 /* The unit axis h and its perpendiculars f, g (see the header), local. */
-static void local_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3])
+void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3])
 {
     double n = sqrt(ux * ux + uy * uy + uz * uz);
     h[0] = ux / n, h[1] = uy / n, h[2] = uz / n;
@@ -175,9 +175,9 @@ static Frame3 frame3(Dag *d, const Joint *j, bool b)
 {
     double h[3], f[3], g[3];
     if (b)
-        local_frame(j->bx, j->by, j->bz, h, f, g);
+        joints_spatial_frame(j->bx, j->by, j->bz, h, f, g);
     else
-        local_frame(j->ux, j->uy, j->uz, h, f, g);
+        joints_spatial_frame(j->ux, j->uy, j->uz, h, f, g);
     Attach at = b ? j->b : j->a;
     Frame3 fr;
     fr.h = rotate3(d, at, h);

@@ -535,7 +535,7 @@ static void lower_joint(Builder *b, Joint *j)
 /* lhs - rhs of a constraint, driver or velocity statement; in a spatial
    file, driver D: angle(R) = theta is the branch-free row of
    joints_spatial_angle_row. */
-static NodeId statement_row(Builder *b, const Stmt *s, ExprContext ctx)
+static NodeId statement_row(Builder *b, const Stmt *s, ExprContext ctx, Joint *j)
 {
     Model *m = b->model;
     if (b->spatial && s->joint == JOINT_DRIVER && s->lhs->kind == AST_ANGLE && ctx != EXPR_VELOCITY) {
@@ -544,10 +544,13 @@ static NodeId statement_row(Builder *b, const Stmt *s, ExprContext ctx)
         const Joint *r = e->kind == ENT_JOINT ? &m->joints[e->q] : NULL;
         NodeId row = joints_spatial_angle_row(m, spatial_joint_of(b, s->lhs, e, r), theta);
         check_nodes(b);
+        j->measures = e->q + 1, j->option = theta;  /* for the generic evaluator's formula */
         return row;
     }
     NodeId rhs = lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
     NodeId lhs = lower(b, s->lhs, ctx);
+    if (b->spatial && s->joint == JOINT_DRIVER && s->lhs->kind == AST_SLIDE && ctx != EXPR_VELOCITY)
+        j->measures = -(lookup(b, s->lhs->name, s->lhs->member_pos)->q + 1), j->option = rhs;
     return dag_sub(&m->dag, lhs, rhs);
 }
 
@@ -593,7 +596,7 @@ static void build_joint(Builder *b, const Stmt *s)
         if (s->joint == JOINT_VELOCITY && !mentions_der(s->lhs) && !mentions_der(s->rhs))
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
-        j->expr = statement_row(b, s, j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC);
+        j->expr = statement_row(b, s, j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC, j);
     }
     lower_joint(b, j);
     if (s->joint == JOINT_S_ROLLING)

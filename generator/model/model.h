@@ -28,7 +28,10 @@ typedef struct Joint {
     double ux, uy;      /* axis, as written */
     double uz;          /* spatial: A's axis is (ux, uy, uz) in A's frame, */
     double bx, by, bz;  /* and B's (bx, by, bz) in B's (A's vector unless given) */
-    NodeId option;      /* length, angle or radius (angle absent: 0) */
+    NodeId option;      /* length, angle or radius (angle absent: 0); a
+                           measuring driver's right side E (below) */
+    int measures;       /* spatial `driver D: angle(R) = E`: 1 + R's index in
+                           joints; `slide(T) = E`: -(1 + T's); 0 otherwise */
     NodeId expr;        /* expression statements: lhs - rhs */
     bool velocity;      /* its rows are velocity level */
     int first_row, nrows;
@@ -112,6 +115,9 @@ char *model_file_stem(Arena *arena, const char *path);
 void joints_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
 /* The same for the spatial kinds (generator/model/joints_spatial.c). */
 void joints_spatial_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
+/* A spatial axis (ux, uy, uz) made unit, h, and its perpendiculars f and g
+   (the generic evaluator's formulas use the builder's very frame). */
+void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3]);
 /* A spatial attachment's global position P = r + A(p) s: xyz_out[0..2]. */
 void joints_spatial_point(Model *model, Attach at, NodeId xyz_out[3]);
 /* slide(T) of a spatial translational or cylindrical joint: h_A . (P_B - P_A), |h| = 1. */
