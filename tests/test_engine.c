@@ -350,6 +350,35 @@ static void test_kernels_survive_a_moved_engine(void **s)
     pipeline_free(mech);
 }
 
+/* Newton's kernels: the fused `all` where it costs about what phi, jac and
+   nu cost (planar linkages), phi then jac where gamma dominates it (the
+   Stewart platform: all 1400 operations against 1087); the generic engine
+   keeps its own. */
+static void test_newton_kernels(void **s)
+{
+    (void)s;
+    static const struct {
+        const char *file;
+        bool all;
+    } cases[] = {{"slider_crank.mech", true}, {"four_bar.mech", true}, {"stewart.mech", false}};
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        Mech *mech = load_example(cases[i].file);
+        Engine e;
+        assert_true(open_kind(&e, ENGINE_JIT, mech));
+        MechrtKernels k = engine_newton_kernels(&e);
+        assert_true((k.all != NULL) == cases[i].all);
+        assert_ptr_equal(k.phi, e.k.phi);
+        assert_ptr_equal(k.jac, e.k.jac);
+        engine_close(&e);
+        if (open_kind(&e, ENGINE_GENERIC, mech)) {
+            k = engine_newton_kernels(&e);
+            assert_ptr_equal(k.all, e.k.all);
+            engine_close(&e);
+        }
+        pipeline_free(mech);
+    }
+}
+
 /* The runtime takes an engine's k as it is: Newton assembles the four-bar
    through every kind to the same configuration. */
 static void test_runtime_assembles_through_k(void **s)
@@ -394,6 +423,7 @@ int main(void)
         cmocka_unit_test(test_generic_spatial_formulas),
         cmocka_unit_test(test_kernels_survive_a_moved_engine),
         cmocka_unit_test(test_runtime_assembles_through_k),
+        cmocka_unit_test(test_newton_kernels),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

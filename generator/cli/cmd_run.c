@@ -560,7 +560,8 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
     progress_start(&out.progress, "run", 1000);
-    RunStatus rs = run_analysis(m, &k, &c->ro, on_state_keep, &last, &res);
+    MechrtKernels newton = engine_newton_kernels(e);
+    RunStatus rs = run_analysis(m, &newton, &c->ro, on_state_keep, &last, &res);
     progress_finish(&out.progress);
     int status = report(c, m, &out, pics, rs, &res, &k, &jnz, &last);
     status = finish_output(c, out.csv, status);

@@ -164,6 +164,17 @@ bool engine_open(Engine *e, EngineKind kind, const Mech *mech, Diag *diag)
     return engine_open_with(e, kind, mech, NULL, diag);
 }
 
+MechrtKernels engine_newton_kernels(const Engine *e)
+{
+    MechrtKernels k = e->k;
+    const int *ops = e->emitted.ops;
+    bool compiled = e->kind == ENGINE_JIT || e->kind == ENGINE_AOT;
+    if (compiled && k.phi && k.jac
+        && 4L * ops[EMIT_ALL] > 5L * (ops[EMIT_PHI] + ops[EMIT_JAC] + ops[EMIT_NU]))
+        k.all = NULL;
+    return k;
+}
+
 void engine_close(Engine *e)
 {
     jit_free(e->jit);
