@@ -350,10 +350,9 @@ static void test_kernels_survive_a_moved_engine(void **s)
     pipeline_free(mech);
 }
 
-/* Newton's kernels: the fused `all` where it costs about what phi, jac and
-   nu cost (planar linkages), phi then jac where gamma dominates it (the
-   Stewart platform: all 1400 operations against 1087); the generic engine
-   keeps its own. */
+/* Newton's kernels: the fused `all` where gamma is the smaller part of it
+   (planar linkages), phi then jac where gamma outweighs phi and jac (the
+   Stewart platform); the generic engine keeps its own. */
 static void test_newton_kernels(void **s)
 {
     (void)s;

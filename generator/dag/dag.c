@@ -275,6 +275,22 @@ static void order_commutative(const Dag *dag, NodeId *a, NodeId *b)
     }
 }
 
+static bool is_power_of_two(const Dag *dag, NodeId id);
+
+/* c x + sign c y = c (x + sign y) for the same power of two c: exact
+   (scaling by 2^k commutes with rounding), one product instead of two;
+   the Euler-parameter rows' 2 e0 e0' + 2 e1 e1' + ... become 2 (...). */
+static bool factor_power_of_two(Dag *dag, NodeId a, NodeId b, double sign, NodeId *out)
+{
+    const DagNode na = dag->nodes[a], nb = dag->nodes[b];   /* copies: the array may move */
+    if (na.op != OP_MUL || nb.op != OP_MUL || na.a != nb.a || !is_power_of_two(dag, na.a)
+        || dag_is_const(dag, na.b, NULL) || dag_is_const(dag, nb.b, NULL))
+        return false;
+    NodeId inner = sign > 0 ? dag_add(dag, na.b, nb.b) : dag_sub(dag, na.b, nb.b);
+    *out = dag_mul(dag, na.a, inner);
+    return true;
+}
+
 /* a + sign*b when both are multiples of the same term: (ca + sign*cb) term. */
 static bool merge_terms(Dag *dag, NodeId a, NodeId b, double sign, NodeId *out)
 {
@@ -303,7 +319,7 @@ NodeId dag_add(Dag *dag, NodeId a, NodeId b)
         return dag_sub(dag, a, dag->nodes[b].a);
     if (dag->nodes[a].op == OP_NEG)
         return dag_sub(dag, b, dag->nodes[a].a);
-    if (merge_terms(dag, a, b, 1.0, &r))
+    if (merge_terms(dag, a, b, 1.0, &r) || factor_power_of_two(dag, a, b, 1.0, &r))
         return r;
     /* a + (-c) y = a - c y: positive coefficients, so c y is shared with
        the rows that add it. */
@@ -339,7 +355,7 @@ NodeId dag_sub(Dag *dag, NodeId a, NodeId b)
         return dag_add(dag, a, dag->nodes[b].a);
     if (dag->nodes[a].op == OP_NEG)     /* -x - b = -(x + b) */
         return dag_neg(dag, dag_add(dag, dag->nodes[a].a, b));
-    if (merge_terms(dag, a, b, -1.0, &r))
+    if (merge_terms(dag, a, b, -1.0, &r) || factor_power_of_two(dag, a, b, -1.0, &r))
         return r;
     NodeId term;
     double coef = split_coefficient(dag, b, &term);

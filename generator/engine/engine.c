@@ -170,7 +170,7 @@ MechrtKernels engine_newton_kernels(const Engine *e)
     const int *ops = e->emitted.ops;
     bool compiled = e->kind == ENGINE_JIT || e->kind == ENGINE_AOT;
     if (compiled && k.phi && k.jac
-        && 4L * ops[EMIT_ALL] > 5L * (ops[EMIT_PHI] + ops[EMIT_JAC] + ops[EMIT_NU]))
+        && ops[EMIT_GAMMA] >= ops[EMIT_PHI] + ops[EMIT_JAC])
         k.all = NULL;
     return k;
 }

@@ -50,12 +50,11 @@ bool engine_open_with(Engine *engine, EngineKind kind, const Mech *mech,
                       const EngineOptions *options, Diag *diag);
 void engine_close(Engine *engine);
 
-/* The kernels Newton should see: e->k, without the fused `all` when its
-   operations exceed by more than a quarter those of phi, jac and nu
-   together (Newton needs no gamma; a spatial mechanism's gamma dominates
-   `all`: the Stewart platform's step fell by 14 % of its instructions),
-   with it otherwise (a planar linkage's `all` shares the trigonometry and
-   is cheaper than phi then jac). */
+/* The kernels Newton should see: e->k, without the fused `all` when gamma,
+   which Newton does not need, has at least as many operations as phi and
+   jac together (the Stewart platform: 988 against 787; its step fell by
+   14 % of its instructions), with it otherwise (a linkage's `all` shares
+   the trigonometry of phi and jac and is the cheaper call). */
 MechrtKernels engine_newton_kernels(const Engine *engine);
 
 /* Evaluation through e->k (spec section 4's kernels). The generic engine
