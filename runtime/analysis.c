@@ -23,7 +23,7 @@ typedef struct AnWork {
     mechrt_real *jac, *rhs, *piv, *cwork;
 } AnWork;
 
-static void an_report_init(MechrtReport *r)
+void mechrt_report_clear(MechrtReport *r)
 {
     if (!r)
         return;
@@ -164,7 +164,7 @@ MechrtStatus mechrt_velocity(const MechrtKernels *k, const MechrtOptions *opts,
     AnWork w;
     MechrtStatus st;
 
-    an_report_init(report);
+    mechrt_report_clear(report);
     if (!q || !qd_out)
         return MECHRT_EINVAL;
     st = an_prepare(k, &o, q, NULL, t, work, lwork, &w, report);
@@ -182,7 +182,7 @@ MechrtStatus mechrt_acceleration(const MechrtKernels *k, const MechrtOptions *op
     AnWork w;
     MechrtStatus st;
 
-    an_report_init(report);
+    mechrt_report_clear(report);
     if (!q || !qd || !qdd_out)
         return MECHRT_EINVAL;
     st = an_prepare(k, &o, q, qd, t, work, lwork, &w, report);
@@ -201,7 +201,7 @@ MechrtStatus mechrt_velocity_acceleration(const MechrtKernels *k, const MechrtOp
     AnWork w;
     MechrtStatus st;
 
-    an_report_init(report);
+    mechrt_report_clear(report);
     if (!q || !qd_out || !qdd_out)
         return MECHRT_EINVAL;
     st = an_prepare(k, &o, q, NULL, t, work, lwork, &w, report);
@@ -233,7 +233,7 @@ MechrtStatus mechrt_step(const MechrtKernels *k, const MechrtOptions *opts,
     size_t need;
     int i, n;
 
-    an_report_init(report);
+    mechrt_report_clear(report);
     if (!an_kernels_ok(k) || !q || !qd || !qdd || !work || !isfinite(h))
         return MECHRT_EINVAL;
     if (k->nh != k->nq || k->nv != 0)

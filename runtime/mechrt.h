@@ -125,6 +125,7 @@ typedef enum MechrtStatus {
 #define mechrt_acceleration          mechrtf_acceleration
 #define mechrt_velocity_acceleration mechrtf_velocity_acceleration
 #define mechrt_step                  mechrtf_step
+#define mechrt_report_clear          mechrtf_report_clear
 typedef float mechrt_real;
 #else
 typedef double mechrt_real;
@@ -208,6 +209,9 @@ typedef struct MechrtReport {
     int factorisations;    /* LU factorisations the call did (Newton's and the
                               analysis'): mechrt_step's cost in O(n^3) work */
 } MechrtReport;
+
+/* A report with nothing done yet: counts 0, step and rows -1. NULL is ignored. */
+void mechrt_report_clear(MechrtReport *r);
 
 /* Newton state (GSL's multiroot solver, decomposed): init, then iterate and
    test until test returns MECHRT_OK. The caller owns it; its fields are

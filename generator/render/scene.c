@@ -434,7 +434,7 @@ static void draw_prismatic(Scene *sc, const Joint *jt)
     scene_end_shape(sc, s);
 }
 
-static void draw_distance(Scene *sc, const Joint *jt)
+void scene_draw_distance(Scene *sc, const Joint *jt)
 {
     Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "distance");
     scene_add_vtx(sc, scene_vtx_at(jt->a));
@@ -524,7 +524,7 @@ static void build_joints(Scene *sc)
             add_guide(sc, jt, 24 * sc->px);
             break;
         case JOINT_DISTANCE:
-            draw_distance(sc, jt);
+            scene_draw_distance(sc, jt);
             break;
         case JOINT_ROLLING:
             draw_rolling(sc, jt);
@@ -547,7 +547,7 @@ static void build_joints(Scene *sc)
 
 /* ---- over the bodies: pins, dots, arrows, trace dots ---- */
 
-static void add_pin(Scene *sc, Attach a, const char *cls, double r, const char *name)
+void scene_add_pin(Scene *sc, Attach a, const char *cls, double r, const char *name)
 {
     Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, cls);
     scene_add_vtx(sc, scene_vtx_at(a));
@@ -568,13 +568,13 @@ static void draw_pins(Scene *sc, const Joint *jt)
     }
     if (jt->kind == JOINT_DISTANCE) {
         if (jt->a.q >= 0 && jt->a.has_phi)
-            add_pin(sc, jt->a, "pin", 3, jt->name);
+            scene_add_pin(sc, jt->a, "pin", 3, jt->name);
         if (jt->b.q >= 0 && jt->b.has_phi)
-            add_pin(sc, jt->b, "pin", 3, jt->name);
+            scene_add_pin(sc, jt->b, "pin", 3, jt->name);
         return;
     }
     Attach at = jt->a.q < 0 ? jt->a : jt->b.q < 0 ? jt->b : jt->a;
-    add_pin(sc, at, jt->kind == JOINT_WELD ? "weld" : "pin", jt->kind == JOINT_WELD ? 3.5 : 4.5,
+    scene_add_pin(sc, at, jt->kind == JOINT_WELD ? "weld" : "pin", jt->kind == JOINT_WELD ? 3.5 : 4.5,
             jt->name);
 }
 
@@ -591,7 +591,7 @@ static void build_pins(Scene *sc)
             draw_pins(sc, jt);
             break;
         case JOINT_POINTLINE:
-            add_pin(sc, jt->b, "dot", 3.5, jt->name);
+            scene_add_pin(sc, jt->b, "dot", 3.5, jt->name);
             break;
         case JOINT_PRISMATIC:       /* drawn under the bodies */
         case JOINT_ROLLING:

@@ -105,6 +105,10 @@ int scene_add_vtx(Scene *sc, Vtx v);
 Shape *scene_add_shape(Scene *sc, ShapeKind kind, const char *cls);
 void scene_end_shape(Scene *sc, Shape *s);
 void scene_add_ground(Scene *sc, Ground g);
+/* A distance joint: a line between its two attachments. */
+void scene_draw_distance(Scene *sc, const Joint *jt);
+/* A circle of radius r (pixels) at attachment a: a pin, weld or dot. */
+void scene_add_pin(Scene *sc, Attach a, const char *cls, double r, const char *name);
 
 /* The coordinates of frame k. */
 const double *scene_frame_q(const Scene *sc, int k);

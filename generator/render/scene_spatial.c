@@ -318,15 +318,6 @@ static void draw_disk(Scene *sc, const Joint *jt)
     scene_end_shape(sc, s);
 }
 
-static void draw_distance(Scene *sc, const Joint *jt)
-{
-    Shape *s = scene_add_shape(sc, SHAPE_POLYLINE, "distance");
-    scene_add_vtx(sc, scene_vtx_at(jt->a));
-    scene_add_vtx(sc, scene_vtx_at(jt->b));
-    s->name = jt->name;
-    scene_end_shape(sc, s);
-}
-
 /* Everything drawn under the bodies; kinds with no drawing of their own
    take the generic one (default). */
 static void build_joints(Scene *sc)
@@ -339,7 +330,7 @@ static void build_joints(Scene *sc)
             draw_guide(sc, jt);
             break;
         case JOINT_S_DISTANCE:
-            draw_distance(sc, jt);
+            scene_draw_distance(sc, jt);
             break;
         case JOINT_S_ROLLING:
             draw_disk(sc, jt);
@@ -365,15 +356,6 @@ static void build_joints(Scene *sc)
 }
 
 /* ---- over the bodies: pins, dots, revolute axes ---- */
-
-static void add_pin(Scene *sc, Attach a, const char *cls, double r, const char *name)
-{
-    Shape *s = scene_add_shape(sc, SHAPE_CIRCLE, cls);
-    scene_add_vtx(sc, scene_vtx_at(a));
-    s->r = r;
-    s->name = name;
-    scene_end_shape(sc, s);
-}
 
 /* A ground pivot at a ground attachment (it does not move: projected once). */
 static void mark_ground(Scene *sc, Attach a)
@@ -410,7 +392,7 @@ static void draw_pins(Scene *sc, const Joint *jt)
         draw_axis(sc, jt);
     Attach at = jt->a.q < 0 ? jt->a : jt->b.q < 0 ? jt->b : jt->a;
     bool weld = jt->kind == JOINT_S_WELD;
-    add_pin(sc, at, weld ? "weld" : "pin", weld ? 3.5 : 4.5, jt->name);
+    scene_add_pin(sc, at, weld ? "weld" : "pin", weld ? 3.5 : 4.5, jt->name);
 }
 
 static void build_pins(Scene *sc)
@@ -430,13 +412,13 @@ static void build_pins(Scene *sc)
                 if (a.q < 0)
                     mark_ground(sc, a);
                 else if (a.has_p)
-                    add_pin(sc, a, "pin", 3, jt->name);
+                    scene_add_pin(sc, a, "pin", 3, jt->name);
             }
             break;
         case JOINT_S_TRANSLATIONAL:
         case JOINT_S_CYLINDRICAL:
         case JOINT_S_POINTPLANE:
-            add_pin(sc, jt->b, "dot", 3.5, jt->name);
+            scene_add_pin(sc, jt->b, "dot", 3.5, jt->name);
             break;
         case JOINT_S_ROLLING:       /* drawn under the bodies, or nothing */
         case JOINT_S_PARALLEL:

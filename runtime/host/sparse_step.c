@@ -14,18 +14,6 @@
 
 #include <math.h>
 
-static void sp_report_init(MechrtReport *r)
-{
-    r->iterations = 0;
-    r->residual = 0;
-    r->step = -1;
-    r->worst_row = -1;
-    r->sing_index = -1;
-    r->cond = 0;
-    r->cond_warning = false;
-    r->factorisations = 0;
-}
-
 /* Phi and the Jacobian's nonzeros at q; the residual norm and worst row
    into r. NaN or Inf in Phi is an error. */
 static MechrtStatus sp_eval(MechrtHostSparse *s, const MechrtKernels *k, const double *q,
@@ -115,7 +103,7 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
     MechrtOptions o = opts ? *opts : mechrt_default_options();
     MechrtReport dummy;
     MechrtReport *r = report ? report : &dummy;
-    sp_report_init(r);
+    mechrt_report_clear(r);
     if (!s || !k || !k->phi || !k->nu || !k->gamma || !q || !qd || !qdd || !work || !isfinite(h))
         return MECHRT_EINVAL;
     if (k->nh != k->nq || k->nv != 0)
