@@ -620,6 +620,42 @@ static void test_trig_choices(void **state)
     pipeline_free(mech);
 }
 
+/* A sin or cos whose partner no code of the function needs: written files
+   call the single form (one libm call where not optimising, the pair's
+   half otherwise), the JIT still the tool's pair. */
+static void test_trig_single(void **state)
+{
+    (void)state;
+    Diag diag;
+    Mech *mech = load_text("point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\n"
+                           "driver d: m.y = sin(t)\n", &diag);
+    EmitResult res = emit(mech, "pl", false, NULL);
+    const char *phi = strstr(res.c_text, "void pl_phi(const pl_real *q, pl_real t, pl_real *phi)\n{");
+    const char *nu = strstr(res.c_text, "void pl_nu(const pl_real *q, pl_real t, pl_real *nu)\n{");
+    assert_true(phi && nu);
+    assert_non_null(strstr(phi, "    const pl_real u0 = pl_sin(t);\n    phi[0] = q[0] - 3.0;\n"
+                                "    phi[1] = q[1] - u0;\n}\n"));
+    assert_non_null(strstr(nu, "    const pl_real u0 = pl_cos(t);\n"));
+    assert_null(strstr(res.c_text, "&w0"));     /* no pair with a discarded value */
+    assert_non_null(strstr(res.c_text, "pl_sincos(t, &u0, &u1);"));    /* all: both */
+    assert_non_null(strstr(res.c_text, "#define pl_sin(x) sin(x)\n#define pl_cos(x) cos(x)\n#endif"));
+    const char *single = strstr(res.c_text, "static inline double pl_sin(double x)\n{");
+    assert_non_null(single);
+    assert_non_null(strstr(single, "pl_sincos(x, &s, &c);\n    return s;"));
+    emit_result_free(&res);
+
+    EmitOptions opt = emit_default_options();
+    opt.prefix = "pl";
+    opt.declare_math = true;    /* the JIT: the tool's pair, as before */
+    Diag ed;
+    diag_init(&ed, "emit", NULL, 0);
+    assert_true(emit_mechanism(&mech->kin, &opt, &res, &ed));
+    assert_non_null(strstr(res.c_text, "mechc_sincos(t, &u0, &w0);"));
+    assert_null(strstr(res.c_text, "pl_sin"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+}
+
 /* Error of v against the long double reference, in units in the last place
    of the double nearest the reference. */
 static double ulps(double v, long double ref)
@@ -714,6 +750,7 @@ int main(void)
         cmocka_unit_test(test_chain_compiles),
         cmocka_unit_test(test_gcc_build_matches_jit),
         cmocka_unit_test(test_trig_choices),
+        cmocka_unit_test(test_trig_single),
         cmocka_unit_test(test_sincos_accuracy),
         cmocka_unit_test(test_sincos_pairs),
     };

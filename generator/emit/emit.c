@@ -160,6 +160,10 @@ typedef struct Emitter {
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
     bool sincos_used;           /* some function called sincos_name */
     bool sincos2_used;          /* some function called sincos2_name */
+    const char *sin_name;       /* sin alone, for an angle whose cos no code
+                                   uses; NULL: through sincos_name */
+    const char *cos_name;       /* cos alone, likewise */
+    bool single_used;           /* some function called sin_name or cos_name */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
     int chunk;                  /* the chunk being written */
@@ -299,20 +303,44 @@ static void put_export(const Emitter *e, StrBuf *sb, NodeId id)
         sb_printf(sb, "    ws[%d] = u%d;\n", slot, e->sched.temp[id]);
 }
 
+/* True when the sin or cos id has no partner and is written alone
+   (sin_name or cos_name): compilers that do not optimise then make one
+   libm call for it, not two. */
+static bool is_single(const Emitter *e, NodeId id)
+{
+    return e->sin_name && sincos_partner(e, id) == DAG_NONE;
+}
+
+/* A lone sin or cos through sin_name or cos_name. */
+static void put_single(Emitter *e, StrBuf *sb, NodeId id)
+{
+    e->single_used = true;
+    e->written[id] = true;
+    sb_printf(sb, "    const %s_real u%d = %s(", e->prefix, e->sched.temp[id],
+              dag_op(e->dag, id) == OP_SIN ? e->sin_name : e->cos_name);
+    put_expr(e, sb, dag_node(e->dag, id)->a, false);
+    sb_puts(sb, ");\n");
+    put_export(e, sb, id);
+}
+
 /* The sin and cos temporaries of the group led by id, through one sincos
    call; with a two-angle function, a later group of the chunk whose
    argument is already at hand (a leaf, or a node written before this
    one) shares the call, so that both angles go through one instruction
-   stream. */
+   stream. A lone value with a single form of its own takes that. */
 static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
+    if (is_single(e, id)) {
+        put_single(e, sb, id);
+        return;
+    }
     char ts[24], tc[24], ts2[24], tc2[24];
     NodeId arg = dag_node(e->dag, id)->a;
     sincos_targets(e, id, sincos_partner(e, id), ts, tc);
     NodeId other = DAG_NONE;
     for (int j = at + 1; e->sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
         NodeId cand = sincos_leader(e, c->nodes[j]);
-        if (cand == DAG_NONE)
+        if (cand == DAG_NONE || is_single(e, cand))
             continue;
         NodeId cand_arg = dag_node(e->dag, cand)->a;
         if (e->hoisting ? at_hand(e, cand_arg)
@@ -725,18 +753,20 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
               "   sin/cos series into slow code, get sin and cos of <math.h>. */\n"
               "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
-    if (!e->sincos_used)
+    if (!e->sincos_used && !e->single_used)
         return;
     /* Inlined at every call (gcc splits the pair function at its rare-case
        test and calls the rest out of line, through memory, unless forced),
        the pair takes gcc -O2 several times as long as libm calls would:
        large files call one copy. */
     bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
-                       count_calls(parts, bodies, e->sincos2_name) <= EMIT_INLINE_TRIG_MAX;
+                       count_calls(parts, bodies, e->sincos2_name) +
+                       count_calls(parts, bodies, e->sin_name) +
+                       count_calls(parts, bodies, e->cos_name) <= EMIT_INLINE_TRIG_MAX;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
     TemplateVar sv[] = {
-        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""},
+        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""}, {"SINGLE", ""},
         {"TRIG_X86", inline_pair ? "static inline __attribute__((always_inline))"
                                  : "static __attribute__((noinline))"},
         {"TRIG_WHY", inline_pair ? "x86-64 compilers vectorize the two-angle sincos only where "
@@ -756,6 +786,16 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
         if (template_render(&sincos, template_sincos2, sv, nsv))
             abort();
     }
+    char single[160];
+    single[0] = '\0';
+    if (e->single_used) {   /* libm's sin or cos alone where not optimising */
+        sb_puts(&sincos, "\n");
+        if (template_render(&sincos, template_sincos1, sv, nsv))
+            abort();
+        snprintf(single, sizeof single, "#define %s(x) sin(x)\n#define %s(x) cos(x)\n",
+                 e->sin_name, e->cos_name);
+    }
+    template_set(sv, nsv, "SINGLE", single);
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");
     if (template_render(math, template_trig, sv, nsv))
@@ -877,15 +917,19 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
        its own P_sincos and P_sincos2 (templates/sincos*.tmpl) or, with
        libm_trig, sin and cos as written (sincos is not C99; gcc merges the
        pairs itself). */
-    char sincos_name[160], sincos2_name[160];
+    char sincos_name[160], sincos2_name[160], sin_name[160], cos_name[160];
     snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
     snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
+    snprintf(sin_name, sizeof sin_name, "%s_sin", out->prefix);
+    snprintf(cos_name, sizeof cos_name, "%s_cos", out->prefix);
     if (!opt->real_float && opt->declare_math) {
         e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
         e.sincos2_name = opt->libm_trig ? NULL : "mechc_sincos2";
     } else if (!opt->real_float && !opt->libm_trig) {
         e.sincos_name = sincos_name;
         e.sincos2_name = sincos2_name;
+        e.sin_name = sin_name;  /* the JIT keeps the tool's pair: its results stay */
+        e.cos_name = cos_name;
     }
     e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
