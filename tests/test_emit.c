@@ -621,8 +621,9 @@ static void test_trig_choices(void **state)
 }
 
 /* A sin or cos whose partner no code of the function needs: written files
-   call the single form (one libm call where not optimising, the pair's
-   half otherwise), the JIT still the tool's pair. */
+   call the pair through P_sincos_s / P_sincos_c, macros that are the pair
+   where optimising (the same bits) and libm's one function elsewhere; the
+   JIT still calls the tool's pair. */
 static void test_trig_single(void **state)
 {
     (void)state;
@@ -633,25 +634,36 @@ static void test_trig_single(void **state)
     const char *phi = strstr(res.c_text, "void pl_phi(const pl_real *q, pl_real t, pl_real *phi)\n{");
     const char *nu = strstr(res.c_text, "void pl_nu(const pl_real *q, pl_real t, pl_real *nu)\n{");
     assert_true(phi && nu);
-    assert_non_null(strstr(phi, "    const pl_real u0 = pl_sin(t);\n    phi[0] = q[0] - 3.0;\n"
-                                "    phi[1] = q[1] - u0;\n}\n"));
-    assert_non_null(strstr(nu, "    const pl_real u0 = pl_cos(t);\n"));
-    assert_null(strstr(res.c_text, "&w0"));     /* no pair with a discarded value */
+    assert_non_null(strstr(phi, "    pl_real u0, w0;\n    pl_sincos_s(t, &u0, &w0);\n"
+                                "    phi[0] = q[0] - 3.0;\n    phi[1] = q[1] - u0;\n}\n"));
+    assert_non_null(strstr(nu, "    pl_real w0, u0;\n    pl_sincos_c(t, &w0, &u0);\n"));
     assert_non_null(strstr(res.c_text, "pl_sincos(t, &u0, &u1);"));    /* all: both */
-    assert_non_null(strstr(res.c_text, "#define pl_sin(x) sin(x)\n#define pl_cos(x) cos(x)\n#endif"));
-    const char *single = strstr(res.c_text, "static inline double pl_sin(double x)\n{");
-    assert_non_null(single);
-    assert_non_null(strstr(single, "pl_sincos(x, &s, &c);\n    return s;"));
+    const char *opt = strstr(res.c_text, "#define pl_sincos_s(x, s, c) pl_sincos(x, s, c)\n"
+                                         "#define pl_sincos_c(x, s, c) pl_sincos(x, s, c)\n#else\n");
+    const char *libm = strstr(res.c_text, "#define pl_sincos_s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
+                                          "#define pl_sincos_c(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n"
+                                          "#endif\n");
+    assert_true(opt && libm && opt < libm);
     emit_result_free(&res);
 
-    EmitOptions opt = emit_default_options();
-    opt.prefix = "pl";
-    opt.declare_math = true;    /* the JIT: the tool's pair, as before */
+    EmitOptions opt_jit = emit_default_options();
+    opt_jit.prefix = "pl";
+    opt_jit.declare_math = true;    /* the JIT: the tool's pair, as before */
     Diag ed;
     diag_init(&ed, "emit", NULL, 0);
-    assert_true(emit_mechanism(&mech->kin, &opt, &res, &ed));
+    assert_true(emit_mechanism(&mech->kin, &opt_jit, &res, &ed));
     assert_non_null(strstr(res.c_text, "mechc_sincos(t, &u0, &w0);"));
-    assert_null(strstr(res.c_text, "pl_sin"));
+    assert_null(strstr(res.c_text, "sincos_s"));
+    emit_result_free(&res);
+
+    /* four-bar: every angle's sin and cos used together, no single form */
+    pipeline_free(mech);
+    char path[600];
+    snprintf(path, sizeof path, "%s/examples/four_bar.mech", root);
+    mech = load_path(path, &diag);
+    res = emit(mech, "fb", false, NULL);
+    assert_null(strstr(res.c_text, "fb_sincos_s"));
+    assert_null(strstr(res.c_text, "fb_sincos_c"));
     emit_result_free(&res);
     pipeline_free(mech);
 }

@@ -177,7 +177,7 @@ phi_calls() {
 if ! have objdump || [ "$(uname -m)" != x86_64 ]; then
     skip "objdump or x86-64 is missing: the lone sin's calls"
 elif "$mechc" gen "$tmp/lone.mech" --prefix m -o "$tmp/lone.c" 2> "$tmp/err"; then
-    check "lone sin: written as m_sin" grep -q '= m_sin(t);$' "$tmp/lone.c"
+    check "lone sin: written as m_sincos_s" grep -q '^    m_sincos_s(t, &u0, &w0);$' "$tmp/lone.c"
     echo "$compilers" | while IFS='|' read -r cname cc; do
         # shellcheck disable=SC2086 # cc is a command with options
         $cc -c "$tmp/lone.c" -o "$tmp/lone-$cname.o" 2> "$tmp/err" || { echo "bad compile"; continue; }

@@ -160,9 +160,10 @@ typedef struct Emitter {
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
     bool sincos_used;           /* some function called sincos_name */
     bool sincos2_used;          /* some function called sincos2_name */
-    const char *sin_name;       /* sin alone, for an angle whose cos no code
-                                   uses; NULL: through sincos_name */
-    const char *cos_name;       /* cos alone, likewise */
+    const char *sin_name;       /* the pair where only its sin is used (a macro:
+                                   libm's sin alone where not optimising);
+                                   NULL: sincos_name */
+    const char *cos_name;       /* the pair where only its cos is used */
     bool single_used;           /* some function called sin_name or cos_name */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
@@ -303,42 +304,28 @@ static void put_export(const Emitter *e, StrBuf *sb, NodeId id)
         sb_printf(sb, "    ws[%d] = u%d;\n", slot, e->sched.temp[id]);
 }
 
-/* True when the sin or cos id has no partner and is written alone
-   (sin_name or cos_name): compilers that do not optimise then make one
-   libm call for it, not two. */
+/* True when the sin or cos id has no partner and goes through sin_name or
+   cos_name: compilers that do not optimise then make one libm call for
+   it, not two. */
 static bool is_single(const Emitter *e, NodeId id)
 {
     return e->sin_name && sincos_partner(e, id) == DAG_NONE;
-}
-
-/* A lone sin or cos through sin_name or cos_name. */
-static void put_single(Emitter *e, StrBuf *sb, NodeId id)
-{
-    e->single_used = true;
-    e->written[id] = true;
-    sb_printf(sb, "    const %s_real u%d = %s(", e->prefix, e->sched.temp[id],
-              dag_op(e->dag, id) == OP_SIN ? e->sin_name : e->cos_name);
-    put_expr(e, sb, dag_node(e->dag, id)->a, false);
-    sb_puts(sb, ");\n");
-    put_export(e, sb, id);
 }
 
 /* The sin and cos temporaries of the group led by id, through one sincos
    call; with a two-angle function, a later group of the chunk whose
    argument is already at hand (a leaf, or a node written before this
    one) shares the call, so that both angles go through one instruction
-   stream. A lone value with a single form of its own takes that. */
+   stream. A lone value with a single form (sin_name, cos_name) takes that,
+   alone. */
 static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
-    if (is_single(e, id)) {
-        put_single(e, sb, id);
-        return;
-    }
     char ts[24], tc[24], ts2[24], tc2[24];
     NodeId arg = dag_node(e->dag, id)->a;
     sincos_targets(e, id, sincos_partner(e, id), ts, tc);
     NodeId other = DAG_NONE;
-    for (int j = at + 1; e->sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
+    for (int j = at + 1; e->sincos2_name && !is_single(e, id) && j < c->nnodes &&
+                         other == DAG_NONE; j++) {
         NodeId cand = sincos_leader(e, c->nodes[j]);
         if (cand == DAG_NONE || is_single(e, cand))
             continue;
@@ -352,7 +339,12 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     if (sincos_partner(e, id) != DAG_NONE)
         e->written[sincos_partner(e, id)] = true;
     if (other == DAG_NONE) {
-        sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
+        const char *name = e->sincos_name;
+        if (is_single(e, id)) {
+            e->single_used = true;
+            name = dag_op(e->dag, id) == OP_SIN ? e->sin_name : e->cos_name;
+        }
+        sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, name);
         put_expr(e, sb, arg, false);
         sb_printf(sb, ", &%s, &%s);\n", ts, tc);
         put_export(e, sb, id);
@@ -786,14 +778,21 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
         if (template_render(&sincos, template_sincos2, sv, nsv))
             abort();
     }
-    char single[160];
-    single[0] = '\0';
-    if (e->single_used) {   /* libm's sin or cos alone where not optimising */
-        sb_puts(&sincos, "\n");
-        if (template_render(&sincos, template_sincos1, sv, nsv))
-            abort();
-        snprintf(single, sizeof single, "#define %s(x) sin(x)\n#define %s(x) cos(x)\n",
+    /* the pair where one value is used, libm's one function where not
+       optimising (macros: the firmware rules allow no other static) */
+    char single[400], single_pair[400];
+    single[0] = single_pair[0] = '\0';
+    if (e->single_used) {
+        snprintf(single_pair, sizeof single_pair,
+                 "\n/* an angle whose sin (or cos) alone is used: the pair here, libm's sin\n"
+                 "   (or cos) alone where not optimising */\n"
+                 "#define %s(x, s, c) %s(x, s, c)\n#define %s(x, s, c) %s(x, s, c)\n",
+                 e->sin_name, e->sincos_name, e->cos_name, e->sincos_name);
+        snprintf(single, sizeof single,
+                 "#define %s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
+                 "#define %s(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n",
                  e->sin_name, e->cos_name);
+        sb_puts(&sincos, single_pair);
     }
     template_set(sv, nsv, "SINGLE", single);
     template_set(sv, nsv, "SINCOS", sincos.data);
@@ -920,8 +919,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     char sincos_name[160], sincos2_name[160], sin_name[160], cos_name[160];
     snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
     snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
-    snprintf(sin_name, sizeof sin_name, "%s_sin", out->prefix);
-    snprintf(cos_name, sizeof cos_name, "%s_cos", out->prefix);
+    snprintf(sin_name, sizeof sin_name, "%s_sincos_s", out->prefix);
+    snprintf(cos_name, sizeof cos_name, "%s_sincos_c", out->prefix);
     if (!opt->real_float && opt->declare_math) {
         e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
         e.sincos2_name = opt->libm_trig ? NULL : "mechc_sincos2";

@@ -8,7 +8,6 @@ extern const char template_jac_spread[];
 extern const char template_mech_c[];
 extern const char template_mech_h[];
 extern const char template_sincos[];
-extern const char template_sincos1[];
 extern const char template_sincos2[];
 extern const char template_trig[];
 
