@@ -164,7 +164,8 @@ typedef struct Emitter {
                                    libm's sin alone where not optimising);
                                    NULL: sincos_name */
     const char *cos_name;       /* the pair where only its cos is used */
-    bool single_used;           /* some function called sin_name or cos_name */
+    const char *sincos2_some_name;  /* sincos2 where some values go unused */
+    bool single_used;           /* some function called one of the three */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
     int chunk;                  /* the chunk being written */
@@ -316,18 +317,18 @@ static bool is_single(const Emitter *e, NodeId id)
    call; with a two-angle function, a later group of the chunk whose
    argument is already at hand (a leaf, or a node written before this
    one) shares the call, so that both angles go through one instruction
-   stream. A lone value with a single form (sin_name, cos_name) takes that,
-   alone. */
+   stream. Where a value goes unused the call names the ones used
+   (sin_name, cos_name, sincos2_some_name), so that compilers that do not
+   optimise make only their libm calls. */
 static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
     char ts[24], tc[24], ts2[24], tc2[24];
     NodeId arg = dag_node(e->dag, id)->a;
     sincos_targets(e, id, sincos_partner(e, id), ts, tc);
     NodeId other = DAG_NONE;
-    for (int j = at + 1; e->sincos2_name && !is_single(e, id) && j < c->nnodes &&
-                         other == DAG_NONE; j++) {
+    for (int j = at + 1; e->sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
         NodeId cand = sincos_leader(e, c->nodes[j]);
-        if (cand == DAG_NONE || is_single(e, cand))
+        if (cand == DAG_NONE)
             continue;
         NodeId cand_arg = dag_node(e->dag, cand)->a;
         if (e->hoisting ? at_hand(e, cand_arg)
@@ -357,12 +358,19 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     e->written[other] = true;
     if (other_partner != DAG_NONE)
         e->written[other_partner] = true;
+    /* the values used, 1 s0, 2 c0, 4 s1, 8 c1 (w temporaries go unused) */
+    int used = (ts[0] == 'u') | (tc[0] == 'u') << 1 | (ts2[0] == 'u') << 2 | (tc2[0] == 'u') << 3;
+    bool some = used != 15 && e->sincos2_some_name;
+    e->single_used |= some;
     sb_printf(sb, "    %s_real %s, %s, %s, %s;\n    %s(", e->prefix, ts, tc, ts2, tc2,
-              e->sincos2_name);
+              some ? e->sincos2_some_name : e->sincos2_name);
     put_expr(e, sb, arg, false);
     sb_puts(sb, ", ");
     put_expr(e, sb, dag_node(e->dag, other)->a, false);
-    sb_printf(sb, ", &%s, &%s, &%s, &%s);\n", ts, tc, ts2, tc2);
+    sb_printf(sb, ", &%s, &%s, &%s, &%s", ts, tc, ts2, tc2);
+    if (some)
+        sb_printf(sb, ", %d", used);
+    sb_puts(sb, ");\n");
     put_export(e, sb, id);
     put_export(e, sb, sincos_partner(e, id));
     put_export(e, sb, other);
@@ -716,6 +724,31 @@ static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *n
     return n;
 }
 
+/* The calls that leave some values unused (sin_name, cos_name,
+   sincos2_some_name) as macros, the firmware rules allowing no other
+   static function: where optimising (opt) the pair itself, so the bits
+   are the pair's and the compiler drops the unused work; elsewhere
+   (plain) libm's functions of the values used, `used` a constant that
+   even tcc and gcc -O0 fold. */
+static void put_some_macros(const Emitter *e, StrBuf *opt, StrBuf *plain)
+{
+    sb_printf(opt, "\n/* angles some of whose values go unused (used: 1 s0, 2 c0, 4 s1,\n"
+              "   8 c1): the pair here, libm's functions of the values used where\n"
+              "   not optimising */\n"
+              "#define %s(x, s, c) %s(x, s, c)\n#define %s(x, s, c) %s(x, s, c)\n"
+              "#define %s(x0, x1, s0, c0, s1, c1, used) %s(x0, x1, s0, c0, s1, c1)\n",
+              e->sin_name, e->sincos_name, e->cos_name, e->sincos_name,
+              e->sincos2_some_name, e->sincos2_name);
+    sb_printf(plain, "#define %s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
+              "#define %s(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n",
+              e->sin_name, e->cos_name);
+    sb_printf(plain, "#define %s(x0, x1, s0, c0, s1, c1, used) \\\n"
+              "    ((void)((used) & 1 ? *(s0) = sin(x0) : 0), \\\n"
+              "     (void)((used) & 2 ? *(c0) = cos(x0) : 0), \\\n"
+              "     (void)((used) & 4 ? *(s1) = sin(x1) : 0), \\\n"
+              "     (void)((used) & 8 ? *(c1) = cos(x1) : 0))\n", e->sincos2_some_name);
+}
+
 /* What the kernels call for math: libm declared (JIT) or included, and
    the sincos functions the emitter used, for written files chosen by the
    compiler (templates/trig.tmpl). parts and bodies: the written functions. */
@@ -754,7 +787,8 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
                        count_calls(parts, bodies, e->sincos2_name) +
                        count_calls(parts, bodies, e->sin_name) +
-                       count_calls(parts, bodies, e->cos_name) <= EMIT_INLINE_TRIG_MAX;
+                       count_calls(parts, bodies, e->cos_name) +
+                       count_calls(parts, bodies, e->sincos2_some_name) <= EMIT_INLINE_TRIG_MAX;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
     TemplateVar sv[] = {
@@ -778,28 +812,18 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
         if (template_render(&sincos, template_sincos2, sv, nsv))
             abort();
     }
-    /* the pair where one value is used, libm's one function where not
-       optimising (macros: the firmware rules allow no other static) */
-    char single[400], single_pair[400];
-    single[0] = single_pair[0] = '\0';
-    if (e->single_used) {
-        snprintf(single_pair, sizeof single_pair,
-                 "\n/* an angle whose sin (or cos) alone is used: the pair here, libm's sin\n"
-                 "   (or cos) alone where not optimising */\n"
-                 "#define %s(x, s, c) %s(x, s, c)\n#define %s(x, s, c) %s(x, s, c)\n",
-                 e->sin_name, e->sincos_name, e->cos_name, e->sincos_name);
-        snprintf(single, sizeof single,
-                 "#define %s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
-                 "#define %s(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n",
-                 e->sin_name, e->cos_name);
-        sb_puts(&sincos, single_pair);
-    }
-    template_set(sv, nsv, "SINGLE", single);
+    StrBuf single;
+    sb_init(&single);
+    sb_puts(&single, "");
+    if (e->single_used)
+        put_some_macros(e, &sincos, &single);
+    template_set(sv, nsv, "SINGLE", single.data);
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");
     if (template_render(math, template_trig, sv, nsv))
         abort();
     sb_free(&sincos);
+    sb_free(&single);
 }
 
 /* The data section's lists: initial values, names, Jacobian structure. */
@@ -921,6 +945,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
     snprintf(sin_name, sizeof sin_name, "%s_sincos_s", out->prefix);
     snprintf(cos_name, sizeof cos_name, "%s_sincos_c", out->prefix);
+    char sincos2_some_name[160];
+    snprintf(sincos2_some_name, sizeof sincos2_some_name, "%s_sincos2_some", out->prefix);
     if (!opt->real_float && opt->declare_math) {
         e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
         e.sincos2_name = opt->libm_trig ? NULL : "mechc_sincos2";
@@ -929,6 +955,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
         e.sincos2_name = sincos2_name;
         e.sin_name = sin_name;  /* the JIT keeps the tool's pair: its results stay */
         e.cos_name = cos_name;
+        e.sincos2_some_name = sincos2_some_name;
     }
     e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
