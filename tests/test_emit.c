@@ -620,6 +620,73 @@ static void test_trig_choices(void **state)
     pipeline_free(mech);
 }
 
+/* A sin or cos whose partner no code of the function needs: written files
+   call the pair through P_sincos_s / P_sincos_c / P_sincos2_some, macros
+   that are the pair where optimising (the same bits) and libm's functions
+   of the values used elsewhere; the JIT still calls the tool's pair. */
+static void test_trig_single(void **state)
+{
+    (void)state;
+    Diag diag;
+    Mech *mech = load_text("point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\n"
+                           "driver d: m.y = sin(t)\n", &diag);
+    EmitResult res = emit(mech, "pl", false, NULL);
+    const char *phi = strstr(res.c_text, "void pl_phi(const pl_real *q, pl_real t, "
+                                         "pl_real *phi)\n{");
+    const char *nu = strstr(res.c_text, "void pl_nu(const pl_real *q, pl_real t, pl_real *nu)\n{");
+    assert_true(phi && nu);
+    assert_non_null(strstr(phi, "    pl_real u0, w0;\n    pl_sincos_s(t, &u0, &w0);\n"
+                                "    phi[0] = q[0] - 3.0;\n    phi[1] = q[1] - u0;\n}\n"));
+    assert_non_null(strstr(nu, "    pl_real w0, u0;\n    pl_sincos_c(t, &w0, &u0);\n"));
+    assert_non_null(strstr(res.c_text, "pl_sincos(t, &u0, &u1);"));    /* all: both */
+    const char *opt = strstr(res.c_text, "#define pl_sincos_s(x, s, c) pl_sincos(x, s, c)\n"
+                                         "#define pl_sincos_c(x, s, c) pl_sincos(x, s, c)\n");
+    const char *libm = strstr(res.c_text,
+                              "#define pl_sincos_s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
+                              "#define pl_sincos_c(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n");
+    assert_true(opt && libm && opt < libm);
+    emit_result_free(&res);
+    pipeline_free(mech);
+
+    /* two angles in one call: the values used as a mask, 2 cos 2t and 4 sin t */
+    mech = load_text("point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\n"
+                     "driver d: m.y = sin(t) + cos(2*t)\n", &diag);
+    res = emit(mech, "pl", false, NULL);
+    phi = strstr(res.c_text, "void pl_phi(const pl_real *q, pl_real t, pl_real *phi)\n{");
+    assert_non_null(phi);
+    assert_non_null(strstr(phi, "    pl_sincos2_some(2.0 * t, t, &w0, &u0, &u1, &w1, 6);\n"));
+    opt = strstr(res.c_text, "#define pl_sincos2_some(x0, x1, s0, c0, s1, c1, used) "
+                             "pl_sincos2(x0, x1, s0, c0, s1, c1)\n");
+    libm = strstr(res.c_text, "#define pl_sincos2_some(x0, x1, s0, c0, s1, c1, used) \\\n"
+                              "    ((void)((used) & 1 ? *(s0) = sin(x0) : 0), \\\n"
+                              "     (void)((used) & 2 ? *(c0) = cos(x0) : 0), \\\n"
+                              "     (void)((used) & 4 ? *(s1) = sin(x1) : 0), \\\n"
+                              "     (void)((used) & 8 ? *(c1) = cos(x1) : 0))\n#endif\n");
+    assert_true(opt && libm && opt < libm);
+    emit_result_free(&res);
+
+    EmitOptions opt_jit = emit_default_options();
+    opt_jit.prefix = "pl";
+    opt_jit.declare_math = true;    /* the JIT: the tool's pair, as before */
+    Diag ed;
+    diag_init(&ed, "emit", NULL, 0);
+    assert_true(emit_mechanism(&mech->kin, &opt_jit, &res, &ed));
+    assert_non_null(strstr(res.c_text, "mechc_sincos2(2.0 * t, t, &w0, &u0, &u1, &w1);"));
+    assert_null(strstr(res.c_text, "_some"));
+    emit_result_free(&res);
+
+    /* four-bar: every angle's sin and cos used together, no single form */
+    pipeline_free(mech);
+    char path[600];
+    snprintf(path, sizeof path, "%s/examples/four_bar.mech", root);
+    mech = load_path(path, &diag);
+    res = emit(mech, "fb", false, NULL);
+    assert_null(strstr(res.c_text, "fb_sincos_s"));
+    assert_null(strstr(res.c_text, "fb_sincos_c"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+}
+
 /* Error of v against the long double reference, in units in the last place
    of the double nearest the reference. */
 static double ulps(double v, long double ref)
@@ -714,6 +781,7 @@ int main(void)
         cmocka_unit_test(test_chain_compiles),
         cmocka_unit_test(test_gcc_build_matches_jit),
         cmocka_unit_test(test_trig_choices),
+        cmocka_unit_test(test_trig_single),
         cmocka_unit_test(test_sincos_accuracy),
         cmocka_unit_test(test_sincos_pairs),
     };

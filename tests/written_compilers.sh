@@ -16,7 +16,9 @@
 # 1e-12 (relative above 1). The driver also requires jac from jac_nz,
 # all and jac to agree exactly. Checks too that the trig is the one chosen:
 # the sincos table is in the gcc -O2 object and not in the others, and the
-# pair is always_inline in the four-bar's file, noinline in chain_20's.
+# pair is always_inline in the four-bar's file, noinline in chain_20's, and
+# that values used alone cost only their libm calls under tcc and gcc -O0
+# (objdump, x86-64).
 . "$(dirname "$0")/lib.sh"
 suite_begin written_compilers "${1:-build/mechc}"
 
@@ -164,6 +166,45 @@ check "four_bar: the sincos pair always_inline on x86-64" \
     grep -q '^#define M_TRIG static inline __attribute__((always_inline))$' "$tmp/four_bar/m.c"
 check "chain_20: one noinline copy of the sincos pair" \
     grep -q '^#define M_TRIG static __attribute__((noinline))$' "$tmp/chain_20/m.c"
+# values used alone: Phi of a driver y = sin t needs no cos (lone), of
+# y = sin t + cos 2t neither cos t nor sin 2t (lone2, one two-angle call).
+# Under tcc and gcc -O0 m_phi makes only the libm calls of the values used,
+# not the pair's; under gcc -O2 the inlined pair keeps no cos work for lone
+# (no cos in its rare case)
+printf 'point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\ndriver d: m.y = sin(t)\n' > "$tmp/lone.mech"
+printf 'point m x = 3 y = 1\nconstraint line: m.x - 3 = 0\ndriver d: m.y = sin(t) + cos(2*t)\n' > "$tmp/lone2.mech"
+# phi_calls OBJECT: the functions m_phi of OBJECT calls, on one line, sorted
+phi_calls() {
+    objdump -dr "$1" | awk '/^[0-9a-f]+ <m_phi>:/ { p = 1; next } /^[0-9a-f]+ </ { p = 0 }
+        p && /R_X86_64_PLT32/ { sub(/-0x4$/, "", $NF); print $NF }' | sort | tr '\n' ' '
+}
+if ! have objdump || [ "$(uname -m)" != x86_64 ]; then
+    skip "objdump or x86-64 is missing: the calls of values used alone"
+elif "$mechc" gen "$tmp/lone.mech" --prefix m -o "$tmp/lone.c" 2> "$tmp/err" &&
+     "$mechc" gen "$tmp/lone2.mech" --prefix m -o "$tmp/lone2.c" 2> "$tmp/err"; then
+    check "lone: written as m_sincos_s" grep -q '^    m_sincos_s(t, &u0, &w0);$' "$tmp/lone.c"
+    check "lone2: written as m_sincos2_some" \
+        grep -q '^    m_sincos2_some(2.0 \* t, t, &w0, &u0, &u1, &w1, 6);$' "$tmp/lone2.c"
+    echo "$compilers" | while IFS='|' read -r cname cc; do
+        for m in lone lone2; do
+            # shellcheck disable=SC2086 # cc is a command with options
+            $cc -c "$tmp/$m.c" -o "$tmp/$m-$cname.o" 2> "$tmp/err" || { echo "bad $m-$cname"; continue; }
+            calls=$(phi_calls "$tmp/$m-$cname.o")
+            case $cname:$m in
+                gcc_O2:lone) want="sin " ;;
+                gcc_O2:*) continue ;;
+                *:lone) want="sin " ;;
+                *) want="cos sin " ;;
+            esac
+            if [ "$calls" = "$want" ]; then echo "ok $m-$cname"; else echo "bad $m-$cname: m_phi calls $calls"; fi
+        done
+    done > "$tmp/lone"
+    while read -r verdict rest; do
+        if [ "$verdict" = ok ]; then ok; else bad "values used alone, $rest"; fi
+    done < "$tmp/lone"
+else
+    bad "lone: gen"
+fi
 # every case and compiler gave its 3 results (all 5 cases use sin/cos)
 n=$(grep -c . "$tmp/results")
 want=$(($(echo "$compilers" | grep -c .) * 5 * 3))

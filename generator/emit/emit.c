@@ -160,6 +160,12 @@ typedef struct Emitter {
     const char *sincos2_name;   /* two angles in one call; NULL: no such function */
     bool sincos_used;           /* some function called sincos_name */
     bool sincos2_used;          /* some function called sincos2_name */
+    const char *sin_name;       /* the pair where only its sin is used (a macro:
+                                   libm's sin alone where not optimising);
+                                   NULL: sincos_name */
+    const char *cos_name;       /* the pair where only its cos is used */
+    const char *sincos2_some_name;  /* sincos2 where some values go unused */
+    bool single_used;           /* some function called one of the three */
     bool *written;              /* per node: its sincos call was already written
                                    (paired with an earlier one) in this chunk */
     int chunk;                  /* the chunk being written */
@@ -299,11 +305,21 @@ static void put_export(const Emitter *e, StrBuf *sb, NodeId id)
         sb_printf(sb, "    ws[%d] = u%d;\n", slot, e->sched.temp[id]);
 }
 
+/* True when the sin or cos id has no partner and goes through sin_name or
+   cos_name: compilers that do not optimise then make one libm call for
+   it, not two. */
+static bool is_single(const Emitter *e, NodeId id)
+{
+    return e->sin_name && sincos_partner(e, id) == DAG_NONE;
+}
+
 /* The sin and cos temporaries of the group led by id, through one sincos
    call; with a two-angle function, a later group of the chunk whose
    argument is already at hand (a leaf, or a node written before this
    one) shares the call, so that both angles go through one instruction
-   stream. */
+   stream. Where a value goes unused the call names the ones used
+   (sin_name, cos_name, sincos2_some_name), so that compilers that do not
+   optimise make only their libm calls. */
 static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, NodeId id)
 {
     char ts[24], tc[24], ts2[24], tc2[24];
@@ -324,7 +340,12 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     if (sincos_partner(e, id) != DAG_NONE)
         e->written[sincos_partner(e, id)] = true;
     if (other == DAG_NONE) {
-        sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, e->sincos_name);
+        const char *name = e->sincos_name;
+        if (is_single(e, id)) {
+            e->single_used = true;
+            name = dag_op(e->dag, id) == OP_SIN ? e->sin_name : e->cos_name;
+        }
+        sb_printf(sb, "    %s_real %s, %s;\n    %s(", e->prefix, ts, tc, name);
         put_expr(e, sb, arg, false);
         sb_printf(sb, ", &%s, &%s);\n", ts, tc);
         put_export(e, sb, id);
@@ -337,12 +358,19 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     e->written[other] = true;
     if (other_partner != DAG_NONE)
         e->written[other_partner] = true;
+    /* the values used, 1 s0, 2 c0, 4 s1, 8 c1 (w temporaries go unused) */
+    int used = (ts[0] == 'u') | (tc[0] == 'u') << 1 | (ts2[0] == 'u') << 2 | (tc2[0] == 'u') << 3;
+    bool some = used != 15 && e->sincos2_some_name;
+    e->single_used |= some;
     sb_printf(sb, "    %s_real %s, %s, %s, %s;\n    %s(", e->prefix, ts, tc, ts2, tc2,
-              e->sincos2_name);
+              some ? e->sincos2_some_name : e->sincos2_name);
     put_expr(e, sb, arg, false);
     sb_puts(sb, ", ");
     put_expr(e, sb, dag_node(e->dag, other)->a, false);
-    sb_printf(sb, ", &%s, &%s, &%s, &%s);\n", ts, tc, ts2, tc2);
+    sb_printf(sb, ", &%s, &%s, &%s, &%s", ts, tc, ts2, tc2);
+    if (some)
+        sb_printf(sb, ", %d", used);
+    sb_puts(sb, ");\n");
     put_export(e, sb, id);
     put_export(e, sb, sincos_partner(e, id));
     put_export(e, sb, other);
@@ -696,6 +724,31 @@ static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *n
     return n;
 }
 
+/* The calls that leave some values unused (sin_name, cos_name,
+   sincos2_some_name) as macros, the firmware rules allowing no other
+   static function: where optimising (opt) the pair itself, so the bits
+   are the pair's and the compiler drops the unused work; elsewhere
+   (plain) libm's functions of the values used, `used` a constant that
+   even tcc and gcc -O0 fold. */
+static void put_some_macros(const Emitter *e, StrBuf *opt, StrBuf *plain)
+{
+    sb_printf(opt, "\n/* angles some of whose values go unused (used: 1 s0, 2 c0, 4 s1,\n"
+              "   8 c1): the pair here, libm's functions of the values used where\n"
+              "   not optimising */\n"
+              "#define %s(x, s, c) %s(x, s, c)\n#define %s(x, s, c) %s(x, s, c)\n"
+              "#define %s(x0, x1, s0, c0, s1, c1, used) %s(x0, x1, s0, c0, s1, c1)\n",
+              e->sin_name, e->sincos_name, e->cos_name, e->sincos_name,
+              e->sincos2_some_name, e->sincos2_name);
+    sb_printf(plain, "#define %s(x, s, c) ((void)(c), (void)(*(s) = sin(x)))\n"
+              "#define %s(x, s, c) ((void)(s), (void)(*(c) = cos(x)))\n",
+              e->sin_name, e->cos_name);
+    sb_printf(plain, "#define %s(x0, x1, s0, c0, s1, c1, used) \\\n"
+              "    ((void)((used) & 1 ? *(s0) = sin(x0) : 0), \\\n"
+              "     (void)((used) & 2 ? *(c0) = cos(x0) : 0), \\\n"
+              "     (void)((used) & 4 ? *(s1) = sin(x1) : 0), \\\n"
+              "     (void)((used) & 8 ? *(c1) = cos(x1) : 0))\n", e->sincos2_some_name);
+}
+
 /* What the kernels call for math: libm declared (JIT) or included, and
    the sincos functions the emitter used, for written files chosen by the
    compiler (templates/trig.tmpl). parts and bodies: the written functions. */
@@ -725,18 +778,21 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
               "   sin/cos series into slow code, get sin and cos of <math.h>. */\n"
               "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
-    if (!e->sincos_used)
+    if (!e->sincos_used && !e->single_used)
         return;
     /* Inlined at every call (gcc splits the pair function at its rare-case
        test and calls the rest out of line, through memory, unless forced),
        the pair takes gcc -O2 several times as long as libm calls would:
        large files call one copy. */
     bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
-                       count_calls(parts, bodies, e->sincos2_name) <= EMIT_INLINE_TRIG_MAX;
+                       count_calls(parts, bodies, e->sincos2_name) +
+                       count_calls(parts, bodies, e->sin_name) +
+                       count_calls(parts, bodies, e->cos_name) +
+                       count_calls(parts, bodies, e->sincos2_some_name) <= EMIT_INLINE_TRIG_MAX;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
     TemplateVar sv[] = {
-        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""},
+        {"P", e->prefix}, {"PU", upper}, {"STATIC", trig}, {"SINCOS", ""}, {"SINGLE", ""},
         {"TRIG_X86", inline_pair ? "static inline __attribute__((always_inline))"
                                  : "static __attribute__((noinline))"},
         {"TRIG_WHY", inline_pair ? "x86-64 compilers vectorize the two-angle sincos only where "
@@ -756,11 +812,18 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
         if (template_render(&sincos, template_sincos2, sv, nsv))
             abort();
     }
+    StrBuf single;
+    sb_init(&single);
+    sb_puts(&single, "");
+    if (e->single_used)
+        put_some_macros(e, &sincos, &single);
+    template_set(sv, nsv, "SINGLE", single.data);
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");
     if (template_render(math, template_trig, sv, nsv))
         abort();
     sb_free(&sincos);
+    sb_free(&single);
 }
 
 /* The data section's lists: initial values, names, Jacobian structure. */
@@ -877,15 +940,22 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
        its own P_sincos and P_sincos2 (templates/sincos*.tmpl) or, with
        libm_trig, sin and cos as written (sincos is not C99; gcc merges the
        pairs itself). */
-    char sincos_name[160], sincos2_name[160];
+    char sincos_name[160], sincos2_name[160], sin_name[160], cos_name[160];
     snprintf(sincos_name, sizeof sincos_name, "%s_sincos", out->prefix);
     snprintf(sincos2_name, sizeof sincos2_name, "%s_sincos2", out->prefix);
+    snprintf(sin_name, sizeof sin_name, "%s_sincos_s", out->prefix);
+    snprintf(cos_name, sizeof cos_name, "%s_sincos_c", out->prefix);
+    char sincos2_some_name[160];
+    snprintf(sincos2_some_name, sizeof sincos2_some_name, "%s_sincos2_some", out->prefix);
     if (!opt->real_float && opt->declare_math) {
         e.sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
         e.sincos2_name = opt->libm_trig ? NULL : "mechc_sincos2";
     } else if (!opt->real_float && !opt->libm_trig) {
         e.sincos_name = sincos_name;
         e.sincos2_name = sincos2_name;
+        e.sin_name = sin_name;  /* the JIT keeps the tool's pair: its results stay */
+        e.cos_name = cos_name;
+        e.sincos2_some_name = sincos2_some_name;
     }
     e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
