@@ -7,6 +7,7 @@
  * sign) and each must be caught at the right row, with the right diagnosis.
  */
 #include "testutil.h"
+#include "testcache.h"
 
 #include "../generator/analysis/check.h"
 #include "../generator/base/arena.h"
@@ -19,39 +20,18 @@
 
 static char cache_dir[256];
 
-static void remove_tree(const char *dir, int depth)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return;
-    struct dirent *e;
-    char path[900];
-    while ((e = readdir(d))) {
-        if (e->d_name[0] == '.')
-            continue;
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (unlink(path) != 0 && depth > 0)
-            remove_tree(path, depth - 1);
-    }
-    closedir(d);
-    rmdir(dir);
-}
-
 static int setup(void **state)
 {
     (void)state;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(cache_dir, sizeof cache_dir, "%s/mechc-test-check-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!mkdtemp(cache_dir))
+    if (!testcache_make(cache_dir, sizeof cache_dir, "check"))
         return -1;
-    setenv("XDG_CACHE_HOME", cache_dir, 1);
     return 0;
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    remove_tree(cache_dir, 2);
+    testcache_remove(cache_dir, 2);
     return 0;
 }
 

@@ -9,6 +9,7 @@
  * Engine struct). The aot library cache goes to a private folder.
  */
 #include "testutil.h"
+#include "testcache.h"
 
 #include "../generator/base/arena.h"
 #include "../generator/engine/aot.h"
@@ -22,32 +23,11 @@
 static char cache_dir[256];
 static bool have_cc;
 
-static void remove_tree(const char *dir, int depth)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return;
-    struct dirent *e;
-    char path[900];
-    while ((e = readdir(d))) {
-        if (e->d_name[0] == '.')
-            continue;
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (unlink(path) != 0 && depth > 0)
-            remove_tree(path, depth - 1);
-    }
-    closedir(d);
-    rmdir(dir);
-}
-
 static int setup(void **state)
 {
     (void)state;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(cache_dir, sizeof cache_dir, "%s/mechc-test-engine-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!mkdtemp(cache_dir))
+    if (!testcache_make(cache_dir, sizeof cache_dir, "engine"))
         return -1;
-    setenv("XDG_CACHE_HOME", cache_dir, 1);
     have_cc = aot_compiler_available();
     return 0;
 }
@@ -55,7 +35,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    remove_tree(cache_dir, 2);
+    testcache_remove(cache_dir, 2);
     return 0;
 }
 
