@@ -10,6 +10,7 @@
  */
 #include "testutil.h"
 #include "testcache.h"
+#include "testout.h"
 
 #include "../generator/base/arena.h"
 #include "../generator/engine/aot.h"
@@ -50,24 +51,6 @@ static Mech *load_example(const char *name)
     if (!mech)
         fail_msg("%s: %s", path, diag.message);
     return mech;
-}
-
-/* The four quantities of one evaluation, sized for m. */
-typedef struct Out {
-    double *phi, *jac, *nu, *gamma;
-} Out;
-
-static void out_alloc(Out *o, const Model *m)
-{
-    o->phi = xcalloc((size_t)m->nh + 1, sizeof(double));
-    o->jac = xcalloc((size_t)m->nr * (size_t)m->nq + 1, sizeof(double));
-    o->nu = xcalloc((size_t)m->nr + 1, sizeof(double));
-    o->gamma = xcalloc((size_t)m->nr + 1, sizeof(double));
-}
-
-static void out_free(Out *o)
-{
-    free(o->phi), free(o->jac), free(o->nu), free(o->gamma);
 }
 
 static void evaluate(const MechrtKernels *k, const double *q, const double *qd, double t, Out *o)

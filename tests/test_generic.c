@@ -8,6 +8,8 @@
  * private folder ($XDG_CACHE_HOME is pointed at it).
  */
 #include "testutil.h"
+#include "testcache.h"
+#include "testout.h"
 
 #include "../generator/base/arena.h"
 #include "../generator/engine/aot.h"
@@ -53,44 +55,11 @@ static const char funcs_mech[] =
 static char cache_dir[256];
 static bool have_cc;
 
-static int remove_cache(void)
-{
-    DIR *d = opendir(cache_dir);
-    if (d) {
-        struct dirent *e;
-        char path[600];
-        while ((e = readdir(d))) {
-            if (e->d_name[0] == '.')
-                continue;
-            snprintf(path, sizeof path, "%s/%s", cache_dir, e->d_name);
-            unlink(path);
-            /* one level of subfolders: mechc/ */
-            DIR *sub = opendir(path);
-            if (sub) {
-                struct dirent *f;
-                char inner[900];
-                while ((f = readdir(sub)))
-                    if (f->d_name[0] != '.') {
-                        snprintf(inner, sizeof inner, "%s/%s", path, f->d_name);
-                        unlink(inner);
-                    }
-                closedir(sub);
-                rmdir(path);
-            }
-        }
-        closedir(d);
-    }
-    return rmdir(cache_dir);
-}
-
 static int setup(void **state)
 {
     (void)state;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(cache_dir, sizeof cache_dir, "%s/mechc-test-generic-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!mkdtemp(cache_dir))
+    if (!testcache_make(cache_dir, sizeof cache_dir, "generic"))
         return -1;
-    setenv("XDG_CACHE_HOME", cache_dir, 1);
     have_cc = aot_compiler_available();
     if (!have_cc)
         fprintf(stderr, "test_generic: no C compiler: the aot engine is not compared\n");
@@ -100,7 +69,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    remove_cache();
+    testcache_remove(cache_dir, 2);
     return 0;
 }
 
@@ -111,23 +80,6 @@ static double rnd(uint64_t *s)
     *s ^= *s << 25;
     *s ^= *s >> 27;
     return (double)((*s * 2685821657736338717ULL) >> 11) / 4503599627370496.0 - 1.0;
-}
-
-typedef struct Out {
-    double *phi, *jac, *nu, *gamma;
-} Out;
-
-static void out_alloc(Out *o, const Model *m)
-{
-    o->phi = xcalloc((size_t)m->nh + 1, sizeof(double));
-    o->jac = xcalloc((size_t)m->nr * (size_t)m->nq + 1, sizeof(double));
-    o->nu = xcalloc((size_t)m->nr + 1, sizeof(double));
-    o->gamma = xcalloc((size_t)m->nr + 1, sizeof(double));
-}
-
-static void out_free(Out *o)
-{
-    free(o->phi), free(o->jac), free(o->nu), free(o->gamma);
 }
 
 static void evaluate(const Engine *e, const double *q, const double *qd, double t, Out *o)
