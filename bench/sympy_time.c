@@ -24,6 +24,8 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "timing.h"
+
 enum { FN_PHI, FN_JAC_NZ, FN_GAMMA, FN_COUNT, FN_TRIG = FN_COUNT, NLIBS = 2 };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac_nz", "gamma"};
 
@@ -43,23 +45,6 @@ typedef struct Work {
     double t;
 } Work;
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);   /* time descheduled does not count */
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void *must_sym(void *h, const char *path, const char *name)
-{
-    void *p = dlsym(h, name);
-    if (!p) {
-        fprintf(stderr, "sympy_time: %s has no %s\n", path, name);
-        exit(2);
-    }
-    return p;
-}
-
 static void *open_lib(Lib *l, const char *path)
 {
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
@@ -68,11 +53,26 @@ static void *open_lib(Lib *l, const char *path)
         exit(2);
     }
     l->path = path;
-    *(void **)&l->phi = must_sym(h, path, "m_phi");
-    *(void **)&l->jac_nz = must_sym(h, path, "m_jac_nz");
-    *(void **)&l->gamma = must_sym(h, path, "m_gamma");
+    *(void **)&l->phi = timing_sym("sympy_time", h, path, "m_phi");
+    *(void **)&l->jac_nz = timing_sym("sympy_time", h, path, "m_jac_nz");
+    *(void **)&l->gamma = timing_sym("sympy_time", h, path, "m_gamma");
     l->trig = NULL;
     return h;
+}
+
+static void call_n(const Lib *l, int fn, long n, Work *w);
+
+/* One function of one library, for timing_batch. */
+typedef struct Timed {
+    const Lib *l;
+    int fn;
+    Work *w;
+} Timed;
+
+static void call_timed(void *ctx, long n)
+{
+    Timed *c = ctx;
+    call_n(c->l, c->fn, n, c->w);
 }
 
 static void call_n(const Lib *l, int fn, long n, Work *w)
@@ -84,28 +84,6 @@ static void call_n(const Lib *l, int fn, long n, Work *w)
         case FN_TRIG: l->trig(w->q, w->t, w->out); break;
         default: l->gamma(w->q, w->qd, w->t, w->out); break;
         }
-}
-
-/* Calls per batch so that one batch lasts about 2 ms; after one call, so
-   that page faults and cold caches do not count. */
-static long batch_size(const Lib *l, int fn, Work *w)
-{
-    long n = 1;
-    call_n(l, fn, 1, w);
-    for (;;) {
-        double t0 = now();
-        call_n(l, fn, n, w);
-        double dt = now() - t0;
-        if (dt > 2e-3 || n > (1L << 30))
-            return n;
-        n = dt < 1e-5 ? n * 16 : (long)((double)n * 2.2e-3 / dt) + 1;
-    }
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* Largest difference between the outputs of function fn of a and b,
@@ -151,8 +129,8 @@ int main(int argc, char **argv)
     Lib libs[NLIBS];
     void *h = open_lib(&libs[0], argv[5]);
     void *hs = open_lib(&libs[1], argv[6]);
-    *(void **)&libs[1].trig = must_sym(hs, argv[6], "m_trig");
-    const double *q0 = must_sym(h, argv[5], "m_q0");
+    *(void **)&libs[1].trig = timing_sym("sympy_time", hs, argv[6], "m_trig");
+    const double *q0 = timing_sym("sympy_time", h, argv[5], "m_q0");
     w.q = calloc((size_t)w.nq, sizeof(double));
     w.qd = calloc((size_t)w.nq, sizeof(double));
     w.out = calloc(2 * (size_t)(w.nq + w.nr + w.nnz) + 16, sizeof(double));
@@ -175,20 +153,22 @@ int main(int argc, char **argv)
     enum { NSLOTS = NLIBS * FN_COUNT + 1 };
     long batch[NSLOTS];
     double *ns = calloc((size_t)NSLOTS * (size_t)repeat, sizeof(double));
-    for (int s = 0; s < NSLOTS; s++)
-        batch[s] = batch_size(&libs[s < NSLOTS - 1 ? s % NLIBS : 1], s / NLIBS, &w);
+    for (int s = 0; s < NSLOTS; s++) {
+        Timed c = {&libs[s < NSLOTS - 1 ? s % NLIBS : 1], s / NLIBS, &w};
+        batch[s] = timing_batch(call_timed, &c);
+    }
     for (int r = -1; r < repeat; r++)       /* round -1 warms up */
         for (int i = 0; i < NSLOTS; i++) {
             int s = (i + (r < 0 ? 0 : r)) % NSLOTS;
-            double t0 = now();
+            double t0 = timing_now();
             call_n(&libs[s < NSLOTS - 1 ? s % NLIBS : 1], s / NLIBS, batch[s], &w);
             if (r >= 0)
-                ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (now() - t0) / (double)batch[s];
+                ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (timing_now() - t0) / (double)batch[s];
         }
     double med[NSLOTS];
     for (int s = 0; s < NSLOTS; s++) {
         double *v = &ns[(size_t)s * (size_t)repeat];
-        qsort(v, (size_t)repeat, sizeof *v, cmp_double);
+        qsort(v, (size_t)repeat, sizeof *v, timing_cmp_double);
         med[s] = v[repeat / 2];
     }
     double trig = med[NSLOTS - 1];

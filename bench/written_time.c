@@ -24,6 +24,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "timing.h"
+
 enum { FN_PHI, FN_JAC, FN_JAC_NZ, FN_NU, FN_GAMMA, FN_ALL, FN_COUNT, MAX_LIBS = 16 };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "jac_nz", "nu", "gamma", "all"};
 
@@ -48,23 +50,6 @@ typedef struct Work {
     double t;
 } Work;
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);   /* time descheduled does not count */
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void *must_sym(void *h, const char *path, const char *name)
-{
-    void *p = dlsym(h, name);
-    if (!p) {
-        fprintf(stderr, "written_time: %s has no %s\n", path, name);
-        exit(2);
-    }
-    return p;
-}
-
 static void open_lib(Lib *l, const char *path)
 {
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
@@ -73,15 +58,30 @@ static void open_lib(Lib *l, const char *path)
         exit(2);
     }
     l->path = path;
-    *(void **)&l->phi = must_sym(h, path, "m_phi");
-    *(void **)&l->jac = must_sym(h, path, "m_jac");
-    *(void **)&l->jac_nz = must_sym(h, path, "m_jac_nz");
-    *(void **)&l->nu = must_sym(h, path, "m_nu");
-    *(void **)&l->gamma = must_sym(h, path, "m_gamma");
-    *(void **)&l->all = must_sym(h, path, "m_all");
-    l->q0 = must_sym(h, path, "m_q0");
-    l->row = must_sym(h, path, "m_jac_row");
-    l->col = must_sym(h, path, "m_jac_col");
+    *(void **)&l->phi = timing_sym("written_time", h, path, "m_phi");
+    *(void **)&l->jac = timing_sym("written_time", h, path, "m_jac");
+    *(void **)&l->jac_nz = timing_sym("written_time", h, path, "m_jac_nz");
+    *(void **)&l->nu = timing_sym("written_time", h, path, "m_nu");
+    *(void **)&l->gamma = timing_sym("written_time", h, path, "m_gamma");
+    *(void **)&l->all = timing_sym("written_time", h, path, "m_all");
+    l->q0 = timing_sym("written_time", h, path, "m_q0");
+    l->row = timing_sym("written_time", h, path, "m_jac_row");
+    l->col = timing_sym("written_time", h, path, "m_jac_col");
+}
+
+static void call_n(const Lib *l, int fn, long n, Work *w, const Lib *shape);
+
+/* One function of one library (or the floor), for timing_batch. */
+typedef struct Timed {
+    const Lib *l, *shape;
+    int fn;
+    Work *w;
+} Timed;
+
+static void call_timed(void *ctx, long n)
+{
+    Timed *c = ctx;
+    call_n(c->l, c->fn, n, c->w, c->shape);
 }
 
 /* Calls function fn of l n times; the floor (l NULL) is memset and stores. */
@@ -103,28 +103,6 @@ static void call_n(const Lib *l, int fn, long n, Work *w, const Lib *shape)
         default: l->all(w->q, w->qd, w->t, w->phi, w->jac, w->nu, w->gamma); break;
         }
     }
-}
-
-/* Calls per batch so that one batch lasts about 2 ms; after one call, so
-   that page faults and cold caches do not count. */
-static long batch_size(const Lib *l, int fn, Work *w, const Lib *shape)
-{
-    long n = 1;
-    call_n(l, fn, 1, w, shape);
-    for (;;) {
-        double t0 = now();
-        call_n(l, fn, n, w, shape);
-        double dt = now() - t0;
-        if (dt > 2e-3 || n > (1L << 30))
-            return n;
-        n = dt < 1e-5 ? n * 16 : (long)((double)n * 2.2e-3 / dt) + 1;
-    }
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* Largest difference between the outputs of a and b, relative to the
@@ -200,22 +178,24 @@ int main(int argc, char **argv)
     int nslots = nlibs * FN_COUNT + 1;
     long *batch = calloc((size_t)nslots, sizeof(long));
     double *ns = calloc((size_t)nslots * (size_t)repeat, sizeof(double));
-    for (int s = 0; s < nslots; s++)
-        batch[s] = batch_size(s < nslots - 1 ? &libs[s / FN_COUNT] : NULL, s % FN_COUNT, &w, &libs[0]);
+    for (int s = 0; s < nslots; s++) {
+        Timed c = {s < nslots - 1 ? &libs[s / FN_COUNT] : NULL, &libs[0], s % FN_COUNT, &w};
+        batch[s] = timing_batch(call_timed, &c);
+    }
     /* round -1 warms up; each round starts at another slot, so that no
        LIB always follows the floor (whose memset evicts the Jacobian) */
     for (int r = -1; r < repeat; r++)
         for (int i = 0; i < nslots; i++) {
             int s = (i + (r < 0 ? 0 : r) * (FN_COUNT + 1)) % nslots;
             const Lib *l = s < nslots - 1 ? &libs[s / FN_COUNT] : NULL;
-            double t0 = now();
+            double t0 = timing_now();
             call_n(l, s % FN_COUNT, batch[s], &w, &libs[0]);
             if (r >= 0)
-                ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (now() - t0) / (double)batch[s];
+                ns[(size_t)s * (size_t)repeat + (size_t)r] = 1e9 * (timing_now() - t0) / (double)batch[s];
         }
     for (int s = 0; s < nslots; s++) {
         double *v = &ns[(size_t)s * (size_t)repeat];
-        qsort(v, (size_t)repeat, sizeof *v, cmp_double);
+        qsort(v, (size_t)repeat, sizeof *v, timing_cmp_double);
         if (s % FN_COUNT == 0 || s == nslots - 1)
             printf("%s", s < nslots - 1 ? libs[s / FN_COUNT].path : "floor");
         printf(" %.1f", v[repeat / 2]);
