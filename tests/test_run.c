@@ -12,6 +12,7 @@
  * Runs from the repository root (examples/ relative), like `make check`.
  */
 #include "testutil.h"
+#include "testload.h"
 
 #include <dlfcn.h>
 #include <stdlib.h>
@@ -52,26 +53,6 @@ static int coord_index(const Model *m, const char *name)
             return i;
     fail_msg("no coordinate %s", name);
     return -1;
-}
-
-static Mech *load_file(const char *path)
-{
-    static Diag diag;   /* must outlive the Mech on failure paths only */
-    MechLimits limits = mech_default_limits();
-    Mech *m = pipeline_load(path, &limits, &diag);
-    if (!m)
-        fail_msg("%s: %s", path, diag.message);
-    return m;
-}
-
-static Mech *load_text(const char *text, const char *name)
-{
-    static Diag diag;
-    MechLimits limits = mech_default_limits();
-    Mech *m = pipeline_load_text(text, name, &limits, &diag);
-    if (!m)
-        fail_msg("%s: %s", name, diag.message);
-    return m;
 }
 
 /* Runs mech with engine kind and options o (notes captured); c must be freed

@@ -10,6 +10,7 @@
  * and coordinate named; what sparse refuses. Runs from the repository root.
  */
 #include "testutil.h"
+#include "testload.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -172,26 +173,6 @@ static void collect(void *ctx, double t, const double *q, const double *qd, cons
 {
     Collected *c = ctx;
     assert_true(mechrt_trace_push(&c->trace, t, q, qd, qdd));
-}
-
-static Mech *load_text(const char *text, const char *name)
-{
-    static Diag diag;
-    MechLimits limits = mech_default_limits();
-    Mech *m = pipeline_load_text(text, name, &limits, &diag);
-    if (!m)
-        fail_msg("%s: %s", name, diag.message);
-    return m;
-}
-
-static Mech *load_file(const char *path)
-{
-    static Diag diag;
-    MechLimits limits = mech_default_limits();
-    Mech *m = pipeline_load(path, &limits, &diag);
-    if (!m)
-        fail_msg("%s: %s", path, diag.message);
-    return m;
 }
 
 /* examples/chain.sh N, loaded. */
