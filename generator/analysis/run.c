@@ -346,8 +346,20 @@ static void fail(Run *r, MechrtStatus st, double t, const double *q, const Mechr
 
 static void fail_assembly(Run *r, const AssembleResult *ar);
 
+/* The start of the assembly at t0: the file's values into q0 (the note on
+   how far assembly moved them compares with these), then r->q as the
+   construction places it (construct.h), also into start, where a robust
+   assembly begins again when Newton cannot start. q0, start: nq each. */
+static void place_at_t0(Run *r, double *q0, double *start)
+{
+    size_t nq = (size_t)r->nq;
+    memcpy(q0, r->q, nq * sizeof *q0);
+    r->res->constructed = construct_with_kernels(r->m, r->k, r->o->t0, r->q);
+    memcpy(start, r->q, nq * sizeof *start);
+}
+
 /* Minimum-norm Newton with step halving over the holonomic rows, from the
- * initial values in r->q (assemble_kernels, what `info` uses):
+ * start in r->q (assemble_kernels, what `info` uses):
  * unlike Newton with LU it starts from any guess, including one where the
  * Jacobian is singular because two links are merely parallel (all angles
  * 0). False, with the message filled, when even it finds no configuration
@@ -355,7 +367,6 @@ static void fail_assembly(Run *r, const AssembleResult *ar);
 static bool assemble_robustly(Run *r)
 {
     const RunOptions *o = r->o;
-    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
     AnalysisOptions ao = analysis_default_options();
     ao.tol_phi = o->mechrt.tol_phi;
     ao.tol_dq = o->mechrt.tol_dq;
@@ -685,18 +696,17 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     MechrtReport rep;
     RunStatus status = RUN_OK;
     size_t nq = (size_t)r->nq;
-    double *q0 = xmalloc(nq * sizeof *q0);
+    double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
     double *keep = xmalloc(8 * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
-    memcpy(q0, r->q, nq * sizeof *q0);
-    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
+    place_at_t0(r, q0, start);
     MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
     r->res->assembly_iterations = rep.iterations;
     if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
         /* a guess Newton cannot start from: assemble robustly, then
            Newton again for the velocities and accelerations there */
-        memcpy(r->q, q0, nq * sizeof *q0);
+        memcpy(r->q, start, nq * sizeof *start);
         if (!assemble_robustly(r)) {
             status = RUN_FAILED;
             goto out;
@@ -757,13 +767,12 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         return RUN_FAILED;
     }
     r->res->integrated = true;
-    double *q0 = xmalloc((size_t)r->nq * sizeof *q0);
-    memcpy(q0, r->q, (size_t)r->nq * sizeof *q0);
-    r->res->constructed = construct_with_kernels(r->m, r->k, o->t0, r->q);
+    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
+    place_at_t0(r, q0, start);
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
     r->res->assembly_iterations = rep.iterations;
     if (st != MECHRT_OK && st != MECHRT_EINVAL) {
-        memcpy(r->q, q0, (size_t)r->nq * sizeof *q0);
+        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
         if (!assemble_robustly(r)) {
             status = RUN_FAILED;
             goto out;
