@@ -302,13 +302,13 @@ static bool place_dyad(Place *p, int j)
     for (int flip = 0; flip < 2; flip++) {
         const Attach *ma = flip ? &M->b : &M->a, *mb = flip ? &M->a : &M->b;
         const Attach *sa, *oa;
-        if (!unplaced_link(p, ma) || !pin_to_placed(p, ma->q, j, -1, &sa, &oa))
+        const Joint *J1 = unplaced_link(p, ma) ? pin_to_placed(p, ma->q, j, -1, &sa, &oa) : NULL;
+        if (!J1)
             continue;
         Side a = side_of(p, sa, oa, ma);
         P2 cand[2];
         if (unplaced_link(p, mb)) {
             const Attach *sb, *ob;
-            const Joint *J1 = pin_to_placed(p, ma->q, j, -1, &sa, &oa);
             if (!pin_to_placed(p, mb->q, j, (int)(J1 - p->m->joints), &sb, &ob))
                 continue;
             Side b = side_of(p, sb, ob, mb);
