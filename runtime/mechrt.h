@@ -88,7 +88,7 @@ typedef enum MechrtStatus {
     { (void)ctx; p##_all(q, qd, t, phi, jac, nu, gamma); }                       \
     static const MechrtKernels p##_kernels = {                                   \
         P##_NQ, P##_NH, P##_NV, NULL, p##_mechrt_phi, p##_mechrt_jac,            \
-        p##_mechrt_nu, p##_mechrt_gamma, p##_mechrt_all}
+        p##_mechrt_nu, p##_mechrt_gamma, p##_mechrt_all, NULL, NULL}
 
 #endif /* MECHRT_H_COMMON */
 
@@ -139,7 +139,8 @@ typedef double mechrt_real;
 /* The kernels of one mechanism (spec section 4), taken by pointer so the
    runtime never depends on the generated names. NR = nh + nv rows:
    holonomic rows first, then velocity-level rows. phi, jac, nu and gamma
-   are required; all is optional (Newton uses it when present).
+   are required; all, mass and force are optional (Newton uses all when
+   present).
    Every kernel receives ctx first: NULL for generated code (wrapped by
    MECHRT_DEFINE_KERNELS below), the evaluator's state for a host-side
    engine that needs one (mechc's generic evaluator). */
@@ -159,6 +160,12 @@ typedef struct MechrtKernels {
     /* all four at once, sharing common subexpressions; may be NULL */
     void (*all)(void *ctx, const mechrt_real *q, const mechrt_real *qd, mechrt_real t,
                 mechrt_real *phi, mechrt_real *jac, mechrt_real *nu, mechrt_real *gamma);
+    /* Dynamics, M(q) qdd + Phi_q^T lambda = Q(q, qd, t); both NULL when the
+       mechanism has no masses. Q holds the applied forces and the velocity
+       (quadratic) terms of the kinetic energy. */
+    void (*mass)(void *ctx, const mechrt_real *q, mechrt_real *M);          /* nq*nq, row-major */
+    void (*force)(void *ctx, const mechrt_real *q, const mechrt_real *qd, mechrt_real t,
+                  mechrt_real *Q);                                         /* nq values */
 } MechrtKernels;
 
 /* Tunable constants. Fill with mechrt_default_options(), then change fields.

@@ -129,7 +129,7 @@ static void sc_all(void *ctx, const double *q, const double *qd, double t,
     sc_gamma(ctx, q, qd, t, gamma);
 }
 
-static const MechrtKernels sc_kernels = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, sc_all};
+static const MechrtKernels sc_kernels = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, sc_all, NULL, NULL};
 
 /* The slider crank with one redundant velocity-level row appended,
    Psi = thd - (w + al t): NH == NQ, NR = 4. Newton uses the top 3 rows. */
@@ -156,8 +156,8 @@ static void scv_gamma(void *ctx, const double *q, const double *qd, double t, do
     g[3] = SC_AL;
 }
 
-static const MechrtKernels scv_kernels = {3, 3, 1, NULL, sc_phi, scv_jac, scv_nu, scv_gamma, NULL};
-static const MechrtKernels sc_kernels_noall = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, NULL};
+static const MechrtKernels scv_kernels = {3, 3, 1, NULL, sc_phi, scv_jac, scv_nu, scv_gamma, NULL, NULL, NULL};
+static const MechrtKernels sc_kernels_noall = {3, 3, 0, NULL, sc_phi, sc_jac, sc_nu, sc_gamma, NULL, NULL, NULL};
 
 static void sc_exact(double t, double *q, double *qd, double *qdd)
 {
@@ -214,7 +214,7 @@ static void ci_gamma(void *ctx, const double *q, const double *qd, double t, dou
     g[1] = -CI_R * CI_W * CI_W * cos(CI_C + CI_W * t);
 }
 
-static const MechrtKernels ci_kernels = {2, 2, 0, NULL, ci_phi, ci_jac, ci_nu, ci_gamma, NULL};
+static const MechrtKernels ci_kernels = {2, 2, 0, NULL, ci_phi, ci_jac, ci_nu, ci_gamma, NULL, NULL, NULL};
 
 /* ---- mechanism 3: knife-edge cart driven by heading and speed ----------
  * q = (x, y, th). One holonomic row, two velocity-level rows:
@@ -268,7 +268,7 @@ static void kn_gamma(void *ctx, const double *q, const double *qd, double t, dou
     g[2] = (s * qd[0] - c * qd[1]) * qd[2];
 }
 
-static const MechrtKernels kn_kernels = {3, 1, 2, NULL, kn_phi, kn_jac, kn_nu, kn_gamma, NULL};
+static const MechrtKernels kn_kernels = {3, 1, 2, NULL, kn_phi, kn_jac, kn_nu, kn_gamma, NULL, NULL, NULL};
 
 /* A kernel set whose second row is NaN: the runtime must say so. */
 static void nan_phi(void *ctx, const double *q, double t, double *phi)
@@ -278,7 +278,7 @@ static void nan_phi(void *ctx, const double *q, double t, double *phi)
     phi[1] = NAN;
 }
 
-static const MechrtKernels nan_kernels = {3, 3, 0, NULL, nan_phi, sc_jac, sc_nu, sc_gamma, NULL};
+static const MechrtKernels nan_kernels = {3, 3, 0, NULL, nan_phi, sc_jac, sc_nu, sc_gamma, NULL, NULL, NULL};
 
 /* ---- LU ---------------------------------------------------------------- */
 
@@ -1066,7 +1066,7 @@ static void test_kernel_wrappers(void **state)
     double work[64];
     MechrtReport rep;
     CountCtx cc = {4242, 0, 0, 0, 0};
-    MechrtKernels ck = {2, 2, 0, &cc, cc_phi, cc_jac, cc_nu, cc_gamma, NULL};
+    MechrtKernels ck = {2, 2, 0, &cc, cc_phi, cc_jac, cc_nu, cc_gamma, NULL, NULL, NULL};
 
     assert_int_equal(gc_kernels.nq, 2);
     assert_int_equal(gc_kernels.nh, 2);
@@ -1177,7 +1177,7 @@ static void test_float_build(void **state)
     assert_true(cf > 0);
 
     /* assembly and a short run of the slider crank */
-    MechrtKernels k = {3, 3, 0, NULL, fsc_phi, fsc_jac, fsc_nu, fsc_gamma, NULL};
+    MechrtKernels k = {3, 3, 0, NULL, fsc_phi, fsc_jac, fsc_nu, fsc_gamma, NULL, NULL, NULL};
     float q[3], qd[3] = {0}, qdd[3] = {0}, work[64];
     double eq[3], eqd[3], eqdd[3];
     MechrtReport rep;

@@ -35,7 +35,8 @@ MECHRT_DEFINE_KERNELS(st, ST);
 
 /* The position solve's kernels: without `all`, Newton calls phi and jac. */
 static const MechrtKernels st_fk_kernels = {
-    ST_NQ, ST_NH, ST_NV, NULL, st_mechrt_phi, st_mechrt_jac, st_mechrt_nu, st_mechrt_gamma, NULL
+    ST_NQ, ST_NH, ST_NV, NULL, st_mechrt_phi, st_mechrt_jac, st_mechrt_nu, st_mechrt_gamma, NULL,
+    NULL, NULL
 };
 
 enum {

@@ -89,8 +89,9 @@ static void gen_all(void *ctx, const double *q, const double *qd, double t,
 static void bind_code(Engine *e, const Kernels *code)
 {
     e->kernels = *code;
-    e->k = (MechrtKernels){e->nq, e->nh, e->nv, (void *)code,
-                           code_phi, code_jac, code_nu, code_gamma, code_all};
+    e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = (void *)code,
+                           .phi = code_phi, .jac = code_jac, .nu = code_nu,
+                           .gamma = code_gamma, .all = code_all};
 }
 
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
@@ -142,8 +143,9 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
         double t0 = pipeline_now();
         e->generic = generic_open(mech->model);
         e->gen_seconds = pipeline_now() - t0;
-        e->k = (MechrtKernels){e->nq, e->nh, e->nv, e->generic,
-                               gen_phi, gen_jac, gen_nu, gen_gamma, gen_all};
+        e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = e->generic,
+                               .phi = gen_phi, .jac = gen_jac, .nu = gen_nu,
+                               .gamma = gen_gamma, .all = gen_all};
         return true;
     }
     case ENGINE_AOT:
