@@ -12,27 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-int mechrt_format_real(char *buf, size_t size, double v, int digits)
-{
-    if (isnan(v))
-        return snprintf(buf, size, "nan");
-    if (isinf(v))
-        return snprintf(buf, size, v > 0 ? "inf" : "-inf");
-    if (v == 0)
-        v = 0;   /* -0 prints as 0: a sign on zero is noise to a reader */
-    if (digits > 0)
-        return snprintf(buf, size, "%.*g", digits, v);
-    /* 17 significant digits always round-trip a double; fewer usually do
-       and read better (0.3, not 0.29999999999999999) */
-    int n = 0;
-    for (int d = 15; d <= 17; d++) {
-        n = snprintf(buf, size, "%.*g", d, v);
-        if (d == 17 || strtod(buf, NULL) == v)
-            break;
-    }
-    return n;
-}
-
 static void put_real(FILE *out, double v, int digits)
 {
     char buf[40];
@@ -66,22 +45,41 @@ void mechrt_csv_row(FILE *out, int nq, double t, const double *q, const double *
     mechrt_csv_row_omega(out, nq, t, q, qd, qdd, 0, NULL, digits);
 }
 
+/* A CSV row is formatted into this, written when nearly full: one fwrite
+   per few hundred numbers instead of one stdio call per number and comma. */
+typedef struct {
+    FILE *out;
+    size_t len;
+    char buf[8192];
+} RowBuf;
+
+static void rowbuf_real(RowBuf *rb, char sep, double v, int digits)
+{
+    if (rb->len > sizeof rb->buf - 48) {
+        fwrite(rb->buf, 1, rb->len, rb->out);
+        rb->len = 0;
+    }
+    if (sep)
+        rb->buf[rb->len++] = sep;
+    rb->len += (size_t)mechrt_format_real(rb->buf + rb->len, 40, v, digits);
+}
+
 void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
                           const double *qdd, int nw, const double *w, int digits)
 {
-    put_real(out, t, digits);
+    RowBuf rb;
+    rb.out = out;
+    rb.len = 0;
+    rowbuf_real(&rb, 0, t, digits);
     const double *v[3] = {q, qd, qdd};
     for (int k = 0; k < 3; k++) {
-        for (int i = 0; i < nq; i++) {
-            fputc(',', out);
-            put_real(out, v[k][i], digits);
-        }
-        for (int i = 0; k == 1 && i < nw; i++) {
-            fputc(',', out);
-            put_real(out, w[i], digits);
-        }
+        for (int i = 0; i < nq; i++)
+            rowbuf_real(&rb, ',', v[k][i], digits);
+        for (int i = 0; k == 1 && i < nw; i++)
+            rowbuf_real(&rb, ',', w[i], digits);
     }
-    fputc('\n', out);
+    rb.buf[rb.len++] = '\n';
+    fwrite(rb.buf, 1, rb.len, out);
 }
 
 void mechrt_trace_init(MechrtTrace *tr, int nq)
