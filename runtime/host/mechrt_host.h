@@ -207,7 +207,7 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
                                      double *qdd, double t, double h, double *work, size_t lwork,
                                      MechrtReport *report);
 
-/* ---- Output (output.c) ---------------------------------------------------- */
+/* ---- Output (output.c; numbers: format_real.c) ---------------------------- */
 
 /* v as text: with digits == 0 the shortest of %.15g, %.16g, %.17g that
    reads back as v (0.3 stays "0.3"), else %.<digits>g. -0 is "0"; NaN
