@@ -5,7 +5,10 @@
 # failure; a chain of 50 four-bar loops goes sparse under auto and matches
 # the dense run; bad values, velocity-level rows and the generic engine are
 # refused with exit 2; the toggle's sparse failure names its time, row and
-# coordinate.
+# coordinate. gen --sparse writes PREFIX_all_nz (and only then), a C99 file
+# whose all_nz agrees with phi, jac_nz, nu and gamma; the dense-Jacobian
+# limit (--max-jac-entries) binds only runs that form one, and a chain of
+# 1000 loops runs sparse in less address space than its dense Jacobian.
 #
 #   sh tests/sparse_cli.sh build/mechc
 set -u
@@ -72,6 +75,77 @@ check "--linear sparse --engine generic: says why" err_has "generic engine"
 run "$ex/slider_crank.mech" --linear sparse --engine generic --steps 2 --linear dense \
     --csv "$tmp/g.csv"
 check "the last --linear wins" status_is 0
+
+# ---- gen --sparse: PREFIX_all_nz --------------------------------------------
+run_mechc gen "$ex/four_bar.mech" --prefix fb -o "$tmp/fb.c"
+check "gen: no all_nz without --sparse" sh -c "! grep -q all_nz '$tmp/fb.c'"
+run_mechc gen "$ex/four_bar.mech" --prefix fb --sparse -o "$tmp/fbs.c" --header "$tmp/fbs.h"
+check "gen --sparse: exit 0" status_is 0
+check "gen --sparse: all_nz declared" grep -q "^void fb_all_nz(const fb_real \*q" "$tmp/fbs.h"
+check "gen --sparse: all_nz defined" grep -q "^void fb_all_nz(const fb_real \*q" "$tmp/fbs.c"
+check "gen --sparse: its ops in the banner" grep -q "all [0-9]*, all_nz [0-9]*" "$tmp/fbs.c"
+if have cc; then
+    cat > "$tmp/fbs_main.c" << 'EOF'
+#include "fbs.h"
+#include <math.h>
+int main(void)
+{
+    fb_real q[FB_NQ], qd[FB_NQ], phi[FB_NR], nu[FB_NR], g[FB_NR], v[FB_NNZ];
+    fb_real phi2[FB_NR], nu2[FB_NR], g2[FB_NR], v2[FB_NNZ];
+    int i, bad = 0;
+    for (i = 0; i < FB_NQ; i++) {
+        q[i] = fb_q0[i] + 0.01 * i;
+        qd[i] = 0.5 - 0.1 * i;
+    }
+    fb_all_nz(q, qd, 0.2, phi, v, nu, g);
+    fb_phi(q, 0.2, phi2);
+    fb_jac_nz(q, 0.2, v2);
+    fb_nu(q, 0.2, nu2);
+    fb_gamma(q, qd, 0.2, g2);
+    for (i = 0; i < FB_NH; i++) bad += !(fabs(phi[i] - phi2[i]) <= 1e-12);
+    for (i = 0; i < FB_NNZ; i++) bad += !(fabs(v[i] - v2[i]) <= 1e-12);
+    for (i = 0; i < FB_NR; i++) bad += !(fabs(nu[i] - nu2[i]) <= 1e-12 && fabs(g[i] - g2[i]) <= 1e-12);
+    return bad != 0;
+}
+EOF
+    check "gen --sparse: compiles as C99 without warnings" \
+        cc -std=c99 -pedantic -Wall -Wextra -Werror -O1 -I"$tmp" "$tmp/fbs.c" "$tmp/fbs_main.c" \
+        -lm -o "$tmp/fbs_main"
+    check "gen --sparse: all_nz agrees with phi, jac_nz, nu, gamma" "$tmp/fbs_main"
+else
+    skip "no cc: the written all_nz is not compiled"
+fi
+
+# ---- the dense-Jacobian limit binds dense runs only ---------------------------
+run "$tmp/chain50.mech" --steps 4 --max-jac-entries 1000 --csv "$tmp/lim.csv"
+check "chain 50, --max-jac-entries 1000, auto: runs sparse" status_is 0
+run "$tmp/chain50.mech" --steps 4 --max-jac-entries 1000 --linear dense
+check "... --linear dense: exit 2" status_is 2
+check "... --linear dense: the limit named" err_has "more than the limit of 1000"
+run "$tmp/chain50.mech" --steps 4 --max-jac-entries 1000 --engine generic
+check "... --engine generic (dense only): exit 2" status_is 2
+check "... --engine generic: says sparse cannot serve" err_has "the sparse path cannot serve"
+
+# ---- no nr x nq matrix on the sparse path: 1000 loops in 250 MB of address
+# space, where the dense Jacobian alone takes 288 MB (skipped where the
+# build cannot start under that limit: sanitizers reserve terabytes) -------
+sh "$ex/chain.sh" 1000 "$tmp/chain1000.mech"
+if (ulimit -v 250000 && "$mechc" run "$ex/four_bar.mech" --steps 1 > /dev/null 2>&1); then
+    (ulimit -v 250000 && "$mechc" run "$tmp/chain1000.mech" --steps 2 --linear sparse \
+        --csv "$tmp/c1000.csv") > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+    check "chain 1000 sparse within 250 MB of address space: exit 0" status_is 0
+    check "chain 1000 sparse: 3 states" test "$(wc -l < "$tmp/c1000.csv")" = 4
+    # the subshell waits (no exec of its last command), so the abort's
+    # report goes to its stderr, not the suite's
+    (ulimit -v 250000; "$mechc" run "$tmp/chain1000.mech" --steps 2 --linear dense \
+        --csv /dev/null; echo $? > "$tmp/rc") > "$tmp/out" 2> "$tmp/err"
+    rc=$(cat "$tmp/rc")
+    check "chain 1000 dense within 250 MB: out of memory (the limit means something)" \
+        test "$rc" != 0
+else
+    skip "the build does not start within 250 MB of address space"
+fi
 
 # ---- the toggle, sparse ------------------------------------------------------
 run "$ex/slider_crank_toggle.mech" --linear sparse

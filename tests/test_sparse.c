@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "../generator/analysis/run.h"
+#include "../generator/jit/jit.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"
 
@@ -38,7 +39,7 @@ static void fill_vals(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostJacNz small_pattern(double *v)
 {
-    return (MechrtHostJacNz){6, p_row, p_col, v, fill_vals};
+    return (MechrtHostJacNz){6, p_row, p_col, v, fill_vals, NULL};
 }
 
 static void test_klu_solve(void **state)
@@ -124,7 +125,7 @@ static void test_klu_repivots(void **state)
 {
     (void)state;
     double v[4] = {1, 1, 1e-3, 2};
-    MechrtHostJacNz j = {4, full_row, full_col, v, fill_full};
+    MechrtHostJacNz j = {4, full_row, full_col, v, fill_full, NULL};
     MechrtHostSparse *s = mechrt_host_sparse_new(2, &j);
     assert_non_null(s);
     mechrt_host_sparse_eval(s, NULL, 0);
@@ -150,7 +151,7 @@ static void test_klu_bad_pattern(void **state)
     (void)state;
     double v[6] = {1, 1, 1, 1, 1, 1};
     static const int dup_col[] = {0, 0, 0, 1, 1, 2};    /* (0, 0) twice */
-    MechrtHostJacNz j = {6, p_row, dup_col, v, fill_vals};
+    MechrtHostJacNz j = {6, p_row, dup_col, v, fill_vals, NULL};
     assert_null(mechrt_host_sparse_new(3, &j));
     static const int far_col[] = {0, 3, 0, 1, 1, 2};    /* column 3 of 3 */
     j.col = far_col;
@@ -341,6 +342,133 @@ static void test_refusals(void **state)
     pipeline_free(mech);
 }
 
+/* ---- the fused kernel, all_nz ------------------------------------------ */
+
+/* all_nz of the engine's code against phi, jac_nz, nu and gamma at a state
+   off the initial one: the same values (the same expressions, scheduled
+   together). */
+static void expect_all_nz_agrees(Mech *mech, EngineKind kind)
+{
+    Engine e;
+    Diag diag;
+    if (!engine_open(&e, kind, mech, &diag))
+        fail_msg("engine: %s", diag.message);
+    const Kernels *code = e.k.ctx;
+    assert_non_null(code->all_nz);
+    const Model *m = mech->model;
+    size_t nq = (size_t)m->nq, nr = (size_t)m->nr, nnz = (size_t)mech->kin.nnz;
+    double *buf = calloc(6 * nr + 2 * nnz + 2 * nq, sizeof *buf);
+    double *phi = buf, *nu = buf + nr, *gamma = buf + 2 * nr, *phi2 = buf + 3 * nr;
+    double *nu2 = buf + 4 * nr, *gamma2 = buf + 5 * nr, *vals = buf + 6 * nr;
+    double *vals2 = vals + nnz, *q = vals2 + nnz, *qd = q + nq;
+    for (size_t i = 0; i < nq; i++) {
+        q[i] = m->q0[i] + 0.01 * sin((double)i);
+        qd[i] = cos(3.0 * (double)i);
+    }
+    code->all_nz(q, qd, 0.3, phi, vals, nu, gamma);
+    code->phi(q, 0.3, phi2);
+    code->jac_nz(q, 0.3, vals2);
+    code->nu(q, 0.3, nu2);
+    code->gamma(q, qd, 0.3, gamma2);
+    const double *a[4] = {phi, vals, nu, gamma}, *b[4] = {phi2, vals2, nu2, gamma2};
+    size_t n[4] = {(size_t)m->nh, nnz, nr, nr};
+    int nonzero = 0;
+    for (int k = 0; k < 4; k++)
+        for (size_t i = 0; i < n[k]; i++) {
+            if (!(fabs(a[k][i] - b[k][i]) <= 1e-12 * fmax(1, fabs(b[k][i]))))
+                fail_msg("%s: output %d entry %zu: all_nz %.17g, alone %.17g", m->name, k, i,
+                         a[k][i], b[k][i]);
+            nonzero += a[k][i] != 0;
+        }
+    assert_true(nonzero > (int)nnz / 2);   /* a state where the values mean something */
+    free(buf);
+    engine_close(&e);
+}
+
+static void test_all_nz_kernel(void **state)
+{
+    (void)state;
+    Mech *mech = load_chain(50);
+    expect_all_nz_agrees(mech, ENGINE_JIT);
+    pipeline_free(mech);
+    mech = load_file("examples/four_bar.mech");
+    expect_all_nz_agrees(mech, ENGINE_JIT);
+    expect_all_nz_agrees(mech, ENGINE_AOT);
+    pipeline_free(mech);
+    /* the KLU module without it: eval_all declines, does nothing */
+    double v[6] = {2, 1, 1, 3, 1, 4}, x = 1;
+    MechrtHostJacNz j = small_pattern(v);
+    MechrtHostSparse *s = mechrt_host_sparse_new(3, &j);
+    assert_false(mechrt_host_sparse_eval_all(s, &x, &x, 0, NULL, NULL, NULL));
+    mechrt_host_sparse_free(s);
+}
+
+/* The sparse path with and without the fused kernel: the same states, the
+   same iterations (nu from the last Newton evaluation is the nu kernel's). */
+static void test_all_nz_run(void **state)
+{
+    (void)state;
+    Mech *mech = load_chain(20);
+    RunOptions o = run_default_options();
+    o.steps = 10;
+    Collected c[2];
+    for (int fused = 0; fused < 2; fused++) {
+        Engine e;
+        Diag diag;
+        MechrtHostJacNz jnz;
+        memset(&c[fused], 0, sizeof c[fused]);
+        mechrt_trace_init(&c[fused].trace, mech->model->nq);
+        assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
+        MechrtKernels k = e.k;
+        o.linear = RUN_LINEAR_SPARSE;
+        assert_true(run_jac_nz_of(&e, &jnz));
+        assert_non_null(jnz.all_nz);
+        if (!fused)
+            jnz.all_nz = NULL;
+        o.jac_nz = &jnz;
+        c[fused].status = run_analysis(mech->model, &k, &o, collect, &c[fused], &c[fused].res);
+        assert_int_equal(c[fused].status, RUN_OK);
+        engine_close(&e);
+    }
+    expect_same(&c[0], &c[1], "chain 20, all_nz");
+    assert_int_equal(c[0].res.newton_iterations, c[1].res.newton_iterations);
+    assert_int_equal(c[0].res.substeps, c[1].res.substeps);
+    mechrt_trace_free(&c[0].trace);
+    mechrt_trace_free(&c[1].trace);
+    pipeline_free(mech);
+}
+
+/* RunOptions.max_dense_entries: the sparse path forms no dense Jacobian
+   and runs past it; the dense one is refused, saying what would serve. */
+static void test_dense_limit(void **state)
+{
+    (void)state;
+    Mech *mech = load_chain(20);    /* 123 coordinates: 15129 dense entries */
+    RunOptions o = run_default_options();
+    o.steps = 4;
+    o.max_dense_entries = 15000;
+    Collected c;
+    run_linear(mech, RUN_LINEAR_AUTO, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, RUN_OK);
+    assert_true(c.res.sparse);
+    mechrt_trace_free(&c.trace);
+    run_linear(mech, RUN_LINEAR_DENSE, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_non_null(strstr(c.res.message, "123 rows x 123 coordinates = 15129 entries, more "
+                                          "than the limit of 15000 (--max-jac-entries): use "
+                                          "--linear sparse"));
+    mechrt_trace_free(&c.trace);
+    run_linear(mech, RUN_LINEAR_AUTO, o, ENGINE_GENERIC, &c);     /* no jac_nz: dense */
+    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_non_null(strstr(c.res.message, "the sparse path cannot serve this run"));
+    mechrt_trace_free(&c.trace);
+    o.max_dense_entries = 15129;    /* at the limit: allowed */
+    run_linear(mech, RUN_LINEAR_DENSE, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, RUN_OK);
+    mechrt_trace_free(&c.trace);
+    pipeline_free(mech);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -352,6 +480,9 @@ int main(void)
         cmocka_unit_test(test_chain_agrees),
         cmocka_unit_test(test_toggle_sparse),
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_all_nz_kernel),
+        cmocka_unit_test(test_all_nz_run),
+        cmocka_unit_test(test_dense_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -94,6 +94,7 @@ RunOptions run_default_options(void)
     o.notes = NULL;
     o.linear = RUN_LINEAR_AUTO;
     o.jac_nz = NULL;
+    o.max_dense_entries = 0;
     return o;
 }
 
@@ -358,6 +359,12 @@ static void place_at_t0(Run *r, double *q0, double *start)
     memcpy(start, r->q, nq * sizeof *start);
 }
 
+/* Whether a dense nr x nq Jacobian would be beyond RunOptions.max_dense_entries. */
+static bool run_dense_too_large(const Model *m, const RunOptions *o)
+{
+    return o->max_dense_entries > 0 && (long long)m->nr * m->nq > o->max_dense_entries;
+}
+
 /* Minimum-norm Newton with step halving over the holonomic rows, from the
  * start in r->q (assemble_kernels, what `info` uses):
  * unlike Newton with LU it starts from any guess, including one where the
@@ -373,6 +380,16 @@ static bool assemble_robustly(Run *r)
     ao.max_iter = o->assembly_max_iter;
     ao.stall_iter = ASSEMBLE_ROUGH_STALL;
     AssembleResult ar;
+    if (run_dense_too_large(r->m, o)) {     /* it works on the dense Jacobian */
+        r->res->status = RUN_FAILED;
+        r->res->cause = MECHRT_EMAXITER;
+        r->res->t_fail = o->t0;
+        snprintf(r->res->message, sizeof r->res->message, "t = %.10g: Newton found no "
+                 "configuration from these initial values, and the robust assembly's dense "
+                 "Jacobian would have more than %lld entries (--max-jac-entries)", o->t0,
+                 o->max_dense_entries);
+        return false;
+    }
     bool ok = assemble_restarting(r->k, o->t0, r->q, &ao, &ar);
     r->res->assembly_iterations += ar.iterations;
     r->res->assembled_robustly = true;
@@ -863,6 +880,13 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
                  "which the generic engine does not have: use --engine jit or aot");
         return false;
     }
+    if (!*sparse && run_dense_too_large(m, o)) {
+        snprintf(why, size, "the dense Jacobian would have %d rows x %d coordinates = %lld "
+                 "entries, more than the limit of %lld (--max-jac-entries)%s", m->nr, m->nq,
+                 (long long)m->nr * m->nq, o->max_dense_entries,
+                 can ? ": use --linear sparse" : "; the sparse path cannot serve this run");
+        return false;
+    }
     return true;
 }
 
@@ -960,7 +984,9 @@ double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const do
     double t0 = pipeline_now(), elapsed;
     do {
         for (long i = 0; i < batch; i++) {
-            if (jnz) {
+            if (jnz && jnz->all_nz) {
+                jnz->all_nz(jnz->ctx, q, qd, t, phi, jac, nu, gamma);
+            } else if (jnz) {
                 k->phi(k->ctx, q, t, phi);
                 jnz->jac_nz(jnz->ctx, q, t, jac);
                 k->nu(k->ctx, q, t, nu);
@@ -987,6 +1013,12 @@ static void code_jac_nz(void *ctx, const double *q, double t, double *vals)
     ((const Kernels *)ctx)->jac_nz(q, t, vals);
 }
 
+static void code_all_nz(void *ctx, const double *q, const double *qd, double t, double *phi,
+                        double *vals, double *nu, double *gamma)
+{
+    ((const Kernels *)ctx)->all_nz(q, qd, t, phi, vals, nu, gamma);
+}
+
 bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
 {
     const Kernels *code = e->k.ctx;
@@ -994,6 +1026,6 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
         || !code->jac_row || !code->jac_col)
         return false;
     *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
-                             code_jac_nz};
+                             code_jac_nz, code->all_nz ? code_all_nz : NULL};
     return true;
 }

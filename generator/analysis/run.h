@@ -57,6 +57,11 @@ typedef struct RunOptions {
     /* the kernels' sparse Jacobian (run_jac_nz_of); NULL: none, dense only
        (the generic engine has none); default NULL */
     const MechrtHostJacNz *jac_nz;
+    /* most rows x coordinates of a dense Jacobian, checked when the run
+       would form one (dense linear algebra, the robust assembly at t0);
+       0: no limit (default; mechc run passes --max-jac-entries here when
+       the sparse path may serve, instead of the model builder) */
+    long long max_dense_entries;
 } RunOptions;
 
 RunOptions run_default_options(void);

@@ -18,7 +18,9 @@ typedef struct MechLimits {
     int max_coords;         /* coordinates (default 200000) */
     int max_rows;           /* constraint rows (default 200000) */
     int max_jac_entries;    /* rows x coordinates of the dense Jacobian (default 50000000:
-                               400 MB of doubles; generated C indexes it with int) */
+                               400 MB of doubles), checked as the model is built; 0:
+                               not checked there (run's sparse path forms no dense
+                               Jacobian and checks only where it would, RunOptions) */
     int max_nodes;          /* expression-graph nodes incl. derivatives (default 2000000) */
     int max_code_ops;       /* operations in the generated C, all functions (default 4000000) */
 } MechLimits;

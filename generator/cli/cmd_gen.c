@@ -20,7 +20,7 @@ typedef struct GenCli {
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
-    "                 [--chunk N] [--stats]\n"
+    "                 [--sparse] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
@@ -52,6 +52,10 @@ static const CliOption options[] = {
              "PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
              "direct stores every entry itself, zeros included: more\n"
              "code, a faster dense Jacobian (what jit and aot use)"},
+    {"--sparse", CLI_FLAG_AT(GenCli, emit.all_nz),
+     .help = "also write PREFIX_all_nz: Phi, the Jacobian's nonzeros, nu\n"
+             "and gamma in one call (the sparse counterpart of _all,\n"
+             "what run's sparse path calls)"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"
@@ -141,7 +145,9 @@ static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, 
             mech->model->nh, mech->model->nv, mech->kin.nnz);
     fprintf(stderr, "mechc gen: operations after sharing:");
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
-        fprintf(stderr, " %s %d%s", emit_function_names[f], res->ops[f], f + 1 < EMIT_FUNCTION_COUNT ? "," : "\n");
+        if (f != EMIT_ALL_NZ || res->ops[f] > 0)
+            fprintf(stderr, "%s %s %d", f ? "," : "", emit_function_names[f], res->ops[f]);
+    fputc('\n', stderr);
     fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
             (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
     EmitResult jit_src;

@@ -337,7 +337,8 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
     double ns_all = run_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
     fprintf(stderr, "mechc run: stats: one %s call (Phi, Phi_q, nu, gamma) takes "
             "%.1f ns: a step costs %.2f of them\n",
-            res->sparse ? "phi + jac_nz + nu + gamma kernel" : "`all` kernel", ns_all,
+            !res->sparse ? "`all` kernel" : jnz->all_nz ? "`all_nz` kernel"
+                                                        : "phi + jac_nz + nu + gamma kernel", ns_all,
             ns_all > 0 ? ns_step / ns_all : 0);
     if (res->max_cond > 0)
         fprintf(stderr, "mechc run: stats: largest condition estimate %.3g\n", res->max_cond);
@@ -380,6 +381,10 @@ static bool finish(Args *a, void *opts)
         }
         c->ro.t0 = c->at;
         c->ro.steps = 0;
+    }
+    if (c->linear != RUN_LINEAR_DENSE) {    /* checked by the run, where a dense one is formed */
+        c->ro.max_dense_entries = c->limits.max_jac_entries;
+        c->limits.max_jac_entries = 0;
     }
     if (c->ro.steps > 0 && c->ro.t0 == c->ro.t1) {
         fprintf(stderr, "mechc run: error: --t0 and --t1 are both %g: nothing to run\n", c->ro.t0);
@@ -578,6 +583,10 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     Engine e;
     if (!prepare(a, c, mech, &pics, &e, diag))
         return EXIT_USAGE;
+    if (c->stats)   /* what it took to have the kernels (wall time) */
+        fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
+                "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
+                e.gen_seconds, e.compile_seconds);
     int status = analyse(c, mech->model, &e, &pics);
     engine_close(&e);
     return status;

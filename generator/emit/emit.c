@@ -22,7 +22,7 @@
 #include <string.h>
 
 const char *const emit_function_names[EMIT_FUNCTION_COUNT] = {
-    "phi", "jac", "jac_nz", "nu", "gamma", "all",
+    "phi", "jac", "jac_nz", "nu", "gamma", "all", "all_nz",
 };
 
 /* A parameter of the generated functions. */
@@ -44,6 +44,8 @@ static const Param function_params[EMIT_FUNCTION_COUNT][8] = {
     [EMIT_NU] = {IN("q"), VALUE("t"), OUT("nu")},
     [EMIT_GAMMA] = {IN("q"), IN("qd"), VALUE("t"), OUT("gamma")},
     [EMIT_ALL] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac"), OUT("nu"), OUT("gamma")},
+    [EMIT_ALL_NZ] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac_vals"), OUT("nu"),
+                     OUT("gamma")},
 };
 #undef IN
 #undef VALUE
@@ -523,24 +525,26 @@ static void add_output(SchedOutput **outs, int *n, const char *array, int index,
     (*outs)[(*n)++] = (SchedOutput){array, index, value};
 }
 
-/* The outputs of each function. The fused _all goes row by row (phi,
-   Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk holds
-   whole rows and shares their sin/cos and products across the four. */
+/* The outputs of each function. The fused _all and _all_nz go row by row
+   (phi, Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk
+   holds whole rows and shares their sin/cos and products across the four. */
 static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
 {
     const Model *m = kin->model;
     *outs = xmalloc((size_t)(m->nh + 2 * m->nr + 2 * kin->nnz + 1) * sizeof **outs);
     *n = 0;
-    bool all = which == EMIT_ALL;
+    bool all = which == EMIT_ALL || which == EMIT_ALL_NZ;
     for (int r = 0; r < m->nr; r++) {
         if ((which == EMIT_PHI || all) && r < m->nh)
             add_output(outs, n, "phi", r, kin->phi[r]);
         for (int k = kin->row_start[r]; k < kin->row_start[r + 1]; k++) {
             const JacEntry *j = &kin->jac[k];
-            if (all || which == EMIT_JAC)
+            if (which == EMIT_ALL || which == EMIT_JAC)
                 add_output(outs, n, "jac", j->row * m->nq + j->col, j->value);
             else if (which == EMIT_JAC_NZ)
                 add_output(outs, n, "vals", k, j->value);
+            else if (which == EMIT_ALL_NZ)
+                add_output(outs, n, "jac_vals", k, j->value);
         }
         if (which == EMIT_NU || all)
             add_output(outs, n, "nu", r, kin->nu[r]);
@@ -549,6 +553,8 @@ static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutp
     }
     if (which == EMIT_JAC_NZ && kin->nnz == 0)     /* the one placeholder slot */
         add_output(outs, n, "vals", 0, DAG_ZERO);
+    if (which == EMIT_ALL_NZ && kin->nnz == 0)
+        add_output(outs, n, "jac_vals", 0, DAG_ZERO);
 }
 
 static void put_string_list(StrBuf *sb, const char *const *names, int n)
@@ -688,6 +694,8 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
         if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
+            continue;
+        if (f == EMIT_ALL_NZ && !opt->all_nz)
             continue;
         SchedOutput *outs;
         int n;
@@ -846,27 +854,47 @@ static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows,
     put_int_list(jcol, e->kin, false);
 }
 
+/* PREFIX_all_nz's declaration and definition (templates/all_nz*.tmpl);
+   both empty unless asked for, so that other files keep their bytes. */
+static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodies, StrBuf *decl,
+                       StrBuf *def)
+{
+    if (!e->opt->all_nz)
+        return;
+    TemplateVar v[] = {
+        {"P", e->prefix}, {"PU", e->prefix_upper},
+        {"ALL_NZ_PARTS", parts[EMIT_ALL_NZ].data}, {"ALL_NZ_BODY", bodies[EMIT_ALL_NZ].data},
+    };
+    int nv = (int)(sizeof v / sizeof *v);
+    /* every placeholder of the templates is given: they render */
+    if (template_render(decl, template_all_nz_decl, v, nv) || template_render(def, template_all_nz, v, nv))
+        abort();
+    def->data[--def->len] = '\0';   /* mech.c.tmpl ends the line after it */
+}
+
 /* Fills the templates with the written functions: out's source and header. */
 static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
 {
     const EmitOptions *opt = e->opt;
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
-    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves;
+    StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves, nzd, nzf;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac, &inc, &moves};
+                          &zero, &jac, &inc, &moves, &nzd, &nzf};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
     }
     put_banner(&banner, opt->source_name ? opt->source_name : m->file);
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
-        sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
+        if (f != EMIT_ALL_NZ || opt->all_nz)
+            sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
     if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
+    put_all_nz(e, parts, bodies, &nzd, &nzf);
 
     char nq[32], nh[32], nv[32], nnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
@@ -889,6 +917,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
         {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
+        {"ALL_NZ_DECL", nzd.data}, {"ALL_NZ", nzf.data},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     /* INTERFACE and JAC are rendered from the others, then filled in */

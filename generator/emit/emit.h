@@ -27,11 +27,16 @@ typedef struct EmitOptions {
     const char *source_name;    /* the input file, named in the banner */
     long max_ops;               /* most operations in all functions together
                                    (default: MechLimits max_code_ops); 0: no limit */
+    bool all_nz;                /* also PREFIX_all_nz: Phi, the Jacobian's
+                                   nonzeros, nu and gamma in one call (the
+                                   sparse path of run; gen --sparse) */
 } EmitOptions;
 
-/* The spec's function order, for op counts and reports. */
+/* The spec's function order, for op counts and reports; then all_nz, an
+   extension (written only with EmitOptions.all_nz: its ops count 0 without). */
 typedef enum EmitFunction {
-    EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_FUNCTION_COUNT
+    EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_ALL_NZ,
+    EMIT_FUNCTION_COUNT
 } EmitFunction;
 
 extern const char *const emit_function_names[EMIT_FUNCTION_COUNT];

@@ -103,6 +103,7 @@ static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag
     /* Stores in place are faster than the spread from jac_nz; only large
        mechanisms keep the compact form, for the compiler's sake. */
     eo.direct_jac = mech->kin.nnz <= 4000;
+    eo.all_nz = true;       /* run's sparse path */
     eo.source_name = mech->model->file;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))

@@ -81,6 +81,7 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->nu = (KernelPhi)kernel(find, handle, prefix, "nu");
     k->gamma = (KernelGamma)kernel(find, handle, prefix, "gamma");
     k->all = (KernelAll)kernel(find, handle, prefix, "all");
+    k->all_nz = (KernelAll)kernel(find, handle, prefix, "all_nz");
     k->jac_row = kernel(find, handle, prefix, "jac_row");
     k->jac_col = kernel(find, handle, prefix, "jac_col");
     return k->phi && k->jac && k->jac_nz && k->nu && k->gamma && k->all && k->jac_row

@@ -12,11 +12,12 @@ typedef void (*KernelAll)(const double *q, const double *qd, double t,
 /* The generated functions of one mechanism as the compiled unit exports
    them (libtcc, dlopen of a cc-built library): context-free, with jac_nz
    and its pattern. Engines evaluate through a MechrtKernels whose ctx is
-   this struct (engine.c). */
+   this struct (engine.c). all_nz (the fused kernel with the Jacobian's
+   nonzeros, EmitOptions.all_nz) is NULL in a unit written without it. */
 typedef struct Kernels {
     KernelPhi phi, jac, jac_nz, nu;
     KernelGamma gamma;
-    KernelAll all;
+    KernelAll all, all_nz;
     const int *jac_row, *jac_col;
 } Kernels;
 
@@ -24,7 +25,7 @@ typedef struct Kernels {
 typedef void *(*KernelFind)(void *handle, const char *symbol);
 
 /* Fills k with the generated functions PREFIX_phi, PREFIX_jac, ... of
-   handle; false when one is missing. */
+   handle; false when one is missing (PREFIX_all_nz may be). */
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix);
 
 typedef struct Jit Jit;

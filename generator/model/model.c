@@ -135,11 +135,11 @@ static Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos
     return e;
 }
 
-/* Rows x coordinates: the dense Jacobian every engine fills (and the
-   generated C indexes with int). */
+/* Rows x coordinates: the dense Jacobian every engine fills (run's sparse
+   path excepted: it asks for no check here, max_jac_entries 0). */
 static void check_jacobian_size(Builder *b, long long nr, long long nq, SrcPos pos)
 {
-    if (nr * nq > b->limits->max_jac_entries)
+    if (b->limits->max_jac_entries > 0 && nr * nq > b->limits->max_jac_entries)
         diag_fail(b->diag, pos, "the dense Jacobian would have %lld row%s x %lld coordinate%s = "
                   "%lld entries, more than the limit of %d", nr, nr == 1 ? "" : "s", nq,
                   nq == 1 ? "" : "s", nr * nq, b->limits->max_jac_entries);

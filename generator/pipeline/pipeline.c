@@ -95,6 +95,7 @@ Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
     EmitOptions opt = emit_default_options();
     opt.declare_math = true;
     opt.direct_jac = true;
+    opt.all_nz = true;      /* run's sparse path */
     opt.prefix = "mechc_jit";
     opt.source_name = mech->model->file;
     opt.max_ops = mech->limits.max_code_ops;

@@ -159,8 +159,12 @@ double mechrt_host_singular_direction(int m, int n, const double *a, double *row
 typedef struct MechrtHostJacNz {
     int nnz;
     const int *row, *col;
-    void *ctx;              /* passed unchanged to jac_nz */
+    void *ctx;              /* passed unchanged to jac_nz and all_nz */
     void (*jac_nz)(void *ctx, const double *q, double t, double *vals);
+    /* Phi, the nnz values, nu and gamma in one call, sharing their work
+       (PREFIX_all_nz); may be NULL */
+    void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
+                   double *vals, double *nu, double *gamma);
 } MechrtHostJacNz;
 
 typedef struct MechrtHostSparse MechrtHostSparse;
@@ -175,6 +179,10 @@ int mechrt_host_sparse_nnz(const MechrtHostSparse *s);
    takes: jac_nz's output; mechrt_host_sparse_eval fills them at (q, t). */
 double *mechrt_host_sparse_values(MechrtHostSparse *s);
 void mechrt_host_sparse_eval(MechrtHostSparse *s, const double *q, double t);
+/* The same values with Phi, nu and gamma (at qd) from one all_nz call;
+   false, and nothing done, when the pattern came without all_nz. */
+bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const double *qd,
+                                 double t, double *phi, double *nu, double *gamma);
 /* LU of the values with partial pivoting. MECHRT_ESING when a pivot
    |u_kk| <= pivot_tol * max|a_ij| (the dense test of lu.c), naming it in
    mechrt_host_sparse_singular; MECHRT_ENOTFINITE for NaN or Inf (its row
@@ -195,7 +203,7 @@ void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col);
 void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored);
 
 /* Workspace length, in doubles, of mechrt_host_sparse_step. */
-#define MECHRT_HOST_SPARSE_WORK_LEN(nq) (2u * (size_t)(nq))
+#define MECHRT_HOST_SPARSE_WORK_LEN(nq) (4u * (size_t)(nq))
 
 /* mechrt_step (runtime/analysis.c) on the sparse Jacobian s of k's
    mechanism: predictor, Newton with one factorisation per iteration, then

@@ -139,6 +139,15 @@ void mechrt_host_sparse_eval(MechrtHostSparse *s, const double *q, double t)
     s->jnz.jac_nz(s->jnz.ctx, q, t, s->vals);
 }
 
+bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const double *qd,
+                                 double t, double *phi, double *nu, double *gamma)
+{
+    if (!s->jnz.all_nz)
+        return false;
+    s->jnz.all_nz(s->jnz.ctx, q, qd, t, phi, s->vals, nu, gamma);
+    return true;
+}
+
 /* max|u_kk| / min|u_kk| (INFINITY with a zero pivot). */
 static double sparse_spread(const MechrtHostSparse *s)
 {

@@ -7,20 +7,34 @@
  * iteration counts that run's branch check relies on, so the two paths
  * step alike), then one factorisation at the converged q for the velocity
  * and the acceleration, with the same condition screen and estimate. Phi
- * comes from the phi kernel, the Jacobian's nonzeros from jac_nz, nu and
- * gamma from theirs: nothing of size nr x nq is ever formed.
+ * and the Jacobian's nonzeros come from one all_nz call where the kernels
+ * have it (nu comes with them: the last one, at the converged q, serves;
+ * gamma needs the new velocities and is called after), else from the phi
+ * and jac_nz kernels: nothing of size nr x nq is ever formed.
  */
 #include "mechrt_host.h"
 
 #include <math.h>
+#include <string.h>
+
+/* Where the fused kernel writes what a Newton evaluation does not need:
+   nu (kept: the last one is at the converged q) and gamma (at the old qd). */
+typedef struct SpExtra {
+    const double *qd;
+    double *nu, *gamma;
+    bool have_nu;
+} SpExtra;
 
 /* Phi and the Jacobian's nonzeros at q; the residual norm and worst row
    into r. NaN or Inf in Phi is an error. */
 static MechrtStatus sp_eval(MechrtHostSparse *s, const MechrtKernels *k, const double *q,
-                            double t, double *phi, MechrtReport *r)
+                            double t, double *phi, SpExtra *x, MechrtReport *r)
 {
-    k->phi(k->ctx, q, t, phi);
-    mechrt_host_sparse_eval(s, q, t);
+    x->have_nu = mechrt_host_sparse_eval_all(s, q, x->qd, t, phi, x->nu, x->gamma);
+    if (!x->have_nu) {
+        k->phi(k->ctx, q, t, phi);
+        mechrt_host_sparse_eval(s, q, t);
+    }
     r->residual = 0;
     r->worst_row = k->nh > 0 ? 0 : -1;
     for (int i = 0; i < k->nh; i++) {
@@ -52,10 +66,11 @@ static MechrtStatus sp_factor(MechrtHostSparse *s, const MechrtOptions *o, Mechr
 /* Newton on Phi(q, t) = 0 from q (updated in place), stopping as
    mechrt_newton_run does. */
 static MechrtStatus sp_newton(MechrtHostSparse *s, const MechrtKernels *k, const MechrtOptions *o,
-                              double *q, double t, double *phi, double *dq, MechrtReport *r)
+                              double *q, double t, double *phi, double *dq, SpExtra *x,
+                              MechrtReport *r)
 {
     int n = k->nq;
-    MechrtStatus st = sp_eval(s, k, q, t, phi, r);
+    MechrtStatus st = sp_eval(s, k, q, t, phi, x, r);
     if (st != MECHRT_OK)
         return st;
     for (;;) {
@@ -76,7 +91,7 @@ static MechrtStatus sp_newton(MechrtHostSparse *s, const MechrtKernels *k, const
         }
         r->step = step;
         r->iterations++;
-        if ((st = sp_eval(s, k, q, t, phi, r)) != MECHRT_OK)
+        if ((st = sp_eval(s, k, q, t, phi, x, r)) != MECHRT_OK)
             return st;
     }
 }
@@ -112,16 +127,20 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
     if (lwork < MECHRT_HOST_SPARSE_WORK_LEN(n))
         return MECHRT_EBADLEN;
     double *phi = work, *rhs = work + n;
+    SpExtra x = {qd, work + 2 * n, work + 3 * n, false};
     if (h != 0)
         for (int i = 0; i < n; i++)
             q[i] += h * qd[i] + 0.5 * h * h * qdd[i];
     double tn = t + h;
-    MechrtStatus st = sp_newton(s, k, &o, q, tn, phi, rhs, r);
+    MechrtStatus st = sp_newton(s, k, &o, q, tn, phi, rhs, &x, r);
     if (st != MECHRT_OK)
         return st;
     if ((st = sp_factor_cond(s, &o, r)) != MECHRT_OK)
         return st;
-    k->nu(k->ctx, q, tn, qd);
+    if (x.have_nu)
+        memcpy(qd, x.nu, (size_t)n * sizeof *qd);
+    else
+        k->nu(k->ctx, q, tn, qd);
     if ((st = mechrt_host_sparse_solve(s, qd)) != MECHRT_OK)
         return st;
     k->gamma(k->ctx, q, qd, tn, qdd);   /* gamma needs the velocities just found */
