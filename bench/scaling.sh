@@ -1,10 +1,11 @@
 #!/bin/sh
 # bench/scaling.sh MECHC - how `mechc run` grows with the mechanism: chains
 # of N four-bar loops (examples/chain.sh N, 6N + 3 coordinates), run with
-# the dense LU and with the sparse one (KLU), then the issue-15 target run.
+# the dense LU and with the sparse one (KLU), then the issue-15 target run
+# and the N = 10 000 chain.
 #
 #   sh bench/scaling.sh build/mechc                    (part of `make bench`)
-#   SIZES="10 100 1000 3000" STEPS=100 sh bench/scaling.sh build/mechc
+#   SIZES="10 100 1000 3000" STEPS=100 BIG_N= sh bench/scaling.sh build/mechc
 #
 # Per size and linear algebra, one `mechc run --steps STEPS --csv /dev/null
 # --stats` (the dense LU's O(n^3) steps are few at N >= DENSE_FEW_N: their
@@ -17,11 +18,13 @@
 #   max RSS MB     peak resident memory (/usr/bin/time -f %M)
 # and the ratio dense / sparse of the step CPU time. Then the target run:
 # N = TARGET_N, `run --steps 1000` (auto: sparse), CSV to a file, whole
-# command wall time and peak memory, and the same with --digits 6 (the
-# shortest round-trip printing of 18 million numbers is most of the time).
+# command CPU and peak memory, split into set-up (the same command with
+# --steps 0: parse, derivatives, emission, libtcc, assembly), the steps
+# (--stats) and the rest, the printing of 3 x 6003 x 1001 numbers; the same
+# with --digits 6. Then N = BIG_N (10 000: 60 003 coordinates, sparse; empty
+# BIG_N: left out), `run --steps BIG_STEPS`: set-up CPU and its stages
+# (--stats, wall), CPU per step, peak memory.
 # Without /usr/bin/time the whole-command columns say "-".
-# N = 10 000 needs the dense-Jacobian limit raised past what the generated
-# code's int indices allow (60 003^2 entries): not runnable yet.
 # POSIX sh and awk only.
 set -u
 mechc=${1:-build/mechc}
@@ -31,6 +34,8 @@ dense_few_n=${DENSE_FEW_N:-1000}
 dense_few_steps=${DENSE_FEW_STEPS:-2}
 dense_max_n=${DENSE_MAX_N:-1000}
 target_n=${TARGET_N:-1000}
+big_n=${BIG_N-10000}
+big_steps=${BIG_STEPS:-100}
 if [ ! -x "$mechc" ]; then
     echo "usage: sh bench/scaling.sh MECHC   ('$mechc' is not an executable; run make first)" >&2
     exit 2
@@ -69,8 +74,6 @@ printf '%6s %6s %-6s %5s %10s %12s %8s %8s %10s\n' \
 for n in $sizes; do
     sh "$here/../examples/chain.sh" "$n" "$tmp/chain.mech" || exit 2
     nq=$((6 * n + 3))
-    # 60 003^2 > INT_MAX: the generated dense Jacobian's limit (other work)
-    limit=$((nq * nq < 2000000000 ? nq * nq : 2000000000))
     for lin in dense sparse; do
         s=$steps
         [ "$lin" = dense ] && [ "$n" -ge "$dense_few_n" ] && s=$dense_few_steps
@@ -79,8 +82,7 @@ for n in $sizes; do
                 $((nq * nq / 131072))
             continue
         fi
-        timed "$tmp/r" "$tmp/chain.mech" --steps "$s" --linear "$lin" --csv /dev/null \
-            --stats --max-jac-entries "$limit"
+        timed "$tmp/r" "$tmp/chain.mech" --steps "$s" --linear "$lin" --csv /dev/null --stats
         a=$(stat "$tmp/r.err" analysis)
         c=$(stat "$tmp/r.err" CPU)
         if [ -z "$a" ]; then
@@ -104,16 +106,47 @@ done
 echo
 echo "target (issue 15): chain N = $target_n, mechc run --steps 1000 (auto), whole command"
 sh "$here/../examples/chain.sh" "$target_n" "$tmp/target.mech" || exit 2
+timed "$tmp/s" "$tmp/target.mech" --steps 0 --csv /dev/null
+read -r wall user sys rss < "$tmp/s.time"
+setup=$(awk -v u="$user" -v y="$sys" 'BEGIN { print (u == "-") ? "-" : u + y }')
 for digits in "" 6; do
     timed "$tmp/t" "$tmp/target.mech" --steps 1000 --csv "$tmp/target.csv" --stats \
         ${digits:+--digits "$digits"}
     read -r wall user sys rss < "$tmp/t.time"
-    a=$(stat "$tmp/t.err" analysis)
-    awk -v w="$wall" -v u="$user" -v y="$sys" -v r="$rss" -v a="$a" -v d="$digits" \
-        -v b="$(wc -c < "$tmp/target.csv" 2> /dev/null || echo 0)" 'BEGIN {
+    c=$(stat "$tmp/t.err" CPU)
+    awk -v w="$wall" -v u="$user" -v y="$sys" -v r="$rss" -v c="$c" -v d="$digits" \
+        -v su="$setup" -v b="$(wc -c < "$tmp/target.csv" 2> /dev/null || echo 0)" 'BEGIN {
         how = (d == "") ? "shortest round-trip CSV" : "CSV with --digits " d
-        cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
         mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
-        printf "  %-24s wall %s s, CPU %s s, max RSS %s MB; steps alone %.2f s; CSV %.0f MB\n",
-               how, w, cpu, mb, a * 1000 / 1e9, b / 1e6 }'
+        steps = c * 1000 / 1e9
+        if (u == "-" || su == "-") {
+            printf "  %-24s wall %s s, max RSS %s MB; steps %.2f s CPU; CSV %.0f MB\n",
+                   how, w, mb, steps, b / 1e6
+        } else {
+            printf "  %-24s wall %s s, CPU %.2f s = set-up %.2f + steps %.2f + printing %.2f; max RSS %s MB; CSV %.0f MB\n",
+                   how, w, u + y, su, steps, u + y - su - steps, mb, b / 1e6
+        }
+    }'
 done
+
+[ -n "$big_n" ] || exit 0
+echo
+echo "chain N = $big_n ($((6 * big_n + 3)) coordinates), mechc run --steps $big_steps (auto: sparse)"
+sh "$here/../examples/chain.sh" "$big_n" "$tmp/big.mech" || exit 2
+timed "$tmp/b0" "$tmp/big.mech" --steps 0 --csv /dev/null --stats
+timed "$tmp/b" "$tmp/big.mech" --steps "$big_steps" --csv /dev/null --stats
+if [ -z "$(stat "$tmp/b.err" CPU)" ]; then
+    echo "  failed: $(grep -v stats "$tmp/b.err" | head -1)"
+    exit 0
+fi
+read -r wall0 user0 sys0 rss0 < "$tmp/b0.time"
+read -r wall user sys rss < "$tmp/b.time"
+awk -v u0="$user0" -v y0="$sys0" -v w="$wall" -v u="$user" -v y="$sys" -v r="$rss" \
+    -v c="$(stat "$tmp/b.err" CPU)" -v st="$big_steps" \
+    -v stages="$(sed -n 's/.*stats: set-up: //p' "$tmp/b0.err")" 'BEGIN {
+    mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
+    su = (u0 == "-") ? "-" : sprintf("%.2f", u0 + y0)
+    cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
+    printf "  set-up %s s CPU (wall, by stage: %s)\n", su, stages
+    printf "  %d steps: %.1f ms CPU per step; whole command wall %s s, CPU %s s; max RSS %s MB\n",
+           st, c / 1e6, w, cpu, mb }'

@@ -93,7 +93,6 @@ typedef struct {
     int nd;         /* its digit count */
     int exp10;      /* the decimal exponent of its first digit in v */
     bool low_gap;   /* v a power of two: the gap below is half the gap above */
-    bool even;      /* strtod's ties go to v */
 } FrScaled;
 
 static bool fr_scale(double v, FrScaled *sc)
@@ -124,8 +123,20 @@ static bool fr_scale(double v, FrScaled *sc)
     sc->nd = sc->d >= fr_p10[17] ? 18 : 17;
     sc->exp10 = sc->nd - 1 - s;
     sc->low_gap = m == 1ull << 52 && be > 1;
-    sc->even = (m & 1) == 0;
     return true;
+}
+
+/* d / 10^k: the shortest path drops 0 to 3 digits, by constants (a
+   multiplication) rather than a division instruction. */
+static uint64_t fr_div_p10(uint64_t d, int k)
+{
+    switch (k) {
+    case 0: return d;
+    case 1: return d / 10u;
+    case 2: return d / 100u;
+    case 3: return d / 1000u;
+    default: return d / fr_p10[k];
+    }
 }
 
 /* X rounded to p digits, as an integer q (p digits, or 10^p after a carry)
@@ -133,10 +144,10 @@ static bool fr_scale(double v, FrScaled *sc)
 static bool fr_round(const FrScaled *sc, int p, uint64_t *q, uint64_t *cx)
 {
     int k = sc->nd - p;
-    uint64_t r = sc->d % fr_p10[k];
+    *q = fr_div_p10(sc->d, k);
+    uint64_t r = sc->d - *q * fr_p10[k];
     fr_u128 dropped = (fr_u128)r << 64 | (uint64_t)sc->xa;
     fr_u128 half = k ? (fr_u128)(fr_p10[k] / 2) << 64 : (fr_u128)1 << 63;
-    *q = sc->d / fr_p10[k];
     if (dropped > half)
         ++*q;
     else if (dropped + 2 > half)
@@ -145,17 +156,18 @@ static bool fr_round(const FrScaled *sc, int p, uint64_t *q, uint64_t *cx)
     return true;
 }
 
-/* Whether the candidate cx reads back as v: 1 yes, 0 no, -1 too near to tell. */
+/* Whether the candidate cx reads back as v: 1 yes, 0 no, -1 too near to
+   tell (a tie of strtod's, say). X 2^64 is in [lo, hi), half an ulp in
+   [ha, ha + 2); the gap below a power of two is half as wide. */
 static int fr_reads_back(const FrScaled *sc, uint64_t cx)
 {
-    fr_u128 c = (fr_u128)cx << 64;
-    bool below = c < sc->xa + 2;   /* possibly below v: the smaller gap applies */
-    fr_u128 dmax = c >= sc->xa ? c - sc->xa : sc->xa + 2 - c;
-    fr_u128 dmin = c >= sc->xa + 2 ? c - sc->xa - 2 : c >= sc->xa ? 0 : sc->xa - c;
-    bool halved = sc->low_gap && below;
-    if ((halved ? 2 * dmax : dmax) < sc->ha)
+    fr_u128 c = (fr_u128)cx << 64, lo = sc->xa, hi = sc->xa + 2;
+    fr_u128 above_most = c > lo ? c - lo : 0, below_most = hi > c ? hi - c : 0;
+    fr_u128 dmax = above_most > below_most ? above_most : below_most;
+    fr_u128 dmin = c >= hi ? c - hi : c >= lo ? 0 : lo - c;
+    bool maybe_below = c < hi, surely_below = c < lo;
+    if ((sc->low_gap && maybe_below ? 2 * dmax : dmax) < sc->ha)
         return 1;
-    bool surely_below = c < sc->xa;
     if ((sc->low_gap && surely_below ? 2 * dmin : dmin) > sc->ha + 2)
         return 0;
     return -1;
@@ -164,9 +176,16 @@ static int fr_reads_back(const FrScaled *sc, uint64_t cx)
 /* printf's %.<p>g of the p digits q (value q 10^(exp10 - p + 1)). */
 static int fr_put_g(char *buf, bool neg, uint64_t q, int p, int exp10)
 {
+    static const char pairs[] =
+        "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+        "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+        "8081828384858687888990919293949596979899";
     char dig[20];
-    for (int i = p - 1; i >= 0; i--, q /= 10)
-        dig[i] = (char)('0' + q % 10);
+    int at = p;
+    for (; at >= 2; at -= 2, q /= 100)   /* two digits a division */
+        memcpy(dig + at - 2, pairs + 2 * (q % 100), 2);
+    if (at)
+        dig[0] = (char)('0' + q);
     int len = p, n = 0;
     while (len > 1 && dig[len - 1] == '0')
         len--;
