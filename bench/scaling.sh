@@ -60,11 +60,13 @@ timed() {
     fi
 }
 
-# stat FILE WHAT: the ns per step of a --stats line ("analysis" or "CPU").
+# stat FILE WHAT: the ns per step of a --stats line ("analysis" or "CPU"),
+# or the ns of one kernel call ("kernel").
 stat() {
     case $2 in
         analysis) sed -n 's/.*of analysis: \([0-9.]*\) ns per step.*/\1/p' "$1" ;;
         CPU) sed -n 's/.*of CPU time in the steps: \([0-9.]*\) ns per step.*/\1/p' "$1" ;;
+        kernel) sed -n 's/.*kernel call .* takes \([0-9.]*\) ns.*/\1/p' "$1" ;;
     esac
 }
 
@@ -142,11 +144,12 @@ fi
 read -r wall0 user0 sys0 rss0 < "$tmp/b0.time"
 read -r wall user sys rss < "$tmp/b.time"
 awk -v u0="$user0" -v y0="$sys0" -v w="$wall" -v u="$user" -v y="$sys" -v r="$rss" \
-    -v c="$(stat "$tmp/b.err" CPU)" -v st="$big_steps" \
+    -v c="$(stat "$tmp/b.err" CPU)" -v a="$(stat "$tmp/b.err" analysis)" -v st="$big_steps" \
+    -v k="$(stat "$tmp/b.err" kernel)" \
     -v stages="$(sed -n 's/.*stats: set-up: //p' "$tmp/b0.err")" 'BEGIN {
     mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
     su = (u0 == "-") ? "-" : sprintf("%.2f", u0 + y0)
     cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
     printf "  set-up %s s CPU (wall, by stage: %s)\n", su, stages
-    printf "  %d steps: %.1f ms CPU per step; whole command wall %s s, CPU %s s; max RSS %s MB\n",
-           st, c / 1e6, w, cpu, mb }'
+    printf "  %d steps: %.1f ms per step, %.1f ms CPU; one all_nz call %.2f ms; whole command wall %s s, CPU %s s; max RSS %s MB\n",
+           st, a / 1e6, c / 1e6, k / 1e6, w, cpu, mb }'
