@@ -1025,7 +1025,7 @@ static void lin_gamma(void *ctx, const double *q, const double *qd, double t, do
 static void test_host_projection(void **state)
 {
     (void)state;
-    MechrtKernels k = {2, 1, 1, NULL, lin_phi, lin_jac, lin_nu, lin_gamma, NULL};
+    MechrtKernels k = {2, 1, 1, NULL, lin_phi, lin_jac, lin_nu, lin_gamma, NULL, NULL, NULL};
     MechrtHost *h = mechrt_host_new(&k);
     assert_non_null(h);
     double q[2] = {1, 1};
@@ -1191,7 +1191,7 @@ static void test_float_kernels(void **state)
     /* the float run, stepped like firmware would step it */
     enum { NQ = 9 };
     assert_int_equal(m->nq, NQ);
-    MechrtKernels k = {NQ, NQ, 0, &fl, fl_phi, fl_jac, fl_nu, fl_gamma, fl_all};
+    MechrtKernels k = {NQ, NQ, 0, &fl, fl_phi, fl_jac, fl_nu, fl_gamma, fl_all, NULL, NULL};
     float q[NQ], qd[NQ] = {0}, qdd[NQ] = {0}, work[MECHRT_WORKSPACE_LEN(NQ, NQ)];
     for (int i = 0; i < NQ; i++)
         q[i] = (float)m->q0[i];
