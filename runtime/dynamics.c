@@ -25,6 +25,14 @@
  *     (K^T K + I, eigenvalues >= 1): the minimum-norm lambda.
  * Inverse dynamics is step 1 and 4 with the given qdd.
  *
+ * The rank decision is made wherever the call is; an integrator's stages
+ * lie off the constraint manifold by the step's error, where a redundant
+ * row is independent to that error and a fresh decision would lock the
+ * mechanism (a rank tolerance below the error) or drop a genuine row
+ * (above it). So mechrt_dynamics_rows tells which rows the elimination
+ * keeps at a state on the manifold, and MechrtDynOptions.active leaves the
+ * others out (as zero rows, never pivoted on) for the stages of the step.
+ *
  * Cost: O(nr nq r) for the elimination, O(nq^2 (nq - r)) for Z^T M Z; the
  * mechanisms this serves have tens of coordinates. No square root is
  * needed (no library call: the runtime's rule).
