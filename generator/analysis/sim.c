@@ -19,6 +19,16 @@
  * output times only and restarts there. Baumgarte's stabilisation
  * (SimOptions.dyn) may be added on top.
  *
+ * Redundant rows and singular positions: after each projection, on the
+ * manifold, the rows the rank-revealing elimination keeps (pivots above
+ * SimOptions.row_tol) are chosen for the next step (mechrt_dynamics_rows)
+ * and the others left out at its stages, which lie off the manifold by the
+ * step's error: there a redundant row is independent to that error, and
+ * near a singular position (a parallelogram's cranks in line with its
+ * coupler) the row becoming dependent has an acceleration equation
+ * inconsistent by the error over its small pivot. The projection restores
+ * the rows left out.
+ *
  * Energy: E = T - W with T = 1/2 qd^T M qd and W' = qd^T M qdd +
  * 1/2 qd^T Mdot qd = qd.(Q - Phi_q^T lambda) + 1/2 qd^T Mdot qd, the power of
  * the applied forces (Q without its velocity terms, which the Mdot term
