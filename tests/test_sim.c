@@ -495,6 +495,123 @@ static void test_errors(void **state)
     free(work);
 }
 
+/* Baumgarte: the accelerations meet gamma - 2 alpha (Phi_q qd - nu) - beta^2 Phi
+   off the manifold. */
+static void test_baumgarte(void **state)
+{
+    (void)state;
+    TMech tm = pendulum(1.0, 0.05, 0.5);
+    MechrtKernels k = t_kernels(&tm);
+    size_t lw;
+    double *work = t_work(&k, &lw), q[3], qd[3], qdd[3], jac[6], phi[2], gam[2];
+    pendulum_state(0.5, 0.4, 1.0, q, qd);
+    q[0] += 1e-3, qd[1] += 2e-3;                  /* off the rows */
+    MechrtDynOptions o = mechrt_dyn_default_options();
+    o.baumgarte_alpha = 5, o.baumgarte_beta = 7;
+    assert_int_equal(mechrt_forward_dynamics(&k, &o, q, qd, 0, qdd, NULL, work, lw, NULL),
+                     MECHRT_OK);
+    t_jac(&tm, q, 0, jac);
+    t_phi(&tm, q, 0, phi);
+    t_gamma(&tm, q, qd, 0, gam);
+    for (int i = 0; i < 2; i++) {
+        double acc = 0, vel = 0;
+        for (int j = 0; j < 3; j++)
+            acc += jac[i * 3 + j] * qdd[j], vel += jac[i * 3 + j] * qd[j];
+        assert_near(acc, gam[i] - 2 * 5 * vel - 49 * phi[i], 1e-12, 1e-12);
+    }
+    free(work);
+}
+
+/* The rows to keep at a state: the parallelogram's one dependent row left
+   out, and the accelerations the same with it out. */
+static void test_dynamics_rows(void **state)
+{
+    (void)state;
+    double L = 0.4, d = 0.5, q[12], qd[12], qdd[12], qdd2[12], lam[12];
+    TMech tm = parallelogram(L, d);
+    MechrtKernels k = t_kernels(&tm);
+    size_t lw;
+    double *work = t_work(&k, &lw);
+    unsigned char active[12];
+    parallelogram_state(L, d, 0.9, 0.7, q, qd);
+    MechrtDynReport rep;
+    assert_int_equal(mechrt_dynamics_rows(&k, NULL, q, 0, active, work, lw, &rep), MECHRT_OK);
+    int kept = 0;
+    for (int i = 0; i < 12; i++)
+        kept += active[i];
+    assert_int_equal(kept, 11);
+    assert_int_equal(rep.redundant, 1);
+    assert_int_equal(mechrt_forward_dynamics(&k, NULL, q, qd, 0, qdd, NULL, work, lw, NULL),
+                     MECHRT_OK);
+    MechrtDynOptions o = mechrt_dyn_default_options();
+    o.active = active;
+    assert_int_equal(mechrt_forward_dynamics(&k, &o, q, qd, 0, qdd2, lam, work, lw, &rep),
+                     MECHRT_OK);
+    for (int i = 0; i < 12; i++) {
+        assert_near(qdd2[i], qdd[i], 1e-12, 1e-12);
+        if (!active[i])
+            assert_true(lam[i] == 0);
+    }
+    free(work);
+}
+
+/* A velocity-level row (nv = 1): a knife edge (x, y, phi) that cannot slide
+   sideways, -sin(phi) x' + cos(phi) y' = 0, pushed by a force F along its
+   heading and a torque tau: v' = F / m, phi'' = tau / J. */
+static void k_jac(void *ctx, const double *q, double t, double *out)
+{
+    (void)ctx, (void)t;
+    out[0] = -sin(q[2]), out[1] = cos(q[2]), out[2] = 0;
+}
+
+static void k_nu(void *ctx, const double *q, double t, double *out)
+{
+    (void)ctx, (void)q, (void)t;
+    out[0] = 0;
+}
+
+static void k_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    (void)ctx, (void)t;
+    out[0] = qd[2] * (cos(q[2]) * qd[0] + sin(q[2]) * qd[1]);
+}
+
+static void k_phi(void *ctx, const double *q, double t, double *out)
+{
+    (void)ctx, (void)q, (void)t, (void)out;
+}
+
+static void k_mass(void *ctx, const double *q, double *M)
+{
+    (void)ctx, (void)q;
+    memset(M, 0, 9 * sizeof *M);
+    M[0] = M[4] = 2.0, M[8] = 0.1;
+}
+
+static void k_force(void *ctx, const double *q, const double *qd, double t, double *Q)
+{
+    (void)ctx, (void)qd, (void)t;
+    Q[0] = 3.0 * cos(q[2]), Q[1] = 3.0 * sin(q[2]), Q[2] = 0.5;
+}
+
+static void test_knife_edge_forward(void **state)
+{
+    (void)state;
+    MechrtKernels k = {3, 0, 1, NULL, k_phi, k_jac, k_nu, k_gamma, NULL, k_mass, k_force};
+    size_t lw;
+    double *work = t_work(&k, &lw), phi = 0.6, v = 1.5, w = -0.8;
+    double q[3] = {0.1, 0.2, phi}, qd[3] = {v * cos(phi), v * sin(phi), w}, qdd[3], lam[1];
+    assert_int_equal(mechrt_forward_dynamics(&k, NULL, q, qd, 0, qdd, lam, work, lw, NULL),
+                     MECHRT_OK);
+    double vd = 3.0 / 2.0;
+    assert_near(qdd[0], vd * cos(phi) - v * sin(phi) * w, 1e-13, 1e-14);
+    assert_near(qdd[1], vd * sin(phi) + v * cos(phi) * w, 1e-13, 1e-14);
+    assert_near(qdd[2], 0.5 / 0.1, 1e-13, 1e-14);
+    /* the sideways force the blade takes: m v w = -lambda */
+    assert_near(-lam[0], 2.0 * v * w, 1e-12, 1e-13);
+    free(work);
+}
+
 /* ---- the simulation ---------------------------------------------------------- */
 
 typedef struct Collect {
@@ -715,6 +832,9 @@ int main(void)
         cmocka_unit_test(test_inverse_driven_pendulum),
         cmocka_unit_test(test_inverse_undriven_residual),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_baumgarte),
+        cmocka_unit_test(test_dynamics_rows),
+        cmocka_unit_test(test_knife_edge_forward),
         cmocka_unit_test(test_double_pendulum_energy),
         cmocka_unit_test(test_offset_pendulum),
         cmocka_unit_test(test_redundant_simulation),
