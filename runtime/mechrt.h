@@ -354,4 +354,105 @@ MechrtStatus mechrt_step(const MechrtKernels *k, const MechrtOptions *opts,
                          mechrt_real t, mechrt_real h,
                          mechrt_real *work, size_t lwork, MechrtReport *report);
 
+/* ---- Dynamics (dynamics.c) ---------------------------------------------
+   Equations of motion in the coordinates q, with the nr = nh + nv rows of
+   the Jacobian (velocity-level rows included):
+       M(q) qdd + Phi_q^T lambda = Q(q, qd, t),    Phi_q qdd = gamma.
+   Needs the mass and force kernels (MECHRT_EINVAL without them). Redundant
+   rows (Phi_q rank-deficient, also where the rank drops at a singular
+   position) are allowed: qdd is unique when M is positive definite on the
+   null space of Phi_q, and lambda is then the minimum-norm solution. */
+
+#ifdef MECHRT_REAL_FLOAT
+#define MechrtDynOptions                MechrtfDynOptions
+#define MechrtDynReport                 MechrtfDynReport
+#define mechrt_dyn_default_options      mechrtf_dyn_default_options
+#define mechrt_dynamics_workspace_size  mechrtf_dynamics_workspace_size
+#define mechrt_forward_dynamics         mechrtf_forward_dynamics
+#define mechrt_inverse_dynamics         mechrtf_inverse_dynamics
+#define mechrt_dynamics_rows            mechrtf_dynamics_rows
+#endif
+
+/* Workspace length in mechrt_real elements of the dynamics calls for nq
+   coordinates and nr rows: Phi_q (nr*nq), M, the null-space basis and the
+   reduced mass matrix (3 nq*nq), the multiplier block and its normal
+   matrix (2 nr*nr), six coordinate and six row vectors. Usable as a static
+   array size; mechrt_dynamics_workspace_size() checks for overflow. */
+#ifndef MECHRT_DYN_WORKSPACE_LEN
+#define MECHRT_DYN_WORKSPACE_LEN(nq, nr)                                          \
+    ((size_t)(nr) * (size_t)(nq) + 3u * (size_t)(nq) * (size_t)(nq)              \
+     + 2u * (size_t)(nr) * (size_t)(nr) + 6u * (size_t)(nq) + 6u * (size_t)(nr))
+#endif
+
+/* Tunable constants; mechrt_dyn_default_options(), then change fields. */
+typedef struct MechrtDynOptions {
+    /* A row of Phi_q is redundant when its pivot in the complete-pivoting
+       elimination is <= rank_tol * max|Phi_q_ij| (dimensionless). Above the
+       drift of the positions between two projections, where redundant rows
+       are dependent only to that accuracy. default 1e-8 / 1e-4 */
+    mechrt_real rank_tol;
+    /* The reduced mass matrix (M on the null space of Phi_q) is singular when
+       an LU pivot <= pivot_tol * its largest entry. default 1e-12 / 1e-5 */
+    mechrt_real pivot_tol;
+    /* Baumgarte stabilisation, gamma - 2 alpha (Phi_q qd - nu) - beta^2 Phi
+       (Phi on the holonomic rows only); alpha in 1/s, beta in 1/s.
+       default 0, 0: off */
+    mechrt_real baumgarte_alpha, baumgarte_beta;
+    /* NULL: every row. Else nr flags: rows with active[i] == 0 are left
+       out (their lambda is 0). An integrator chooses them once per step
+       with mechrt_dynamics_rows at its start, on the constraint manifold:
+       at its stages, off the manifold by the step's error, a redundant row
+       is independent to that error, and a fresh rank decision there would
+       lock the mechanism. default NULL */
+    const unsigned char *active;
+} MechrtDynOptions;
+
+/* What a dynamics call found. */
+typedef struct MechrtDynReport {
+    int rank;                  /* rank of Phi_q taken (rows kept) */
+    int redundant;             /* nr - rank: rows found dependent */
+    /* smallest kept pivot / max|Phi_q_ij|: near rank_tol, a rank drop is
+       near (a singular position); 1 without rows */
+    mechrt_real pivot_ratio;
+    /* forward: max |(L^-1 P gamma)_i| over the dependent rows, the part of
+       their acceleration equations qdd cannot satisfy (0 when consistent);
+       inverse: max |Phi_q^T lambda - (Q - M qdd)|_j, the applied force the
+       rows cannot carry (0 along a motion the rows fully drive) */
+    mechrt_real residual;
+    int sing_index;            /* forward: column of the reduced mass matrix
+                                  where LU found no pivot, else -1 */
+} MechrtDynReport;
+
+MechrtDynOptions mechrt_dyn_default_options(void);
+
+/* MECHRT_DYN_WORKSPACE_LEN(nq, nr); 0 if nq < 1, nr < 0 or on overflow. */
+size_t mechrt_dynamics_workspace_size(int nq, int nr);
+
+/* Forward dynamics at (q, qd, t): the accelerations qdd (nq) and, when
+   lambda is not NULL, the multipliers (nr). opts and report may be NULL.
+   MECHRT_ESING when M is singular on the null space of Phi_q (a massless
+   direction the rows leave free), MECHRT_ENOTFINITE for NaN/Inf in a
+   kernel result or the solution, MECHRT_EINVAL / MECHRT_EBADLEN. */
+MechrtStatus mechrt_forward_dynamics(const MechrtKernels *k, const MechrtDynOptions *opts,
+                                     const mechrt_real *q, const mechrt_real *qd,
+                                     mechrt_real t, mechrt_real *qdd, mechrt_real *lambda,
+                                     mechrt_real *work, size_t lwork, MechrtDynReport *report);
+
+/* Inverse dynamics along a known motion: lambda (nr) from
+   Phi_q^T lambda = Q(q, qd, t) - M(q) qdd, minimum-norm when rows are
+   redundant; report->residual says how much of the right side the rows
+   cannot carry (a motion not fully driven). */
+MechrtStatus mechrt_inverse_dynamics(const MechrtKernels *k, const MechrtDynOptions *opts,
+                                     const mechrt_real *q, const mechrt_real *qd,
+                                     const mechrt_real *qdd, mechrt_real t, mechrt_real *lambda,
+                                     mechrt_real *work, size_t lwork, MechrtDynReport *report);
+
+/* The rows to keep at (q, t): active[i] = 1 for the rank rows the
+   complete-pivoting elimination of Phi_q keeps, 0 for the rows found
+   dependent on them (opts->active is ignored). report gets rank,
+   redundant and pivot_ratio. */
+MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions *opts,
+                                  const mechrt_real *q, mechrt_real t, unsigned char *active,
+                                  mechrt_real *work, size_t lwork, MechrtDynReport *report);
+
 #endif /* real-type part */

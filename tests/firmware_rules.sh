@@ -37,7 +37,9 @@
 # Linking: slider_crank (prefix sc) + four_bar (prefix fb) + the runtime in
 # one program, run and checked against known values; and the same two in
 # double with four_bar as fbf in float and both runtime builds (mechrt_*,
-# mechrtf_*) in one program.
+# mechrtf_*) in one program; and the forward dynamics of the runtime
+# (dynamics.c) on pendulum_distance with hand-written mass and force, in
+# double and float, against the closed form.
 # With arm-none-eabi-gcc installed (.ci/deps firmware), the kernels and the
 # runtime are also compiled for a Cortex-M4F (float, hard-float ABI) and a
 # Cortex-M3 (double, software floating point) and checked the same way;
@@ -421,5 +423,77 @@ try 12 "link: slider_crank (sc) + four_bar (fb) + runtime in one program: slider
     link_run two "0.282842712475:1e-9 1.725386:1e-6" sc fb
 try 12 "link: sc and fb in double, fbf in float, mechrt_* and mechrtf_* in one program" \
     link_run mixed "0.282842712475:1e-9 1.725386:1e-6 1.725386:1e-4" sc fb fbf
+
+# ---- forward dynamics through the runtime (dynamics.c) ----------------------
+# pendulum_distance (a particle on a circle of radius 2) as pd in double and
+# pdf in float, with hand-written mass (unit) and force (gravity -9.81 along
+# y), since generated kernels have no masses yet: at rest at its initial
+# (1.732, 1) the particle accelerates by gravity's tangential part,
+# qdd = g - (g.n) n = (4.247917, -7.357392), n = (1.732, 1) / |(1.732, 1)|.
+make_dyn_unit() {
+    p=$1 P=$2 real=$3
+    def=""
+    [ "$real" = float ] && def="#define MECHRT_REAL_FLOAT"
+    "$mechc" gen "$root/examples/pendulum_distance.mech" --prefix "$p" --real "$real" \
+        -o "$link/$p.c" --header "$link/$p.h" || return 1
+    cat > "$link/dyn_$p.c" <<EOF
+$def
+#include "$p.h"
+#include "mechrt.h"
+double dyn_$p(int i);
+MECHRT_DEFINE_KERNELS($p, $P);
+static void ${p}_mass(void *ctx, const mechrt_real *q, mechrt_real *M)
+{
+    (void)ctx, (void)q;
+    M[0] = 1, M[1] = 0, M[2] = 0, M[3] = 1;
+}
+static void ${p}_force(void *ctx, const mechrt_real *q, const mechrt_real *qd, mechrt_real t,
+                       mechrt_real *Q)
+{
+    (void)ctx, (void)q, (void)qd, (void)t;
+    Q[0] = 0, Q[1] = (mechrt_real)-9.81;
+}
+static mechrt_real dws[MECHRT_DYN_WORKSPACE_LEN(${P}_NQ, ${P}_NR)];
+double dyn_$p(int i)
+{
+    MechrtKernels k = ${p}_kernels;
+    mechrt_real q[${P}_NQ], qd[${P}_NQ], qdd[${P}_NQ], lam[${P}_NR];
+    int j;
+    k.mass = ${p}_mass;
+    k.force = ${p}_force;
+    for (j = 0; j < ${P}_NQ; j++)
+        q[j] = ${p}_q0[j], qd[j] = 0;
+    if (mechrt_forward_dynamics(&k, NULL, q, qd, 0, qdd, lam, dws, sizeof dws / sizeof dws[0],
+                                NULL) != MECHRT_OK)
+        return -1000;
+    return (double)qdd[i];
+}
+EOF
+    $CC $LINKFLAGS -c "$link/dyn_$p.c" -o "$link/dyn_$p.o" &&
+    $CC $LINKFLAGS -c "$link/$p.c" -o "$link/$p.o"
+}
+dyn_run() {
+    make_dyn_unit pd PD double && make_dyn_unit pdf PDF float || return 1
+    {
+        echo '#include <stdio.h>'
+        echo 'double dyn_pd(int i);'
+        echo 'double dyn_pdf(int i);'
+        echo 'int main(void)'
+        echo '{'
+        printf '%s\n' '    printf("%.9f %.9f %.9f %.9f", dyn_pd(0), dyn_pd(1), dyn_pdf(0), dyn_pdf(1));'
+        echo '    return 0;'
+        echo '}'
+    } > "$link/dyn.c"
+    $CC $LINKFLAGS "$link/dyn.c" "$link/dyn_pd.o" "$link/pd.o" "$link/dyn_pdf.o" "$link/pdf.o" \
+        "$link"/rt_*.o "$link"/rtf_*.o -lm -o "$link/dyn" &&
+    "$link/dyn" | tr ' ' '\n' > "$link/dyn.out" &&
+    echo "got: $(cat "$link/dyn.out")" &&
+    echo "4.247916908:1e-8 -7.357392085:1e-8 4.247916908:1e-4 -7.357392085:1e-4" |
+        tr ' :' '\n ' | paste -d ' ' - "$link/dyn.out" |
+        awk '{ d = $1 - $3; if (d < 0) d = -d; if (d > $2) bad = 1; n++ }
+             END { exit bad || n != 4 }'
+}
+try 12 "link: forward dynamics (mechrt_forward_dynamics) of pendulum_distance, double and float, both runtime builds" \
+    dyn_run
 
 suite_end

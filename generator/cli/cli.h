@@ -147,6 +147,7 @@ bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech
 int cmd_gen(int argc, char **argv);
 int cmd_eval(int argc, char **argv);
 int cmd_run(int argc, char **argv);
+int cmd_sim(int argc, char **argv);
 int cmd_check(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_bench(int argc, char **argv);

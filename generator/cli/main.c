@@ -14,6 +14,7 @@ static const char usage[] =
     "  gen     write the generated C (and header)\n"
     "  eval    evaluate Phi, Phi_q, nu, gamma at one state\n"
     "  run     assemble, then position, velocity and acceleration analysis over time\n"
+    "  sim     forward dynamics over time (a file with masses)\n"
     "  check   compare symbolic derivatives with finite differences, engines with each other\n"
     "  info    coordinates, rows, mobility, rank, redundant rows, integrability\n"
     "  bench   time the evaluation engines side by side\n"
@@ -37,7 +38,7 @@ int main(int argc, char **argv)
         return EXIT_OK;
     }
     static const struct { const char *name; int (*fn)(int, char **); } commands[] = {
-        {"gen", cmd_gen}, {"eval", cmd_eval}, {"run", cmd_run},
+        {"gen", cmd_gen}, {"eval", cmd_eval}, {"run", cmd_run}, {"sim", cmd_sim},
         {"check", cmd_check}, {"info", cmd_info}, {"bench", cmd_bench},
     };
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)

@@ -1,0 +1,701 @@
+/* sim.c - forward dynamics over time on GSL's odeiv2, with coordinate projection.
+ *
+ * The state is y = (q, qd[, W]): q' = qd, qd' = qdd(q, qd, t) from the
+ * runtime's null-space solve of the augmented system (runtime/dynamics.c,
+ * which survives redundant rows), and W' the power of the forces for the
+ * energy balance. GSL steps it with an embedded Runge-Kutta pair (rk8pd by
+ * default, rkf45), or for stiff mechanisms the implicit Gauss-Legendre
+ * rk4imp or the variable-order BDF msbdf, both on a forward-difference
+ * Jacobian of the right side (2 nq + 2 right sides each).
+ *
+ * Drift: the integrator keeps Phi = 0 and Phi_q qd = nu only to its error,
+ * and the error grows (index reduction). So the state is projected back:
+ * positions by minimum-norm Newton onto Phi(q, t) = 0 (mechrt_host_project:
+ * SVD, redundant rows harmless), then velocities by the minimum-norm
+ * correction onto Phi_q qd = nu (one pseudo-inverse solve; every row,
+ * velocity-level ones too) (Hairer & Wanner, Solving ODEs II, VII.2).
+ * One-step methods project after every accepted integrator step; msbdf,
+ * whose history a change of the state would invalidate, projects at the
+ * output times only and restarts there. Baumgarte's stabilisation
+ * (SimOptions.dyn) may be added on top.
+ *
+ * Redundant rows and singular positions: after each projection, on the
+ * manifold, the rows the rank-revealing elimination keeps (pivots above
+ * SimOptions.row_tol) are chosen for the next step (mechrt_dynamics_rows)
+ * and the others left out at its stages, which lie off the manifold by the
+ * step's error: there a redundant row is independent to that error, and
+ * near a singular position (a parallelogram's cranks in line with its
+ * coupler) the row becoming dependent has an acceleration equation
+ * inconsistent by the error over its small pivot. The projection restores
+ * the rows left out.
+ *
+ * Energy: E = T - W with T = 1/2 qd^T M qd and W' = qd^T M qdd +
+ * 1/2 qd^T Mdot qd = qd.(Q - Phi_q^T lambda) + 1/2 qd^T Mdot qd, the power of
+ * the applied forces (Q without its velocity terms, which the Mdot term
+ * cancels) and of the constraint forces; Mdot qd by a central difference of
+ * the mass kernel along qd. The identity holds for any mechanism, so the
+ * drift of E measures the integration and projection error; for a
+ * conservative one (gravity and springs, no dampers, no drivers) W = -(V -
+ * V0) and E is the energy, T + V - V0. W rides in the state, so the
+ * integrator is its quadrature; its own error does not steer the step size.
+ */
+#include "sim.h"
+
+#include "../base/arena.h"
+#include "../pipeline/pipeline.h"
+#include "../../runtime/host/mechrt_host.h"
+#include "assemble.h"
+#include "options.h"
+#include "construct.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+/* Relative displacement of the central difference for Mdot qd. */
+#define SIM_MDOT_STEP 1e-5
+/* The step size is said to underflow below this share of |t1 - t0|. */
+#define SIM_HMIN_SHARE 1e-14
+
+const char *const sim_method_names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf", NULL};
+
+SimOptions sim_default_options(void)
+{
+    SimOptions o;
+    memset(&o, 0, sizeof o);
+    o.t0 = 0;
+    o.t1 = 1;
+    o.steps = 100;
+    o.method = SIM_RK8PD;
+    o.rtol = 1e-10;
+    o.atol = 1e-10;
+    o.dyn = mechrt_dyn_default_options();
+    o.mechrt = mechrt_default_options();
+    o.project = true;
+    o.row_tol = 1e-4;
+    o.energy = true;
+    o.qd0 = NULL;
+    o.assembly_max_iter = 100;
+    o.max_steps = 10000000;
+    o.notes = NULL;
+    return o;
+}
+
+bool sim_has_masses(const MechrtKernels *k)
+{
+    return k && k->mass && k->force;
+}
+
+/* ---- the state of one simulation ---------------------------------------- */
+
+typedef struct Sim {
+    const MechrtKernels *inner;  /* the caller's kernels */
+    MechrtKernels kc;            /* the same, counted (ctx: this Sim) */
+    const SimOptions *o;
+    SimResult *res;
+    int nq, nr, dim;             /* dim: 2 nq (+1 with energy) */
+    double *work;                /* mechrt_forward_dynamics' workspace */
+    size_t lwork;
+    MechrtHost *host;            /* position projection */
+    MechrtSvd *svd;              /* velocity projection, nr x nq */
+    double *jac, *nu, *resid, *dqd, *lambda, *mass, *mass2, *qs, *f0, *f1, *y;
+    gsl_odeiv2_system sys;
+    gsl_odeiv2_driver *drv;
+    MechrtStatus fail_status;    /* set by the right-hand side */
+    double fail_t;
+    MechrtDynReport fail_rep;
+    double e0;                   /* E at t0 */
+    MechrtDynOptions dyn;        /* the caller's, with the rows of this step */
+    unsigned char *active;       /* nr: the rows kept during this step */
+} Sim;
+
+/* Counting wrappers: every kernel call of the simulation goes through these. */
+static void c_phi(void *ctx, const double *q, double t, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.phi++;
+    s->inner->phi(s->inner->ctx, q, t, out);
+}
+
+static void c_jac(void *ctx, const double *q, double t, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.jac++;
+    s->inner->jac(s->inner->ctx, q, t, out);
+}
+
+static void c_nu(void *ctx, const double *q, double t, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.nu++;
+    s->inner->nu(s->inner->ctx, q, t, out);
+}
+
+static void c_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.gamma++;
+    s->inner->gamma(s->inner->ctx, q, qd, t, out);
+}
+
+static void c_all(void *ctx, const double *q, const double *qd, double t, double *phi,
+                  double *jac, double *nu, double *gamma)
+{
+    Sim *s = ctx;
+    s->res->calls.all++;
+    s->inner->all(s->inner->ctx, q, qd, t, phi, jac, nu, gamma);
+}
+
+static void c_mass(void *ctx, const double *q, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.mass++;
+    s->inner->mass(s->inner->ctx, q, out);
+}
+
+static void c_force(void *ctx, const double *q, const double *qd, double t, double *out)
+{
+    Sim *s = ctx;
+    s->res->calls.force++;
+    s->inner->force(s->inner->ctx, q, qd, t, out);
+}
+
+static void msgf(Sim *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Appends to res->message, truncating quietly. */
+static void msgf(Sim *s, const char *fmt, ...)
+{
+    char *msg = s->res->message;
+    size_t len = strlen(msg);
+    if (len + 1 >= sizeof s->res->message)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg + len, sizeof s->res->message - len, fmt, ap);
+    va_end(ap);
+}
+
+/* The failure at t: status, cause and message start "t = T: WHAT: ". */
+static void fail(Sim *s, MechrtStatus st, double t, const char *what)
+{
+    SimResult *res = s->res;
+    res->status = SIM_FAILED;
+    res->cause = st;
+    res->t_fail = t;
+    res->message[0] = '\0';
+    msgf(s, "t = %.10g: %s failed: ", t, what);
+}
+
+/* Why mechrt_forward_dynamics failed, after fail(). */
+static void explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep)
+{
+    switch (st) {
+    case MECHRT_ESING:
+        msgf(s, "the augmented matrix is singular: the mass matrix is singular on the motions "
+             "the joints allow (reduced mass matrix, direction %d of %d): a body or coordinate "
+             "free to move without mass or inertia?", rep->sing_index + 1,
+             s->nq - rep->rank);
+        break;
+    case MECHRT_ENOTFINITE:
+        msgf(s, "NaN or infinity in the mass matrix, the forces, the Jacobian, gamma or the "
+             "solution (a function evaluated outside its domain, or the motion blew up)");
+        break;
+    default:
+        msgf(s, "%s (an internal error)", mechrt_strerror(st));
+        break;
+    }
+}
+
+/* ---- energy --------------------------------------------------------------- */
+
+/* 1/2 qd^T Mdot qd by a central difference of M along qd (mass2, qs scratch). */
+static double half_mdot(Sim *s, const double *q, const double *qd)
+{
+    int n = s->nq;
+    double vmax = 0, qmax = 1;
+    for (int i = 0; i < n; i++) {
+        vmax = fmax(vmax, fabs(qd[i]));
+        qmax = fmax(qmax, fabs(q[i]));
+    }
+    if (vmax == 0)
+        return 0;
+    double eps = SIM_MDOT_STEP * qmax / vmax, sum = 0;
+    for (int sign = -1; sign <= 1; sign += 2) {
+        for (int i = 0; i < n; i++)
+            s->qs[i] = q[i] + sign * eps * qd[i];
+        s->kc.mass(s->kc.ctx, s->qs, s->mass2);
+        double quad = 0;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++)
+                quad += qd[i] * s->mass2[(size_t)i * (size_t)n + (size_t)j] * qd[j];
+        sum += sign * quad;
+    }
+    return 0.25 * sum / eps;    /* 1/2 * (quad+ - quad-) / (2 eps) */
+}
+
+/* qd^T M x with M at q (one mass call). */
+static double mass_form(Sim *s, const double *q, const double *qd, const double *x)
+{
+    int n = s->nq;
+    s->kc.mass(s->kc.ctx, q, s->mass);
+    double sum = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            sum += qd[i] * s->mass[(size_t)i * (size_t)n + (size_t)j] * x[j];
+    return sum;
+}
+
+/* E = T - W at the state y, and the drift against E(t0). */
+static void watch_energy(Sim *s, const double *y, bool first)
+{
+    if (!s->o->energy)
+        return;
+    const double *q = y, *qd = y + s->nq;
+    double tk = 0.5 * mass_form(s, q, qd, qd), w = y[2 * s->nq];
+    double e = tk - w;
+    if (first)
+        s->e0 = e;
+    s->res->energy_scale = fmax(s->res->energy_scale, fmax(tk, fabs(w)));
+    s->res->energy_drift = fmax(s->res->energy_drift, fabs(e - s->e0));
+}
+
+/* ---- right-hand side -------------------------------------------------------- */
+
+static int sim_rhs(double t, const double y[], double f[], void *params)
+{
+    Sim *s = params;
+    int n = s->nq;
+    const double *q = y, *qd = y + n;
+    MechrtDynReport rep;
+    s->res->rhs_calls++;
+    MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->dyn, q, qd, t, f + n, NULL,
+                                              s->work, s->lwork, &rep);
+    if (st == MECHRT_OK) {
+        memcpy(f, qd, (size_t)n * sizeof *f);
+        if (rep.redundant > s->res->max_redundant)
+            s->res->max_redundant = rep.redundant;
+        if (s->nr > 0 && rep.pivot_ratio < s->res->min_pivot_ratio)
+            s->res->min_pivot_ratio = rep.pivot_ratio;
+        if (s->o->energy)
+            f[2 * n] = mass_form(s, q, qd, f + n) + half_mdot(s, q, qd);
+        return GSL_SUCCESS;
+    }
+    if (s->fail_status == MECHRT_OK) {
+        s->fail_status = st;
+        s->fail_t = t;
+        s->fail_rep = rep;
+    }
+    return GSL_EBADFUNC;
+}
+
+/* Forward differences of the right side for the implicit methods. */
+static int sim_jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    Sim *s = params;
+    int dim = s->dim;
+    s->res->jacobian_calls++;
+    int gs = sim_rhs(t, y, s->f0, s);
+    memcpy(s->y, y, (size_t)dim * sizeof *y);
+    for (int j = 0; j < dim && gs == GSL_SUCCESS; j++) {
+        double h = 1.4901161193847656e-08 * fmax(fabs(y[j]), 1.0);   /* sqrt(eps) */
+        s->y[j] = y[j] + h;
+        gs = sim_rhs(t, s->y, s->f1, s);
+        for (int i = 0; i < dim; i++)
+            dfdy[(size_t)i * (size_t)dim + (size_t)j] = (s->f1[i] - s->f0[i]) / h;
+        s->y[j] = y[j];
+    }
+    if (gs == GSL_SUCCESS) {
+        double ht = 1.4901161193847656e-08 * fmax(fabs(t), 1.0);
+        gs = sim_rhs(t + ht, y, s->f1, s);
+        for (int i = 0; i < dim; i++)
+            dfdt[i] = (s->f1[i] - s->f0[i]) / ht;
+    }
+    return gs;
+}
+
+/* ---- projection ------------------------------------------------------------- */
+
+/* qd <- qd - pinv(Phi_q) (Phi_q qd - nu): the nearest velocities the rows allow. */
+static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, double t)
+{
+    int n = s->nq, m = s->nr;
+    MechrtSvdResult sv;
+    if (m == 0)
+        return MECHRT_OK;
+    s->kc.jac(s->kc.ctx, q, t, s->jac);
+    s->kc.nu(s->kc.ctx, q, t, s->nu);
+    for (int i = 0; i < m; i++) {
+        double a = -s->nu[i];
+        for (int j = 0; j < n; j++)
+            a += s->jac[(size_t)i * (size_t)n + (size_t)j] * qd[j];
+        s->resid[i] = a;
+    }
+    if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
+        return MECHRT_ENOTFINITE;
+    if (!(sv.sigma_max > 0))
+        return MECHRT_OK;   /* Phi_q = 0: nothing constrains the velocities */
+    mechrt_svd_truncate(s->svd, s->o->dyn.rank_tol * sv.sigma_max);
+    mechrt_svd_pinv_solve(s->svd, s->resid, s->dqd);
+    for (int j = 0; j < n; j++) {
+        qd[j] -= s->dqd[j];
+        if (!isfinite(qd[j]))
+            return MECHRT_ENOTFINITE;
+    }
+    return MECHRT_OK;
+}
+
+/* Positions onto Phi = 0, then velocities onto Phi_q qd = nu; fails with the message set. */
+static bool project_state(Sim *s, double *y, double t)
+{
+    MechrtOptions po = s->o->mechrt;
+    MechrtReport rep;
+    po.pivot_tol = s->o->dyn.rank_tol;      /* redundant rows are dependent only so far */
+    s->res->projections++;
+    MechrtStatus st = mechrt_host_project(s->host, &po, y, t, &rep);
+    s->res->projection_iterations += rep.iterations;
+    if (st != MECHRT_OK) {
+        fail(s, st, t, "position projection");
+        if (st == MECHRT_EMAXITER)
+            msgf(s, "minimum-norm Newton did not bring the rows back within %d iterations "
+                 "(largest residual %.3g); the step may be too long for the motion: "
+                 "tighten --rtol/--atol", po.max_iter, rep.residual);
+        else
+            msgf(s, "%s", mechrt_strerror(st));
+        return false;
+    }
+    st = project_velocities(s, y, y + s->nq, t);
+    if (st != MECHRT_OK) {
+        fail(s, st, t, "velocity projection");
+        msgf(s, "%s", mechrt_strerror(st));
+        return false;
+    }
+    return true;
+}
+
+/* The rows the next step keeps, decided at y (on the manifold after a
+   projection): redundant ones out, for every stage of the step. */
+static bool choose_rows(Sim *s, const double *y, double t)
+{
+    MechrtDynReport rep;
+    MechrtDynOptions ro = s->o->dyn;
+    ro.rank_tol = fmax(ro.rank_tol, s->o->row_tol);
+    MechrtStatus st = mechrt_dynamics_rows(&s->kc, &ro, y, t, s->active, s->work, s->lwork,
+                                           &rep);
+    if (st != MECHRT_OK) {
+        fail(s, st, t, "the rank of the Jacobian");
+        msgf(s, "%s", mechrt_strerror(st));
+        return false;
+    }
+    return true;
+}
+
+/* After a step (or at the start): projection when on, then the rows. */
+static bool settle(Sim *s, double *y, double t, bool project)
+{
+    return (!project || project_state(s, y, t)) && choose_rows(s, y, t);
+}
+
+/* ---- set-up ------------------------------------------------------------------ */
+
+static const gsl_odeiv2_step_type *step_type(SimMethod m)
+{
+    switch (m) {
+    case SIM_RK8PD: return gsl_odeiv2_step_rk8pd;
+    case SIM_RKF45: return gsl_odeiv2_step_rkf45;
+    case SIM_RK4IMP: return gsl_odeiv2_step_rk4imp;
+    case SIM_MSBDF: return gsl_odeiv2_step_msbdf;
+    }
+    return gsl_odeiv2_step_rk8pd;
+}
+
+/* Buffers, projection objects and the GSL driver; false when out of memory. */
+static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *res)
+{
+    size_t n = (size_t)k->nq, m = (size_t)(k->nh + k->nv);
+    s->inner = k;
+    s->o = o;
+    s->res = res;
+    s->nq = k->nq;
+    s->nr = (int)m;
+    s->dim = 2 * k->nq + (o->energy ? 1 : 0);
+    s->kc = (MechrtKernels){k->nq, k->nh, k->nv, s, c_phi, c_jac, c_nu, c_gamma,
+                            k->all ? c_all : NULL, c_mass, c_force};
+    s->lwork = mechrt_dynamics_workspace_size(k->nq, (int)m);
+    s->work = xcalloc(s->lwork, sizeof *s->work);
+    s->jac = xcalloc(m * n + 1, sizeof *s->jac);
+    s->nu = xcalloc(m + 1, sizeof *s->nu);
+    s->resid = xcalloc(m + 1, sizeof *s->resid);
+    s->lambda = xcalloc(m + 1, sizeof *s->lambda);
+    s->dqd = xcalloc(n, sizeof *s->dqd);
+    s->mass = xcalloc(n * n, sizeof *s->mass);
+    s->mass2 = xcalloc(n * n, sizeof *s->mass2);
+    s->qs = xcalloc(n, sizeof *s->qs);
+    s->f0 = xcalloc((size_t)s->dim, sizeof *s->f0);
+    s->f1 = xcalloc((size_t)s->dim, sizeof *s->f1);
+    s->y = xcalloc((size_t)s->dim, sizeof *s->y);
+    s->active = xcalloc(m + 1, sizeof *s->active);
+    s->dyn = o->dyn;
+    s->dyn.active = s->active;
+    s->host = mechrt_host_new(&s->kc);
+    s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
+    if (!s->host || (m > 0 && !s->svd))
+        return false;
+    /* W's error must not steer the step: its absolute scale is huge */
+    double *scale = xcalloc((size_t)s->dim, sizeof *scale);
+    for (int i = 0; i < s->dim; i++)
+        scale[i] = i < 2 * s->nq ? 1.0 : 1e300;
+    double span = fabs(o->t1 - o->t0), h0 = span / o->steps / 16;
+    s->sys = (gsl_odeiv2_system){sim_rhs, sim_jacobian, (size_t)s->dim, s};
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    s->drv = gsl_odeiv2_driver_alloc_scaled_new(&s->sys, step_type(o->method),
+                                                o->t1 > o->t0 ? h0 : -h0, o->atol, o->rtol,
+                                                1.0, 0.0, scale);
+    gsl_set_error_handler(old);
+    free(scale);
+    return s->drv != NULL;
+}
+
+static void sim_close(Sim *s)
+{
+    free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
+    free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
+    free(s->y), free(s->active);
+    mechrt_host_free(s->host);
+    mechrt_svd_free(s->svd);
+    if (s->drv)
+        gsl_odeiv2_driver_free(s->drv);
+}
+
+/* ---- the integration ---------------------------------------------------------- */
+
+static double time_at(const SimOptions *o, int i)
+{
+    if (i == o->steps)
+        return o->t1;
+    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
+}
+
+/* The state y at t out: its accelerations and multipliers, then the callback. */
+static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void *ctx)
+{
+    int n = s->nq;
+    MechrtDynReport rep;
+    MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->o->dyn, y, y + n, t, s->f0,
+                                              s->lambda, s->work, s->lwork, &rep);
+    if (st != MECHRT_OK) {
+        fail(s, st, t, "forward dynamics");
+        explain_dynamics(s, st, &rep);
+        return false;
+    }
+    state(ctx, t, y, y + n, s->f0, s->lambda);
+    s->res->states++;
+    return true;
+}
+
+/* One accepted integrator step from *t towards tn; false with the message set. */
+static bool one_step(Sim *s, double *y, double *t, double tn, double *h)
+{
+    gsl_odeiv2_driver *d = s->drv;
+    double hmin = SIM_HMIN_SHARE * fabs(s->o->t1 - s->o->t0), t_before = *t;
+    unsigned long failed0 = d->e->failed_steps;
+    int gs = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &s->sys, t, tn, h, y);
+    s->res->rejected += (long)(d->e->failed_steps - failed0);
+    if (gs != GSL_SUCCESS) {
+        if (s->fail_status != MECHRT_OK) {
+            fail(s, s->fail_status, s->fail_t, "forward dynamics");
+            explain_dynamics(s, s->fail_status, &s->fail_rep);
+        } else {
+            fail(s, MECHRT_ESTEP, *t, "integration");
+            msgf(s, "the integrator (%s) gave up (GSL: %s)", sim_method_names[s->o->method],
+                 gsl_strerror(gs));
+        }
+        return false;
+    }
+    s->res->steps++;
+    if ((fabs(*t - t_before) < hmin && *t != tn) || s->res->steps > s->o->max_steps) {
+        fail(s, MECHRT_ESTEP, *t, "integration");
+        if (s->res->steps > s->o->max_steps)
+            msgf(s, "more than %ld integrator steps: the motion is stiff or too fast for "
+                 "--rtol/--atol (an implicit --method may help)", s->o->max_steps);
+        else
+            msgf(s, "step size underflow (%.3g) before --rtol/--atol were met: a singular "
+                 "position, an impact or a stiff force? (an implicit --method may help)",
+                 fabs(*t - t_before));
+        return false;
+    }
+    return true;
+}
+
+/* From the consistent state in y: the output times, stepping and projecting. */
+static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
+{
+    const SimOptions *o = s->o;
+    bool per_step = o->project && o->method != SIM_MSBDF;
+    double t = o->t0, h = s->drv->h;
+    watch_energy(s, y, true);
+    if (!put_state(s, y, t, state, ctx))
+        return SIM_FAILED;
+    for (int i = 1; i <= o->steps; i++) {
+        double tn = time_at(o, i);
+        while (t != tn) {
+            if (!one_step(s, y, &t, tn, &h) || (per_step && !settle(s, y, t, true)))
+                return SIM_FAILED;
+            watch_energy(s, y, false);
+        }
+        if (!per_step) {
+            if (!settle(s, y, t, o->project))
+                return SIM_FAILED;
+            if (o->project)
+                gsl_odeiv2_driver_reset(s->drv);    /* the multistep history is stale */
+            watch_energy(s, y, false);
+        }
+        if (!put_state(s, y, t, state, ctx))
+            return SIM_FAILED;
+    }
+    return SIM_OK;
+}
+
+static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(res->message, sizeof res->message, fmt, ap);
+    va_end(ap);
+    res->status = SIM_BAD_INPUT;
+    res->cause = MECHRT_EINVAL;
+    return SIM_BAD_INPUT;
+}
+
+/* Options and kernels usable; SIM_OK or SIM_BAD_INPUT with the message. */
+static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
+{
+    if (!sim_has_masses(k))
+        return bad_input(res, "the mechanism has no masses: forward dynamics needs `mass` "
+                         "statements (and gravity or forces) in the file");
+    if (o->steps < 1)
+        return bad_input(res, "the number of steps must be at least 1, not %d", o->steps);
+    if (!isfinite(o->t0) || !isfinite(o->t1) || o->t0 == o->t1)
+        return bad_input(res, "the time interval must be finite and not empty (t0 = %g, "
+                         "t1 = %g)", o->t0, o->t1);
+    if (!(o->rtol >= 0) || !(o->atol >= 0) || (o->rtol == 0 && o->atol == 0))
+        return bad_input(res, "--rtol and --atol must be non-negative and not both 0");
+    if (k->nh > k->nq)
+        return bad_input(res, "%d holonomic rows for %d coordinates: the position "
+                         "projection needs at most one row per coordinate", k->nh, k->nq);
+    return SIM_OK;
+}
+
+SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+                        SimStateFn state, void *state_ctx, SimResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    res->min_pivot_ratio = 1;
+    if (check_input(k, o, res) != SIM_OK)
+        return SIM_BAD_INPUT;
+    Sim s;
+    memset(&s, 0, sizeof s);
+    SimStatus status = SIM_FAILED;
+    if (!sim_open(&s, k, o, res)) {
+        snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
+        res->status = SIM_FAILED;
+        res->cause = MECHRT_EINVAL;
+        res->t_fail = o->t0;
+        sim_close(&s);
+        return SIM_FAILED;
+    }
+    double *y = xcalloc((size_t)s.dim, sizeof *y);
+    memcpy(y, q0, (size_t)s.nq * sizeof *y);
+    if (o->qd0)
+        memcpy(y + s.nq, o->qd0, (size_t)s.nq * sizeof *y);
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    double c0 = pipeline_now();
+    clock_t cpu0 = clock();
+    if (settle(&s, y, o->t0, true))
+        status = integrate(&s, y, state, state_ctx);
+    res->seconds = pipeline_now() - c0;
+    res->cpu_seconds = (double)(clock() - cpu0) / CLOCKS_PER_SEC;
+    gsl_set_error_handler(old);
+    res->status = status;
+    free(y);
+    sim_close(&s);
+    return status;
+}
+
+/* Construction, then Newton onto the rows from the file's values (as run
+   does at t0); q holds the result. False with the message set. */
+static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                           double *q, SimResult *res)
+{
+    res->constructed = construct_with_kernels(m, k, o->t0, q);
+    MechrtHost *host = mechrt_host_new(k);
+    if (!host)
+        return false;
+    double *start = xmalloc((size_t)m->nq * sizeof *start);
+    memcpy(start, q, (size_t)m->nq * sizeof *q);
+    MechrtReport rep;
+    MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
+    mechrt_host_free(host);
+    bool ok = st == MECHRT_OK;
+    if (!ok) {
+        AnalysisOptions ao = analysis_default_options();
+        AssembleResult ar;
+        ao.tol_phi = o->mechrt.tol_phi;
+        ao.tol_dq = o->mechrt.tol_dq;
+        ao.max_iter = o->assembly_max_iter;
+        ao.stall_iter = ASSEMBLE_ROUGH_STALL;
+        memcpy(q, start, (size_t)m->nq * sizeof *q);
+        ok = assemble_restarting(k, o->t0, q, &ao, &ar);
+        res->assembled_robustly = true;
+        if (!ok)
+            snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
+                     "these initial values: after %d iterations of minimum-norm Newton the "
+                     "largest residual is %.3g in row %s", o->t0, ar.iterations, ar.residual,
+                     ar.worst_row >= 0 ? m->rows[ar.worst_row].name : "?");
+    }
+    free(start);
+    return ok;
+}
+
+SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                  SimStateFn state, void *state_ctx, SimResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
+        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
+                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
+    if (check_input(k, o, res) != SIM_OK)
+        return SIM_BAD_INPUT;
+    double *q = xmalloc((size_t)m->nq * sizeof *q);
+    memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
+    SimResult pre = {0};
+    if (!assemble_at_t0(m, k, o, q, &pre)) {
+        *res = pre;
+        res->status = SIM_FAILED;
+        res->cause = MECHRT_EMAXITER;
+        res->t_fail = o->t0;
+        free(q);
+        return SIM_FAILED;
+    }
+    double move = 0;
+    for (int i = 0; i < m->nq; i++)
+        move = fmax(move, fabs(q[i] - m->q0[i]));
+    if (pre.assembled_robustly && o->notes)
+        fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
+                "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
+    SimStatus st = sim_integrate(k, o, q, state, state_ctx, res);
+    res->constructed = pre.constructed;
+    res->assembled_robustly = pre.assembled_robustly;
+    res->assembly_move = move;
+    free(q);
+    return st;
+}

@@ -1,0 +1,110 @@
+/* sim.h - forward dynamics over time, the machinery of `mechc sim`, as a library.
+ *
+ * sim_run assembles a mechanism with masses at t0 from its file's initial
+ * values (as run does), makes the initial velocities consistent, then
+ * integrates M qdd + Phi_q^T lambda = Q, Phi_q qdd = gamma with GSL's
+ * odeiv2 (state (q, qd), accelerations from mechrt_forward_dynamics),
+ * projecting positions and velocities back onto the constraints, and hands
+ * the state at `steps` equal intervals to a callback. Like run.h: no
+ * printing, no exit; a failure is a SimStatus with a one-line message
+ * naming `t = VALUE` and the cause.
+ */
+#ifndef MECHC_SIM_H
+#define MECHC_SIM_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "../../runtime/mechrt.h"
+#include "../model/model.h"
+
+/* The integrators: explicit embedded Runge-Kutta pairs, and two implicit
+   methods for stiff mechanisms (stiff springs, large damping) that take
+   a finite-difference Jacobian of the right side. */
+typedef enum SimMethod { SIM_RK8PD, SIM_RKF45, SIM_RK4IMP, SIM_MSBDF } SimMethod;
+
+/* "rk8pd", "rkf45", "rk4imp", "msbdf", NULL: the --method names, in order. */
+extern const char *const sim_method_names[];
+
+/* What a simulation does; fill with sim_default_options(). */
+typedef struct SimOptions {
+    double t0, t1;          /* time interval, t1 != t0; 0, 1 */
+    int steps;              /* output intervals, >= 1: steps + 1 states; 100 */
+    SimMethod method;       /* SIM_RK8PD */
+    /* local error per step |err_i| <= atol + rtol |y_i| on every position
+       and velocity; 1e-10, 1e-10 */
+    double rtol, atol;
+    MechrtDynOptions dyn;   /* rank tolerance, Baumgarte (off) */
+    /* the projections' Newton: tol_phi, tol_dq, max_iter; and assembly's */
+    MechrtOptions mechrt;
+    bool project;           /* coordinate projection; true */
+    /* At the start of every step (on the manifold), rows whose pivot in
+       the rank-revealing elimination is <= row_tol * max|Phi_q_ij| are left
+       out for the step's stages: redundant rows, and near a singular
+       position the row that becomes dependent there (off the manifold, at
+       the stages, its acceleration equation is inconsistent by the step's
+       error divided by the pivot); the projection restores it. 1e-4 */
+    double row_tol;
+    /* integrate the work of the forces for the energy balance (3 more
+       mass-kernel calls per right-hand side); true */
+    bool energy;
+    const double *qd0;      /* initial velocities (nq), NULL: zero; projected
+                               onto Phi_q qd = nu either way */
+    int assembly_max_iter;  /* minimum-norm Newton at t0 when projection fails; 100 */
+    long max_steps;         /* integrator steps allowed in all; 10 000 000 */
+    FILE *notes;            /* notes ("FILE: note: ..."); NULL: none */
+} SimOptions;
+
+SimOptions sim_default_options(void);
+
+/* Statuses double as exit codes, as RunStatus does. */
+typedef enum SimStatus { SIM_OK = 0, SIM_FAILED = 1, SIM_BAD_INPUT = 2 } SimStatus;
+
+enum { SIM_MESSAGE_MAX = 1024 };
+
+/* Kernel calls by kind, through the counting wrapper. */
+typedef struct SimKernelCalls {
+    long phi, jac, nu, gamma, all, mass, force;
+} SimKernelCalls;
+
+typedef struct SimResult {
+    SimStatus status;
+    MechrtStatus cause;          /* behind SIM_FAILED */
+    double t_fail;
+    char message[SIM_MESSAGE_MAX];
+    int states;                  /* states handed to the callback */
+    int constructed;             /* coordinates placed by construction at t0 */
+    bool assembled_robustly;     /* minimum-norm Newton with restarts at t0 */
+    double assembly_move;        /* ||q(t0) - q0||_inf */
+    long steps, rejected;        /* accepted and rejected integrator steps */
+    long rhs_calls;              /* forward-dynamics solves for the integrator */
+    long jacobian_calls;         /* finite-difference Jacobians (implicit methods) */
+    long projections;            /* position + velocity projections */
+    long projection_iterations;  /* Newton iterations in the position ones */
+    SimKernelCalls calls;
+    int max_redundant;           /* most rows found dependent at once */
+    double min_pivot_ratio;      /* nearest approach to a rank drop (1: none) */
+    /* energy balance E = T - W, T = 1/2 qd^T M qd, W the work of the applied
+       and constraint forces: max |E - E(t0)| over the accepted steps, and
+       the largest of T and |W| met (the scale it is relative to) */
+    double energy_drift, energy_scale;
+    double seconds, cpu_seconds; /* wall and CPU time of the integration */
+} SimResult;
+
+/* Receives each output state; lambda holds nr multipliers. */
+typedef void (*SimStateFn)(void *ctx, double t, const double *q, const double *qd,
+                           const double *qdd, const double *lambda);
+
+/* The kernels have the dynamics slots (a file with masses). */
+bool sim_has_masses(const MechrtKernels *k);
+
+/* From the file's initial values: construction and assembly at t0 (as
+   run), then sim_integrate. */
+SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                  SimStateFn state, void *state_ctx, SimResult *res);
+
+/* From positions q0 (nq; projected onto Phi = 0 first) and o->qd0. */
+SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+                        SimStateFn state, void *state_ctx, SimResult *res);
+
+#endif
