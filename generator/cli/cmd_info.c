@@ -2,9 +2,12 @@
 #include "cli.h"
 
 #include "../analysis/info.h"
+#include "../analysis/run.h"
 #include "../base/arena.h"
+#include "state_csv.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,12 +16,16 @@ typedef struct InfoCli {
     AnalysisOptions analysis;
     MechLimits limits;
     double t;
+    double at;              /* --at T: NAN when absent */
+    const char *state;      /* --state FILE.csv, or NULL */
+    int linear;             /* --linear, a RunLinear */
     bool json;
 } InfoCli;
 
 static const char usage[] =
     "usage: mechc info FILE.mech [--json] [--rank-tol T] [--t T] [--samples N]\n"
-    "                  [--max-dense N]\n"
+    "                  [--linear dense|sparse|auto] [--max-dense N]\n"
+    "                  [--at T] [--state STATE.csv]\n"
     "\n"
     "Reports the coordinates, every row with its joint, kind and level, the rows\n"
     "per joint against the textbook table and the mobility count (coordinates -\n"
@@ -28,6 +35,9 @@ static const char usage[] =
     "on the rows before it), tells a singular position from a permanent\n"
     "redundancy, and tests every velocity-level row for integrability\n"
     "(holonomic in disguise, with its position law, or nonholonomic).\n"
+    "With --at or --state it reports a given state: the rank drop there against\n"
+    "the rank at t = 0 and nearby, the rows that became dependent and the\n"
+    "directions the rows leave free (null-space vectors by coordinate).\n"
     "\n";
 
 static const CliOption options[] = {
@@ -42,11 +52,24 @@ static const CliOption options[] = {
      .help = "analyse at time T instead of 0 (drivers move with t)"},
     {"--samples", CLI_INT_AT(InfoCli, analysis.samples, 1, 1000), .metavar = "N",
      .help = "random states for the numerical integrability check (default 8)"},
+    {"--linear", CLI_CHOICE_AT(InfoCli, linear, run_linear_names), .metavar = "L",
+     .help = "rank by dense SVD, or by sparse QR (SuiteSparseQR: the rank,\n"
+             "the redundant rows and mobility, no condition number), or\n"
+             "auto (default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates)"},
     {"--max-dense", CLI_REAL_AT(InfoCli, analysis.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "N",
-     .help = "rows x coordinates up to which the rank comes from a dense SVD\n"
-             "(default 500000); larger Jacobians use a sparse QR, which gives\n"
-             "the rank and the redundant rows but no condition number"},
+     .help = "rows x coordinates up to which a dense SVD is allowed\n"
+             "(default 500000): auto goes sparse beyond it, dense refuses"},
+    {"--at", CLI_REAL_AT(InfoCli, at), .metavar = "T",
+     .help = "the state the motion reaches at T: assembled at t = 0 from\n"
+             "the file's initial values, then followed to T in 100 steps\n"
+             "(minimum-norm Newton, through singular positions); reports\n"
+             "the rank drop there, the rows that became dependent and the\n"
+             "directions the rows leave free"},
+    {"--state", CLI_STRING_AT(InfoCli, state), .metavar = "FILE",
+     .help = "the same at a state read from a CSV as run writes it (a\n"
+             "header naming t and the coordinates; the row at --at T, or\n"
+             "the only row), used as it is"},
 };
 
 static const char epilogue[] =
@@ -329,24 +352,81 @@ static void print_text(const InfoReport *rep)
     printf("\nverdict: %s\n", rep->verdict);
 }
 
+/* --linear: dense allowed up to --max-dense, auto dense up to 100
+   coordinates as well; false (reported) when dense is refused. */
+static bool choose_linear(const InfoCli *c, const Model *m, AnalysisOptions *o)
+{
+    bool fits = (double)m->nr * (double)m->nq <= o->max_dense;
+    switch ((RunLinear)c->linear) {
+    case RUN_LINEAR_DENSE:
+        if (!fits) {
+            fprintf(stderr, "mechc info: error: --linear dense: the Jacobian is %d x %d, beyond "
+                    "--max-dense %.0f (a dense SVD of it would take long): use --linear sparse "
+                    "or raise --max-dense\n", m->nr, m->nq, o->max_dense);
+            return false;
+        }
+        break;
+    case RUN_LINEAR_SPARSE:
+        o->max_dense = -1;
+        break;
+    case RUN_LINEAR_AUTO:
+        if (m->nq > RUN_DENSE_MAX_NQ)
+            o->max_dense = -1;
+        break;
+    }
+    return true;
+}
+
+/* --at and --state: where the state comes from; q (nq) receives a state
+   read from the CSV. *t is the time of the analysis. false on a bad
+   --state (reported). */
+static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at, double *t)
+{
+    *t = isnan(c->at) ? c->t : c->at;
+    *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
+    if (!c->state)
+        return true;
+    char err[300];
+    if (!state_csv_read(c->state, m, c->at, q, t, err, sizeof err)) {
+        fprintf(stderr, "mechc info: error: %s: %s\n", c->state, err);
+        return false;
+    }
+    at->q = q;
+    return true;
+}
+
 /* The analysis at t and its report; exit status 1 when the assembly did not converge. */
 static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
     const InfoCli *c = opts;
+    const Model *m = mech->model;
+    AnalysisOptions o = c->analysis;
+    double *q = xmalloc(((size_t)m->nq + 1) * sizeof *q), t;
+    InfoAt at;
+    if (!choose_linear(c, m, &o) || !choose_state(c, m, q, &at, &t)) {
+        free(q);
+        return EXIT_USAGE;
+    }
+    bool asked = at.follow || at.q;
     InfoReport rep;
-    if (!info_analyse(mech, c->t, &c->analysis, &rep, diag)) {
+    if (!info_analyse_at(mech, t, asked ? &at : NULL, &o, &rep, diag)) {
+        free(q);
         cli_error(a, diag);
         return EXIT_USAGE;
     }
+    free(q);
     if (c->json)
         print_json(&rep);
     else
         print_text(&rep);
     int status = EXIT_OK;
-    if (!rep.assembled) {
-        const Model *m = mech->model;
+    if (!rep.assembled && rep.state.asked && at.follow) {
+        fprintf(stderr, "mechc info: error: t = %g: the motion from t = 0 could not be followed "
+                "to t = %g (residual %.3g)\n", t, t, rep.assembly.residual);
+        status = EXIT_ANALYSIS;
+    } else if (!rep.assembled) {
         fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
-                c->t, rep.assembly.residual);
+                rep.state.asked ? 0.0 : t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
         fprintf(stderr, ")\n");
@@ -364,6 +444,7 @@ static const CliCommand command = {
 
 int cmd_info(int argc, char **argv)
 {
-    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits()};
+    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits(),
+                 .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }
