@@ -163,6 +163,68 @@ static void json_joints(const Model *m)
     printf("]");
 }
 
+/* The largest components of a null-space direction, up to `most`, by
+   decreasing size (ties: coordinate order); returns how many are kept. */
+static int top_components(const double *v, int nq, int most, int *idx)
+{
+    int n = 0;
+    for (int j = 0; j < nq; j++) {
+        if (fabs(v[j]) < 1e-12)
+            continue;
+        int k = n < most ? n++ : most - 1;
+        if (n == most && k == most - 1 && fabs(v[j]) <= fabs(v[idx[k]]))
+            continue;
+        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j])) {
+            idx[k] = idx[k - 1];
+            k--;
+        }
+        idx[k] = j;
+    }
+    return n;
+}
+
+enum { TOP_COMPONENTS = 6 };
+
+/* --at / --state: "state" with the drop, the rows that became dependent
+   and the null-space directions. */
+static void json_state(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    const InfoState *st = &rep->state;
+    printf(",\n \"state\": {\"source\": \"%s\"", st->given ? "csv" : "followed");
+    if (!st->given)
+        printf(", \"steps\": %d", st->steps);
+    json_num("residual", st->residual);
+    json_int_or_null("rank", rep->rank);
+    json_int_or_null("generic_rank", st->ref_rank);
+    json_int_or_null("drop", st->drop);
+    json_num("tol", rep->rank_tol);
+    printf(",\n   \"dependent\": [");
+    for (int k = 0; k < st->ndependent; k++) {
+        printf(k ? ", " : "");
+        json_string(stdout, m->rows[st->dependent[k]].name);
+    }
+    printf("]");
+    json_int_or_null("null_dim", st->nnull);
+    printf(",\n   \"directions\": [");
+    for (int k = 0; k < st->nshown; k++) {
+        const double *v = st->null + (size_t)k * (size_t)m->nq;
+        int idx[TOP_COMPONENTS];
+        int n = top_components(v, m->nq, TOP_COMPONENTS, idx);
+        printf(k ? ",\n     {\"free\": " : "{\"free\": ");
+        json_string(stdout, m->coord_names[st->free_coord[k]]);
+        printf(", \"largest\": {");
+        for (int i = 0; i < n; i++) {
+            printf(i ? ", " : "");
+            json_string(stdout, m->coord_names[idx[i]]);
+            printf(": ");
+            json_number(stdout, v[idx[i]]);
+        }
+        printf("}}");
+    }
+    printf("]}");
+}
+
 static void print_json(const InfoReport *rep)
 {
     const Model *m = rep->model;
@@ -205,6 +267,8 @@ static void print_json(const InfoReport *rep)
            !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
     printf(",\n \"system_note\": ");
     json_string(stdout, rep->system.note ? rep->system.note : "");
+    if (rep->state.asked)
+        json_state(rep);
     printf(",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
     printf(",\n \"singular\": ");
     json_string(stdout, rep->singular);
@@ -343,11 +407,50 @@ static void print_integrability(const InfoReport *rep)
            rep->system.note ? rep->system.note : "not tested");
 }
 
+/* --at / --state: the drop against the generic rank, the rows that
+   became dependent, the directions the rows leave free. */
+static void print_state(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    const InfoState *st = &rep->state;
+    if (!st->asked)
+        return;
+    printf("\nat this state (t = %g, %s; residual %.3g):\n", rep->t,
+           st->given ? "read from the CSV" : "the motion followed from t = 0", st->residual);
+    if (st->drop < 0) {
+        printf("  rank drop not computed\n");
+        return;
+    }
+    printf("  rank %d of the holonomic rows (drivers included) against %d at t = 0:\n"
+           "  a drop of %d (singular values above %.3g count)\n", rep->rank, st->ref_rank,
+           st->drop, rep->rank_tol);
+    printf("  rows that became dependent (%d): ", st->ndependent);
+    for (int k = 0; k < st->ndependent; k++)
+        printf("%s%s", k ? ", " : "", m->rows[st->dependent[k]].name);
+    printf("%s\n", st->ndependent ? "" : "none");
+    if (st->nnull <= 0) {
+        printf("  directions the rows leave free: %s\n", st->nnull ? "not computed" : "none");
+        return;
+    }
+    printf("  directions the rows leave free (%d; each 1 at its coordinate, 0 at the others'%s):\n",
+           st->nnull, st->nnull > st->nshown ? ", the first shown" : "");
+    for (int k = 0; k < st->nshown; k++) {
+        const double *v = st->null + (size_t)k * (size_t)m->nq;
+        int idx[TOP_COMPONENTS];
+        int n = top_components(v, m->nq, TOP_COMPONENTS, idx);
+        printf("    %s:", m->coord_names[st->free_coord[k]]);
+        for (int i = 0; i < n; i++)
+            printf(" %s %.4g", m->coord_names[idx[i]], v[idx[i]]);
+        printf("\n");
+    }
+}
+
 static void print_text(const InfoReport *rep)
 {
     print_structure(rep);
     print_assembly(rep);
     print_rank(rep);
+    print_state(rep);
     print_integrability(rep);
     printf("\nverdict: %s\n", rep->verdict);
 }
