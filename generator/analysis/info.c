@@ -211,7 +211,11 @@ static char *make_singular(const InfoReport *rep, int nuh)
         return sb_take(&sb);
     }
     sb_printf(&sb, "singular: rank-deficient by %d", rep->nh - rep->rank);
-    if (rep->singularity == SING_POSITION)
+    if (rep->singularity == SING_POSITION && rep->generic_rank < 0)
+        sb_printf(&sb, "; a singular position: the rows have rank %d here but %d at t = 0 or "
+                  "just before (a dead-centre, toggle or branch point)", rep->rank,
+                  rep->state.ref_rank);
+    else if (rep->singularity == SING_POSITION)
         sb_printf(&sb, "; a singular position: without drivers the rows have rank %d here but %d "
                   "at nearby assembled configurations (a dead-centre, toggle or branch point)",
                   rep->rank_undriven_h, rep->generic_rank);
@@ -328,6 +332,8 @@ static Singularity classify_singularity(const InfoReport *rep, int nuh)
         return SING_POSITION;
     if (rep->rank_undriven_h == nuh)
         return SING_DRIVERS;
+    if (rep->generic_rank < 0 && rep->state.drop > 0)
+        return SING_POSITION;       /* --at, --state: more rank at the reference */
     if (rep->generic_rank >= 0 && rep->generic_rank == rep->rank_undriven_h)
         return SING_PERMANENT;
     return SING_UNKNOWN;
@@ -441,10 +447,21 @@ static void reach_state(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
         rep->constructed = 0;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (rep->assembled && nh > 0 && rep->t != 0.0) {
-        int constructed = rep->constructed;
-        st->reached = info_follow(me, w, hrows, nh, rep->t, rep->q, opt, &rep->assembly, &st->steps);
+        double *near = xmalloc(((size_t)nq + 1) * sizeof *near), t_near;
+        bool *near_red = xcalloc((size_t)nh + 1, sizeof *near_red);
+        st->reached = info_follow(me, w, hrows, nh, rep->t, rep->q, opt, &rep->assembly, &st->steps,
+                                  near, &t_near);
         rep->assembled = st->reached;
-        rep->constructed = constructed;
+        /* the regular state just before t, with the state's tolerance: the
+           reference when its rank is the larger (t = 0 may be singular) */
+        int near_rank = !st->reached ? -1
+            : info_holonomic_rank(me, w, near, t_near, info_state_tolerance(me, w, near, t_near),
+                                  near_red);
+        if (near_rank > *ref_rank) {
+            *ref_rank = near_rank;
+            memcpy(ref_red, near_red, (size_t)nh * sizeof *ref_red);
+        }
+        free(near), free(near_red);
     } else {
         st->reached = rep->assembled;
     }

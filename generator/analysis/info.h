@@ -44,8 +44,9 @@ typedef struct InfoState {
     int steps;              /* --at: steps taken from t = 0 (substeps included) */
     bool reached;           /* --at: the motion was followed to t */
     double residual;        /* ||Phi||_inf of the holonomic rows at the state */
-    int ref_rank;           /* rank of the holonomic rows at the reference,
-                               t = 0 (the state's own when larger); -1 */
+    int ref_rank;           /* rank of the holonomic rows at the reference:
+                               the largest at t = 0, at the last state Newton
+                               reached before t (--at) and here; -1 */
     int drop;               /* ref_rank - rank, -1 when a rank is missing */
     int ndependent;         /* rows dependent here, independent at the reference */
     int *dependent;         /* their model row indices */

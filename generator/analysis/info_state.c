@@ -128,7 +128,8 @@ static bool follow_to(MechEval *me, MechrtSvd *w, const int *hrows, int nh, doub
 }
 
 bool info_follow(MechEval *me, MechrtSvd *w, const int *hrows, int nh, double t1, double *q,
-                 const AnalysisOptions *opt, AssembleResult *res, int *steps)
+                 const AnalysisOptions *opt, AssembleResult *res, int *steps, double *q_near,
+                 double *t_near)
 {
     int nq = me->nq;
     History hist = {0};
@@ -148,6 +149,8 @@ bool info_follow(MechEval *me, MechrtSvd *w, const int *hrows, int nh, double t1
                         opt, res, steps)
               && follow_to(me, w, hrows, nh, t1 - hf, hf, &hist, trial, pred, opt, res, steps);
     if (ok) {
+        memcpy(q_near, hist.q[hist.n - 1], (size_t)nq * sizeof *q_near);
+        *t_near = hist.t[hist.n - 1];
         predict(&hist, t1, nq, q);
         ++*steps;
     } else {

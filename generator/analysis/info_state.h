@@ -10,11 +10,14 @@
    predictor corrected by minimum-norm Newton (dense with w, sparse QR
    without), halved down to 1/64 when Newton fails or corrects much more
    than the predictor moved (a jump to another branch). Minimum-norm
-   Newton passes singular positions, where Newton with LU stops. q is the
-   state at t1 on success, the last state reached otherwise; *steps counts
-   the steps taken. */
+   Newton passes singular positions, where Newton with LU stops. The last
+   FOLLOW_ORDER + 1 steps are 16 times shorter and the state at t1 is the
+   cubic through them, not Newton's. q is the state at t1 on success (and
+   q_near, t_near the last state reached by Newton before it), the last
+   state reached otherwise; *steps counts the steps taken. */
 bool info_follow(MechEval *me, MechrtSvd *w, const int *hrows, int nh, double t1, double *q,
-                 const AnalysisOptions *opt, AssembleResult *res, int *steps);
+                 const AnalysisOptions *opt, AssembleResult *res, int *steps, double *q_near,
+                 double *t_near);
 
 /* Rank of the holonomic rows (drivers included) at q, t, and which of them
    depend on the rows before them (red, nh): dense SVD with w, else

@@ -339,9 +339,21 @@ static void print_assembly(const InfoReport *rep)
         printf("nothing to assemble (no holonomic rows)\n");
         return;
     }
+    if (rep->state.given) {
+        printf("the state read from the CSV, used as it is: residual %.3g\n", rep->state.residual);
+        return;
+    }
     if (rep->constructed > 0)
         printf("%d of %d coordinates placed by construction (drivers, pins, dyads), then\n  ",
                rep->constructed, m->nq);
+    if (rep->state.asked) {
+        printf("assembled at t = 0, %s to t = %g in %d steps (the last Newton: %d\n"
+               "  iteration%s); the state at t = %g: the cubic through the last four, residual %.3g\n",
+               rep->assembled ? "the motion followed" : "the motion NOT FOLLOWED", rep->t,
+               rep->state.steps, rep->assembly.iterations,
+               rep->assembly.iterations == 1 ? "" : "s", rep->t, rep->assembly.residual);
+        return;
+    }
     printf("%s after %d iteration%s, residual %.3g%s%s\n",
            rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
            rep->assembly.iterations == 1 ? "" : "s", rep->assembly.residual,
