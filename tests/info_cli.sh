@@ -192,8 +192,8 @@ run info "$tmp/a02.mech" --at 0.25
 check "A02 --at 0.25: exit 0" status_is 0
 check "A02 --at 0.25: the motion followed from t = 0" out_has "the motion followed from t = 0"
 check "A02 --at 0.25: rank 203 against 243" \
-    out_has "rank 203 of the holonomic rows (drivers included) against 243 at t = 0:"
-check "A02 --at 0.25: a drop of 40" out_has "a drop of 40 (singular values above"
+    out_has "rank 203 of the holonomic rows (drivers included) against 243 generically"
+check "A02 --at 0.25: a drop of 40" out_has "(at t = 0 or just before): a drop of 40 (singular values above 3.27e-08 count)"
 check "A02 --at 0.25: 40 rows became dependent, b0.x first" out_has "rows that became dependent (40): b0.x, b1.x"
 check "A02 --at 0.25: ... and b39.x last" grep -q "dependent (40): .*b38.x, b39.x$" "$tmp/out"
 check "A02 --at 0.25: 40 free directions" out_has "directions the rows leave free (40;"
@@ -204,7 +204,8 @@ check "A02 --at 0.25 --json: state.drop 40" out_has '"drop": 40'
 check "A02 --at 0.25 --json: generic_rank 243" out_has '"generic_rank": 243'
 # at an ordinary time of the same chain nothing drops
 run info "$tmp/a02.mech" --at 0.1
-check "A02 --at 0.1: a drop of 0" out_has "a drop of 0 "
+check "A02 --at 0.1: a drop of 0" out_has "against 243 generically"
+check "A02 --at 0.1: ... a drop of 0" out_has ": a drop of 0 "
 check "A02 --at 0.1: no dependent rows" out_has "rows that became dependent (0): none"
 # one parallelogram four-bar, folded flat: a drop of 1
 sh "$ex/chain.sh" 1 "$tmp/c1.mech"
@@ -212,7 +213,7 @@ sed -e 's/^driver drive: rod0.phi = .*/driver drive: rod0.phi = pi\/2 - 2*pi*t/'
     > "$tmp/pg.mech"
 run info "$tmp/pg.mech" --at 0.25
 check "parallelogram four-bar folded: rank 8 against 9" \
-    out_has "rank 8 of the holonomic rows (drivers included) against 9 at t = 0:"
+    out_has "rank 8 of the holonomic rows (drivers included) against 9 generically"
 check "parallelogram four-bar folded: b0.x dependent" out_has "rows that became dependent (1): b0.x"
 check "parallelogram four-bar folded: rod1 and cpl0 free to fold" \
     out_has "rod1.phi: cpl0.phi 1 rod1.phi 1"

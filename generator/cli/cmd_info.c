@@ -433,9 +433,9 @@ static void print_state(const InfoReport *rep)
         printf("  rank drop not computed\n");
         return;
     }
-    printf("  rank %d of the holonomic rows (drivers included) against %d at t = 0:\n"
-           "  a drop of %d (singular values above %.3g count)\n", rep->rank, st->ref_rank,
-           st->drop, rep->rank_tol);
+    printf("  rank %d of the holonomic rows (drivers included) against %d generically\n"
+           "  (at t = 0%s): a drop of %d (singular values above %.3g count)\n", rep->rank,
+           st->ref_rank, st->given ? "" : " or just before", st->drop, rep->rank_tol);
     printf("  rows that became dependent (%d): ", st->ndependent);
     for (int k = 0; k < st->ndependent; k++)
         printf("%s%s", k ? ", " : "", m->rows[st->dependent[k]].name);
