@@ -31,13 +31,15 @@ static const char usage[] =
     "per joint against the textbook table and the mobility count (coordinates -\n"
     "rows, with and without drivers). Then assembles the mechanism at t = 0 by\n"
     "minimum-norm Newton on its holonomic rows (any number of rows), takes the\n"
-    "rank of their Jacobian by SVD, names the redundant rows (a row that depends\n"
-    "on the rows before it), tells a singular position from a permanent\n"
+    "rank of their Jacobian by SVD or sparse QR, names the redundant rows (a row\n"
+    "that depends on the rows before it), tells a singular position from a permanent\n"
     "redundancy, and tests every velocity-level row for integrability\n"
     "(holonomic in disguise, with its position law, or nonholonomic).\n"
     "With --at or --state it reports a given state: the rank drop there against\n"
-    "the rank at t = 0 and nearby, the rows that became dependent and the\n"
-    "directions the rows leave free (null-space vectors by coordinate).\n"
+    "the generic rank (at t = 0, or just before T), the rows that became\n"
+    "dependent and the directions the rows leave free (null-space vectors by\n"
+    "coordinate), with the rank tolerance there: sqrt(eps) * largest singular\n"
+    "value, unless --rank-tol.\n"
     "\n";
 
 static const CliOption options[] = {
@@ -74,8 +76,9 @@ static const CliOption options[] = {
 
 static const char epilogue[] =
     "\n"
-    "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
-    "printed, at the last iterate), 2 bad usage or bad input.\n";
+    "Exit status: 0 success, 1 the assembly did not converge or --at could not\n"
+    "follow the motion (the report is still printed, at the last iterate), 2 bad\n"
+    "usage or bad input (a bad --state file, --linear dense beyond --max-dense).\n";
 
 static const char *level_name(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
