@@ -198,7 +198,7 @@ check "A02 --at 0.25: 40 rows became dependent, b0.x first" out_has "rows that b
 check "A02 --at 0.25: ... and b39.x last" grep -q "dependent (40): .*b38.x, b39.x$" "$tmp/out"
 check "A02 --at 0.25: 40 free directions" out_has "directions the rows leave free (40;"
 check "A02 --at 0.25: the first one folds loop 0 (rod1 with cpl0)" \
-    out_has "cpl1.phi: cpl1.phi 1 cpl0.phi -1 rod1.phi -1"
+    out_has "cpl1.phi: cpl0.phi -1 rod1.phi -1 cpl1.phi 1 cpl0.y -0.5 rod1.y -0.5 cpl1.y -0.5"
 run info "$tmp/a02.mech" --at 0.25 --json
 check "A02 --at 0.25 --json: state.drop 40" out_has '"drop": 40'
 check "A02 --at 0.25 --json: generic_rank 243" out_has '"generic_rank": 243'

@@ -167,17 +167,22 @@ static void json_joints(const Model *m)
 }
 
 /* The largest components of a null-space direction, up to `most`, by
-   decreasing size (ties: coordinate order); returns how many are kept. */
+   decreasing size (equal to 1e-9, as rounding leaves them: coordinate
+   order); returns how many are kept. */
 static int top_components(const double *v, int nq, int most, int *idx)
 {
     int n = 0;
     for (int j = 0; j < nq; j++) {
         if (fabs(v[j]) < 1e-12)
             continue;
-        int k = n < most ? n++ : most - 1;
-        if (n == most && k == most - 1 && fabs(v[j]) <= fabs(v[idx[k]]))
+        int k;
+        if (n < most)
+            k = n++;
+        else if (fabs(v[j]) * (1 - 1e-9) > fabs(v[idx[most - 1]]))
+            k = most - 1;           /* the smallest kept gives way */
+        else
             continue;
-        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j])) {
+        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j]) * (1 - 1e-9)) {
             idx[k] = idx[k - 1];
             k--;
         }
