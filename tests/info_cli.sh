@@ -242,6 +242,15 @@ run info "$tmp/pg.mech" --state "$tmp/pg.csv" --at 0.21
 check "--state --at 0.2: no such row, exit 2" status_is 2
 run info "$ex/four_bar.mech" --state "$tmp/nothing.csv"
 check "--state on a missing file: exit 2" status_is 2
+# velocity-level rows: run integrates the positions, --at does not follow them
+run info "$ex/knife_cart.mech" --at 0.5
+check "--at with velocity-level rows: exit 2" status_is 2
+check "--at with velocity-level rows: points to --state" err_has "give it with --state"
+"$mechc" run "$ex/knife_cart.mech" --at 0.5 --csv "$tmp/knife.csv" > /dev/null 2>&1
+run info "$ex/knife_cart.mech" --state "$tmp/knife.csv"
+check "--state with velocity-level rows: exit 0" status_is 0
+check "--state with velocity-level rows: the knife is free in 3 directions" \
+    out_has "directions the rows leave free (3;"
 
 # ---- --linear: SuiteSparseQR gives the dense SVD's verdicts (issue 15) ----
 for f in "$ex"/*.mech; do

@@ -67,7 +67,8 @@ static const CliOption options[] = {
              "the file's initial values, then followed to T in 100 steps\n"
              "(minimum-norm Newton, through singular positions); reports\n"
              "the rank drop there, the rows that became dependent and the\n"
-             "directions the rows leave free"},
+             "directions the rows leave free (holonomic rows only: with\n"
+             "velocity-level rows use --state)"},
     {"--state", CLI_STRING_AT(InfoCli, state), .metavar = "FILE",
      .help = "the same at a state read from a CSV as run writes it (a\n"
              "header naming t and the coordinates; the row at --at T, or\n"
@@ -507,6 +508,13 @@ static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at
 {
     *t = isnan(c->at) ? c->t : c->at;
     *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
+    if (at->follow && m->nv > 0) {
+        fprintf(stderr, "mechc info: error: --at follows the holonomic rows only, and %s has "
+                "velocity-level rows, whose positions run integrates: write the state with "
+                "`mechc run FILE --at T --csv STATE.csv` and give it with --state STATE.csv\n",
+                m->name);
+        return false;
+    }
     if (!c->state)
         return true;
     char err[300];
