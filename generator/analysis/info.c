@@ -14,6 +14,11 @@
  * assembled again from a few random perturbations of the configuration
  * (minimum-norm Newton lands on nearby generic configurations) and their
  * rank there, the generic rank, is compared with the rank here.
+ *
+ * Beyond the dense limit (`--linear sparse`, or auto above 100
+ * coordinates) the ranks and redundant rows come from SuiteSparseQR
+ * (spqr_rank.c) with the same definition. `--at` and `--state` take all of
+ * this at a given state (info_state.c).
  */
 #include "info.h"
 
