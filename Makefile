@@ -21,11 +21,16 @@ CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) -MMD -MP
 KLU_CFLAGS := $(shell pkg-config --cflags klu 2>/dev/null || echo -I/usr/include/suitesparse)
 KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig)
 CFLAGS_TOOL += $(KLU_CFLAGS)
+# SuiteSparseQR, the sparse rank-revealing QR of `info` at scale
+# (generator/analysis/spqr_rank.c): C++ inside, hence libstdc++. It goes
+# after -lgslcblas: CHOLMOD pulls in the system BLAS, whose cblas_* would
+# otherwise be found before GSL's and change the SVD's last digits.
+SPQR_LIBS  := $(shell pkg-config --libs spqr cholmod 2>/dev/null || echo -lspqr -lcholmod) -lstdc++
 
 # libtcc: Debian ships only a static, non-PIC libtcc.a, so the tool links it
 # statically and is itself linked without PIE.
 LDFLAGS_TOOL := -no-pie $(SAN)
-LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic $(KLU_LIBS) -lgsl -lgslcblas -ldl -lm -lpthread
+LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic $(KLU_LIBS) -lgsl -lgslcblas $(SPQR_LIBS) -ldl -lm -lpthread
 LDLIBS_TEST  := -lcmocka
 
 GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))

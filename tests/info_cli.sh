@@ -181,4 +181,115 @@ check "rssr: 1 DOF without its driver" out_has "without its 1 driver: 1 DOF by t
 sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/' "$ex/four_bar.mech" > "$tmp/fb0.mech"
 run info "$tmp/fb0.mech" --json
 check "info from every guess 0: assembled" out_has '"assembled": true'
+# ---- info at a given state (issue 19): --at T, --state FILE.csv ----------
+# The A02 chain of 40 parallelograms driven flat at t = 0.25: every loop
+# folds at once, the holonomic rows lose 40 ranks and 40 rows turn
+# dependent (beyond 100 coordinates: SuiteSparseQR).
+sh "$ex/chain.sh" 40 "$tmp/c40.mech"
+sed -e 's/^driver drive: rod0.phi = .*/driver drive: rod0.phi = pi\/2 - 2*pi*t/' "$tmp/c40.mech" \
+    > "$tmp/a02.mech"
+run info "$tmp/a02.mech" --at 0.25
+check "A02 --at 0.25: exit 0" status_is 0
+check "A02 --at 0.25: the motion followed from t = 0" out_has "the motion followed from t = 0"
+check "A02 --at 0.25: rank 203 against 243" \
+    out_has "rank 203 of the holonomic rows (drivers included) against 243 generically"
+check "A02 --at 0.25: a drop of 40" out_has "(at t = 0 or just before): a drop of 40 (singular values above 3.27e-08 count)"
+check "A02 --at 0.25: 40 rows became dependent, b0.x first" out_has "rows that became dependent (40): b0.x, b1.x"
+check "A02 --at 0.25: ... and b39.x last" grep -q "dependent (40): .*b38.x, b39.x$" "$tmp/out"
+check "A02 --at 0.25: 40 free directions" out_has "directions the rows leave free (40;"
+check "A02 --at 0.25: the first one folds loop 0 (rod1 with cpl0)" \
+    out_has "cpl1.phi: cpl0.phi -1 rod1.phi -1 cpl1.phi 1 cpl0.y -0.5 rod1.y -0.5 cpl1.y -0.5"
+run info "$tmp/a02.mech" --at 0.25 --json
+check "A02 --at 0.25 --json: state.drop 40" out_has '"drop": 40'
+check "A02 --at 0.25 --json: generic_rank 243" out_has '"generic_rank": 243'
+# at an ordinary time of the same chain nothing drops
+run info "$tmp/a02.mech" --at 0.1
+check "A02 --at 0.1: a drop of 0" out_has "against 243 generically"
+check "A02 --at 0.1: ... a drop of 0" out_has ": a drop of 0 "
+check "A02 --at 0.1: no dependent rows" out_has "rows that became dependent (0): none"
+# one parallelogram four-bar, folded flat: a drop of 1
+sh "$ex/chain.sh" 1 "$tmp/c1.mech"
+sed -e 's/^driver drive: rod0.phi = .*/driver drive: rod0.phi = pi\/2 - 2*pi*t/' "$tmp/c1.mech" \
+    > "$tmp/pg.mech"
+run info "$tmp/pg.mech" --at 0.25
+check "parallelogram four-bar folded: rank 8 against 9" \
+    out_has "rank 8 of the holonomic rows (drivers included) against 9 generically"
+check "parallelogram four-bar folded: b0.x dependent" out_has "rows that became dependent (1): b0.x"
+check "parallelogram four-bar folded: rod1 and cpl0 free to fold" \
+    out_has "rod1.phi: cpl0.phi 1 rod1.phi 1"
+run info "$tmp/pg.mech" --at 0.25 --linear sparse
+check "parallelogram four-bar folded, sparse: the same drop" out_has "rows that became dependent (1): b0.x"
+# an ordinary example at an ordinary time
+run info "$ex/four_bar.mech" --at 0.3
+check "four_bar --at 0.3: a drop of 0" out_has "rank 9 of the holonomic rows (drivers included) against 9"
+check "four_bar --at 0.3: no free direction" out_has "directions the rows leave free: none"
+# --state: the row run writes, read back
+"$mechc" run "$tmp/pg.mech" --t0 0 --t1 0.2 --steps 8 --csv "$tmp/pg.csv" > /dev/null 2>&1
+"$mechc" run "$ex/four_bar.mech" --at 0.3 --csv "$tmp/fb.csv" > /dev/null 2>&1
+run info "$ex/four_bar.mech" --state "$tmp/fb.csv" --json
+check "--state: exit 0" status_is 0
+check "--state: the state's t" out_has '"t": 0.3'
+check "--state: read from the CSV" out_has '"source": "csv"'
+run info "$ex/four_bar.mech" --state "$tmp/pg.csv"
+check "--state with another mechanism's CSV: exit 2" status_is 2
+check "--state with another mechanism's CSV: names the column" err_has "no column named crank.x"
+run info "$tmp/pg.mech" --state "$tmp/pg.csv"
+check "--state with several rows and no --at: exit 2" status_is 2
+check "--state with several rows: asks for --at" err_has "rows: give --at T"
+run info "$tmp/pg.mech" --state "$tmp/pg.csv" --at 0.125
+check "--state --at 0.125: that row" out_has "at this state (t = 0.125, read from the CSV"
+run info "$tmp/pg.mech" --state "$tmp/pg.csv" --at 0.21
+check "--state --at 0.2: no such row, exit 2" status_is 2
+run info "$ex/four_bar.mech" --state "$tmp/nothing.csv"
+check "--state on a missing file: exit 2" status_is 2
+# velocity-level rows: run integrates the positions, --at does not follow them
+run info "$ex/knife_cart.mech" --at 0.5
+check "--at with velocity-level rows: exit 2" status_is 2
+check "--at with velocity-level rows: points to --state" err_has "give it with --state"
+"$mechc" run "$ex/knife_cart.mech" --at 0.5 --csv "$tmp/knife.csv" > /dev/null 2>&1
+run info "$ex/knife_cart.mech" --state "$tmp/knife.csv"
+check "--state with velocity-level rows: exit 0" status_is 0
+check "--state with velocity-level rows: the knife is free in 3 directions" \
+    out_has "directions the rows leave free (3;"
+
+# ---- --linear: SuiteSparseQR gives the dense SVD's verdicts (issue 15) ----
+for f in "$ex"/*.mech; do
+    n=$(basename "$f" .mech)
+    "$mechc" info "$f" --json --linear dense > "$tmp/$n.dense.json" 2>/dev/null
+    "$mechc" info "$f" --json --linear sparse > "$tmp/$n.sparse.json" 2>/dev/null
+done
+if have python3; then
+    check "--linear sparse and dense: the same rank, redundant rows and mobility on every example" \
+        python3 - "$tmp" "$ex" <<'EOF'
+import glob, json, os, sys
+tmp, ex = sys.argv[1], sys.argv[2]
+keys = ("rank", "rank_all", "redundant", "redundant_velocity", "dof_rank", "mobility_rank")
+n = 0
+for f in sorted(glob.glob(os.path.join(ex, "*.mech"))):
+    name = os.path.basename(f)[:-5]
+    d = json.load(open(os.path.join(tmp, name + ".dense.json")))
+    s = json.load(open(os.path.join(tmp, name + ".sparse.json")))
+    assert d["dense"] is True and s["dense"] is False, name
+    for k in keys:
+        assert d[k] == s[k], (name, k, d[k], s[k])
+    n += 1
+assert n >= 20, n
+EOF
+else
+    skip "python3 not found: --linear comparison"
+fi
+run info "$ex/parallelogram_redundant.mech" --linear sparse
+check "parallelogram --linear sparse: A2.y redundant" out_has "row A2.y is redundant"
+check "parallelogram --linear sparse: says sparse QR" out_has "rank (sparse QR at the assembled configuration)"
+run info "$ex/four_bar.mech" --linear nope
+check "--linear nope: exit 2" status_is 2
+# chain N = 1000 (6003 x 6003): auto goes sparse and is quick; dense is refused
+sh "$ex/chain.sh" 1000 "$tmp/c1000.mech"
+run info "$tmp/c1000.mech"
+check "chain 1000: exit 0" status_is 0
+check "chain 1000: full rank by sparse QR" out_has "holonomic rows: rank 6003 of 6003"
+check "chain 1000: 1 DOF without the driver" out_has "DOF by the rank: 0 with drivers, 1 without"
+run info "$tmp/c1000.mech" --linear dense
+check "chain 1000 --linear dense: refused, exit 2" status_is 2
+check "chain 1000 --linear dense: says why" err_has "beyond --max-dense"
 suite_end

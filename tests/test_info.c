@@ -4,6 +4,7 @@
 
 #include "../generator/analysis/info.h"
 #include "../generator/analysis/mech_eval.h"
+#include "../generator/analysis/spqr_rank.h"
 #include "../generator/analysis/svd.h"
 #include "../generator/base/limits.h"
 
@@ -591,6 +592,193 @@ static void test_sparse_large_ladder(void **state)
     free(text);
 }
 
+/* ---- SuiteSparseQR: dependent rows and null space (spqr_rank.c) ---- */
+
+/* Rows r0, r1, r0 + r1, r2, 2 r2, r3 of 4 columns (CSR). */
+static const int dep_start[] = {0, 2, 4, 7, 9, 11, 12};
+static const int dep_cols[] = {0, 1,  1, 2,  0, 1, 2,  2, 3,  2, 3,  0};
+static const double dep_vals[] = {1, 2,  3, -1,  1, 5, -1,  0.5, 4,  1, 8,  7};
+
+static void test_spqr_dependent_rows_as_svd(void **state)
+{
+    (void)state;
+    SpqrRows a = {.m = 6, .n = 4, .start = dep_start, .cols = dep_cols, .vals = dep_vals};
+    bool dep[6];
+    int upto;
+    assert_int_equal(spqr_dependent_rows(&a, 1e-12, dep, 3, &upto), 4);
+    assert_int_equal(upto, 2);                  /* rows 0..2: r0, r1, r0 + r1 */
+    bool want[6] = {false, false, true, false, true, false};
+    /* the dense SVD's answer on the same matrix */
+    double dense[24] = {0};
+    for (int i = 0; i < 6; i++)
+        for (int e = dep_start[i]; e < dep_start[i + 1]; e++)
+            dense[i * 4 + dep_cols[e]] = dep_vals[e];
+    MechrtSvd *w = svd_work_new(6, 4);
+    bool red[6];
+    assert_int_equal(svd_redundant_rows(w, dense, 6, 4, 4, 1e-12, 0, -1, red), 2);
+    mechrt_svd_free(w);
+    for (int i = 0; i < 6; i++) {
+        assert_int_equal(dep[i], want[i]);
+        assert_int_equal(red[i], want[i]);
+    }
+    /* a tolerance above every remaining norm: only the first row counts */
+    assert_int_equal(spqr_dependent_rows(&a, 1e3, dep, 0, NULL), 0);
+    double bad[12];
+    memcpy(bad, dep_vals, sizeof bad);
+    bad[5] = NAN;
+    a.vals = bad;
+    assert_int_equal(spqr_dependent_rows(&a, 1e-12, dep, 0, NULL), -1);
+}
+
+static void test_spqr_null_basis(void **state)
+{
+    (void)state;
+    /* the 6 x 4 matrix above has rank 4: no null space; its first two rows
+       (2 x 4, rank 2) leave two directions, free at columns 2 and 3 */
+    SpqrRows a = {.m = 6, .n = 4, .start = dep_start, .cols = dep_cols, .vals = dep_vals};
+    double basis[16];
+    int free_coords[4];
+    assert_int_equal(spqr_null_basis(&a, 1e-12, 4, basis, free_coords), 0);
+    a.m = 2;
+    assert_int_equal(spqr_null_basis(&a, 1e-12, 4, basis, free_coords), 2);
+    assert_int_equal(free_coords[0], 2);
+    assert_int_equal(free_coords[1], 3);
+    for (int k = 0; k < 2; k++) {
+        const double *v = basis + 4 * k;
+        assert_near(v[free_coords[k]], 1.0, 0, 0);
+        assert_near(v[free_coords[1 - k]], 0.0, 0, 0);
+        for (int i = 0; i < 2; i++) {           /* A v = 0 */
+            double s = 0;
+            for (int e = dep_start[i]; e < dep_start[i + 1]; e++)
+                s += dep_vals[e] * v[dep_cols[e]];
+            assert_near(s, 0.0, 0, 1e-14);
+        }
+    }
+    /* only one vector asked for: the dimension is still 2 */
+    assert_int_equal(spqr_null_basis(&a, 1e-12, 1, basis, free_coords), 2);
+}
+
+/* ---- info at a state: the A02 chain of n parallelograms driven flat ---- */
+
+/* examples/chain.sh n with rod0.phi = pi/2 - 2 pi t: flat at t = 0.25. */
+static char *flat_chain(int n)
+{
+    size_t cap = 200 + (size_t)n * 300;
+    char *t = malloc(cap);
+    size_t k = (size_t)snprintf(t, cap, "body rod0 x = 0 y = 0.5 phi = pi/2\n"
+                                "revolute g0: ground(0, 0) rod0(-0.5, 0)\n"
+                                "driver drive: rod0.phi = pi/2 - 2*pi*t\n");
+    for (int i = 0; i < n; i++)
+        k += (size_t)snprintf(t + k, cap - k,
+                              "body cpl%d x = %g y = 1 phi = 0\n"
+                              "body rod%d x = %d y = 0.5 phi = pi/2\n"
+                              "revolute g%d: ground(%d, 0) rod%d(-0.5, 0)\n"
+                              "revolute a%d: rod%d(0.5, 0) cpl%d(-0.5, 0)\n"
+                              "revolute b%d: cpl%d(0.5, 0) rod%d(0.5, 0)\n",
+                              i, i + 0.5, i + 1, i + 1, i + 1, i + 1, i + 1, i, i, i, i, i, i + 1);
+    return t;
+}
+
+static Loaded *load_state(const char *text, double t, const InfoAt *at, const AnalysisOptions *o)
+{
+    Loaded *l = calloc(1, sizeof *l);
+    MechLimits limits = mech_default_limits();
+    l->mech = pipeline_load_text(text, "test.mech", &limits, &l->diag);
+    if (!l->mech) {
+        diag_print(&l->diag, stderr);
+        fail_msg("fixture does not load");
+    }
+    if (!info_analyse_at(l->mech, t, at, o, &l->rep, &l->diag))
+        fail_msg("info_analyse_at failed: %s", l->diag.message);
+    return l;
+}
+
+/* The drop, the rows that became dependent (b0.x .. b{n-1}.x: each loop's
+   last pin, in x) and n null directions, each a true null vector. */
+static void check_flat(Loaded *l, int n)
+{
+    const InfoReport *rep = &l->rep;
+    const InfoState *st = &rep->state;
+    const Model *m = l->mech->model;
+    assert_true(st->asked);
+    assert_true(rep->assembled);
+    assert_true(st->residual < 1e-10);
+    assert_int_equal(st->ref_rank, 6 * n + 3);
+    assert_int_equal(rep->rank, 5 * n + 3);
+    assert_int_equal(st->drop, n);
+    assert_int_equal(st->ndependent, n);
+    for (int k = 0; k < n; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "b%d.x", k);
+        assert_string_equal(m->rows[st->dependent[k]].name, name);
+    }
+    assert_int_equal(st->nnull, n);
+    assert_int_equal(st->nshown, n);
+    double *jac = malloc((size_t)m->nr * (size_t)m->nq * sizeof *jac);
+    MechEval me;
+    mech_eval_init(&me, &l->mech->kin);
+    mech_eval(&me, rep->q, rep->t, NULL, jac);
+    for (int k = 0; k < n; k++) {
+        const double *v = st->null + (size_t)k * (size_t)m->nq;
+        assert_near(v[st->free_coord[k]], 1.0, 0, 0);
+        for (int r = 0; r < m->nh; r++) {
+            double s = 0;
+            for (int j = 0; j < m->nq; j++)
+                s += jac[(size_t)r * (size_t)m->nq + (size_t)j] * v[j];
+            assert_near(s, 0.0, 0, 1e-9);
+        }
+    }
+    mech_eval_free(&me);
+    free(jac);
+}
+
+static void test_state_followed_to_flat(void **state)
+{
+    (void)state;
+    char *text = flat_chain(3);
+    AnalysisOptions o = analysis_default_options();
+    InfoAt at = {.follow = true};
+    Loaded *d = load_state(text, 0.25, &at, &o);
+    assert_true(d->rep.dense);
+    assert_true(d->rep.state.steps > 100);
+    assert_true(d->rep.state.reached);
+    check_flat(d, 3);
+    o.max_dense = -1;                   /* the same by SuiteSparseQR */
+    Loaded *s = load_state(text, 0.25, &at, &o);
+    assert_false(s->rep.dense);
+    check_flat(s, 3);
+    for (int i = 0; i < d->rep.nq; i++)
+        assert_near(s->rep.q[i], d->rep.q[i], 1e-10, 1e-10);
+    /* the same state given coordinate by coordinate */
+    InfoAt given = {.q = d->rep.q};
+    o = analysis_default_options();
+    Loaded *g = load_state(text, 0.25, &given, &o);
+    assert_true(g->rep.state.given);
+    check_flat(g, 3);
+    unload(d), unload(s), unload(g);
+    /* at an ordinary time nothing drops and nothing is free */
+    Loaded *r = load_state(text, 0.1, &at, &o);
+    assert_int_equal(r->rep.state.drop, 0);
+    assert_int_equal(r->rep.state.ndependent, 0);
+    assert_int_equal(r->rep.state.nnull, 0);
+    assert_int_equal(r->rep.rank, 21);
+    unload(r);
+    free(text);
+}
+
+/* Assembled directly at t = 0.25 from the file's initial values (--t),
+   the chain lands on a folded branch: one loop folded, not all of them. */
+static void test_direct_assembly_is_not_the_motion(void **state)
+{
+    (void)state;
+    char *text = flat_chain(3);
+    Loaded *l = load_at(text, 0.25);
+    assert_false(l->rep.state.asked);
+    assert_true(l->rep.rank > 5 * 3 + 3);
+    unload(l);
+    free(text);
+}
+
 /* ---- integrability ---- */
 
 static void test_knife_is_nonholonomic(void **state)
@@ -771,6 +959,10 @@ int main(void)
         cmocka_unit_test(test_assembly_failure_reported),
         cmocka_unit_test(test_sparse_path_agrees_with_dense),
         cmocka_unit_test(test_sparse_large_ladder),
+        cmocka_unit_test(test_spqr_dependent_rows_as_svd),
+        cmocka_unit_test(test_spqr_null_basis),
+        cmocka_unit_test(test_state_followed_to_flat),
+        cmocka_unit_test(test_direct_assembly_is_not_the_motion),
         cmocka_unit_test(test_knife_is_nonholonomic),
         cmocka_unit_test(test_rolling_disk_is_integrable),
         cmocka_unit_test(test_rolling_statement_is_integrable),

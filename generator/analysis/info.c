@@ -14,6 +14,11 @@
  * assembled again from a few random perturbations of the configuration
  * (minimum-norm Newton lands on nearby generic configurations) and their
  * rank there, the generic rank, is compared with the rank here.
+ *
+ * Beyond the dense limit (`--linear sparse`, or auto above 100
+ * coordinates) the ranks and redundant rows come from SuiteSparseQR
+ * (spqr_rank.c) with the same definition. `--at` and `--state` take all of
+ * this at a given state (info_state.c).
  */
 #include "info.h"
 
@@ -21,7 +26,9 @@
 #include "../base/rng.h"
 #include "../base/strbuf.h"
 #include "construct.h"
+#include "info_state.h"
 #include "sparse.h"
+#include "spqr_rank.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -209,7 +216,11 @@ static char *make_singular(const InfoReport *rep, int nuh)
         return sb_take(&sb);
     }
     sb_printf(&sb, "singular: rank-deficient by %d", rep->nh - rep->rank);
-    if (rep->singularity == SING_POSITION)
+    if (rep->singularity == SING_POSITION && rep->generic_rank < 0)
+        sb_printf(&sb, "; a singular position: the rows have rank %d here but %d at t = 0 or "
+                  "just before (a dead-centre, toggle or branch point)", rep->rank,
+                  rep->state.ref_rank);
+    else if (rep->singularity == SING_POSITION)
         sb_printf(&sb, "; a singular position: without drivers the rows have rank %d here but %d "
                   "at nearby assembled configurations (a dead-centre, toggle or branch point)",
                   rep->rank_undriven_h, rep->generic_rank);
@@ -222,16 +233,35 @@ static char *make_singular(const InfoReport *rep, int nuh)
     return sb_take(&sb);
 }
 
-/* Beyond the dense limit: ranks and redundant rows by sparse Givens QR of
-   the structural nonzeros, one tolerance for all rows (from sigma_max of
-   all rows); no smallest singular value. */
+/* The listed rows of the Jacobian's nonzeros as a CSR matrix (start:
+   n + 1 entries, cols and vals: the rows' nonzeros). */
+static SpqrRows pick_sparse(const Kinematics *kin, const int *cols, const double *vals,
+                            const int *rows, int n, int *start, int *scols, double *svals)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        start[i] = k;
+        for (int e = kin->row_start[rows[i]]; e < kin->row_start[rows[i] + 1]; e++) {
+            scols[k] = cols[e];
+            svals[k++] = vals[e];
+        }
+    }
+    start[n] = k;
+    return (SpqrRows){.m = n, .n = kin->model->nq, .start = start, .cols = scols, .vals = svals};
+}
+
+/* Beyond the dense limit: ranks and redundant rows by SuiteSparseQR of
+   Phi_q^T (spqr_rank.c), one tolerance for all rows (from sigma_max of all
+   rows); no smallest singular value. */
 static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, const int *undriven,
                          int nu, int nuh, const AnalysisOptions *opt, bool *red)
 {
     int nq = rep->nq, nh = rep->nh, nr = rep->nr;
-    double *vals = xmalloc(((size_t)kin->nnz + 1) * sizeof *vals);
-    int *cols = xmalloc(((size_t)kin->nnz + 1) * sizeof *cols);
-    int *all = xmalloc(((size_t)nr + 1) * sizeof *all);
+    size_t nnz = (size_t)kin->nnz + 1;
+    double *vals = xmalloc(nnz * sizeof *vals), *svals = xmalloc(nnz * sizeof *svals);
+    int *cols = xmalloc(nnz * sizeof *cols), *scols = xmalloc(nnz * sizeof *scols);
+    int *all = xmalloc(((size_t)nr + 1) * sizeof *all), *start = xmalloc(((size_t)nr + 1) * sizeof *start);
+    bool *dep = xcalloc((size_t)nr + 1, sizeof *dep);
     for (int e = 0; e < kin->nnz; e++)
         cols[e] = kin->jac[e].col;
     for (int r = 0; r < nr; r++)
@@ -242,44 +272,22 @@ static void sparse_ranks(const Kinematics *kin, MechEval *me, InfoReport *rep, c
     rep->sigma_max = smax;
     rep->sigma_min = rep->cond = NAN;
     rep->rank_tol = tol;
-    const size_t fill_max = 50u * 1000u * 1000u;      /* 400 MB of R */
-    for (int pass = 0; pass < 2; pass++) {
-        /* pass 0: all rows in order; pass 1: the rows without drivers */
-        const int *rows = pass ? undriven : all;
-        int n = pass ? nu : nr, nhold = pass ? nuh : nh;
-        SparseRank *s = sparse_rank_new(nq, tol, fill_max);
-        int rank_h = nhold ? -1 : 0, st = 0;
-        for (int k = 0; k < n && st >= 0; k++) {
-            int r = rows[k];
-            st = sparse_rank_add(s, cols + kin->row_start[r], vals + kin->row_start[r],
-                                 kin->row_start[r + 1] - kin->row_start[r]);
-            if (!pass)
-                red[r] = st == 0;
-            if (k + 1 == nhold)
-                rank_h = sparse_rank_of(s);
-        }
-        int rank = sparse_rank_of(s);
-        sparse_rank_free(s);
-        if (st < 0) {
-            rep->rank = rep->rank_all = -1;
-            break;
-        }
-        if (!pass) {
-            rep->rank = rank_h;
-            rep->rank_all = rank;
-            for (int r = 0; r < nr; r++)
-                *(r < nh ? &rep->nredundant : &rep->nredundant_velocity) += red[r];
-            if (rank == nr) {               /* independent rows: so is every subset */
-                rep->rank_undriven_h = nuh;
-                rep->rank_undriven = nu;
-                break;
-            }
+    SpqrRows a = pick_sparse(kin, cols, vals, all, nr, start, scols, svals);
+    rep->rank_all = spqr_dependent_rows(&a, tol, red, nh, &rep->rank);
+    if (rep->rank_all >= 0) {
+        for (int r = 0; r < nr; r++)
+            *(r < nh ? &rep->nredundant : &rep->nredundant_velocity) += red[r];
+        if (rep->rank_all == nr) {          /* independent rows: so is every subset */
+            rep->rank_undriven_h = nuh;
+            rep->rank_undriven = nu;
         } else {
-            rep->rank_undriven_h = rank_h;
-            rep->rank_undriven = rank;
+            SpqrRows u = pick_sparse(kin, cols, vals, undriven, nu, start, scols, svals);
+            rep->rank_undriven = spqr_dependent_rows(&u, tol, dep, nuh, &rep->rank_undriven_h);
         }
+    } else {
+        rep->rank = -1;
     }
-    free(vals), free(cols), free(all);
+    free(vals), free(svals), free(cols), free(scols), free(all), free(start), free(dep);
 }
 
 /* Ranks of the dense Jacobian jac (nr x nq, evaluated) by SVD: of the
@@ -329,6 +337,8 @@ static Singularity classify_singularity(const InfoReport *rep, int nuh)
         return SING_POSITION;
     if (rep->rank_undriven_h == nuh)
         return SING_DRIVERS;
+    if (rep->generic_rank < 0 && rep->state.drop > 0)
+        return SING_POSITION;       /* --at, --state: more rank at the reference */
     if (rep->generic_rank >= 0 && rep->generic_rank == rep->rank_undriven_h)
         return SING_PERMANENT;
     return SING_UNKNOWN;
@@ -358,20 +368,15 @@ static int count_rows(const Model *m, InfoReport *rep, int *undriven, int *hrows
     return nu;
 }
 
-/* Assembly at t, then the ranks at the assembled configuration, the
-   redundant rows and, where rows are lost, the generic rank. w is NULL
-   beyond the dense limit (sparse QR instead of SVD). */
-static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
-                              const int *hrows, const int *undriven, int nu, int nuh,
-                              const AnalysisOptions *opt)
+/* Assembly at t from the file's initial values: construction, then
+   minimum-norm Newton (restarting from jittered guesses when it stalls),
+   or beyond the dense limit (w NULL) minimum-norm Newton by sparse QR. */
+static void assemble_at(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
+                        const int *hrows, double t, const AnalysisOptions *opt)
 {
     const Model *m = mech->model;
-    int nq = m->nq, nh = m->nh, nr = m->nr;
-    double t = rep->t;
-    size_t dense_len = w ? (size_t)nr * (size_t)nq : 0;
-    double *jac = xcalloc(dense_len + 1, sizeof *jac);
-    double *sub = xcalloc(dense_len + 1, sizeof *sub);
-    bool *red = xcalloc((size_t)nr + 1, sizeof *red);
+    int nq = m->nq, nh = m->nh;
+    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
     if (nh == 0) {
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
@@ -389,6 +394,21 @@ static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
         rep->assembled = assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
     }
+}
+
+/* The ranks at rep->q, the redundant rows and, where rows are lost, the
+   generic rank. w is NULL beyond the dense limit (sparse QR instead of
+   SVD). */
+static void rank_here(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
+                      const int *undriven, int nu, int nuh, const AnalysisOptions *opt)
+{
+    const Model *m = mech->model;
+    int nq = m->nq, nh = m->nh, nr = m->nr;
+    double t = rep->t;
+    size_t dense_len = w ? (size_t)nr * (size_t)nq : 0;
+    double *jac = xcalloc(dense_len + 1, sizeof *jac);
+    double *sub = xcalloc(dense_len + 1, sizeof *sub);
+    bool *red = xcalloc((size_t)nr + 1, sizeof *red);
     if (w) {
         mech_eval(me, rep->q, t, NULL, jac);
         dense_ranks(w, jac, sub, m, rep, undriven, nu, nuh, opt, red);
@@ -414,7 +434,52 @@ static void assemble_and_rank(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport
     free(jac), free(sub), free(red);
 }
 
+/* --at / --state: the reference at t = 0 (its rank and redundant rows into
+   *ref_rank, ref_red), then the state: the motion followed to rep->t, or
+   at->q as given. */
+static void reach_state(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep, const int *hrows,
+                        const InfoAt *at, const AnalysisOptions *opt, int *ref_rank, bool *ref_red)
+{
+    int nq = rep->nq, nh = rep->nh;
+    InfoState *st = &rep->state;
+    st->asked = true;
+    assemble_at(mech, me, w, rep, hrows, 0.0, opt);
+    *ref_rank = rep->assembled ? info_holonomic_rank(me, w, rep->q, 0.0, opt->rank_tol, ref_red) : -1;
+    if (at->q) {
+        st->given = true;
+        memcpy(rep->q, at->q, (size_t)nq * sizeof *rep->q);
+        rep->assembled = true;
+        rep->constructed = 0;
+        rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
+    } else if (rep->assembled && nh > 0 && rep->t != 0.0) {
+        double *near = xmalloc(((size_t)nq + 1) * sizeof *near), t_near;
+        bool *near_red = xcalloc((size_t)nh + 1, sizeof *near_red);
+        st->reached = info_follow(me, w, hrows, nh, rep->t, rep->q, opt, &rep->assembly, &st->steps,
+                                  near, &t_near);
+        rep->assembled = st->reached;
+        /* the regular state just before t, with the state's tolerance: the
+           reference when its rank is the larger (t = 0 may be singular) */
+        int near_rank = !st->reached ? -1
+            : info_holonomic_rank(me, w, near, t_near, info_state_tolerance(me, w, near, t_near),
+                                  near_red);
+        if (near_rank > *ref_rank) {
+            *ref_rank = near_rank;
+            memcpy(ref_red, near_red, (size_t)nh * sizeof *ref_red);
+        }
+        free(near), free(near_red);
+    } else {
+        st->reached = rep->assembled;
+    }
+    rep->assembly.residual = st->residual = info_residual(me, rep->q, rep->t);
+}
+
 bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag)
+{
+    return info_analyse_at(mech, t, NULL, opt, rep, diag);
+}
+
+bool info_analyse_at(Mech *mech, double t, const InfoAt *at, const AnalysisOptions *opt,
+                     InfoReport *rep, Diag *diag)
 {
     Model *m = mech->model;
     int nq = m->nq, nh = m->nh, nr = m->nr;
@@ -429,14 +494,26 @@ bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *
     int nu = count_rows(m, rep, undriven, hrows, &nuh);
     rep->rank = rep->rank_all = rep->rank_undriven = rep->rank_undriven_h = -1;
     rep->generic_rank = -1;
-    rep->q = xmalloc((size_t)nq * sizeof *rep->q);
-    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
+    rep->q = xmalloc((size_t)nq * sizeof *rep->q + 1);
     rep->dense = (double)nr * (double)nq <= opt->max_dense;
 
     MechEval me;
     mech_eval_init(&me, &mech->kin);
     MechrtSvd *w = rep->dense ? svd_work_new(nr, nq) : NULL;
-    assemble_and_rank(mech, &me, w, rep, hrows, undriven, nu, nuh, opt);
+    int ref_rank = -1;
+    bool *ref_red = xcalloc((size_t)nh + 1, sizeof *ref_red);
+    AnalysisOptions so = *opt;      /* at a state: its own tolerance */
+    if (at) {
+        reach_state(mech, &me, w, rep, hrows, at, opt, &ref_rank, ref_red);
+        if (so.rank_tol < 0)
+            so.rank_tol = info_state_tolerance(&me, w, rep->q, t);
+    } else {
+        assemble_at(mech, &me, w, rep, hrows, t, opt);
+    }
+    rank_here(mech, &me, w, rep, undriven, nu, nuh, &so);
+    if (at)
+        info_state_finish(&me, rep, ref_rank, ref_red);
+    free(ref_red);
     rep->singularity = classify_singularity(rep, nuh);
     rep->verdict = make_verdict(rep);
     rep->singular = make_singular(rep, nuh);
@@ -467,5 +544,8 @@ void info_report_free(InfoReport *rep)
     free(rep->q);
     free(rep->verdict);
     free(rep->singular);
+    free(rep->state.dependent);
+    free(rep->state.null);
+    free(rep->state.free_coord);
     memset(rep, 0, sizeof *rep);
 }

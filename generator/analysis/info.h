@@ -27,6 +27,36 @@ typedef enum Singularity {
 
 extern const char *const info_singularity_names[];  /* "none", "position", ... */
 
+/* Where `info --at` / `--state` takes the rank: the motion followed from
+   t = 0 to t, or a state given coordinate by coordinate. */
+typedef struct InfoAt {
+    bool follow;            /* assemble at t = 0, then follow the motion to t */
+    const double *q;        /* or this state (nq values), used as it is */
+} InfoAt;
+
+/* Null-space directions kept for the report, at most. */
+#define INFO_MAX_DIRECTIONS 64
+
+/* The rank drop at a given state against the generic rank. */
+typedef struct InfoState {
+    bool asked;             /* --at or --state */
+    bool given;             /* the state came from --state */
+    int steps;              /* --at: steps taken from t = 0 (substeps included) */
+    bool reached;           /* --at: the motion was followed to t */
+    double residual;        /* ||Phi||_inf of the holonomic rows at the state */
+    int ref_rank;           /* rank of the holonomic rows at the reference:
+                               the largest at t = 0, at the last state Newton
+                               reached before t (--at) and here; -1 */
+    int drop;               /* ref_rank - rank, -1 when a rank is missing */
+    int ndependent;         /* rows dependent here, independent at the reference */
+    int *dependent;         /* their model row indices */
+    int nnull;              /* null-space dimension of the holonomic rows here (QR) */
+    int nshown;             /* vectors kept in null, <= INFO_MAX_DIRECTIONS */
+    double *null;           /* nshown x nq: direction k is 1 at free[k], 0 at
+                               the other free coordinates */
+    int *free_coord;        /* nshown */
+} InfoState;
+
 typedef struct InfoReport {
     const Model *model;
     double t;               /* the time of the analysis (0) */
@@ -62,12 +92,17 @@ typedef struct InfoReport {
     Involutivity system;    /* the velocity rows without drivers, with the holonomic ones */
     char *verdict;          /* plain words (malloc'd) */
     char *singular;         /* about the configuration's singularity (malloc'd) */
+    InfoState state;        /* --at / --state only */
 } InfoReport;
 
 /* Analyses a loaded mechanism at time t. Returns false with diag filled only
    on an internal limit (graph size); an assembly that does not converge is
    reported in rep->assembled. */
 bool info_analyse(Mech *mech, double t, const AnalysisOptions *opt, InfoReport *rep, Diag *diag);
+/* The same at a state (at != NULL): the motion followed to t, or at->q;
+   fills rep->state as well. */
+bool info_analyse_at(Mech *mech, double t, const InfoAt *at, const AnalysisOptions *opt,
+                     InfoReport *rep, Diag *diag);
 void info_report_free(InfoReport *rep);
 
 /* The textbook's row count for a joint kind (what each joint removes:

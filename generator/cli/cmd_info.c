@@ -2,9 +2,12 @@
 #include "cli.h"
 
 #include "../analysis/info.h"
+#include "../analysis/run.h"
 #include "../base/arena.h"
+#include "state_csv.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,21 +16,30 @@ typedef struct InfoCli {
     AnalysisOptions analysis;
     MechLimits limits;
     double t;
+    double at;              /* --at T: NAN when absent */
+    const char *state;      /* --state FILE.csv, or NULL */
+    int linear;             /* --linear, a RunLinear */
     bool json;
 } InfoCli;
 
 static const char usage[] =
     "usage: mechc info FILE.mech [--json] [--rank-tol T] [--t T] [--samples N]\n"
-    "                  [--max-dense N]\n"
+    "                  [--linear dense|sparse|auto] [--max-dense N]\n"
+    "                  [--at T] [--state STATE.csv]\n"
     "\n"
     "Reports the coordinates, every row with its joint, kind and level, the rows\n"
     "per joint against the textbook table and the mobility count (coordinates -\n"
     "rows, with and without drivers). Then assembles the mechanism at t = 0 by\n"
     "minimum-norm Newton on its holonomic rows (any number of rows), takes the\n"
-    "rank of their Jacobian by SVD, names the redundant rows (a row that depends\n"
-    "on the rows before it), tells a singular position from a permanent\n"
+    "rank of their Jacobian by SVD or sparse QR, names the redundant rows (a row\n"
+    "that depends on the rows before it), tells a singular position from a permanent\n"
     "redundancy, and tests every velocity-level row for integrability\n"
     "(holonomic in disguise, with its position law, or nonholonomic).\n"
+    "With --at or --state it reports a given state: the rank drop there against\n"
+    "the generic rank (at t = 0, or just before T), the rows that became\n"
+    "dependent and the directions the rows leave free (null-space vectors by\n"
+    "coordinate), with the rank tolerance there: sqrt(eps) * largest singular\n"
+    "value, unless --rank-tol.\n"
     "\n";
 
 static const CliOption options[] = {
@@ -42,17 +54,32 @@ static const CliOption options[] = {
      .help = "analyse at time T instead of 0 (drivers move with t)"},
     {"--samples", CLI_INT_AT(InfoCli, analysis.samples, 1, 1000), .metavar = "N",
      .help = "random states for the numerical integrability check (default 8)"},
+    {"--linear", CLI_CHOICE_AT(InfoCli, linear, run_linear_names), .metavar = "L",
+     .help = "rank by dense SVD, or by sparse QR (SuiteSparseQR: the rank,\n"
+             "the redundant rows and mobility, no condition number), or\n"
+             "auto (default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates)"},
     {"--max-dense", CLI_REAL_AT(InfoCli, analysis.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "N",
-     .help = "rows x coordinates up to which the rank comes from a dense SVD\n"
-             "(default 500000); larger Jacobians use a sparse QR, which gives\n"
-             "the rank and the redundant rows but no condition number"},
+     .help = "rows x coordinates up to which a dense SVD is allowed\n"
+             "(default 500000): auto goes sparse beyond it, dense refuses"},
+    {"--at", CLI_REAL_AT(InfoCli, at), .metavar = "T",
+     .help = "the state the motion reaches at T: assembled at t = 0 from\n"
+             "the file's initial values, then followed to T in 100 steps\n"
+             "(minimum-norm Newton, through singular positions); reports\n"
+             "the rank drop there, the rows that became dependent and the\n"
+             "directions the rows leave free (holonomic rows only: with\n"
+             "velocity-level rows use --state)"},
+    {"--state", CLI_STRING_AT(InfoCli, state), .metavar = "FILE",
+     .help = "the same at a state read from a CSV as run writes it (a\n"
+             "header naming t and the coordinates; the row at --at T, or\n"
+             "the only row), used as it is"},
 };
 
 static const char epilogue[] =
     "\n"
-    "Exit status: 0 success, 1 the assembly did not converge (the report is still\n"
-    "printed, at the last iterate), 2 bad usage or bad input.\n";
+    "Exit status: 0 success, 1 the assembly did not converge or --at could not\n"
+    "follow the motion (the report is still printed, at the last iterate), 2 bad\n"
+    "usage or bad input (a bad --state file, --linear dense beyond --max-dense).\n";
 
 static const char *level_name(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
@@ -140,6 +167,73 @@ static void json_joints(const Model *m)
     printf("]");
 }
 
+/* The largest components of a null-space direction, up to `most`, by
+   decreasing size (equal to 1e-9, as rounding leaves them: coordinate
+   order); returns how many are kept. */
+static int top_components(const double *v, int nq, int most, int *idx)
+{
+    int n = 0;
+    for (int j = 0; j < nq; j++) {
+        if (fabs(v[j]) < 1e-12)
+            continue;
+        int k;
+        if (n < most)
+            k = n++;
+        else if (fabs(v[j]) * (1 - 1e-9) > fabs(v[idx[most - 1]]))
+            k = most - 1;           /* the smallest kept gives way */
+        else
+            continue;
+        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j]) * (1 - 1e-9)) {
+            idx[k] = idx[k - 1];
+            k--;
+        }
+        idx[k] = j;
+    }
+    return n;
+}
+
+enum { TOP_COMPONENTS = 6 };
+
+/* --at / --state: "state" with the drop, the rows that became dependent
+   and the null-space directions. */
+static void json_state(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    const InfoState *st = &rep->state;
+    printf(",\n \"state\": {\"source\": \"%s\"", st->given ? "csv" : "followed");
+    if (!st->given)
+        printf(", \"steps\": %d", st->steps);
+    json_num("residual", st->residual);
+    json_int_or_null("rank", rep->rank);
+    json_int_or_null("generic_rank", st->ref_rank);
+    json_int_or_null("drop", st->drop);
+    json_num("tol", rep->rank_tol);
+    printf(",\n   \"dependent\": [");
+    for (int k = 0; k < st->ndependent; k++) {
+        printf(k ? ", " : "");
+        json_string(stdout, m->rows[st->dependent[k]].name);
+    }
+    printf("]");
+    json_int_or_null("null_dim", st->nnull);
+    printf(",\n   \"directions\": [");
+    for (int k = 0; k < st->nshown; k++) {
+        const double *v = st->null + (size_t)k * (size_t)m->nq;
+        int idx[TOP_COMPONENTS];
+        int n = top_components(v, m->nq, TOP_COMPONENTS, idx);
+        printf(k ? ",\n     {\"free\": " : "{\"free\": ");
+        json_string(stdout, m->coord_names[st->free_coord[k]]);
+        printf(", \"largest\": {");
+        for (int i = 0; i < n; i++) {
+            printf(i ? ", " : "");
+            json_string(stdout, m->coord_names[idx[i]]);
+            printf(": ");
+            json_number(stdout, v[idx[i]]);
+        }
+        printf("}}");
+    }
+    printf("]}");
+}
+
 static void print_json(const InfoReport *rep)
 {
     const Model *m = rep->model;
@@ -182,6 +276,8 @@ static void print_json(const InfoReport *rep)
            !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
     printf(",\n \"system_note\": ");
     json_string(stdout, rep->system.note ? rep->system.note : "");
+    if (rep->state.asked)
+        json_state(rep);
     printf(",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
     printf(",\n \"singular\": ");
     json_string(stdout, rep->singular);
@@ -252,9 +348,21 @@ static void print_assembly(const InfoReport *rep)
         printf("nothing to assemble (no holonomic rows)\n");
         return;
     }
+    if (rep->state.given) {
+        printf("the state read from the CSV, used as it is: residual %.3g\n", rep->state.residual);
+        return;
+    }
     if (rep->constructed > 0)
         printf("%d of %d coordinates placed by construction (drivers, pins, dyads), then\n  ",
                rep->constructed, m->nq);
+    if (rep->state.asked) {
+        printf("assembled at t = 0, %s to t = %g in %d steps (the last Newton: %d\n"
+               "  iteration%s); the state at t = %g: the cubic through the last four, residual %.3g\n",
+               rep->assembled ? "the motion followed" : "the motion NOT FOLLOWED", rep->t,
+               rep->state.steps, rep->assembly.iterations,
+               rep->assembly.iterations == 1 ? "" : "s", rep->t, rep->assembly.residual);
+        return;
+    }
     printf("%s after %d iteration%s, residual %.3g%s%s\n",
            rep->assembled ? "converged" : "DID NOT CONVERGE", rep->assembly.iterations,
            rep->assembly.iterations == 1 ? "" : "s", rep->assembly.residual,
@@ -320,33 +428,136 @@ static void print_integrability(const InfoReport *rep)
            rep->system.note ? rep->system.note : "not tested");
 }
 
+/* --at / --state: the drop against the generic rank, the rows that
+   became dependent, the directions the rows leave free. */
+static void print_state(const InfoReport *rep)
+{
+    const Model *m = rep->model;
+    const InfoState *st = &rep->state;
+    if (!st->asked)
+        return;
+    printf("\nat this state (t = %g, %s; residual %.3g):\n", rep->t,
+           st->given ? "read from the CSV" : "the motion followed from t = 0", st->residual);
+    if (st->drop < 0) {
+        printf("  rank drop not computed\n");
+        return;
+    }
+    printf("  rank %d of the holonomic rows (drivers included) against %d generically\n"
+           "  (at t = 0%s): a drop of %d (singular values above %.3g count)\n", rep->rank,
+           st->ref_rank, st->given ? "" : " or just before", st->drop, rep->rank_tol);
+    printf("  rows that became dependent (%d): ", st->ndependent);
+    for (int k = 0; k < st->ndependent; k++)
+        printf("%s%s", k ? ", " : "", m->rows[st->dependent[k]].name);
+    printf("%s\n", st->ndependent ? "" : "none");
+    if (st->nnull <= 0) {
+        printf("  directions the rows leave free: %s\n", st->nnull ? "not computed" : "none");
+        return;
+    }
+    printf("  directions the rows leave free (%d; each 1 at its coordinate, 0 at the others'%s):\n",
+           st->nnull, st->nnull > st->nshown ? ", the first shown" : "");
+    for (int k = 0; k < st->nshown; k++) {
+        const double *v = st->null + (size_t)k * (size_t)m->nq;
+        int idx[TOP_COMPONENTS];
+        int n = top_components(v, m->nq, TOP_COMPONENTS, idx);
+        printf("    %s:", m->coord_names[st->free_coord[k]]);
+        for (int i = 0; i < n; i++)
+            printf(" %s %.4g", m->coord_names[idx[i]], v[idx[i]]);
+        printf("\n");
+    }
+}
+
 static void print_text(const InfoReport *rep)
 {
     print_structure(rep);
     print_assembly(rep);
     print_rank(rep);
+    print_state(rep);
     print_integrability(rep);
     printf("\nverdict: %s\n", rep->verdict);
+}
+
+/* --linear: dense allowed up to --max-dense, auto dense up to 100
+   coordinates as well; false (reported) when dense is refused. */
+static bool choose_linear(const InfoCli *c, const Model *m, AnalysisOptions *o)
+{
+    bool fits = (double)m->nr * (double)m->nq <= o->max_dense;
+    switch ((RunLinear)c->linear) {
+    case RUN_LINEAR_DENSE:
+        if (!fits) {
+            fprintf(stderr, "mechc info: error: --linear dense: the Jacobian is %d x %d, beyond "
+                    "--max-dense %.0f (a dense SVD of it would take long): use --linear sparse "
+                    "or raise --max-dense\n", m->nr, m->nq, o->max_dense);
+            return false;
+        }
+        break;
+    case RUN_LINEAR_SPARSE:
+        o->max_dense = -1;
+        break;
+    case RUN_LINEAR_AUTO:
+        if (m->nq > RUN_DENSE_MAX_NQ)
+            o->max_dense = -1;
+        break;
+    }
+    return true;
+}
+
+/* --at and --state: where the state comes from; q (nq) receives a state
+   read from the CSV. *t is the time of the analysis. false on a bad
+   --state (reported). */
+static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at, double *t)
+{
+    *t = isnan(c->at) ? c->t : c->at;
+    *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
+    if (at->follow && m->nv > 0) {
+        fprintf(stderr, "mechc info: error: --at follows the holonomic rows only, and %s has "
+                "velocity-level rows, whose positions run integrates: write the state with "
+                "`mechc run FILE --at T --csv STATE.csv` and give it with --state STATE.csv\n",
+                m->name);
+        return false;
+    }
+    if (!c->state)
+        return true;
+    char err[300];
+    if (!state_csv_read(c->state, m, c->at, q, t, err, sizeof err)) {
+        fprintf(stderr, "mechc info: error: %s: %s\n", c->state, err);
+        return false;
+    }
+    at->q = q;
+    return true;
 }
 
 /* The analysis at t and its report; exit status 1 when the assembly did not converge. */
 static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
     const InfoCli *c = opts;
+    const Model *m = mech->model;
+    AnalysisOptions o = c->analysis;
+    double *q = xmalloc(((size_t)m->nq + 1) * sizeof *q), t;
+    InfoAt at;
+    if (!choose_linear(c, m, &o) || !choose_state(c, m, q, &at, &t)) {
+        free(q);
+        return EXIT_USAGE;
+    }
+    bool asked = at.follow || at.q;
     InfoReport rep;
-    if (!info_analyse(mech, c->t, &c->analysis, &rep, diag)) {
+    if (!info_analyse_at(mech, t, asked ? &at : NULL, &o, &rep, diag)) {
+        free(q);
         cli_error(a, diag);
         return EXIT_USAGE;
     }
+    free(q);
     if (c->json)
         print_json(&rep);
     else
         print_text(&rep);
     int status = EXIT_OK;
-    if (!rep.assembled) {
-        const Model *m = mech->model;
+    if (!rep.assembled && rep.state.asked && at.follow) {
+        fprintf(stderr, "mechc info: error: t = %g: the motion from t = 0 could not be followed "
+                "to t = %g (residual %.3g)\n", t, t, rep.assembly.residual);
+        status = EXIT_ANALYSIS;
+    } else if (!rep.assembled) {
         fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
-                c->t, rep.assembly.residual);
+                rep.state.asked ? 0.0 : t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
         fprintf(stderr, ")\n");
@@ -364,6 +575,7 @@ static const CliCommand command = {
 
 int cmd_info(int argc, char **argv)
 {
-    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits()};
+    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits(),
+                 .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }
