@@ -140,8 +140,9 @@ static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, 
             "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
             mech->model->nh, mech->model->nv, mech->kin.nnz);
     fprintf(stderr, "mechc gen: operations after sharing:");
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
-        fprintf(stderr, " %s %d%s", emit_function_names[f], res->ops[f], f + 1 < EMIT_FUNCTION_COUNT ? "," : "\n");
+    int nf = emit_function_count(&mech->kin);
+    for (int f = 0; f < nf; f++)
+        fprintf(stderr, " %s %d%s", emit_function_names[f], res->ops[f], f + 1 < nf ? "," : "\n");
     fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
             (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
     EmitResult jit_src;

@@ -2,6 +2,8 @@
 #ifndef MECHC_TEMPLATES_H
 #define MECHC_TEMPLATES_H
 
+extern const char template_dynamics[];
+extern const char template_dynamics_h[];
 extern const char template_interface[];
 extern const char template_jac_direct[];
 extern const char template_jac_spread[];
