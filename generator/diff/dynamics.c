@@ -92,10 +92,50 @@ static NodeId dot2(Dag *d, NodeId a, NodeId b, NodeId c, NodeId e)
     return dag_add(d, ab, ce);
 }
 
+/* A planar body's own mass, the formula worked out (DYN.md's with
+   p = r + A(phi) s, u = A(phi) s, p_phi = B s = (-u_y, u_x), w = phi'):
+   M(x, x) = M(y, y) = m, M(x, phi) = -m u_y, M(y, phi) = m u_x,
+   M(phi, phi) = J + m s.s; velocity terms m u w^2 on (x, y), none on phi
+   (B s is normal to u); weight m g on (x, y), m (B s).g on phi. The
+   symbolic route gives the same numbers with sin^2 + cos^2 left unfolded. */
+static void add_body(DynWork *w, const MassElement *e)
+{
+    Dag *d = w->dag;
+    int x = e->body, y = x + 1, phi = x + 2;
+    NodeId c = dag_call(d, OP_COS, e->theta, DAG_NONE);     /* as joints.c's rotate */
+    NodeId sn = dag_call(d, OP_SIN, e->theta, DAG_NONE);
+    NodeId vx = dag_const(d, e->sx), vy = dag_const(d, e->sy);
+    NodeId sy = dag_mul(d, sn, vy), cx = dag_mul(d, c, vx);
+    NodeId ux = dag_sub(d, cx, sy);
+    NodeId cy = dag_mul(d, c, vy), sx = dag_mul(d, sn, vx);
+    NodeId uy = dag_add(d, sx, cy);
+    NodeId m = dag_const(d, e->m);
+    add_mass(w, x, x, m);
+    add_mass(w, y, y, m);
+    NodeId muy = dag_mul(d, m, uy);
+    add_mass(w, x, phi, dag_neg(d, muy));
+    add_mass(w, y, phi, dag_mul(d, m, ux));
+    add_mass(w, phi, phi, dag_const(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy)));
+    NodeId rate = dag_vard(d, phi);
+    NodeId w2 = dag_mul(d, rate, rate);
+    NodeId mw2 = dag_mul(d, m, w2);
+    accumulate(w, w->velocity, x, dag_mul(d, mw2, ux));
+    accumulate(w, w->velocity, y, dag_mul(d, mw2, uy));
+    double gx = w->m->gravity[0], gy = w->m->gravity[1];
+    accumulate(w, w->applied, x, dag_const(d, e->m * gx));
+    accumulate(w, w->applied, y, dag_const(d, e->m * gy));
+    NodeId bsg = dot2(d, uy, dag_const(d, -e->m * gx), ux, dag_const(d, e->m * gy));
+    accumulate(w, w->applied, phi, bsg);
+}
+
 /* One mass element's share of M, its velocity terms and its weight. */
 static void add_element(DynWork *w, const MassElement *e)
 {
     Dag *d = w->dag;
+    if (e->body >= 0) {
+        add_body(w, e);
+        return;
+    }
     NodeId parts[3] = {e->px, e->py, e->theta};
     int n = support_of(w, parts, 3);
     NodeId *dx = xmalloc((size_t)(3 * n + 1) * sizeof *dx), *dy = dx + n, *dth = dy + n;

@@ -729,7 +729,7 @@ static MassElement *new_mass(Builder *b, const Stmt *s)
                       "mass statement", s->name, line_of(b, m->masses[i].pos));
     grow(&m->arena, (void **)&m->masses, &b->cap_masses, m->nmasses + 1, sizeof *m->masses);
     MassElement *e = &m->masses[m->nmasses++];
-    *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO};
+    *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1};
     e->m = dyn_constant(b, s, DKEY_M, "the mass m", true);
     e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true);
     return e;
@@ -760,8 +760,11 @@ static void build_body_mass(Builder *b, const Stmt *s)
     NodeId xy[2];
     joints_point(b->model, at, xy);
     e->px = xy[0], e->py = xy[1];
-    if (body)
+    if (body) {
         e->theta = dag_var(&b->model->dag, ent->q + 2);
+        e->body = ent->q;
+        e->sx = at.sx, e->sy = at.sy;
+    }
     check_nodes(b);
 }
 

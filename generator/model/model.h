@@ -82,6 +82,9 @@ typedef struct MassElement {
     double m, J;
     NodeId px, py;
     NodeId theta;       /* DAG_ZERO when there is no angle (J = 0) */
+    int body;           /* a planar body's own mass: its x coordinate (then
+                           p = r + A(phi) s, s = (sx, sy)); -1 otherwise */
+    double sx, sy;
 } MassElement;
 
 typedef enum ForceKind {
