@@ -798,10 +798,11 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
 }
 
 /* keys = {KEY '=' expr | 'com' pair | 'at' pair}, each at most once;
-   com and at only where the form takes them. */
+   com and at only where the form takes them (a body's own mass, with
+   com, turns with the body: no angle key). */
 static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
 {
-    unsigned allowed = dyn_allowed[s->dyn];
+    unsigned allowed = dyn_allowed[s->dyn] & (com ? ~KEYBIT(DKEY_ANGLE) : ~0u);
     while (p->tok.kind == TOK_IDENT) {
         bool is_com = com && lex_is_word(&p->tok, "com"), is_at = at && lex_is_word(&p->tok, "at");
         if ((is_com && s->vec[0]) || (is_at && s->attach[0].at))
@@ -911,11 +912,21 @@ static void dynamics(Parser *p, Stmt *s, DynKind kind)
         expected(p, "':' after the %s name '%s'", kw, s->name);
     advance(p);
     switch (kind) {
-    case DYN_FORCE:
+    case DYN_FORCE: {
+        AstAttach *a = &s->attach[0];
+        SrcPos offset_pos = p->tok.pos;
         dyn_attachment(p, s, 0, 1, false);
+        if (p->tok.kind != TOK_LPAREN && a->has_offset && !a->at) {
+            /* `force F: body (fx, fy)`: the pair was the force, not an offset */
+            a->has_offset = false;
+            s->vec[0] = a->sx, s->vec[1] = a->sy, a->sx = a->sy = NULL;
+            s->vec_pos = offset_pos;
+            return;
+        }
         s->vec_pos = p->tok.pos;
         pair(p, "the force (fx, fy)", &s->vec[0], &s->vec[1]);
         return;
+    }
     case DYN_TORQUE:
         dyn_torque(p, s);
         return;
