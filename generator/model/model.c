@@ -915,6 +915,11 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             break;
         }
     }
+    /* M is dense nq x nq in the engines and the generated P_mass */
+    if (m->nmasses > 0 && (long long)m->nq * m->nq > b->limits->max_jac_entries)
+        diag_fail(b->diag, m->masses[0].pos, "the dense mass matrix would have %d x %d = %lld "
+                  "entries, more than the limit of %d (--max-jac-entries)", m->nq, m->nq,
+                  (long long)m->nq * m->nq, b->limits->max_jac_entries);
     if (b->first_force && m->nmasses == 0)
         diag_fail(b->diag, b->first_force->pos, "%s without masses: the file has no 'mass' "
                   "statement, so there is nothing for it to move", b->first_force->dyn == DYN_GRAVITY
