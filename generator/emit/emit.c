@@ -866,9 +866,10 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     sb_free(&single);
 }
 
-/* The data section's lists: initial values, names, Jacobian structure. */
+/* The data section's lists: initial values, names, the Jacobian's
+   structure and (a file with masses) M's, mrow and mcol. */
 static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows, StrBuf *jrow,
-                     StrBuf *jcol)
+                     StrBuf *jcol, StrBuf *mrow, StrBuf *mcol)
 {
     const Model *m = e->kin->model;
     for (int i = 0; i < m->nq; i++) {
@@ -884,6 +885,8 @@ static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows,
     }
     put_int_list(jrow, e->kin->jac, e->kin->nnz, true);
     put_int_list(jcol, e->kin->jac, e->kin->nnz, false);
+    put_int_list(mrow, e->kin->dyn.mass, e->kin->dyn.nnz, true);
+    put_int_list(mcol, e->kin->dyn.mass, e->kin->dyn.nnz, false);
 }
 
 /* The dynamics part of the source (DYNAMICS) and of the interface
@@ -908,6 +911,12 @@ static const char *put_dynamics(const Emitter *e, TemplateVar *vars, int nvars, 
     return NULL;
 }
 
+static _Noreturn void placeholder_bug(const char *name)
+{
+    fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", name);
+    abort();
+}
+
 /* Fills the templates with the written functions: out's source and header. */
 static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
 {
@@ -925,22 +934,20 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     put_banner(&banner, opt->source_name ? opt->source_name : m->file);
     for (int f = 0; f < emit_function_count(e->kin); f++)
         sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
-    put_data(e, &q0, &coords, &rows, &jrow, &jcol);
+    put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
     if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
-    put_int_list(&mrow, e->kin->dyn.mass, e->kin->dyn.nnz, true);
-    put_int_list(&mcol, e->kin->dyn.mass, e->kin->dyn.nnz, false);
 
     char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
-    snprintf(mnnz, sizeof mnnz, "%d", e->kin->dyn.nnz > 0 ? e->kin->dyn.nnz : 1);
     snprintf(nq, sizeof nq, "%d", m->nq);
     snprintf(nh, sizeof nh, "%d", m->nh);
     snprintf(nv, sizeof nv, "%d", m->nv);
     /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
        placeholder entry (row 0, column 0, value 0). */
     snprintf(nnz, sizeof nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
+    snprintf(mnnz, sizeof mnnz, "%d", e->kin->dyn.nnz > 0 ? e->kin->dyn.nnz : 1);
     snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
     TemplateVar vars[] = {
         {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
@@ -954,13 +961,12 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"GAMMA_PARTS", parts[EMIT_GAMMA].data}, {"GAMMA_BODY", bodies[EMIT_GAMMA].data},
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
-        {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
-        {"M_NNZ", mnnz}, {"MASS_ROW", mrow.data}, {"MASS_COL", mcol.data},
+        {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""}, {"M_NNZ", mnnz},
+        {"MASS_ROW", mrow.data}, {"MASS_COL", mcol.data}, {"DYNAMICS", ""}, {"DYN_INTERFACE", ""},
         {"MASS_PARTS", parts[EMIT_MASS].data}, {"MASS_BODY", bodies[EMIT_MASS].data},
         {"MASS_NZ_PARTS", parts[EMIT_MASS_NZ].data}, {"MASS_NZ_BODY", bodies[EMIT_MASS_NZ].data},
         {"FORCE_PARTS", parts[EMIT_FORCE].data}, {"FORCE_BODY", bodies[EMIT_FORCE].data},
         {"EOM_PARTS", parts[EMIT_EOM].data}, {"EOM_BODY", bodies[EMIT_EOM].data},
-        {"DYNAMICS", ""}, {"DYN_INTERFACE", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
     /* DYNAMICS, DYN_INTERFACE, INTERFACE and JAC are rendered from the
@@ -988,10 +994,8 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         bad = template_render(&source, template_mech_c, vars, nvars);
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++)
         sb_free(all_bufs[i]);
-    if (bad) {
-        fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", bad);
-        abort();
-    }
+    if (bad)
+        placeholder_bug(bad);
     out->c_text = sb_take(&source);
     out->h_text = sb_take(&header);
 }
