@@ -124,8 +124,9 @@ static void add_body(DynWork *w, const MassElement *e)
     double gx = w->m->gravity[0], gy = w->m->gravity[1];
     accumulate(w, w->applied, x, dag_const(d, e->m * gx));
     accumulate(w, w->applied, y, dag_const(d, e->m * gy));
-    NodeId bsg = dot2(d, uy, dag_const(d, -e->m * gx), ux, dag_const(d, e->m * gy));
-    accumulate(w, w->applied, phi, bsg);
+    NodeId mgx = dag_const(d, -e->m * gx);
+    NodeId mgy = dag_const(d, e->m * gy);
+    accumulate(w, w->applied, phi, dot2(d, uy, mgx, ux, mgy));
 }
 
 /* One mass element's share of M, its velocity terms and its weight. */
