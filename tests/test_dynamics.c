@@ -14,6 +14,7 @@
 #include "testcache.h"
 #include "testload.h"
 
+#include "../generator/analysis/check.h"
 #include "../generator/base/arena.h"
 #include "../generator/base/rng.h"
 #include "../generator/engine/aot.h"
@@ -311,6 +312,31 @@ static void test_constant_mass_costs_nothing(void **state)
     pipeline_free(mech);
 }
 
+/* check passes the examples with masses, and catches a wrong entry of M
+   (planted in the jit's): the engines disagree, and M is not symmetric. */
+static void test_check_catches_mass_mistakes(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("pendulum_dynamics.mech");
+    CheckOptions opt = check_default_options();
+    opt.samples = 4;
+    opt.use_aot = false;
+    CheckReport rep;
+    Diag diag;
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    assert_true(rep.ok);
+    for (int w = CHECK_DYN_FIRST; w < CHECK_WHAT_COUNT; w++)
+        assert_int_equal(rep.items[w].checked, strstr(rep.items[w].what, "aot") == NULL);
+    opt.fault = (CheckFault){.kind = CHECK_FAULT_MASS_SCALE, .row = 0, .col = 2, .factor = -1.0};
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    assert_false(rep.ok);
+    assert_true(rep.items[CHECK_DYN_FIRST].error > 0.1);            /* M jit/generic */
+    assert_true(rep.items[CHECK_M_SYMMETRIC].error > 0.1);
+    assert_non_null(strstr(rep.items[CHECK_M_SYMMETRIC].hint, "one triangle"));
+    assert_true(rep.items[CHECK_DYN_FIRST + 1].error <= 1e-12);     /* Q untouched */
+    pipeline_free(mech);
+}
+
 /* ---- bad input ---- */
 
 typedef struct BadCase {
@@ -369,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_engines_agree),
         cmocka_unit_test(test_spring_potential),
         cmocka_unit_test(test_constant_mass_costs_nothing),
+        cmocka_unit_test(test_check_catches_mass_mistakes),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -147,10 +147,14 @@ static void under_test(Checker *c)
         e->k.force(e->k.ctx, c->q, c->qd, c->t, c->force[ENGINE_JIT]);
     }
     const CheckFault *f = &c->opt->fault;
+    if (f->kind == CHECK_FAULT_MASS_SCALE && c->dyn && f->row >= 0 && f->row < c->nq
+        && f->col >= 0 && f->col < c->nq)
+        c->mass[ENGINE_JIT][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
     if (f->kind == CHECK_FAULT_NONE || f->row < 0 || f->row >= c->nr)
         return;
     switch (f->kind) {
     case CHECK_FAULT_NONE:
+    case CHECK_FAULT_MASS_SCALE:
         break;
     case CHECK_FAULT_JAC_SCALE:
         if (f->col >= 0 && f->col < c->nq)

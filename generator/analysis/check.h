@@ -13,6 +13,7 @@ typedef enum CheckFaultKind {
     CHECK_FAULT_GAMMA_ZERO,     /* gamma[row] = 0 */
     CHECK_FAULT_GAMMA_DROP_TT,  /* gamma[row] loses its -Phi_tt term */
     CHECK_FAULT_GAMMA_DROP_QD,  /* gamma[row] keeps only -Phi_tt (the qd terms dropped) */
+    CHECK_FAULT_MASS_SCALE,     /* M[row][col] *= factor (row: a coordinate here) */
 } CheckFaultKind;
 
 typedef struct CheckFault {
