@@ -180,6 +180,15 @@ bad_input unknown_function  2 15 'point m x = 1\nconstraint c: foo(m.x) = 0\n' "
 bad_input missing_colon     2 14 'point m x = 1\ndistance rod ground m length = 2\n' "':'"
 bad_input no_coordinates    1 1  'param a = 1\n' "no coordinates"
 bad_input tab_indent        2 22 'point m x = 1\n\tconstraint c: m.x = q\n' "unknown name 'q'"
+# masses and forces (issue 16)
+pin='body a x = 1\npoint p\nrevolute O: ground a\n'
+bad_input negative_mass     4 8  "${pin}mass a m = -2\n" "the mass m of mass 'a' is negative"
+bad_input negative_inertia  4 14 "${pin}mass a m = 1 J = -1\n" "moment of inertia J of mass 'a' is negative"
+bad_input negative_length   5 21 "${pin}mass a m = 1\nspring S: a p k = 1 length = -1\n" "free length of spring 'S' is negative"
+bad_input mass_unknown      4 6  "${pin}mass b m = 1\n" "unknown name 'b'"
+bad_input point_torque      5 11 "${pin}mass p m = 1\ntorque T: p = 1\n" "'p' is a point (it has no angle)"
+bad_input point_inertia     4 14 "${pin}mass p m = 1 J = 1\n" "it has no angle, so no moment of inertia J"
+bad_input force_no_mass     4 1  "${pin}gravity (0, -9.81)\n" "gravity without masses"
 
 # the same error from gen: nothing on stdout, no output file
 printf 'point m x = 1\nconstraint c: m.x = nope\n' > "$tmp/genbad.mech"
@@ -189,6 +198,25 @@ check "gen on bad input: FILE:LINE:COL" err_has "$tmp/genbad.mech:2:21: error: "
 check "gen on bad input writes no file" [ ! -e "$tmp/genbad.c" ]
 run gen "$tmp/genbad.mech"
 check "gen on bad input: nothing on stdout" out_empty
+
+# ---- dynamics (issue 16): eval's M and Q, gen's kernels only with masses ----
+run eval examples/pendulum_dynamics.mech --qd 0,0,2 --json
+check "eval dynamics: exit 0" status_is 0
+check "eval dynamics: M's last row" grep -q '\[0.8660254037844386, 0.5000000000000001, 0.6666666666666666\]' "$tmp/out"
+check "eval dynamics: Q" grep -q '"Q": \[2.0000000000000004, -23.084101615137754, -4.905000000000001\]' "$tmp/out"
+run eval examples/pendulum_dynamics.mech --engine generic
+check "eval dynamics text: M shown" grep -q '^Mass matrix M' "$tmp/out"
+run eval examples/pendulum_distance.mech --json
+check "eval without masses: no M" sh -c "! grep -q '\"M\"' '$tmp/out'"
+run gen examples/pendulum_dynamics.mech --prefix fb
+check "gen dynamics: FB_HAS_DYNAMICS" grep -q '^#define FB_HAS_DYNAMICS 1' "$tmp/out"
+check "gen dynamics: fb_eom" grep -q '^void fb_eom(' "$tmp/out"
+run gen examples/pendulum_distance.mech --prefix fb
+check "gen without masses: no dynamics" sh -c "! grep -q 'DYNAMICS\|fb_mass' '$tmp/out'"
+run check examples/slider_crank_dynamics.mech --samples 3
+check "check dynamics: exit 0" status_is 0
+check "check dynamics: M compared" grep -q 'M jit/generic' "$tmp/out"
+check "check dynamics: velocity terms" grep -q '^ok   Q velocity fd' "$tmp/out"
 
 # ---- gen ----
 

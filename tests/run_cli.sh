@@ -390,7 +390,7 @@ check "one row too many: points at the last statement" err_has "over.mech:4:1: e
 for f in "$ex"/*.mech; do
     name=$(basename "$f" .mech)
     case $name in
-        pendulum_distance|pendulum_constraint) want=2 ;;
+        pendulum_distance|pendulum_constraint|pendulum_dynamics) want=2 ;;
         parallelogram_redundant|slider_crank_toggle|bricard) want=1 ;;
         *) want=0 ;;
     esac

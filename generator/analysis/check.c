@@ -55,6 +55,7 @@
 #include "../eval/generic.h"
 
 #include <gsl/gsl_deriv.h>
+#include <gsl/gsl_eigen.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -95,6 +96,10 @@ static const char *const pair_names[PAIR_COUNT * QTY_COUNT] = {
     "phi jit/aot",     "jac jit/aot",     "nu jit/aot",     "gamma jit/aot",
     "phi generic/aot", "jac generic/aot", "nu generic/aot", "gamma generic/aot",
 };
+static const char *const dyn_names[CHECK_WHAT_COUNT - CHECK_DYN_FIRST] = {
+    "M jit/generic", "Q jit/generic", "M jit/aot", "Q jit/aot", "M generic/aot", "Q generic/aot",
+    "M symmetric", "M semi-definite", "Q velocity fd",
+};
 static const EngineKind pair_engines[PAIR_COUNT][2] = {
     {ENGINE_JIT, ENGINE_GENERIC}, {ENGINE_JIT, ENGINE_AOT}, {ENGINE_GENERIC, ENGINE_AOT},
 };
@@ -118,6 +123,11 @@ typedef struct Checker {
     double *ladder[FD_STEPS];                   /* gamma's second differences at each step */
     bool ladder_have[FD_STEPS];
     double *vec;                                /* one vector of rows */
+    bool dyn;                                   /* the file has masses: */
+    double *mass[ENGINE_KIND_COUNT];            /* each engine's M (nq*nq) */
+    double *force[ENGINE_KIND_COUNT];           /* and Q (nq) at the sample */
+    double *mw, *mw2, *qv, *qv_fd;              /* M elsewhere; Q's velocity terms */
+    gsl_eigen_symm_workspace *eigen;
     double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
     Arena buffers;                              /* owns every array above */
 } Checker;
@@ -132,11 +142,19 @@ static void under_test(Checker *c)
     engine_jac(e, c->q, c->t, o[QTY_JAC]);
     engine_nu(e, c->q, c->t, o[QTY_NU]);
     engine_gamma(e, c->q, c->qd, c->t, o[QTY_GAMMA]);
+    if (c->dyn) {
+        e->k.mass(e->k.ctx, c->q, c->mass[ENGINE_JIT]);
+        e->k.force(e->k.ctx, c->q, c->qd, c->t, c->force[ENGINE_JIT]);
+    }
     const CheckFault *f = &c->opt->fault;
+    if (f->kind == CHECK_FAULT_MASS_SCALE && c->dyn && f->row >= 0 && f->row < c->nq
+        && f->col >= 0 && f->col < c->nq)
+        c->mass[ENGINE_JIT][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
     if (f->kind == CHECK_FAULT_NONE || f->row < 0 || f->row >= c->nr)
         return;
     switch (f->kind) {
     case CHECK_FAULT_NONE:
+    case CHECK_FAULT_MASS_SCALE:
         break;
     case CHECK_FAULT_JAC_SCALE:
         if (f->col >= 0 && f->col < c->nq)
@@ -454,6 +472,11 @@ static void eval_engine(Checker *c, EngineKind k)
     engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
     engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
     engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
+    if (c->dyn) {
+        const MechrtKernels *mk = &c->eng[k].k;
+        mk->mass(mk->ctx, c->q, c->mass[k]);
+        mk->force(mk->ctx, c->q, c->qd, c->t, c->force[k]);
+    }
 }
 
 static void compare_pair(Checker *c, int pair)
@@ -470,6 +493,82 @@ static void compare_pair(Checker *c, int pair)
         if (n == 0)
             c->rep->items[what].checked = true;
     }
+    for (int qty = 0; qty < 2 && c->dyn; qty++) {     /* M, then Q: col names the coordinate */
+        int what = CHECK_DYN_FIRST + 2 * pair + qty;
+        const double *va = qty == 0 ? c->mass[a] : c->force[a], *vb = qty == 0 ? c->mass[b] : c->force[b];
+        for (int i = 0; i < (qty == 0 ? nq * nq : nq); i++)
+            record(c, what, -1, i % nq, va[i], vb[i], 0.0);
+    }
+}
+
+/* ---- dynamics: M's symmetry and definiteness, Q's velocity terms ---- */
+
+/* The smallest eigenvalue of the jit's M, made relative: the error is
+   max(0, -lambda_min) / (1 + max |lambda|). */
+static void check_definite(Checker *c)
+{
+    size_t nq = (size_t)c->nq;
+    memcpy(c->mw, c->mass[ENGINE_JIT], nq * nq * sizeof *c->mw);
+    gsl_matrix_view a = gsl_matrix_view_array(c->mw, nq, nq);
+    gsl_vector_view ev = gsl_vector_view_array(c->qv, nq);
+    gsl_eigen_symm(&a.matrix, &ev.vector, c->eigen);
+    double lo = c->qv[0], big = 0.0;
+    for (size_t i = 0; i < nq; i++) {
+        lo = fmin(lo, c->qv[i]);
+        big = fmax(big, fabs(c->qv[i]));
+    }
+    record(c, CHECK_M_PSD, -1, -1, fmax(0.0, -lo) / (1.0 + big), 0.0, 0.0);
+}
+
+/* The jit's M at q + x dir (dir a unit column j >= 0, or qd) into out. */
+static void mass_at(Checker *c, int j, double x, double *out)
+{
+    for (int i = 0; i < c->nq; i++)
+        c->qw[i] = c->q[i] + x * (j >= 0 ? (i == j) : c->qd[i]);
+    const MechrtKernels *k = &c->eng[ENGINE_JIT].k;
+    k->mass(k->ctx, c->qw, out);
+}
+
+/* Lagrange: the velocity terms are -(d/dt(M qd) - dT/dq) with qdd = 0,
+   -(M_dot qd)_i + 1/2 qd^T M_{q_i} qd, by central differences of the jit's
+   M, against the generic evaluator's own velocity terms. */
+static void check_velocity_terms(Checker *c)
+{
+    int nq = c->nq;
+    double h = c->opt->fd_step;
+    for (int i = 0; i < nq; i++)
+        c->qv_fd[i] = 0.0;
+    mass_at(c, -1, h, c->mw);
+    mass_at(c, -1, -h, c->mw2);
+    for (int i = 0; i < nq; i++)
+        for (int k = 0; k < nq; k++)
+            c->qv_fd[i] -= (c->mw[(size_t)i * nq + k] - c->mw2[(size_t)i * nq + k]) / (2 * h) * c->qd[k];
+    for (int j = 0; j < nq; j++) {
+        double hj = h * fmax(1.0, fabs(c->q[j]));
+        mass_at(c, j, hj, c->mw);
+        mass_at(c, j, -hj, c->mw2);
+        double quad = 0.0;
+        for (int i = 0; i < nq; i++)
+            for (int k = 0; k < nq; k++)
+                quad += c->qd[i] * (c->mw[(size_t)i * nq + k] - c->mw2[(size_t)i * nq + k]) * c->qd[k];
+        c->qv_fd[j] += 0.5 * quad / (2 * hj);
+    }
+    generic_velocity_terms(c->eng[ENGINE_GENERIC].generic, c->q, c->qd, c->qv);
+    for (int i = 0; i < nq; i++)
+        record(c, CHECK_QV_FD, -1, i, c->qv[i], c->qv_fd[i], h);
+}
+
+static void check_dynamics(Checker *c)
+{
+    int nq = c->nq;
+    const double *m = c->mass[ENGINE_JIT];
+    for (int i = 0; i < nq; i++)
+        for (int j = 0; j < i; j++)
+            record(c, CHECK_M_SYMMETRIC, -1, j, m[(size_t)i * nq + j], m[(size_t)j * nq + i], 0.0);
+    if (nq == 1)
+        c->rep->items[CHECK_M_SYMMETRIC].checked = true;
+    check_definite(c);
+    check_velocity_terms(c);
 }
 
 /* ---- diagnosis ---- */
@@ -676,8 +775,10 @@ static void init_items(CheckReport *rep, const CheckOptions *opt)
 {
     for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
         CheckItem *it = &rep->items[w];
-        it->what = w < CHECK_PAIR_FIRST ? fd_names[w] : pair_names[w - CHECK_PAIR_FIRST];
-        it->tol = w < CHECK_PAIR_FIRST ? opt->tol : opt->tol_engines;
+        it->what = w < CHECK_PAIR_FIRST ? fd_names[w]
+                   : w < CHECK_DYN_FIRST ? pair_names[w - CHECK_PAIR_FIRST]
+                   : dyn_names[w - CHECK_DYN_FIRST];
+        it->tol = w < CHECK_PAIR_FIRST || w == CHECK_QV_FD ? opt->tol : opt->tol_engines;
         it->row = it->col = -1;
         it->unsettled_row = it->unsettled_col = -1;
     }
@@ -744,6 +845,17 @@ static void take_buffers(Checker *c)
         c->ladder[k] = take(c, nvec);
     c->vec = take(c, nvec);
     c->scratch = take(c, FD_CACHE * nvec);
+    for (int k = 0; k < ENGINE_KIND_COUNT && c->dyn; k++) {
+        c->mass[k] = take(c, nq * nq);
+        c->force[k] = take(c, nq);
+    }
+    if (c->dyn) {
+        c->mw = take(c, nq * nq);
+        c->mw2 = take(c, nq * nq);
+        c->qv = take(c, nq);
+        c->qv_fd = take(c, nq);
+        c->eigen = gsl_eigen_symm_alloc(nq);
+    }
 }
 
 /* Sample s: the assembled state itself at s = 0, then random states
@@ -774,6 +886,8 @@ static void sample_loop(Checker *c)
             if (c->open[pair_engines[pair][0]] && c->open[pair_engines[pair][1]])
                 compare_pair(c, pair);
         check_fd(c, c->scratch, c->vec);
+        if (c->dyn)
+            check_dynamics(c);
     }
     c->rep->samples = c->opt->samples;
 }
@@ -795,10 +909,24 @@ static void diagnose(Checker *c)
         else if (w == CHECK_GAMMA_FD)
             hint_gamma(c, it, c->scratch, c->vec);
     }
-    for (int w = CHECK_PAIR_FIRST; w < CHECK_WHAT_COUNT; w++) {
+    for (int w = CHECK_PAIR_FIRST; w < CHECK_DYN_FIRST; w++) {
         CheckItem *it = &rep->items[w];
         if (it->checked && !(it->error <= it->tol))
             hint_pair(c, it, (w - CHECK_PAIR_FIRST) / QTY_COUNT, (w - CHECK_PAIR_FIRST) % QTY_COUNT);
+    }
+    static const char *const dyn_hints[] = {
+        "the generated M or Q and the engine's differ: compare the mass element's or force's "
+        "lowering (generator/diff/dynamics.c) with generic_dynamics.c",
+        "M is not symmetric: an entry was added to one triangle only",
+        "M has a negative eigenvalue: a negative mass or J, or a wrong sign in p_q",
+        "the velocity terms disagree with the kinetic energy's: a dropped or doubled "
+        "convective term (pdot_q qd)",
+    };
+    for (int w = CHECK_DYN_FIRST; w < CHECK_WHAT_COUNT; w++) {
+        CheckItem *it = &rep->items[w];
+        int h = w < CHECK_M_SYMMETRIC ? 0 : 1 + (w - CHECK_M_SYMMETRIC);
+        if (it->checked && !(it->error <= it->tol))
+            snprintf(it->hint, sizeof it->hint, "%s", dyn_hints[h]);
     }
 }
 
@@ -809,13 +937,16 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
         opt = &defaults;
     memset(rep, 0, sizeof *rep);
     const Model *m = mech->model;
-    Checker c = {.m = m, .opt = opt, .rep = rep, .nq = m->nq, .nh = m->nh, .nv = m->nv, .nr = m->nr};
+    Checker c = {.m = m, .opt = opt, .rep = rep, .nq = m->nq, .nh = m->nh, .nv = m->nv, .nr = m->nr,
+                 .dyn = m->nmasses > 0};
     init_items(rep, opt);
     bool ok = open_engines(&c, mech, diag);
     if (ok) {
         take_buffers(&c);
         sample_loop(&c);
         diagnose(&c);
+        if (c.eigen)
+            gsl_eigen_symm_free(c.eigen);
         arena_free(&c.buffers);
     }
     close_engines(&c);

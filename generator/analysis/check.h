@@ -13,6 +13,7 @@ typedef enum CheckFaultKind {
     CHECK_FAULT_GAMMA_ZERO,     /* gamma[row] = 0 */
     CHECK_FAULT_GAMMA_DROP_TT,  /* gamma[row] loses its -Phi_tt term */
     CHECK_FAULT_GAMMA_DROP_QD,  /* gamma[row] keeps only -Phi_tt (the qd terms dropped) */
+    CHECK_FAULT_MASS_SCALE,     /* M[row][col] *= factor (row: a coordinate here) */
 } CheckFaultKind;
 
 typedef struct CheckFault {
@@ -45,11 +46,18 @@ typedef struct CheckOptions {
 CheckOptions check_default_options(void);
 
 /* The checks, in report order. FD: the engine under test (jit) against
-   finite differences; then every pair of engines on every quantity. */
+   finite differences; then every pair of engines on every quantity; then,
+   for a file with masses only, every pair on M and Q, M's symmetry and
+   positive semi-definiteness, and Q's velocity terms against finite
+   differences of the kinetic energy (M from the jit). */
 typedef enum CheckWhat {
     CHECK_JAC_FD, CHECK_NU_FD, CHECK_GAMMA_FD,
     CHECK_PAIR_FIRST,
-    CHECK_WHAT_COUNT = CHECK_PAIR_FIRST + 12
+    CHECK_DYN_FIRST = CHECK_PAIR_FIRST + 12,    /* M and Q of each pair */
+    CHECK_M_SYMMETRIC = CHECK_DYN_FIRST + 6,
+    CHECK_M_PSD,
+    CHECK_QV_FD,
+    CHECK_WHAT_COUNT
 } CheckWhat;
 
 typedef struct CheckItem {

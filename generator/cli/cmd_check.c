@@ -179,7 +179,7 @@ static void print_text(const Model *m, const CheckReport *rep)
         const CheckItem *it = &rep->items[w];
         if (!it->checked)
             continue;
-        if (w == CHECK_PAIR_FIRST)
+        if (w == CHECK_PAIR_FIRST || w == CHECK_DYN_FIRST)
             printf("\n");
         char step[40] = "";
         if (item_fd(it, rep)) {

@@ -19,7 +19,8 @@ static const char usage[] =
     "usage: mechc eval FILE.mech [--q v,v,...] [--qd v,v,...] [--t T]\n"
     "                  [--engine jit|generic|aot] [--json]\n"
     "\n"
-    "Evaluates Phi, Phi_q, nu and gamma at exactly the given state (no assembly).\n"
+    "Evaluates Phi, Phi_q, nu and gamma at exactly the given state (no assembly);\n"
+    "with masses also M and Q (M(q) qdd + Phi_q^T lambda = Q(q, qd, t)).\n"
     "\n";
 
 static const CliOption options[] = {
@@ -31,13 +32,34 @@ static const CliOption options[] = {
     {"--engine", CLI_CHOICE_AT(EvalCli, engine, cli_engine_choices), .metavar = "E",
      .help = "jit (default: generated C compiled in memory), generic\n"
              "(no code generation) or aot (system compiler)"},
-    {"--json", CLI_FLAG_AT(EvalCli, json), .help = "print JSON: coords, rows, phi, jac, nu, gamma"},
+    {"--json", CLI_FLAG_AT(EvalCli, json), .help = "print JSON: coords, rows, phi, jac, nu, gamma\n(and M, Q with masses)"},
 };
 
 static const char *row_level(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
+/* "M" and "Q" (a file with masses): after the spec's keys. */
+static void print_json_dynamics(const Model *m, const double *M, const double *Q)
+{
+    printf(",\n \"M\": [");
+    for (int r = 0; r < m->nq; r++) {
+        printf(r ? ",\n       [" : "[");
+        for (int c = 0; c < m->nq; c++) {
+            printf(c ? ", " : "");
+            json_number(stdout, M[(size_t)r * (size_t)m->nq + (size_t)c]);
+        }
+        printf("]");
+    }
+    printf("],\n \"Q\": [");
+    for (int i = 0; i < m->nq; i++) {
+        printf(i ? ", " : "");
+        json_number(stdout, Q[i]);
+    }
+    printf("]");
+}
+
 static void print_json(const Model *m, double t, const double *q, const double *qd, const double *phi,
-                       const double *jac, const double *nu, const double *gamma)
+                       const double *jac, const double *nu, const double *gamma, const double *M,
+                       const double *Q)
 {
     printf("{\"coords\": ");
     json_string_list(stdout, m->coord_names, m->nq);
@@ -74,7 +96,10 @@ static void print_json(const Model *m, double t, const double *q, const double *
         }
         printf("]");
     }
-    printf("]}\n");
+    printf("]");
+    if (M)
+        print_json_dynamics(m, M, Q);
+    printf("}\n");
 }
 
 static int name_width(const char *const *names, int n, int min)
@@ -88,6 +113,28 @@ static int name_width(const char *const *names, int n, int min)
 
 /* -0 and 0 are the same answer; print one of them. */
 static double tidy(double v) { return v == 0.0 ? 0.0 : v; }
+
+/* M's nonzero entries row by row, then Q (a file with masses). */
+static void print_text_dynamics(const Model *m, const double *M, const double *Q)
+{
+    int cw = name_width(m->coord_names, m->nq, 5);
+    printf("\nMass matrix M (nonzero entries, row by row):\n");
+    for (int r = 0; r < m->nq; r++) {
+        printf("  %-*s", cw, m->coord_names[r]);
+        int shown = 0;
+        for (int c = 0; c < m->nq; c++) {
+            double v = M[(size_t)r * (size_t)m->nq + (size_t)c];
+            if (v != 0.0) {
+                printf("%s %s = %.17g", shown ? "," : "", m->coord_names[c], v);
+                shown++;
+            }
+        }
+        printf("%s\n", shown ? "" : " (all zero)");
+    }
+    printf("\n%-*s  %24s\n", cw, "coord", "Q");
+    for (int i = 0; i < m->nq; i++)
+        printf("%-*s  %24.17g\n", cw, m->coord_names[i], tidy(Q[i]));
+}
 
 static void print_text(const Model *m, double t, const double *q, const double *qd, const double *phi,
                        const double *jac, const double *nu, const double *gamma)
@@ -142,12 +189,22 @@ static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const do
     engine_jac(&e, q, c->t, jac);
     engine_nu(&e, q, c->t, nu);
     engine_gamma(&e, q, qd, c->t, gamma);
+    double *M = NULL, *Q = NULL;
+    if (e.k.mass) {         /* the file has masses */
+        M = xcalloc(nq * nq, sizeof *M);
+        Q = xcalloc(nq, sizeof *Q);
+        e.k.mass(e.k.ctx, q, M);
+        e.k.force(e.k.ctx, q, qd, c->t, Q);
+    }
     engine_close(&e);
-    if (c->json)
-        print_json(m, c->t, q, qd, phi, jac, nu, gamma);
-    else
+    if (c->json) {
+        print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q);
+    } else {
         print_text(m, c->t, q, qd, phi, jac, nu, gamma);
-    free(phi), free(nu), free(gamma), free(jac);
+        if (M)
+            print_text_dynamics(m, M, Q);
+    }
+    free(phi), free(nu), free(gamma), free(jac), free(M), free(Q);
     return true;
 }
 

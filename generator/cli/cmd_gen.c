@@ -144,7 +144,8 @@ static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, 
             "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
             mech->model->nh, mech->model->nv, mech->kin.nnz);
     fprintf(stderr, "mechc gen: operations after sharing:");
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+    int nf = emit_function_count(&mech->kin);
+    for (int f = 0; f < nf; f++)
         if (f != EMIT_ALL_NZ || res->ops[f] > 0)
             fprintf(stderr, "%s %s %d", f ? "," : "", emit_function_names[f], res->ops[f]);
     fputc('\n', stderr);

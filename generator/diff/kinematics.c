@@ -114,6 +114,8 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
         kin->jac = arena_alloc_array(&m->arena, (size_t)kin->nnz + 1, sizeof *kin->jac);
         memcpy(kin->jac, w.jac, (size_t)kin->nnz * sizeof *w.jac);
     }
+    if (ok && m->nmasses > 0)
+        ok = dynamics_build(m, &kin->dyn, diag);
     free(w.jac);
     free(w.cols);
     free(w.inner);

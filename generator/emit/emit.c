@@ -22,8 +22,13 @@
 #include <string.h>
 
 const char *const emit_function_names[EMIT_FUNCTION_COUNT] = {
-    "phi", "jac", "jac_nz", "nu", "gamma", "all", "all_nz",
+    "phi", "jac", "jac_nz", "nu", "gamma", "all", "all_nz", "mass", "mass_nz", "force", "eom",
 };
+
+int emit_function_count(const Kinematics *kin)
+{
+    return kin->dyn.present ? EMIT_FUNCTION_COUNT : EMIT_KINEMATIC_COUNT;
+}
 
 /* A parameter of the generated functions. */
 typedef struct Param {
@@ -46,6 +51,10 @@ static const Param function_params[EMIT_FUNCTION_COUNT][8] = {
     [EMIT_ALL] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac"), OUT("nu"), OUT("gamma")},
     [EMIT_ALL_NZ] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac_vals"), OUT("nu"),
                      OUT("gamma")},
+    [EMIT_MASS] = {IN("q"), OUT("M")},
+    [EMIT_MASS_NZ] = {IN("q"), OUT("vals")},
+    [EMIT_FORCE] = {IN("q"), IN("qd"), VALUE("t"), OUT("Q")},
+    [EMIT_EOM] = {IN("q"), IN("qd"), VALUE("t"), OUT("M"), OUT("Q"), OUT("jac"), OUT("gamma")},
 };
 #undef IN
 #undef VALUE
@@ -525,21 +534,48 @@ static void add_output(SchedOutput **outs, int *n, const char *array, int index,
     (*outs)[(*n)++] = (SchedOutput){array, index, value};
 }
 
+/* The dynamics functions' outputs: M's entries (dense, or its nonzeros),
+   then Q. */
+static void collect_dynamics(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
+{
+    const Model *m = kin->model;
+    const Dynamics *dyn = &kin->dyn;
+    if (which != EMIT_FORCE)
+        for (int k = 0; k < dyn->nnz; k++) {
+            const JacEntry *e = &dyn->mass[k];
+            if (which == EMIT_MASS_NZ)
+                add_output(outs, n, "vals", k, e->value);
+            else
+                add_output(outs, n, "M", e->row * m->nq + e->col, e->value);
+        }
+    if (which == EMIT_MASS_NZ && dyn->nnz == 0)     /* the one placeholder slot */
+        add_output(outs, n, "vals", 0, DAG_ZERO);
+    if (which == EMIT_FORCE || which == EMIT_EOM)
+        for (int j = 0; j < m->nq; j++)
+            add_output(outs, n, "Q", j, dyn->force[j]);
+}
+
 /* The outputs of each function. The fused _all and _all_nz go row by row
-   (phi, Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk
-   holds whole rows and shares their sin/cos and products across the four. */
+   (phi, Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk holds
+   whole rows and shares their sin/cos and products across the four; _eom
+   the same without phi and nu, then M and Q. */
 static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
 {
     const Model *m = kin->model;
-    *outs = xmalloc((size_t)(m->nh + 2 * m->nr + 2 * kin->nnz + 1) * sizeof **outs);
+    *outs = xmalloc((size_t)(m->nh + 2 * m->nr + 2 * kin->nnz + 1 + kin->dyn.nnz + m->nq)
+                    * sizeof **outs);
     *n = 0;
-    bool all = which == EMIT_ALL || which == EMIT_ALL_NZ;
+    bool all = which == EMIT_ALL || which == EMIT_ALL_NZ, eom = which == EMIT_EOM;
+    if (which >= EMIT_MASS && !eom) {
+        collect_dynamics(kin, which, outs, n);
+        return;
+    }
     for (int r = 0; r < m->nr; r++) {
         if ((which == EMIT_PHI || all) && r < m->nh)
             add_output(outs, n, "phi", r, kin->phi[r]);
         for (int k = kin->row_start[r]; k < kin->row_start[r + 1]; k++) {
             const JacEntry *j = &kin->jac[k];
-            if (which == EMIT_ALL || which == EMIT_JAC)
+            if (which == EMIT_ALL || eom || which == EMIT_JAC)
                 add_output(outs, n, "jac", j->row * m->nq + j->col, j->value);
             else if (which == EMIT_JAC_NZ)
                 add_output(outs, n, "vals", k, j->value);
@@ -548,13 +584,15 @@ static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutp
         }
         if (which == EMIT_NU || all)
             add_output(outs, n, "nu", r, kin->nu[r]);
-        if (which == EMIT_GAMMA || all)
+        if (which == EMIT_GAMMA || all || eom)
             add_output(outs, n, "gamma", r, kin->gamma[r]);
     }
     if (which == EMIT_JAC_NZ && kin->nnz == 0)     /* the one placeholder slot */
         add_output(outs, n, "vals", 0, DAG_ZERO);
     if (which == EMIT_ALL_NZ && kin->nnz == 0)
         add_output(outs, n, "jac_vals", 0, DAG_ZERO);
+    if (eom)
+        collect_dynamics(kin, which, outs, n);
 }
 
 static void put_string_list(StrBuf *sb, const char *const *names, int n)
@@ -566,14 +604,14 @@ static void put_string_list(StrBuf *sb, const char *const *names, int n)
     }
 }
 
-static void put_int_list(StrBuf *sb, const Kinematics *kin, bool rows)
+static void put_int_list(StrBuf *sb, const JacEntry *entries, int nnz, bool rows)
 {
-    for (int k = 0; k < kin->nnz; k++) {
-        sb_printf(sb, "%s%d,", k % 16 == 0 ? "    " : " ", rows ? kin->jac[k].row : kin->jac[k].col);
-        if (k % 16 == 15 || k == kin->nnz - 1)
+    for (int k = 0; k < nnz; k++) {
+        sb_printf(sb, "%s%d,", k % 16 == 0 ? "    " : " ", rows ? entries[k].row : entries[k].col);
+        if (k % 16 == 15 || k == nnz - 1)
             sb_putc(sb, '\n');
     }
-    if (kin->nnz == 0)
+    if (nnz == 0)
         sb_puts(sb, "    0\n");
 }
 
@@ -693,6 +731,8 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
+        if (f >= emit_function_count(e->kin))
+            continue;
         if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
             continue;
         if (f == EMIT_ALL_NZ && !opt->all_nz)
@@ -834,9 +874,10 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     sb_free(&single);
 }
 
-/* The data section's lists: initial values, names, Jacobian structure. */
+/* The data section's lists: initial values, names, the Jacobian's
+   structure and (a file with masses) M's, mrow and mcol. */
 static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows, StrBuf *jrow,
-                     StrBuf *jcol)
+                     StrBuf *jcol, StrBuf *mrow, StrBuf *mcol)
 {
     const Model *m = e->kin->model;
     for (int i = 0; i < m->nq; i++) {
@@ -850,8 +891,38 @@ static void put_data(const Emitter *e, StrBuf *q0, StrBuf *coords, StrBuf *rows,
         sb_put_c_string(rows, m->rows[r].name);
         sb_puts(rows, ",\n");
     }
-    put_int_list(jrow, e->kin, true);
-    put_int_list(jcol, e->kin, false);
+    put_int_list(jrow, e->kin->jac, e->kin->nnz, true);
+    put_int_list(jcol, e->kin->jac, e->kin->nnz, false);
+    put_int_list(mrow, e->kin->dyn.mass, e->kin->dyn.nnz, true);
+    put_int_list(mcol, e->kin->dyn.mass, e->kin->dyn.nnz, false);
+}
+
+/* The dynamics part of the source (DYNAMICS) and of the interface
+   (DYN_INTERFACE), rendered from vars without their last newline (the
+   placeholder's line gives it back); both stay empty for a file without
+   masses, whose output is what it always was. Returns a placeholder
+   without value, or NULL. */
+static const char *put_dynamics(const Emitter *e, TemplateVar *vars, int nvars, StrBuf *dyn_c,
+                                StrBuf *dyn_h)
+{
+    if (!e->kin->dyn.present)
+        return NULL;
+    const char *bad = template_render(dyn_h, template_dynamics_h, vars, nvars);
+    if (!bad)
+        bad = template_render(dyn_c, template_dynamics, vars, nvars);
+    if (bad)
+        return bad;
+    dyn_h->data[--dyn_h->len] = '\0';
+    dyn_c->data[--dyn_c->len] = '\0';
+    template_set(vars, nvars, "DYN_INTERFACE", dyn_h->data);
+    template_set(vars, nvars, "DYNAMICS", dyn_c->data);
+    return NULL;
+}
+
+static _Noreturn void placeholder_bug(const char *name)
+{
+    fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", name);
+    abort();
 }
 
 /* PREFIX_all_nz's declaration and definition (templates/all_nz*.tmpl);
@@ -879,30 +950,32 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
     StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves, nzd, nzf;
+    StrBuf mrow, mcol, dyn_c, dyn_h;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac, &inc, &moves, &nzd, &nzf};
+                          &zero, &jac, &inc, &moves, &nzd, &nzf, &mrow, &mcol, &dyn_c, &dyn_h};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
     }
     put_banner(&banner, opt->source_name ? opt->source_name : m->file);
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+    for (int f = 0; f < emit_function_count(e->kin); f++)
         if (f != EMIT_ALL_NZ || opt->all_nz)
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
-    put_data(e, &q0, &coords, &rows, &jrow, &jcol);
+    put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
     if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
 
-    char nq[32], nh[32], nv[32], nnz[32], guard[160];
+    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
     snprintf(nq, sizeof nq, "%d", m->nq);
     snprintf(nh, sizeof nh, "%d", m->nh);
     snprintf(nv, sizeof nv, "%d", m->nv);
     /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
        placeholder entry (row 0, column 0, value 0). */
     snprintf(nnz, sizeof nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
+    snprintf(mnnz, sizeof mnnz, "%d", e->kin->dyn.nnz > 0 ? e->kin->dyn.nnz : 1);
     snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
     TemplateVar vars[] = {
         {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
@@ -917,11 +990,19 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
         {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
-        {"ALL_NZ_DECL", nzd.data}, {"ALL_NZ", nzf.data},
+        {"ALL_NZ_DECL", nzd.data}, {"ALL_NZ", nzf.data}, {"M_NNZ", mnnz},
+        {"MASS_ROW", mrow.data}, {"MASS_COL", mcol.data}, {"DYNAMICS", ""}, {"DYN_INTERFACE", ""},
+        {"MASS_PARTS", parts[EMIT_MASS].data}, {"MASS_BODY", bodies[EMIT_MASS].data},
+        {"MASS_NZ_PARTS", parts[EMIT_MASS_NZ].data}, {"MASS_NZ_BODY", bodies[EMIT_MASS_NZ].data},
+        {"FORCE_PARTS", parts[EMIT_FORCE].data}, {"FORCE_BODY", bodies[EMIT_FORCE].data},
+        {"EOM_PARTS", parts[EMIT_EOM].data}, {"EOM_BODY", bodies[EMIT_EOM].data},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
-    /* INTERFACE and JAC are rendered from the others, then filled in */
-    const char *bad = template_render(&iface, template_interface, vars, nvars);
+    /* DYNAMICS, DYN_INTERFACE, INTERFACE and JAC are rendered from the
+       others, then filled in */
+    const char *bad = put_dynamics(e, vars, nvars, &dyn_c, &dyn_h);
+    if (!bad)
+        bad = template_render(&iface, template_interface, vars, nvars);
     template_set(vars, nvars, "INTERFACE", iface.data);
     if (!bad)
         bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
@@ -942,10 +1023,8 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         bad = template_render(&source, template_mech_c, vars, nvars);
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++)
         sb_free(all_bufs[i]);
-    if (bad) {
-        fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", bad);
-        abort();
-    }
+    if (bad)
+        placeholder_bug(bad);
     out->c_text = sb_take(&source);
     out->h_text = sb_take(&header);
 }

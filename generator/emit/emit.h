@@ -33,13 +33,20 @@ typedef struct EmitOptions {
 } EmitOptions;
 
 /* The spec's function order, for op counts and reports; then all_nz, an
-   extension (written only with EmitOptions.all_nz: its ops count 0 without). */
+   extension (written only with EmitOptions.all_nz: its ops count 0 without),
+   and the dynamics functions, written only for a file with masses. */
 typedef enum EmitFunction {
     EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_ALL_NZ,
-    EMIT_FUNCTION_COUNT
+    EMIT_MASS, EMIT_MASS_NZ, EMIT_FORCE, EMIT_EOM, EMIT_FUNCTION_COUNT
 } EmitFunction;
 
+enum { EMIT_KINEMATIC_COUNT = EMIT_MASS };
+
 extern const char *const emit_function_names[EMIT_FUNCTION_COUNT];
+
+/* The functions kin's file gets: the kinematic ones, and the dynamics
+   ones when it has masses (EMIT_KINEMATIC_COUNT or EMIT_FUNCTION_COUNT). */
+int emit_function_count(const Kinematics *kin);
 
 typedef struct EmitResult {
     char *c_text;               /* malloc'ed */

@@ -4,6 +4,8 @@
 
 extern const char template_all_nz[];
 extern const char template_all_nz_decl[];
+extern const char template_dynamics[];
+extern const char template_dynamics_h[];
 extern const char template_interface[];
 extern const char template_jac_direct[];
 extern const char template_jac_spread[];

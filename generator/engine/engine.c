@@ -57,6 +57,16 @@ static void code_all(void *ctx, const double *q, const double *qd, double t,
     ((const Kernels *)ctx)->all(q, qd, t, phi, jac, nu, gamma);
 }
 
+static void code_mass(void *ctx, const double *q, double *M)
+{
+    ((const Kernels *)ctx)->mass(q, M);
+}
+
+static void code_force(void *ctx, const double *q, const double *qd, double t, double *Q)
+{
+    ((const Kernels *)ctx)->force(q, qd, t, Q);
+}
+
 /* ---- generic: ctx is the evaluator's state ---- */
 
 static void gen_phi(void *ctx, const double *q, double t, double *out)
@@ -85,6 +95,16 @@ static void gen_all(void *ctx, const double *q, const double *qd, double t,
     generic_all(ctx, q, qd, t, phi, jac, nu, gamma);
 }
 
+static void gen_mass(void *ctx, const double *q, double *M)
+{
+    generic_mass(ctx, q, M);
+}
+
+static void gen_force(void *ctx, const double *q, const double *qd, double t, double *Q)
+{
+    generic_force(ctx, q, qd, t, Q);
+}
+
 /* e->k for compiled code (jit, aot) whose functions code holds. */
 static void bind_code(Engine *e, const Kernels *code)
 {
@@ -92,6 +112,10 @@ static void bind_code(Engine *e, const Kernels *code)
     e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = (void *)code,
                            .phi = code_phi, .jac = code_jac, .nu = code_nu,
                            .gamma = code_gamma, .all = code_all};
+    if (code->mass) {       /* the file has masses */
+        e->k.mass = code_mass;
+        e->k.force = code_force;
+    }
 }
 
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
@@ -147,6 +171,10 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
         e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = e->generic,
                                .phi = gen_phi, .jac = gen_jac, .nu = gen_nu,
                                .gamma = gen_gamma, .all = gen_all};
+        if (mech->model->nmasses > 0) {
+            e->k.mass = gen_mass;
+            e->k.force = gen_force;
+        }
         return true;
     }
     case ENGINE_AOT:

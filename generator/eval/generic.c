@@ -278,6 +278,8 @@ Generic *generic_open(const Model *m)
             regs = g->progs[k].n;
     g->jreg = xcalloc((size_t)regs, sizeof *g->jreg);
     g->vreg = xcalloc((size_t)regs, sizeof *g->vreg);
+    if (m->nmasses > 0)
+        g->dyn = generic_dynamics_open(m);
     return g;
 }
 
@@ -306,5 +308,6 @@ void generic_free(Generic *g)
     free(g->rot_of);
     free(g->jreg);
     free(g->vreg);
+    generic_dynamics_free(g->dyn);
     free(g);
 }

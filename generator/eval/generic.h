@@ -33,6 +33,14 @@ void generic_all(Generic *g, const double *q, const double *qd, double t,
    before they are split into Jacobian and nu; for finite differences. */
 void generic_psi(Generic *g, const double *q, const double *qd, double t, double *psi);
 
+/* Dynamics, for a model with masses (generic_dynamics.c): M (nq*nq,
+   row-major) and Q (nq) from the mass elements and forces by forward-mode
+   derivatives of their expressions, not from the symbolic ones. */
+void generic_mass(Generic *g, const double *q, double *M);
+void generic_force(Generic *g, const double *q, const double *qd, double t, double *Q);
+/* Q's velocity terms alone, -m p_q^T D(D(p)) - J theta_q^T D(D(theta)). */
+void generic_velocity_terms(Generic *g, const double *q, const double *qd, double *Qv);
+
 /* How many rows the interpreter runs (constraint, driver and velocity
    rows); every other row is a joint's formula. */
 int generic_interpreted_rows(const Generic *g);

@@ -14,6 +14,11 @@ typedef struct Option {
 
 typedef struct Call Call;
 
+/* The dynamics part (generic_dynamics.c), NULL without masses. */
+typedef struct GenericDyn GenericDyn;
+GenericDyn *generic_dynamics_open(const Model *m);
+void generic_dynamics_free(GenericDyn *d);
+
 /* A spatial body's rotation at the current state: A(p), and when qd is
    given dA/dt and H, the part of d2A/dt2 without p'' (generic_spatial.c). */
 typedef struct Rot {
@@ -57,6 +62,7 @@ struct Generic {
     double (*frames)[3];    /* 6 per joint (Plan.frame) */
     Jet *jreg;          /* registers for the longest program */
     double *vreg;
+    GenericDyn *dyn;    /* masses and forces, or NULL */
 };
 
 /* One evaluation: the state and where each requested quantity goes (NULL:

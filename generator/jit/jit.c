@@ -84,8 +84,16 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->all_nz = (KernelAll)kernel(find, handle, prefix, "all_nz");
     k->jac_row = kernel(find, handle, prefix, "jac_row");
     k->jac_col = kernel(find, handle, prefix, "jac_col");
+    k->mass = (KernelMass)kernel(find, handle, prefix, "mass");
+    k->mass_nz = (KernelMass)kernel(find, handle, prefix, "mass_nz");
+    k->force = (KernelGamma)kernel(find, handle, prefix, "force");
+    k->eom = (KernelEom)kernel(find, handle, prefix, "eom");
+    k->mass_row = kernel(find, handle, prefix, "mass_row");
+    k->mass_col = kernel(find, handle, prefix, "mass_col");
+    bool dynamics = k->mass && k->mass_nz && k->force && k->eom && k->mass_row && k->mass_col;
+    bool none = !k->mass && !k->mass_nz && !k->force && !k->eom && !k->mass_row && !k->mass_col;
     return k->phi && k->jac && k->jac_nz && k->nu && k->gamma && k->all && k->jac_row
-           && k->jac_col;
+           && k->jac_col && (dynamics || none);
 }
 
 static void *tcc_find(void *s, const char *symbol) { return tcc_get_symbol(s, symbol); }

@@ -8,6 +8,9 @@ typedef void (*KernelPhi)(const double *q, double t, double *out);
 typedef void (*KernelGamma)(const double *q, const double *qd, double t, double *gamma);
 typedef void (*KernelAll)(const double *q, const double *qd, double t,
                           double *phi, double *jac, double *nu, double *gamma);
+typedef void (*KernelMass)(const double *q, double *M);
+typedef void (*KernelEom)(const double *q, const double *qd, double t,
+                          double *M, double *Q, double *jac, double *gamma);
 
 /* The generated functions of one mechanism as the compiled unit exports
    them (libtcc, dlopen of a cc-built library): context-free, with jac_nz
@@ -19,13 +22,20 @@ typedef struct Kernels {
     KernelGamma gamma;
     KernelAll all, all_nz;
     const int *jac_row, *jac_col;
+    /* Dynamics (DYN.md), NULL unless the file has masses: M (nq*nq dense),
+       its nonzeros and their pattern, Q, and the fused M, Q, jac, gamma. */
+    KernelMass mass, mass_nz;
+    KernelGamma force;
+    KernelEom eom;
+    const int *mass_row, *mass_col;
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
 typedef void *(*KernelFind)(void *handle, const char *symbol);
 
 /* Fills k with the generated functions PREFIX_phi, PREFIX_jac, ... of
-   handle; false when one is missing (PREFIX_all_nz may be). */
+   handle; false when one is missing (PREFIX_all_nz may be). The dynamics
+   functions are bound when the unit has them (all or none), NULL otherwise. */
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix);
 
 typedef struct Jit Jit;

@@ -18,7 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum EntityKind { ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT, ENT_OUTPUT } EntityKind;
+typedef enum EntityKind {
+    ENT_PARAM, ENT_BODY, ENT_POINT, ENT_COORD, ENT_JOINT, ENT_OUTPUT, ENT_MASS, ENT_FORCE
+} EntityKind;
 
 typedef struct Entity {
     EntityKind kind;
@@ -42,6 +44,9 @@ typedef struct Builder {
     int cap_outputs;
     SrcPos unit_use[2];     /* first use of deg, rpm as units (offset -1: none) */
     bool spatial;           /* the file says `spatial` */
+    int cap_masses, cap_forces;
+    const Stmt *first_force;    /* the first force or gravity statement */
+    int gravity_line;           /* the gravity statement's line, 0 if none */
 } Builder;
 
 static const char *entity_word(EntityKind kind)
@@ -53,6 +58,8 @@ static const char *entity_word(EntityKind kind)
     case ENT_COORD: return "a coord";
     case ENT_JOINT: return "a joint";
     case ENT_OUTPUT: return "an output";
+    case ENT_MASS: return "a mass";
+    case ENT_FORCE: return "a force";
     }
     return "a name";
 }
@@ -167,6 +174,7 @@ static int add_coord(Builder *b, const char *owner, const char *suffix, double q
 typedef enum ExprContext {
     EXPR_CONSTANT,      /* params, initial values, offsets, axes */
     EXPR_TIMED,         /* length, angle, radius: may also use t */
+    EXPR_MASS,          /* a mass element's position and angle: coordinates, not t */
     EXPR_HOLONOMIC,     /* may use coordinates and t */
     EXPR_VELOCITY,      /* may also use der() */
 } ExprContext;
@@ -175,6 +183,8 @@ static const char *context_what(ExprContext ctx)
 {
     if (ctx == EXPR_TIMED)
         return "a joint's length, angle or radius (numbers, params and t)";
+    if (ctx == EXPR_MASS)
+        return "a mass element's position or angle (coordinates, numbers and params)";
     return ctx == EXPR_CONSTANT ? "a constant expression (numbers, pi and earlier params)"
                                 : "a holonomic row (use a 'velocity' or 'driver' statement for der())";
 }
@@ -248,7 +258,7 @@ static NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
     case AST_NUM:
         return dag_const(dag, ast->num);
     case AST_TIME:
-        if (ctx == EXPR_CONSTANT)
+        if (ctx == EXPR_CONSTANT || ctx == EXPR_MASS)
             diag_fail(b->diag, ast->pos, "'t' cannot appear in %s", context_what(ctx));
         return dag_time(dag);
     case AST_NAME: {
@@ -457,7 +467,8 @@ static Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
                       e->name, e->name);
         r.q = e->q;
         return r;
-    case ENT_PARAM: case ENT_COORD: case ENT_JOINT: case ENT_OUTPUT:
+    case ENT_PARAM: case ENT_COORD: case ENT_JOINT: case ENT_OUTPUT: case ENT_MASS:
+    case ENT_FORCE:
         break;
     }
     static const char *const takes[] = {
@@ -668,13 +679,214 @@ static void build_output(Builder *b, const Stmt *s)
     push_output(b, s->name, ".y", xy[1]);
 }
 
+/* ---- dynamics statements: masses and applied forces ---- */
+
+/* A constant key's value (0 when absent), refused when negative. */
+static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *what, bool nonnegative)
+{
+    double v = constant_value(b, s->key[key], what);
+    if (nonnegative && v < 0)
+        diag_fail(b->diag, s->key_pos[key], "%s of %s '%s' is negative (%g)", what,
+                  dyn_keywords[s->dyn], s->name, v);
+    return v;
+}
+
+/* A key's expression of q, der(q) and t (absent: 0). */
+static NodeId dyn_expr(Builder *b, const Ast *ast)
+{
+    return ast ? lower(b, ast, EXPR_VELOCITY) : DAG_ZERO;
+}
+
+/* The global position of a dynamics attachment: a body point, a
+   particle, ground, or at(x, y) (ctx: what at's expressions may use). */
+static void dyn_point(Builder *b, const AstAttach *at, ExprContext ctx, const char *keyword,
+                      NodeId xy[2])
+{
+    if (at->at) {
+        NodeId y = lower(b, at->sy, ctx);    /* sequenced: see AST_BINARY */
+        xy[0] = lower(b, at->sx, ctx);
+        xy[1] = y;
+        return;
+    }
+    Attach a = resolve_attach(b, at, ATTACH_ANY, keyword);
+    joints_point(b->model, a, xy);
+    check_nodes(b);
+}
+
+/* The angle of a body (ATTACH_FRAME, no offset): its phi, 0 for ground. */
+static NodeId dyn_angle(Builder *b, const AstAttach *at, const char *keyword)
+{
+    Attach a = resolve_attach(b, at, ATTACH_FRAME, keyword);
+    return a.has_phi ? dag_var(&b->model->dag, a.q + 2) : DAG_ZERO;
+}
+
+static MassElement *new_mass(Builder *b, const Stmt *s)
+{
+    Model *m = b->model;
+    for (int i = 0; i < m->nmasses; i++)
+        if (!s->declares && strcmp(m->masses[i].name, s->name) == 0)
+            diag_fail(b->diag, s->name_pos, "'%s' already has a mass (line %d): give a body one "
+                      "mass statement", s->name, line_of(b, m->masses[i].pos));
+    grow(&m->arena, (void **)&m->masses, &b->cap_masses, m->nmasses + 1, sizeof *m->masses);
+    MassElement *e = &m->masses[m->nmasses++];
+    *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1};
+    e->m = dyn_constant(b, s, DKEY_M, "the mass m", true);
+    e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true);
+    return e;
+}
+
+/* mass BODY m = .. [J = ..] [com(sx, sy)]: the body's centre of mass
+   r + A(phi) s, J about it; mass POINT m = ..: the particle itself. */
+static void build_body_mass(Builder *b, const Stmt *s)
+{
+    Entity *ent = lookup(b, s->name, s->name_pos);
+    if (ent->kind != ENT_BODY && ent->kind != ENT_POINT)
+        diag_fail(b->diag, s->name_pos, "'%s' is %s; 'mass NAME m = ...' gives a body or point its "
+                  "mass (write 'mass NAME: at(x, y) m = ...' for a mass element)", s->name,
+                  entity_word(ent->kind));
+    bool body = ent->kind == ENT_BODY;
+    if (!body && s->key[DKEY_J])
+        diag_fail(b->diag, s->key_pos[DKEY_J], "'%s' is a point (a particle): it has no angle, "
+                  "so no moment of inertia J", s->name);
+    if (!body && s->vec[0])
+        diag_fail(b->diag, s->vec_pos, "'%s' is a point (a particle): its mass is at the point, "
+                  "no com(...)", s->name);
+    MassElement *e = new_mass(b, s);
+    Attach at = {.q = ent->q, .has_phi = body};
+    if (s->vec[0]) {
+        at.sx = constant_value(b, s->vec[0], "a centre-of-mass offset");
+        at.sy = constant_value(b, s->vec[1], "a centre-of-mass offset");
+    }
+    NodeId xy[2];
+    joints_point(b->model, at, xy);
+    e->px = xy[0], e->py = xy[1];
+    if (body) {
+        e->theta = dag_var(&b->model->dag, ent->q + 2);
+        e->body = ent->q;
+        e->sx = at.sx, e->sy = at.sy;
+    }
+    check_nodes(b);
+}
+
+/* mass NAME: at(x, y) m = .. [J = .. angle = ..]: a mass element given by
+   expressions of the coordinates (not of t). */
+static void build_element_mass(Builder *b, const Stmt *s)
+{
+    declare(b, ENT_MASS, s->name, s->name_pos);
+    if (s->key[DKEY_J] && !s->key[DKEY_ANGLE])
+        diag_fail(b->diag, s->key_pos[DKEY_J], "mass '%s' has J but no 'angle = ...': the "
+                  "angle whose rate J multiplies", s->name);
+    MassElement *e = new_mass(b, s);
+    NodeId xy[2];
+    dyn_point(b, &s->attach[0], EXPR_MASS, "mass", xy);
+    e->px = xy[0], e->py = xy[1];
+    if (s->key[DKEY_ANGLE])
+        e->theta = lower(b, s->key[DKEY_ANGLE], EXPR_MASS);
+}
+
+static AppliedForce *new_force(Builder *b, const Stmt *s, ForceKind kind)
+{
+    Model *m = b->model;
+    declare(b, ENT_FORCE, s->name, s->name_pos);
+    grow(&m->arena, (void **)&m->forces, &b->cap_forces, m->nforces + 1, sizeof *m->forces);
+    AppliedForce *f = &m->forces[m->nforces++];
+    *f = (AppliedForce){.kind = kind, .name = s->name, .pos = s->pos, .ax = DAG_ZERO,
+                        .ay = DAG_ZERO, .bx = DAG_ZERO, .by = DAG_ZERO, .fx = DAG_ZERO,
+                        .fy = DAG_ZERO, .coord = -1};
+    return f;
+}
+
+/* A spring's or a force's attachment must move: ground does no work. */
+static void refuse_ground(Builder *b, const Stmt *s, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (s->attach[i].name && strcmp(s->attach[i].name, "ground") == 0
+            && (n == 1 || (s->attach[1 - i].name && strcmp(s->attach[1 - i].name, "ground") == 0)))
+            diag_fail(b->diag, s->attach[i].pos, "%s '%s' acts on ground only: it does no work",
+                      dyn_keywords[s->dyn], s->name);
+}
+
+/* force, torque, spring, rspring, gforce: one applied force. */
+static void build_force(Builder *b, const Stmt *s)
+{
+    static const ForceKind kinds[DYN_KIND_COUNT] = {
+        [DYN_FORCE] = FORCE_POINT, [DYN_TORQUE] = FORCE_TORQUE, [DYN_SPRING] = FORCE_SPRING,
+        [DYN_RSPRING] = FORCE_RSPRING, [DYN_GFORCE] = FORCE_GENERAL,
+    };
+    const char *kw = dyn_keywords[s->dyn];
+    refuse_ground(b, s, s->dyn == DYN_FORCE || s->dyn == DYN_TORQUE ? 1 : 2);
+    AppliedForce *f = new_force(b, s, kinds[s->dyn]);
+    NodeId xy[2];
+    switch (s->dyn) {
+    case DYN_FORCE:
+        dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
+        f->ax = xy[0], f->ay = xy[1];
+        f->fy = dyn_expr(b, s->vec[1]);
+        f->fx = dyn_expr(b, s->vec[0]);
+        return;
+    case DYN_TORQUE:
+        f->ax = s->lhs ? lower(b, s->lhs, EXPR_HOLONOMIC) : dyn_angle(b, &s->attach[0], kw);
+        f->fx = dyn_expr(b, s->value);
+        return;
+    case DYN_SPRING: case DYN_RSPRING:
+        f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
+        f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
+        if (s->dyn == DYN_SPRING) {
+            f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true);
+            dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
+            f->ax = xy[0], f->ay = xy[1];
+            dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
+            f->bx = xy[0], f->by = xy[1];
+            f->fx = dyn_expr(b, s->key[DKEY_FORCE]);
+        } else {
+            f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
+            f->ax = dyn_angle(b, &s->attach[0], kw);
+            f->bx = dyn_angle(b, &s->attach[1], kw);
+            f->fx = dyn_expr(b, s->key[DKEY_TORQUE]);
+        }
+        return;
+    case DYN_GFORCE:
+        if (s->lhs->kind != AST_NAME && s->lhs->kind != AST_MEMBER)
+            diag_fail(b->diag, s->lhs->pos, "gforce '%s' acts on a coordinate (a coord, or a "
+                      "body's x, y or phi), not on %s", s->name, ast_describe(s->lhs));
+        f->coord = coordinate_of(b, s->lhs);
+        f->fx = dyn_expr(b, s->value);
+        return;
+    case DYN_MASS: case DYN_GRAVITY: case DYN_KIND_COUNT:
+        break;
+    }
+}
+
+static void build_dynamics(Builder *b, const Stmt *s)
+{
+    if (s->dyn == DYN_MASS) {
+        if (s->declares)
+            build_element_mass(b, s);
+        else
+            build_body_mass(b, s);
+        return;
+    }
+    if (!b->first_force)
+        b->first_force = s;
+    if (s->dyn != DYN_GRAVITY) {
+        build_force(b, s);
+        return;
+    }
+    if (b->gravity_line)
+        diag_fail(b->diag, s->pos, "a second gravity statement (the first is on line %d)",
+                  b->gravity_line);
+    b->gravity_line = line_of(b, s->pos);
+    b->model->gravity[0] = constant_value(b, s->vec[0], "the gravity component gx");
+    b->model->gravity[1] = constant_value(b, s->vec[1], "the gravity component gy");
+}
+
 static void build(Builder *b, const Program *prog, const char *default_name)
 {
     Model *m = b->model;
     m->name = default_name;
     const Stmt *last = NULL;
     for (const Stmt *s = prog->first; s; s = s->next) {
-        if (s->kind != STMT_OUTPUT)     /* messages about the rows point at a row */
+        if (s->kind != STMT_OUTPUT && s->kind != STMT_DYNAMICS)  /* messages about the rows point at a row */
             last = s;
         m->dag.where = s->pos.offset;
         switch (s->kind) {
@@ -698,8 +910,20 @@ static void build(Builder *b, const Program *prog, const char *default_name)
         case STMT_OUTPUT:
             build_output(b, s);
             break;
+        case STMT_DYNAMICS:
+            build_dynamics(b, s);
+            break;
         }
     }
+    /* M is dense nq x nq in the engines and the generated P_mass */
+    if (m->nmasses > 0 && (long long)m->nq * m->nq > b->limits->max_jac_entries)
+        diag_fail(b->diag, m->masses[0].pos, "the dense mass matrix would have %d x %d = %lld "
+                  "entries, more than the limit of %d (--max-jac-entries)", m->nq, m->nq,
+                  (long long)m->nq * m->nq, b->limits->max_jac_entries);
+    if (b->first_force && m->nmasses == 0)
+        diag_fail(b->diag, b->first_force->pos, "%s without masses: the file has no 'mass' "
+                  "statement, so there is nothing for it to move", b->first_force->dyn == DYN_GRAVITY
+                  ? "gravity" : "a force");
     m->dag.where = -1;
     collect_bodies(b);
     SrcPos where = last ? last->pos : (SrcPos){0};

@@ -71,6 +71,45 @@ typedef struct ModelOutput {
     Attach at;
 } ModelOutput;
 
+/* A mass element (DYN.md): mass m at the point p = (px, py), expressions of
+   q (a body's centre of mass r + A(phi) s, a particle's position, or an
+   element's at(x, y)), and moment of inertia J about p for the angle theta.
+   Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2. Spatial
+   bodies (later) will add pz and an inertia tensor over Euler parameters. */
+typedef struct MassElement {
+    const char *name;   /* the body, point or element */
+    SrcPos pos;
+    double m, J;
+    NodeId px, py;
+    NodeId theta;       /* DAG_ZERO when there is no angle (J = 0) */
+    int body;           /* a planar body's own mass: its x coordinate (then
+                           p = r + A(phi) s, s = (sx, sy)); -1 otherwise */
+    double sx, sy;
+} MassElement;
+
+typedef enum ForceKind {
+    FORCE_POINT,        /* Q += p_q^T (fx, fy) */
+    FORCE_TORQUE,       /* Q += theta_q^T tau, theta = a, tau = fx */
+    FORCE_SPRING,       /* l = |B - A|, f = k (l - L0) + c ldot + fx, Q += -f l_q */
+    FORCE_RSPRING,      /* a = theta_B - theta_A, tau = k (a - a0) + c adot + fx, Q += -tau a_q */
+    FORCE_GENERAL,      /* Q[coord] += fx */
+} ForceKind;
+
+/* An applied force, every kind by virtual work. Expressions (fx, fy) may
+   use q, der(q) and t. */
+typedef struct AppliedForce {
+    ForceKind kind;
+    const char *name;
+    SrcPos pos;
+    NodeId ax, ay;      /* POINT: the point; SPRING: A's point; TORQUE,
+                           RSPRING: ax the angle (of A) */
+    NodeId bx, by;      /* SPRING: B's point; RSPRING: bx B's angle */
+    NodeId fx, fy;      /* POINT: components; otherwise fx the value (the
+                           actuator's force or torque for a spring) */
+    double k, c, free;  /* SPRING, RSPRING: stiffness, damping, free length or angle */
+    int coord;          /* GENERAL: the coordinate */
+} AppliedForce;
+
 typedef struct Model {
     Arena arena;        /* owns every string and array below */
     Dag dag;            /* owns the expression graph (rows and derivatives) */
@@ -91,6 +130,11 @@ typedef struct Model {
     ModelOutput *outputs;   /* in statement order */
     SrcPos last_pos;    /* the last statement: where diagnostics about the
                            mechanism as a whole point */
+    int nmasses;        /* dynamics: none unless the file has masses */
+    MassElement *masses;
+    int nforces;
+    AppliedForce *forces;
+    double gravity[2];  /* (0, 0) without a gravity statement */
 } Model;
 
 /* Reads, parses and resolves a .mech text. Returns NULL with diag filled

@@ -10,6 +10,17 @@ const JointInfo joint_info[JOINT_KIND_COUNT] = {
 #undef X
 };
 
+const char *const dyn_keywords[DYN_KIND_COUNT] = {
+    [DYN_MASS] = "mass", [DYN_FORCE] = "force", [DYN_TORQUE] = "torque",
+    [DYN_SPRING] = "spring", [DYN_RSPRING] = "rspring", [DYN_GFORCE] = "gforce",
+    [DYN_GRAVITY] = "gravity",
+};
+
+const char *const dyn_key_names[DKEY_COUNT] = {
+    [DKEY_M] = "m", [DKEY_J] = "J", [DKEY_K] = "k", [DKEY_C] = "c", [DKEY_LENGTH] = "length",
+    [DKEY_ANGLE] = "angle", [DKEY_FORCE] = "force", [DKEY_TORQUE] = "torque",
+};
+
 bool joint_kind_in(JointKind kind, bool spatial)
 {
     JointDim dim = joint_info[kind].dim;

@@ -91,7 +91,29 @@ typedef enum StmtKind {
     STMT_COORD,         /* coord NAME [= value] */
     STMT_JOINT,         /* KIND NAME: operands [axis(ux, uy)] [option = e] */
     STMT_OUTPUT,        /* output NAME = e  |  output NAME: attachment */
+    STMT_DYNAMICS,      /* a mass, force or gravity statement (DynKind) */
 } StmtKind;
+
+/* ---- dynamics statements: masses and applied forces (no rows) ---- */
+
+typedef enum DynKind {
+    DYN_MASS,       /* mass BODY m = .. [J = ..] [com(sx, sy)]  |  mass NAME: at(X, Y) m = .. [J = .. angle = ..] */
+    DYN_FORCE,      /* force NAME: ATTACHMENT (fx, fy) */
+    DYN_TORQUE,     /* torque NAME: BODY = e  |  torque NAME: angle(e) = e */
+    DYN_SPRING,     /* spring NAME: A B [k = ..] [c = ..] [length = ..] [force = ..] */
+    DYN_RSPRING,    /* rspring NAME: A B [k = ..] [c = ..] [angle = ..] [torque = ..] */
+    DYN_GFORCE,     /* gforce NAME: COORDINATE = e */
+    DYN_GRAVITY,    /* gravity (gx, gy) */
+    DYN_KIND_COUNT
+} DynKind;
+
+/* The `key = value` options of the dynamics statements. */
+typedef enum DynKey {
+    DKEY_M, DKEY_J, DKEY_K, DKEY_C, DKEY_LENGTH, DKEY_ANGLE, DKEY_FORCE, DKEY_TORQUE, DKEY_COUNT
+} DynKey;
+
+extern const char *const dyn_keywords[DYN_KIND_COUNT];
+extern const char *const dyn_key_names[DKEY_COUNT];
 
 /* A spatial body's initial orientation, as written. */
 enum { ORIENT_NONE, ORIENT_AXIS, ORIENT_XYZ, ORIENT_ZYX };
@@ -100,6 +122,8 @@ typedef struct AstAttach {
     const char *name;       /* "ground" for the ground frame */
     SrcPos pos;
     bool has_offset;        /* NAME(sx, sy) rather than NAME */
+    bool at;                /* dynamics: at(X, Y), sx and sy expressions of
+                               the coordinates (name is NULL) */
     Ast *sx, *sy, *sz;      /* sz: spatial files only */
 } AstAttach;
 
@@ -128,6 +152,15 @@ typedef struct Stmt {
     SrcPos option_pos;
     Ast *lhs, *rhs;         /* JOINT with attachments == 0 */
     SrcPos eq_pos;
+
+    DynKind dyn;            /* DYNAMICS; attach[] its attachments, value its
+                               torque or generalised force, lhs a torque's
+                               angle(e) or gforce's coordinate */
+    bool declares;          /* DYNAMICS: name is declared (mass NAME: ...) */
+    Ast *key[DKEY_COUNT];   /* DYNAMICS: key = value (NULL: absent) */
+    SrcPos key_pos[DKEY_COUNT];
+    Ast *vec[2];            /* force (fx, fy), gravity (gx, gy), com(sx, sy) */
+    SrcPos vec_pos;
 
     struct Stmt *next;
 } Stmt;

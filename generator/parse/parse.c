@@ -727,19 +727,250 @@ static void output(Parser *p, Stmt *s)
     }
 }
 
+/* ---- dynamics statements (masses and forces: no rows) ---- */
+
+#define KEYBIT(k) (1u << (k))
+
+/* The `key = value` options each dynamics statement takes. */
+static const unsigned dyn_allowed[DYN_KIND_COUNT] = {
+    [DYN_MASS] = KEYBIT(DKEY_M) | KEYBIT(DKEY_J) | KEYBIT(DKEY_ANGLE),
+    [DYN_SPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_LENGTH) | KEYBIT(DKEY_FORCE),
+    [DYN_RSPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_ANGLE) | KEYBIT(DKEY_TORQUE),
+};
+
+/* The keys of allowed as "m, J or com", for messages. */
+static void list_keys(char *buf, size_t size, unsigned allowed, const char *extra)
+{
+    const char *words[DKEY_COUNT + 1];
+    int n = 0;
+    for (int k = 0; k < DKEY_COUNT; k++)
+        if (allowed & KEYBIT(k))
+            words[n++] = dyn_key_names[k];
+    if (extra)
+        words[n++] = extra;
+    size_t len = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < n && len < size; i++)
+        len += (size_t)snprintf(buf + len, size - len, "%s%s", i == 0 ? "" : i == n - 1 ? " or " : ", ",
+                                words[i]);
+}
+
+/* at(x, y): a point given by expressions of the coordinates, into a. */
+static void at_point(Parser *p, AstAttach *a)
+{
+    a->at = true;
+    a->name = NULL;
+    a->pos = p->tok.pos;
+    advance(p);
+    pair(p, "at(x, y)", &a->sx, &a->sy);
+}
+
+/* dyn_attachment = 'at' pair | NAME [pair]   (frame_only: a body or ground alone) */
+static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_only)
+{
+    AstAttach *a = &s->attach[slot];
+    const char *kw = dyn_keywords[s->dyn];
+    const char *nth = count == 1 ? "" : slot == 0 ? "first " : "second ";
+    if (p->tok.kind != TOK_IDENT || (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
+        expected(p, "%s as the %sattachment of %s '%s'",
+                 frame_only ? "a body or ground" : "a body, point, ground or at(x, y)", nth, kw,
+                 s->name);
+    Token name = p->tok;
+    Lexer saved = p->lx;
+    advance(p);
+    if (!frame_only && lex_is_word(&name, "at") && p->tok.kind == TOK_LPAREN) {
+        p->lx = saved;      /* back to 'at' for at_point */
+        p->tok = name;
+        at_point(p, a);
+        return;
+    }
+    a->name = token_text(p, &name);
+    a->pos = name.pos;
+    if (p->tok.kind != TOK_LPAREN)
+        return;
+    if (frame_only)
+        diag_fail(p->diag, p->tok.pos, "%s '%s' acts on bodies' angles: write '%s' alone, "
+                  "without an offset", kw, s->name, a->name);
+    char what[DIAG_MESSAGE_MAX];
+    snprintf(what, sizeof what, "the offset of '%s'", a->name);
+    a->has_offset = true;
+    pair(p, what, &a->sx, &a->sy);
+}
+
+/* keys = {KEY '=' expr | 'com' pair | 'at' pair}, each at most once;
+   com and at only where the form takes them (a body's own mass, with
+   com, turns with the body: no angle key). */
+static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
+{
+    unsigned allowed = dyn_allowed[s->dyn] & (com ? ~KEYBIT(DKEY_ANGLE) : ~0u);
+    while (p->tok.kind == TOK_IDENT) {
+        bool is_com = com && lex_is_word(&p->tok, "com"), is_at = at && lex_is_word(&p->tok, "at");
+        if ((is_com && s->vec[0]) || (is_at && s->attach[0].at))
+            diag_fail(p->diag, p->tok.pos, "'%.*s' given twice for %s '%s'", p->tok.len,
+                      p->tok.start, dyn_keywords[s->dyn], s->name);
+        if (is_com) {
+            s->vec_pos = p->tok.pos;
+            advance(p);
+            pair(p, "com(sx, sy)", &s->vec[0], &s->vec[1]);
+            continue;
+        }
+        if (is_at) {
+            at_point(p, &s->attach[0]);
+            continue;
+        }
+        int k = 0;
+        while (k < DKEY_COUNT && !lex_is_word(&p->tok, dyn_key_names[k]))
+            k++;
+        char list[128];
+        list_keys(list, sizeof list, allowed, com ? "com(sx, sy)" : at ? "at(x, y)" : NULL);
+        if (k == DKEY_COUNT || !(allowed & KEYBIT(k)))
+            diag_fail(p->diag, p->tok.pos, "unknown key '%.*s' for %s '%s': expected %s",
+                      p->tok.len, p->tok.start, dyn_keywords[s->dyn], s->name, list);
+        if (s->key[k])
+            diag_fail(p->diag, p->tok.pos, "'%s' given twice for %s '%s'", dyn_key_names[k],
+                      dyn_keywords[s->dyn], s->name);
+        s->key_pos[k] = p->tok.pos;
+        advance(p);
+        if (p->tok.kind != TOK_EQ)
+            expected(p, "'=' after '%s'", dyn_key_names[k]);
+        advance(p);
+        s->key[k] = expr(p);
+    }
+}
+
+/* mass = 'mass' NAME keys          (a body's or point's own mass; com for a body)
+        | 'mass' NAME ':' keys      (a mass element: at(x, y) required) */
+static void dyn_mass(Parser *p, Stmt *s)
+{
+    s->name = declared_name(p, "mass", &s->name_pos);
+    if (p->tok.kind == TOK_COLON) {
+        s->declares = true;
+        advance(p);
+        dyn_keys(p, s, false, true);
+        if (!s->attach[0].at)
+            expected(p, "'at(x, y)' for the mass element '%s' (or 'mass BODY m = ...' "
+                     "without ':' for a body's own mass)", s->name);
+    } else {
+        dyn_keys(p, s, true, false);
+    }
+    if (!s->key[DKEY_M])
+        expected(p, "'m = ...' for mass '%s'", s->name);
+}
+
+/* torque = 'torque' NAME ':' (BODY | 'angle' '(' expr ')') '=' expr */
+static void dyn_torque(Parser *p, Stmt *s)
+{
+    Lexer saved = p->lx;
+    Token word = p->tok;
+    if (lex_is_word(&word, "angle")) {
+        advance(p);
+        if (p->tok.kind == TOK_LPAREN) {
+            s->eq_pos = word.pos;
+            advance(p);
+            s->lhs = expr(p);
+            if (p->tok.kind != TOK_RPAREN)
+                expected(p, "')' after the angle of torque '%s'", s->name);
+            advance(p);
+        } else {
+            p->lx = saved;  /* a body called angle */
+            p->tok = word;
+        }
+    }
+    if (!s->lhs)
+        dyn_attachment(p, s, 0, 1, true);
+    if (p->tok.kind != TOK_EQ)
+        expected(p, "'=' and the torque of '%s'", s->name);
+    advance(p);
+    s->value = expr(p);
+}
+
+/* dynamics = mass | torque | gravity pair
+            | 'force' NAME ':' attachment pair
+            | ('spring' | 'rspring') NAME ':' attachment attachment keys
+            | 'gforce' NAME ':' COORDINATE '=' expr */
+static void dynamics(Parser *p, Stmt *s, DynKind kind)
+{
+    s->kind = STMT_DYNAMICS;
+    s->dyn = kind;
+    const char *kw = dyn_keywords[kind];
+    if (p->spatial)
+        diag_fail(p->diag, s->pos, "'%s' is planar only for now: masses and forces cannot be "
+                  "written in a spatial file yet", kw);
+    advance(p);
+    if (kind == DYN_GRAVITY) {
+        s->vec_pos = p->tok.pos;
+        pair(p, "gravity (gx, gy)", &s->vec[0], &s->vec[1]);
+        return;
+    }
+    if (kind == DYN_MASS) {
+        dyn_mass(p, s);
+        return;
+    }
+    s->name = declared_name(p, kw, &s->name_pos);
+    s->declares = true;
+    if (p->tok.kind != TOK_COLON)
+        expected(p, "':' after the %s name '%s'", kw, s->name);
+    advance(p);
+    switch (kind) {
+    case DYN_FORCE: {
+        AstAttach *a = &s->attach[0];
+        SrcPos offset_pos = p->tok.pos;
+        dyn_attachment(p, s, 0, 1, false);
+        if (p->tok.kind != TOK_LPAREN && a->has_offset && !a->at) {
+            /* `force F: body (fx, fy)`: the pair was the force, not an offset */
+            a->has_offset = false;
+            s->vec[0] = a->sx, s->vec[1] = a->sy, a->sx = a->sy = NULL;
+            s->vec_pos = offset_pos;
+            return;
+        }
+        s->vec_pos = p->tok.pos;
+        pair(p, "the force (fx, fy)", &s->vec[0], &s->vec[1]);
+        return;
+    }
+    case DYN_TORQUE:
+        dyn_torque(p, s);
+        return;
+    case DYN_SPRING: case DYN_RSPRING:
+        dyn_attachment(p, s, 0, 2, kind == DYN_RSPRING);
+        dyn_attachment(p, s, 1, 2, kind == DYN_RSPRING);
+        dyn_keys(p, s, false, false);
+        return;
+    case DYN_GFORCE:
+        s->lhs = expr(p);
+        if (p->tok.kind != TOK_EQ)
+            expected(p, "'=' after the coordinate of gforce '%s'", s->name);
+        s->eq_pos = p->tok.pos;
+        advance(p);
+        s->value = expr(p);
+        return;
+    case DYN_MASS: case DYN_GRAVITY: case DYN_KIND_COUNT:
+        break;
+    }
+}
+
+static int dyn_kind_lookup(const Token *tok)
+{
+    for (int k = 0; k < DYN_KIND_COUNT; k++)
+        if (lex_is_word(tok, dyn_keywords[k]))
+            return k;
+    return -1;
+}
+
 /* Appends the statement keywords of the file's dimension to buf, for the
    unknown-statement message. */
 static void list_keywords(char *buf, size_t size, bool spatial)
 {
     int n = snprintf(buf, size, "mechanism, %sparam, body, point, coord, output",
                      spatial ? "spatial, " : "");
-    int last = JOINT_KIND_COUNT - 1;
-    while (last > 0 && !joint_kind_in((JointKind)last, spatial))
-        last--;
-    for (int k = 0; k <= last && n > 0 && (size_t)n < size; k++)
+    const char *words[JOINT_KIND_COUNT + DYN_KIND_COUNT];
+    int count = 0;
+    for (int k = 0; k < JOINT_KIND_COUNT; k++)
         if (joint_kind_in((JointKind)k, spatial))
-            n += snprintf(buf + n, size - (size_t)n, "%s %s", k == last ? " or" : ",",
-                          joint_info[k].keyword);
+            words[count++] = joint_info[k].keyword;
+    for (int k = 0; k < DYN_KIND_COUNT && !spatial; k++)   /* planar only, for now */
+        words[count++] = dyn_keywords[k];
+    for (int k = 0; k < count && n > 0 && (size_t)n < size; k++)
+        n += snprintf(buf + n, size - (size_t)n, "%s %s", k == count - 1 ? " or" : ",", words[k]);
 }
 
 /* 'spatial': once, before every statement but `mechanism`. */
@@ -828,6 +1059,8 @@ static Stmt *statement(Parser *p)
         s->kind = STMT_OUTPUT;
         advance(p);
         output(p, s);
+    } else if (dyn_kind_lookup(&kw) >= 0) {
+        dynamics(p, s, (DynKind)dyn_kind_lookup(&kw));
     } else if (kind >= 0) {
         s->kind = STMT_JOINT;
         s->joint = (JointKind)kind;

@@ -1,0 +1,296 @@
+/* dynamics.c - the mass matrix M(q) and the force vector Q(q, qd, t) as graph nodes, by symbolic differentiation.
+ *
+ * Every mass statement is a mass element: mass m at p(q), moment of inertia
+ * J about it for the angle theta(q) (DYN.md). With T = 1/2 m |p_q qd|^2 +
+ * 1/2 J (theta_q qd)^2, Lagrange's equations give
+ *
+ *   M += m p_q^T p_q + J theta_q^T theta_q
+ *   Q += -m p_q^T (pdot_q qd) - J theta_q^T (thetadot_q qd)      velocity terms
+ *   Q += m p_q^T g                                               gravity
+ *
+ * where pdot_q qd = D(D(p)), the total time derivative twice with qdd = 0:
+ * the convective term gamma is made of (p never depends on t). Applied
+ * forces enter by virtual work, Q += (d position / dq)^T force (model.h's
+ * ForceKind). M is accumulated entry by entry over the coordinates each
+ * element touches, so a body in body coordinates with its centre of mass
+ * at its origin adds the constants m, m, J on the diagonal and nothing else.
+ *
+ * Node ids name the generated C's temporaries: every node is made in a
+ * statement of its own (see joints.c), so the output does not depend on
+ * the compiler that built mechc.
+ */
+#include "kinematics.h"
+
+#include "../base/arena.h"
+#include "../base/hashmap.h"
+#include "../dag/support.h"
+#include "diff.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Scratch of one build. */
+typedef struct DynWork {
+    Model *m;
+    Dag *dag;
+    Differ df;
+    SupportScan scan;
+    int *cols, *tmp;        /* nq each */
+    char *seen;             /* nq */
+    NodeId *velocity, *applied;     /* nq */
+    U64Map where;           /* (row, col), row <= col -> index into entries */
+    JacEntry *entries;      /* upper triangle, in the order first met */
+    int n, cap;
+} DynWork;
+
+/* The coordinates any of the n expressions depends on, ascending, into w->cols. */
+static int support_of(DynWork *w, const NodeId *e, int n)
+{
+    memset(w->seen, 0, (size_t)w->m->nq);
+    for (int k = 0; k < n; k++) {
+        int c = support_collect(&w->scan, w->dag, e[k], OP_VAR, w->tmp);
+        for (int i = 0; i < c; i++)
+            w->seen[w->tmp[i]] = 1;
+    }
+    int count = 0;
+    for (int j = 0; j < w->m->nq; j++)
+        if (w->seen[j])
+            w->cols[count++] = j;
+    return count;
+}
+
+/* M(i, j) += v for i <= j. */
+static void add_mass(DynWork *w, int i, int j, NodeId v)
+{
+    if (dag_is_zero(w->dag, v))
+        return;
+    uint64_t key = (uint64_t)(uint32_t)i << 32 | (uint32_t)j;
+    int32_t at;
+    if (u64map_get(&w->where, key, &at)) {
+        w->entries[at].value = dag_add(w->dag, w->entries[at].value, v);
+        return;
+    }
+    if (w->n == w->cap) {
+        w->cap = w->cap ? 2 * w->cap : 16;
+        w->entries = xrealloc(w->entries, (size_t)w->cap, sizeof *w->entries);
+    }
+    w->entries[w->n] = (JacEntry){.row = i, .col = j, .value = v};
+    u64map_put(&w->where, key, w->n++);
+}
+
+/* acc[j] += v */
+static void accumulate(DynWork *w, NodeId *acc, int j, NodeId v)
+{
+    acc[j] = dag_add(w->dag, acc[j], v);
+}
+
+/* a * b + c * d, each product in a statement of its own */
+static NodeId dot2(Dag *d, NodeId a, NodeId b, NodeId c, NodeId e)
+{
+    NodeId ab = dag_mul(d, a, b);
+    NodeId ce = dag_mul(d, c, e);
+    return dag_add(d, ab, ce);
+}
+
+/* A planar body's own mass, the formula worked out (DYN.md's with
+   p = r + A(phi) s, u = A(phi) s, p_phi = B s = (-u_y, u_x), w = phi'):
+   M(x, x) = M(y, y) = m, M(x, phi) = -m u_y, M(y, phi) = m u_x,
+   M(phi, phi) = J + m s.s; velocity terms m u w^2 on (x, y), none on phi
+   (B s is normal to u); weight m g on (x, y), m (B s).g on phi. The
+   symbolic route gives the same numbers with sin^2 + cos^2 left unfolded. */
+static void add_body(DynWork *w, const MassElement *e)
+{
+    Dag *d = w->dag;
+    int x = e->body, y = x + 1, phi = x + 2;
+    NodeId c = dag_call(d, OP_COS, e->theta, DAG_NONE);     /* as joints.c's rotate */
+    NodeId sn = dag_call(d, OP_SIN, e->theta, DAG_NONE);
+    NodeId vx = dag_const(d, e->sx), vy = dag_const(d, e->sy);
+    NodeId sy = dag_mul(d, sn, vy), cx = dag_mul(d, c, vx);
+    NodeId ux = dag_sub(d, cx, sy);
+    NodeId cy = dag_mul(d, c, vy), sx = dag_mul(d, sn, vx);
+    NodeId uy = dag_add(d, sx, cy);
+    NodeId m = dag_const(d, e->m);
+    add_mass(w, x, x, m);
+    add_mass(w, y, y, m);
+    NodeId muy = dag_mul(d, m, uy);
+    add_mass(w, x, phi, dag_neg(d, muy));
+    add_mass(w, y, phi, dag_mul(d, m, ux));
+    add_mass(w, phi, phi, dag_const(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy)));
+    NodeId rate = dag_vard(d, phi);
+    NodeId w2 = dag_mul(d, rate, rate);
+    NodeId mw2 = dag_mul(d, m, w2);
+    accumulate(w, w->velocity, x, dag_mul(d, mw2, ux));
+    accumulate(w, w->velocity, y, dag_mul(d, mw2, uy));
+    double gx = w->m->gravity[0], gy = w->m->gravity[1];
+    accumulate(w, w->applied, x, dag_const(d, e->m * gx));
+    accumulate(w, w->applied, y, dag_const(d, e->m * gy));
+    NodeId mgx = dag_const(d, -e->m * gx);
+    NodeId mgy = dag_const(d, e->m * gy);
+    accumulate(w, w->applied, phi, dot2(d, uy, mgx, ux, mgy));
+}
+
+/* One mass element's share of M, its velocity terms and its weight. */
+static void add_element(DynWork *w, const MassElement *e)
+{
+    Dag *d = w->dag;
+    if (e->body >= 0) {
+        add_body(w, e);
+        return;
+    }
+    NodeId parts[3] = {e->px, e->py, e->theta};
+    int n = support_of(w, parts, 3);
+    NodeId *dx = xmalloc((size_t)(3 * n + 1) * sizeof *dx), *dy = dx + n, *dth = dy + n;
+    for (int k = 0; k < n; k++) {
+        dx[k] = diff_by_q(&w->df, e->px, w->cols[k]);
+        dy[k] = diff_by_q(&w->df, e->py, w->cols[k]);
+        dth[k] = diff_by_q(&w->df, e->theta, w->cols[k]);
+    }
+    NodeId m = dag_const(d, e->m), J = dag_const(d, e->J);
+    for (int a = 0; a < n && !d->overflow; a++)
+        for (int b = a; b < n; b++) {
+            NodeId pp = dot2(d, dx[a], dx[b], dy[a], dy[b]);
+            NodeId mpp = dag_mul(d, m, pp);
+            NodeId tt = dag_mul(d, dth[a], dth[b]);
+            NodeId jtt = dag_mul(d, J, tt);
+            add_mass(w, w->cols[a], w->cols[b], dag_add(d, mpp, jtt));
+        }
+    /* pdot_q qd = D(D(p)) (p has no t and no qd) */
+    NodeId vx = diff_total(&w->df, e->px);
+    NodeId ax = diff_total(&w->df, vx);
+    NodeId vy = diff_total(&w->df, e->py);
+    NodeId ay = diff_total(&w->df, vy);
+    NodeId vth = diff_total(&w->df, e->theta);
+    NodeId ath = diff_total(&w->df, vth);
+    NodeId gx = dag_const(d, e->m * w->m->gravity[0]);
+    NodeId gy = dag_const(d, e->m * w->m->gravity[1]);
+    for (int k = 0; k < n && !d->overflow; k++) {
+        int j = w->cols[k];
+        NodeId pa = dot2(d, dx[k], ax, dy[k], ay);
+        NodeId mpa = dag_mul(d, m, pa);
+        NodeId ta = dag_mul(d, dth[k], ath);
+        NodeId jta = dag_mul(d, J, ta);
+        NodeId sum = dag_add(d, mpa, jta);
+        w->velocity[j] = dag_sub(d, w->velocity[j], sum);
+        accumulate(w, w->applied, j, dot2(d, dx[k], gx, dy[k], gy));
+    }
+    free(dx);
+}
+
+/* Q += coef * d(e)/dq over e's coordinates (coef: a force along e). */
+static void add_along(DynWork *w, NodeId e, NodeId coef)
+{
+    int n = support_of(w, &e, 1);
+    for (int k = 0; k < n && !w->dag->overflow; k++) {
+        NodeId de = diff_by_q(&w->df, e, w->cols[k]);
+        accumulate(w, w->applied, w->cols[k], dag_mul(w->dag, de, coef));
+    }
+}
+
+/* -(k (s - s0) + c D(s) + act): a spring's pull along its length or angle s */
+static NodeId spring_force(DynWork *w, const AppliedForce *f, NodeId s)
+{
+    Dag *d = w->dag;
+    NodeId stretch = dag_sub(d, s, dag_const(d, f->free));
+    NodeId ks = dag_mul(d, dag_const(d, f->k), stretch);
+    NodeId rate = diff_total(&w->df, s);
+    NodeId cr = dag_mul(d, dag_const(d, f->c), rate);
+    NodeId sum = dag_add(d, ks, cr);
+    NodeId total = dag_add(d, sum, f->fx);
+    return dag_neg(d, total);
+}
+
+/* One applied force by virtual work. */
+static void add_force(DynWork *w, const AppliedForce *f)
+{
+    Dag *d = w->dag;
+    switch (f->kind) {
+    case FORCE_POINT:
+        add_along(w, f->ax, f->fx);
+        add_along(w, f->ay, f->fy);
+        return;
+    case FORCE_TORQUE:
+        add_along(w, f->ax, f->fx);
+        return;
+    case FORCE_SPRING: {
+        NodeId ex = dag_sub(d, f->bx, f->ax);
+        NodeId ey = dag_sub(d, f->by, f->ay);
+        NodeId l2 = dot2(d, ex, ex, ey, ey);
+        NodeId l = dag_call(d, OP_SQRT, l2, DAG_NONE);
+        add_along(w, l, spring_force(w, f, l));
+        return;
+    }
+    case FORCE_RSPRING: {
+        NodeId a = dag_sub(d, f->bx, f->ax);
+        add_along(w, a, spring_force(w, f, a));
+        return;
+    }
+    case FORCE_GENERAL:
+        accumulate(w, w->applied, f->coord, f->fx);
+        return;
+    }
+}
+
+static int compare_entries(const void *x, const void *y)
+{
+    const JacEntry *a = x, *b = y;
+    if (a->row != b->row)
+        return (a->row > b->row) - (a->row < b->row);
+    return (a->col > b->col) - (a->col < b->col);
+}
+
+/* The upper triangle mirrored into both triangles, row-major, in the arena. */
+static void finish_mass(DynWork *w, Dynamics *dyn)
+{
+    int n = 0;
+    for (int k = 0; k < w->n; k++)
+        n += w->entries[k].row == w->entries[k].col ? 1 : 2;
+    dyn->mass = arena_alloc_array(&w->m->arena, (size_t)n + 1, sizeof *dyn->mass);
+    for (int k = 0; k < w->n; k++) {
+        JacEntry e = w->entries[k];
+        dyn->mass[dyn->nnz++] = e;
+        if (e.row != e.col)
+            dyn->mass[dyn->nnz++] = (JacEntry){.row = e.col, .col = e.row, .value = e.value};
+    }
+    qsort(dyn->mass, (size_t)dyn->nnz, sizeof *dyn->mass, compare_entries);
+}
+
+bool dynamics_build(Model *m, Dynamics *dyn, Diag *diag)
+{
+    memset(dyn, 0, sizeof *dyn);
+    dyn->present = true;
+    DynWork w = {.m = m, .dag = &m->dag};
+    size_t nq = (size_t)m->nq;
+    differ_init(&w.df, w.dag, m->nq);
+    support_init(&w.scan);
+    u64map_init(&w.where);
+    w.cols = xmalloc(nq * sizeof *w.cols);
+    w.tmp = xmalloc(nq * sizeof *w.tmp);
+    w.seen = xmalloc(nq);
+    dyn->force = arena_alloc_array(&m->arena, nq, sizeof *dyn->force);
+    dyn->velocity = arena_alloc_array(&m->arena, nq, sizeof *dyn->velocity);
+    w.velocity = dyn->velocity;
+    w.applied = xcalloc(nq, sizeof *w.applied);     /* DAG_ZERO is 0 */
+    for (int i = 0; i < m->nmasses && !w.dag->overflow; i++) {
+        w.dag->where = m->masses[i].pos.offset;
+        add_element(&w, &m->masses[i]);
+    }
+    for (int i = 0; i < m->nforces && !w.dag->overflow; i++) {
+        w.dag->where = m->forces[i].pos.offset;
+        add_force(&w, &m->forces[i]);
+    }
+    for (int j = 0; j < m->nq; j++)
+        dyn->force[j] = dag_add(w.dag, dyn->velocity[j], w.applied[j]);
+    bool ok = dag_check_limit(w.dag, diag);
+    w.dag->where = -1;
+    if (ok)
+        finish_mass(&w, dyn);
+    free(w.entries);
+    free(w.applied);
+    free(w.cols);
+    free(w.tmp);
+    free(w.seen);
+    u64map_free(&w.where);
+    support_free(&w.scan);
+    differ_free(&w.df);
+    return ok;
+}

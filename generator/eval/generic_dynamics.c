@@ -1,0 +1,232 @@
+/* generic_dynamics.c - the generic evaluator's M and Q: the mass elements and forces by forward-mode derivatives, no symbolic ones.
+ *
+ * Each mass element and each force is one program of its expressions
+ * (interp.h): position, angle, components. Their derivatives come from
+ * jets while the program runs, not from generator/diff/, so M and Q here
+ * check the generated kernels:
+ *
+ *   mass element:  p_q by one first-order pass per coordinate it reads;
+ *                  pdot_q qd = D(D(p)), a second-order jet along (qd, 0, 0);
+ *                  M += m p_q^T p_q + J theta_q^T theta_q,
+ *                  Q += -m p_q^T D(D(p)) - J theta_q^T D(D(theta)) + m p_q^T g
+ *   point force:   Q += p_q^T F;  torque: Q += theta_q^T tau
+ *   spring:        l = |P_B - P_A|, l_q and ldot from the points' jets,
+ *                  Q -= (k (l - L0) + c ldot + F) l_q
+ *   rspring:       a = theta_B - theta_A, Q -= (k (a - a0) + c adot + T) a_q
+ *   gforce:        Q[coord] += value
+ */
+#include "generic_impl.h"
+
+#include "../base/arena.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One program per mass element (px, py, theta) and per force (its
+   expressions, in AppliedForce order: ax ay bx by fx fy). */
+struct GenericDyn {
+    const Model *m;
+    Tape *mass_tapes, *force_tapes;
+    Jet *jreg;
+    double *vreg;
+    double *dp;         /* 3 nq: one element's (px, py, theta)_q */
+};
+
+enum { FORCE_ROOTS = 6 };
+
+static void force_roots(const AppliedForce *f, NodeId roots[FORCE_ROOTS])
+{
+    NodeId r[FORCE_ROOTS] = {f->ax, f->ay, f->bx, f->by, f->fx, f->fy};
+    memcpy(roots, r, sizeof r);
+}
+
+GenericDyn *generic_dynamics_open(const Model *m)
+{
+    GenericDyn *d = xcalloc(1, sizeof *d);
+    d->m = m;
+    d->mass_tapes = xcalloc((size_t)m->nmasses + 1, sizeof *d->mass_tapes);
+    d->force_tapes = xcalloc((size_t)m->nforces + 1, sizeof *d->force_tapes);
+    CompileScratch cs;
+    compile_scratch_init(&cs, &m->dag);
+    int regs = 1;
+    for (int i = 0; i < m->nmasses; i++) {
+        const MassElement *e = &m->masses[i];
+        NodeId roots[3] = {e->px, e->py, e->theta};
+        tape_compile_roots(&d->mass_tapes[i], &m->dag, roots, 3, &cs);
+        regs = d->mass_tapes[i].n > regs ? d->mass_tapes[i].n : regs;
+    }
+    for (int i = 0; i < m->nforces; i++) {
+        NodeId roots[FORCE_ROOTS];
+        force_roots(&m->forces[i], roots);
+        tape_compile_roots(&d->force_tapes[i], &m->dag, roots, FORCE_ROOTS, &cs);
+        regs = d->force_tapes[i].n > regs ? d->force_tapes[i].n : regs;
+    }
+    compile_scratch_free(&cs);
+    d->jreg = xcalloc((size_t)regs, sizeof *d->jreg);
+    d->vreg = xcalloc((size_t)regs, sizeof *d->vreg);
+    d->dp = xcalloc(3 * (size_t)m->nq + 1, sizeof *d->dp);
+    return d;
+}
+
+void generic_dynamics_free(GenericDyn *d)
+{
+    if (!d)
+        return;
+    for (int i = 0; i < d->m->nmasses; i++)
+        tape_free(&d->mass_tapes[i]);
+    for (int i = 0; i < d->m->nforces; i++)
+        tape_free(&d->force_tapes[i]);
+    free(d->mass_tapes);
+    free(d->force_tapes);
+    free(d->jreg);
+    free(d->vreg);
+    free(d->dp);
+    free(d);
+}
+
+/* The jet of root k after a tape_jet pass. */
+static Jet root_jet(const GenericDyn *d, const Tape *p, int k)
+{
+    return d->jreg[p->out[k]];
+}
+
+/* d(roots)/dq_j for every coordinate j the program reads: dp[3 k + r] for
+   the k-th of p->qcols (the first nr roots). */
+static void root_gradients(GenericDyn *d, const Tape *p, const double *q, const double *qd,
+                           double t, int nr, double *dp)
+{
+    for (int k = 0; k < p->nqcols; k++) {
+        Seed s = {.q = q, .qd = qd, .t = t, .col_q = p->qcols[k], .col_qd = -1};
+        tape_jet(p, &s, 1, d->jreg);
+        for (int r = 0; r < nr; r++)
+            dp[3 * k + r] = root_jet(d, p, r).d;
+    }
+}
+
+void generic_mass(Generic *g, const double *q, double *M)
+{
+    GenericDyn *d = g->dyn;
+    const Model *m = d->m;
+    size_t nq = (size_t)m->nq;
+    memset(M, 0, nq * nq * sizeof *M);
+    for (int i = 0; i < m->nmasses; i++) {
+        const MassElement *e = &m->masses[i];
+        const Tape *p = &d->mass_tapes[i];
+        root_gradients(d, p, q, NULL, 0.0, 3, d->dp);
+        for (int a = 0; a < p->nqcols; a++)
+            for (int b = 0; b < p->nqcols; b++) {
+                const double *u = d->dp + 3 * a, *v = d->dp + 3 * b;
+                M[(size_t)p->qcols[a] * nq + (size_t)p->qcols[b]] +=
+                    e->m * (u[0] * v[0] + u[1] * v[1]) + e->J * u[2] * v[2];
+            }
+    }
+}
+
+/* Q's velocity terms (with_gravity: and the weights) of every mass element. */
+static void add_inertia(GenericDyn *d, const double *q, const double *qd, bool with_gravity,
+                        double *Q)
+{
+    const Model *m = d->m;
+    for (int i = 0; i < m->nmasses; i++) {
+        const MassElement *e = &m->masses[i];
+        const Tape *p = &d->mass_tapes[i];
+        root_gradients(d, p, q, NULL, 0.0, 3, d->dp);
+        Seed s = {.q = q, .dq = qd, .col_q = -1, .col_qd = -1};
+        tape_jet(p, &s, 2, d->jreg);
+        double ax = root_jet(d, p, 0).dd, ay = root_jet(d, p, 1).dd, ath = root_jet(d, p, 2).dd;
+        double gx = with_gravity ? m->gravity[0] : 0.0, gy = with_gravity ? m->gravity[1] : 0.0;
+        for (int k = 0; k < p->nqcols; k++) {
+            const double *u = d->dp + 3 * k;
+            Q[p->qcols[k]] += -e->m * (u[0] * ax + u[1] * ay) - e->J * u[2] * ath
+                              + e->m * (u[0] * gx + u[1] * gy);
+        }
+    }
+}
+
+/* Q += coef * (root a - root b)_q over the program's coordinates (b < 0: none). */
+static void add_gradient(GenericDyn *d, const Tape *p, const double *q, const double *qd, double t,
+                         int a, int b, double coef, double *Q)
+{
+    for (int k = 0; k < p->nqcols; k++) {
+        Seed s = {.q = q, .qd = qd, .t = t, .col_q = p->qcols[k], .col_qd = -1};
+        tape_jet(p, &s, 1, d->jreg);
+        double v = root_jet(d, p, a).d - (b >= 0 ? root_jet(d, p, b).d : 0.0);
+        Q[p->qcols[k]] += coef * v;
+    }
+}
+
+/* A spring's length l (or an rspring's angle), its rate along the motion
+   and the pull -(k (l - L0) + c ldot + F) along it. */
+static double spring_pull(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                          const double *qd, double t, double *len)
+{
+    Seed s = {.q = q, .qd = qd, .t = t, .dq = qd, .col_q = -1, .col_qd = -1, .dt = 1.0};
+    tape_jet(p, &s, 1, d->jreg);
+    Jet ax = root_jet(d, p, 0), ay = root_jet(d, p, 1), bx = root_jet(d, p, 2), by = root_jet(d, p, 3);
+    double act = root_jet(d, p, 4).v, l, rate;
+    if (f->kind == FORCE_RSPRING) {
+        l = bx.v - ax.v;
+        rate = bx.d - ax.d;
+    } else {
+        double ex = bx.v - ax.v, ey = by.v - ay.v;
+        l = sqrt(ex * ex + ey * ey);
+        rate = (ex * (bx.d - ax.d) + ey * (by.d - ay.d)) / l;
+    }
+    *len = l;
+    return -(f->k * (l - f->free) + f->c * rate + act);
+}
+
+/* l_q of a spring: (e . (P_B - P_A)_q) / l. */
+static void add_spring(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                       const double *qd, double t, double *Q)
+{
+    double l, pull = spring_pull(d, f, p, q, qd, t, &l);
+    if (f->kind == FORCE_RSPRING) {
+        add_gradient(d, p, q, qd, t, 2, 0, pull, Q);
+        return;
+    }
+    tape_run(p, q, qd, t, d->vreg);
+    double ex = d->vreg[p->out[2]] - d->vreg[p->out[0]], ey = d->vreg[p->out[3]] - d->vreg[p->out[1]];
+    add_gradient(d, p, q, qd, t, 2, 0, pull * ex / l, Q);
+    add_gradient(d, p, q, qd, t, 3, 1, pull * ey / l, Q);
+}
+
+static void add_applied(GenericDyn *d, const double *q, const double *qd, double t, double *Q)
+{
+    const Model *m = d->m;
+    for (int i = 0; i < m->nforces; i++) {
+        const AppliedForce *f = &m->forces[i];
+        const Tape *p = &d->force_tapes[i];
+        tape_run(p, q, qd, t, d->vreg);
+        double fx = d->vreg[p->out[4]], fy = d->vreg[p->out[5]];
+        switch (f->kind) {
+        case FORCE_POINT:
+            add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
+            add_gradient(d, p, q, qd, t, 1, -1, fy, Q);
+            break;
+        case FORCE_TORQUE:
+            add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
+            break;
+        case FORCE_SPRING: case FORCE_RSPRING:
+            add_spring(d, f, p, q, qd, t, Q);
+            break;
+        case FORCE_GENERAL:
+            Q[f->coord] += fx;
+            break;
+        }
+    }
+}
+
+void generic_force(Generic *g, const double *q, const double *qd, double t, double *Q)
+{
+    memset(Q, 0, (size_t)g->nq * sizeof *Q);
+    add_inertia(g->dyn, q, qd, true, Q);
+    add_applied(g->dyn, q, qd, t, Q);
+}
+
+void generic_velocity_terms(Generic *g, const double *q, const double *qd, double *Qv)
+{
+    memset(Qv, 0, (size_t)g->nq * sizeof *Qv);
+    add_inertia(g->dyn, q, qd, false, Qv);
+}

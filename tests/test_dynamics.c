@@ -1,0 +1,402 @@
+/* test_dynamics.c - masses and forces: M and Q against closed forms, the engines against each other, the generated code, bad input.
+ *
+ * The compound pendulum (examples/pendulum_dynamics.mech, body
+ * coordinates, centre of mass off the origin) and a double pendulum in
+ * its own angles (mass elements given by expressions, a torque on an
+ * expression angle, a generalised force with der()) are compared with
+ * their hand-written M(q) and Q(q, qd, t) at random states, in every
+ * engine; a file with every force kind has its engines agree to 1e-12
+ * and its springs' Q equal -dV/dq of their potential; the fused eom
+ * kernel equals the separate ones; a body with its centre of mass at its
+ * origin costs M no operation; bad input fails at its line and column.
+ */
+#include "testutil.h"
+#include "testcache.h"
+#include "testload.h"
+
+#include "../generator/analysis/check.h"
+#include "../generator/base/arena.h"
+#include "../generator/base/rng.h"
+#include "../generator/engine/aot.h"
+#include "../generator/engine/engine.h"
+#include "../generator/eval/generic.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static char cache_dir[256];
+static bool have_cc;
+
+static int setup(void **state)
+{
+    (void)state;
+    if (!testcache_make(cache_dir, sizeof cache_dir, "dynamics"))
+        return -1;
+    have_cc = aot_compiler_available();
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    testcache_remove(cache_dir, 2);
+    return 0;
+}
+
+static Mech *load_example(const char *name)
+{
+    const char *dir = getenv("MECHC_EXAMPLES");
+    char path[600];
+    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
+    return load_file(path);
+}
+
+/* The engines a test runs: jit, generic, and aot with a compiler. */
+static int engine_count(void) { return have_cc ? ENGINE_KIND_COUNT : 2; }
+
+static void open_engine(Engine *e, EngineKind kind, const Mech *mech)
+{
+    Diag diag;
+    if (!engine_open(e, kind, mech, &diag))
+        fail_msg("%s: %s", engine_names[kind], diag.message);
+    assert_non_null(e->k.mass);
+    assert_non_null(e->k.force);
+}
+
+/* A random state: q = base + U(-1, 1), qd = U(-2, 2), t = U(0, 1). */
+static void random_state(uint64_t *rng, int nq, const double *base, double *q, double *qd, double *t)
+{
+    for (int i = 0; i < nq; i++) {
+        q[i] = (base ? base[i] : 0.0) + rng_symmetric(rng);
+        qd[i] = 2.0 * rng_symmetric(rng);
+    }
+    *t = rng_unit(rng);
+}
+
+static void assert_matrix(const char *what, const double *got, const double *want, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!(fabs(got[i] - want[i]) <= 1e-12 * (1.0 + fabs(want[i]))))
+            fail_msg("%s[%d] = %.17g, expected %.17g", what, i, got[i], want[i]);
+}
+
+/* ---- the compound pendulum: one body, centre of mass at (a, 0) ---- */
+
+/* pendulum_dynamics.mech's closed forms (its header): L = 1, m = 2, g = 9.81. */
+static void pendulum_closed(const double *q, const double *qd, double *M, double *Q)
+{
+    const double L = 1, m = 2, g = 9.81, a = L / 2, J = m * L * L / 12;
+    double s = sin(q[2]), c = cos(q[2]), w = qd[2];
+    double Mw[9] = {m, 0, -m * a * s, 0, m, m * a * c, -m * a * s, m * a * c, J + m * a * a};
+    double Qw[3] = {m * a * c * w * w, m * a * s * w * w - m * g, -m * g * a * c};
+    memcpy(M, Mw, sizeof Mw);
+    memcpy(Q, Qw, sizeof Qw);
+}
+
+static void test_compound_pendulum(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("pendulum_dynamics.mech");
+    assert_int_equal(mech->model->nmasses, 1);
+    assert_true(mech->kin.dyn.present);
+    uint64_t rng = 7;
+    for (int k = 0; k < engine_count(); k++) {
+        Engine e;
+        open_engine(&e, (EngineKind)k, mech);
+        for (int s = 0; s < 25; s++) {
+            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
+            random_state(&rng, 3, NULL, q, qd, &t);
+            e.k.mass(e.k.ctx, q, M);
+            e.k.force(e.k.ctx, q, qd, t, Q);
+            pendulum_closed(q, qd, Mw, Qw);
+            assert_matrix(engine_names[k], M, Mw, 9);
+            assert_matrix(engine_names[k], Q, Qw, 3);
+        }
+        engine_close(&e);
+    }
+    pipeline_free(mech);
+}
+
+/* ---- a double pendulum in its own angles ---- */
+
+/* th1, th2 from the downward vertical; a particle m1 at the end of the
+   first rod (l1), a second rod of mass m2 and inertia J2 about its centre
+   of mass, a2 from the joint; gravity; a motor torque tau t on th1, a
+   viscous generalised force -b th2' on th2. z is a held coordinate (the
+   file needs a row): its row and column of M and its Q are zero. */
+static const char double_pendulum[] =
+    "param l1 = 0.7\nparam a2 = 0.4\nparam m1 = 1.3\nparam m2 = 0.8\nparam J2 = 0.05\n"
+    "coord th1 = 0.3\ncoord th2 = -0.2\ncoord z\n"
+    "constraint hold: z = 0\n"
+    "mass p1: at(l1*sin(th1), -l1*cos(th1)) m = m1\n"
+    "mass rod2: m = m2 J = J2 at(l1*sin(th1) + a2*sin(th2), -l1*cos(th1) - a2*cos(th2)) angle = th2\n"
+    "gravity (0, -9.81)\n"
+    "torque motor: angle(th1) = 2.5*t\n"
+    "gforce damp: th2 = -0.3*der(th2)\n";
+
+static void double_closed(const double *q, const double *qd, double t, double *M, double *Q)
+{
+    const double l1 = 0.7, a2 = 0.4, m1 = 1.3, m2 = 0.8, J2 = 0.05, g = 9.81;
+    double d = q[0] - q[1], c12 = cos(d), s12 = sin(d);
+    memset(M, 0, 9 * sizeof *M);
+    M[0] = (m1 + m2) * l1 * l1;
+    M[1] = M[3] = m2 * l1 * a2 * c12;
+    M[4] = m2 * a2 * a2 + J2;
+    Q[0] = -m2 * l1 * a2 * s12 * qd[1] * qd[1] - (m1 + m2) * g * l1 * sin(q[0]) + 2.5 * t;
+    Q[1] = m2 * l1 * a2 * s12 * qd[0] * qd[0] - m2 * g * a2 * sin(q[1]) - 0.3 * qd[1];
+    Q[2] = 0.0;
+}
+
+static void test_double_pendulum(void **state)
+{
+    (void)state;
+    Mech *mech = load_text(double_pendulum, "double_pendulum.mech");
+    assert_int_equal(mech->model->nmasses, 2);
+    assert_int_equal(mech->model->nforces, 2);
+    uint64_t rng = 11;
+    for (int k = 0; k < engine_count(); k++) {
+        Engine e;
+        open_engine(&e, (EngineKind)k, mech);
+        for (int s = 0; s < 25; s++) {
+            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
+            random_state(&rng, 3, NULL, q, qd, &t);
+            e.k.mass(e.k.ctx, q, M);
+            e.k.force(e.k.ctx, q, qd, t, Q);
+            double_closed(q, qd, t, Mw, Qw);
+            assert_matrix(engine_names[k], M, Mw, 9);
+            assert_matrix(engine_names[k], Q, Qw, 3);
+        }
+        engine_close(&e);
+    }
+    pipeline_free(mech);
+}
+
+/* ---- every force kind ---- */
+
+static const char every_force[] =
+    "param k = 40\n"
+    "body a x = 0.2 y = 0.1 phi = 0.3\nbody b x = 1.1 y = -0.2 phi = -0.4\npoint p x = 0.5 y = 0.9\n"
+    "coord s = 0.1\n"
+    "revolute O: ground(0, 0) a(-0.2, 0)\n"
+    "distance D: b(0.3, 0.1) p length = 0.8\n"
+    "constraint C: s = 0.1*sin(t)\n"
+    "mass a m = 1.2 J = 0.03 com(0.1, -0.05)\n"
+    "mass b m = 0.7 J = 0.02\nmass p m = 0.3\n"
+    "mass e: at(a.x + s*cos(a.phi), a.y + s*sin(a.phi)) m = 0.4 J = 0.01 angle = a.phi + s\n"
+    "gravity (0.5, -9.81)\n"
+    "force F: b(0.2, -0.1) (3*cos(t), der(b.x) - 2)\n"
+    "force G: at(s, a.y) (1, 2*s)\n"
+    "torque T: b = -0.5*der(b.phi)\n"
+    "spring S1: a(0.1, 0.2) b(-0.1, 0) k = k c = 0.7 length = 0.4 force = 3*t\n"
+    "spring S2: ground(2, 1) p k = 10 length = 0.1\n"
+    "rspring R: a b k = 5 c = 0.2 angle = 0.1 torque = 1.5\n"
+    "gforce H: s = -2*s - 0.1*der(s)^3\n";
+
+/* The engines agree on M and Q (to 1e-12), and the jit's eom equals its
+   separate kernels, at random states. */
+static void test_engines_agree(void **state)
+{
+    (void)state;
+    const char *names[] = {"every_force", "pendulum_dynamics.mech", "slider_crank_dynamics.mech"};
+    uint64_t rng = 3;
+    for (int f = 0; f < 3; f++) {
+        Mech *mech = f == 0 ? load_text(every_force, "every_force.mech") : load_example(names[f]);
+        const Model *m = mech->model;
+        size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
+        Engine e[ENGINE_KIND_COUNT];
+        for (int k = 0; k < engine_count(); k++)
+            open_engine(&e[k], (EngineKind)k, mech);
+        double *q = xcalloc(nq, 8), *qd = xcalloc(nq, 8), t, *M = xcalloc(nq * nq, 8);
+        double *M0 = xcalloc(nq * nq, 8), *Q = xcalloc(nq, 8), *Q0 = xcalloc(nq, 8);
+        double *jac = xcalloc(nr * nq, 8), *jac0 = xcalloc(nr * nq, 8);
+        double *gam = xcalloc(nr, 8), *gam0 = xcalloc(nr, 8);
+        for (int s = 0; s < 10; s++) {
+            random_state(&rng, (int)nq, m->q0, q, qd, &t);
+            e[0].k.mass(e[0].k.ctx, q, M0);
+            e[0].k.force(e[0].k.ctx, q, qd, t, Q0);
+            for (int k = 1; k < engine_count(); k++) {
+                e[k].k.mass(e[k].k.ctx, q, M);
+                e[k].k.force(e[k].k.ctx, q, qd, t, Q);
+                assert_matrix(names[f], M, M0, (int)(nq * nq));
+                assert_matrix(names[f], Q, Q0, (int)nq);
+            }
+            const Kernels *code = &e[ENGINE_JIT].kernels;
+            code->eom(q, qd, t, M, Q, jac, gam);
+            code->jac(q, t, jac0);
+            code->gamma(q, qd, t, gam0);
+            assert_matrix("eom M", M, M0, (int)(nq * nq));
+            assert_matrix("eom Q", Q, Q0, (int)nq);
+            assert_matrix("eom jac", jac, jac0, (int)(nr * nq));
+            assert_matrix("eom gamma", gam, gam0, (int)nr);
+            /* mass_nz with its pattern gives M */
+            double *vals = xcalloc((size_t)mech->kin.dyn.nnz + 1, 8);
+            code->mass_nz(q, vals);
+            memset(M, 0, nq * nq * 8);
+            for (int k = 0; k < mech->kin.dyn.nnz; k++)
+                M[code->mass_row[k] * (int)nq + code->mass_col[k]] = vals[k];
+            assert_matrix("mass_nz", M, M0, (int)(nq * nq));
+            free(vals);
+        }
+        for (int k = 0; k < engine_count(); k++)
+            engine_close(&e[k]);
+        free(q), free(qd), free(M), free(M0), free(Q), free(Q0), free(jac), free(jac0), free(gam), free(gam0);
+        pipeline_free(mech);
+    }
+}
+
+/* A spring without damping or actuator is conservative: its Q is -dV/dq,
+   V = k/2 (l - L0)^2, by central differences. */
+static void test_spring_potential(void **state)
+{
+    (void)state;
+    Mech *mech = load_text("body a x = 0.3 y = 0.2 phi = 0.4\npoint p x = 1 y = 1\n"
+                           "weld W: ground a\nconstraint C: p.x = 1\n"
+                           "mass p m = 1\n"
+                           "spring S: a(0.2, -0.1) p k = 30 length = 0.5\n", "spring.mech");
+    Engine e;
+    open_engine(&e, ENGINE_JIT, mech);
+    uint64_t rng = 5;
+    for (int s = 0; s < 10; s++) {
+        double q[5], qd[5] = {0}, t, Q[5];
+        random_state(&rng, 5, mech->model->q0, q, qd, &t);
+        memset(qd, 0, sizeof qd);
+        e.k.force(e.k.ctx, q, qd, t, Q);
+        for (int j = 0; j < 5; j++) {
+            double v[2];
+            for (int side = 0; side < 2; side++) {
+                double w[5];
+                memcpy(w, q, sizeof w);
+                w[j] += side ? -1e-6 : 1e-6;
+                double c = cos(w[2]), sn = sin(w[2]);
+                double ax = w[0] + 0.2 * c + 0.1 * sn, ay = w[1] + 0.2 * sn - 0.1 * c;
+                double l = hypot(w[3] - ax, w[4] - ay);
+                v[side] = 15 * (l - 0.5) * (l - 0.5);
+            }
+            assert_near(Q[j], -(v[0] - v[1]) / 2e-6, 1e-6, 1e-6);
+        }
+    }
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+/* Bodies with their centres of mass at their origins: M is constant, the
+   generated mass function does no arithmetic, and Q only the weights and
+   the spring. Without masses nothing of it is generated. */
+static void test_constant_mass_costs_nothing(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("slider_crank_dynamics.mech");
+    EmitOptions opt = emit_default_options();
+    EmitResult res;
+    Diag diag;
+    assert_true(emit_mechanism(&mech->kin, &opt, &res, &diag));
+    assert_int_equal(res.ops[EMIT_MASS], 0);
+    assert_int_equal(res.ops[EMIT_MASS_NZ], 0);
+    assert_int_equal(mech->kin.dyn.nnz, 9);
+    assert_non_null(strstr(res.h_text, "#define SLIDER_CRANK_DYNAMICS_HAS_DYNAMICS 1"));
+    assert_non_null(strstr(res.c_text, "M[40] = 1.5;"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+
+    mech = load_example("slider_crank.mech");
+    assert_false(mech->kin.dyn.present);
+    assert_true(emit_mechanism(&mech->kin, &opt, &res, &diag));
+    assert_null(strstr(res.c_text, "_mass"));
+    assert_null(strstr(res.h_text, "HAS_DYNAMICS"));
+    Engine e;
+    assert_true(engine_open(&e, ENGINE_GENERIC, mech, &diag));
+    assert_null(e.k.mass);
+    assert_null(e.k.force);
+    engine_close(&e);
+    emit_result_free(&res);
+    pipeline_free(mech);
+}
+
+/* check passes the examples with masses, and catches a wrong entry of M
+   (planted in the jit's): the engines disagree, and M is not symmetric. */
+static void test_check_catches_mass_mistakes(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("pendulum_dynamics.mech");
+    CheckOptions opt = check_default_options();
+    opt.samples = 4;
+    opt.use_aot = false;
+    CheckReport rep;
+    Diag diag;
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    assert_true(rep.ok);
+    for (int w = CHECK_DYN_FIRST; w < CHECK_WHAT_COUNT; w++)
+        assert_int_equal(rep.items[w].checked, strstr(rep.items[w].what, "aot") == NULL);
+    opt.fault = (CheckFault){.kind = CHECK_FAULT_MASS_SCALE, .row = 0, .col = 2, .factor = -1.0};
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    assert_false(rep.ok);
+    assert_true(rep.items[CHECK_DYN_FIRST].error > 0.1);            /* M jit/generic */
+    assert_true(rep.items[CHECK_M_SYMMETRIC].error > 0.1);
+    assert_non_null(strstr(rep.items[CHECK_M_SYMMETRIC].hint, "one triangle"));
+    assert_true(rep.items[CHECK_DYN_FIRST + 1].error <= 1e-12);     /* Q untouched */
+    pipeline_free(mech);
+}
+
+/* ---- bad input ---- */
+
+typedef struct BadCase {
+    const char *text;
+    int line, col;
+    const char *message;
+} BadCase;
+
+#define PRE "body a x = 1\npoint p\ncoord s\nrevolute O: ground a\n"
+
+static const BadCase bad_cases[] = {
+    {PRE "mass a m = -1\n", 5, 8, "the mass m of mass 'a' is negative"},
+    {PRE "mass a m = 1 J = -0.1\n", 5, 14, "the moment of inertia J of mass 'a' is negative"},
+    {PRE "mass b m = 1\n", 5, 6, "unknown name 'b'"},
+    {PRE "mass s m = 1\n", 5, 6, "'s' is a coord"},
+    {PRE "mass p m = 1 J = 2\n", 5, 14, "'p' is a point (a particle): it has no angle"},
+    {PRE "mass a J = 1\n", 5, 13, "expected 'm = ...' for mass 'a'"},
+    {PRE "mass a m = 1\nmass a m = 2\n", 6, 6, "'a' already has a mass (line 5)"},
+    {PRE "mass e: m = 1\n", 5, 14, "expected 'at(x, y)' for the mass element 'e'"},
+    {PRE "mass e: at(a.x, t) m = 1\n", 5, 17, "'t' cannot appear in a mass element's position"},
+    {PRE "mass e: at(a.x, 0) m = 1 J = 2\n", 5, 26, "has J but no 'angle = ...'"},
+    {PRE "mass a m = 1 spin = 2\n", 5, 14, "unknown key 'spin' for mass 'a': expected m, J or com(sx, sy)"},
+    {PRE "mass a m = 1\nspring S: a p k = 1 length = -0.5\n", 6, 21, "the free length of spring 'S' is negative"},
+    {PRE "mass a m = 1\ntorque T: p = 1\n", 6, 11, "'p' is a point (it has no angle)"},
+    {PRE "mass a m = 1\nforce F: q (1, 0)\n", 6, 10, "unknown name 'q'"},
+    {PRE "mass a m = 1\nforce F: ground (1, 0)\n", 6, 10, "acts on ground only: it does no work"},
+    {PRE "mass a m = 1\nrspring R: a p(1, 0) k = 1\n", 6, 15, "acts on bodies' angles"},
+    {PRE "mass a m = 1\ngforce G: a = 1\n", 6, 11, "'a' is a body: write a.x, a.y or a.phi"},
+    {PRE "mass a m = 1\ngravity (0, -9.81)\ngravity (0, 1)\n", 7, 1, "a second gravity statement"},
+    {PRE "gravity (0, -9.81)\n", 5, 1, "gravity without masses"},
+    {PRE "force F: a (1, 0)\n", 5, 1, "a force without masses"},
+    {"spatial\nbody a\nspherical O: ground a\nmass a m = 1\n", 4, 1, "'mass' is planar only for now"},
+};
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof bad_cases / sizeof *bad_cases; i++) {
+        const BadCase *b = &bad_cases[i];
+        MechLimits limits = mech_default_limits();
+        Diag diag;
+        Mech *mech = pipeline_load_text(b->text, "bad.mech", &limits, &diag);
+        if (mech)
+            fail_msg("case %zu loaded: %s", i, b->text);
+        if (!strstr(diag.message, b->message) || diag.line != b->line || diag.col != b->col)
+            fail_msg("case %zu: %d:%d: %s\nexpected %d:%d: %s", i, diag.line, diag.col,
+                     diag.message, b->line, b->col, b->message);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_compound_pendulum),
+        cmocka_unit_test(test_double_pendulum),
+        cmocka_unit_test(test_engines_agree),
+        cmocka_unit_test(test_spring_potential),
+        cmocka_unit_test(test_constant_mass_costs_nothing),
+        cmocka_unit_test(test_check_catches_mass_mistakes),
+        cmocka_unit_test(test_bad_input),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
