@@ -118,10 +118,10 @@ static MechrtStatus ls_newton(Ls *s)
 static MechrtStatus ls_solve(const Ls *s, const mechrt_real *b, mechrt_real *x)
 {
     mechrt_real chk = 0;
-    int i;
+    int n = s->k->nq, i;
 
     mechrt_lup_solve(s->f, b, x);
-    for (i = 0; i < s->k->nq; i++)
+    for (i = 0; i < n; i++)
         chk += x[i] - x[i];
     return chk == 0 ? MECHRT_OK : MECHRT_ENOTFINITE;
 }
