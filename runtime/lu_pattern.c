@@ -26,13 +26,15 @@
  * Storage: slot e < nnz holds pattern entry e (the order of row[] and
  * col[]), fill entries follow. The replay is right-looking like lu.c. The
  * lists are three flat programs of ints, read front to back:
- *   factor, per step k: pivot slot, strict count ns, candidate count nc,
- *     U count nu, U's slots (nu; only when nc > 0), then per candidate its
- *     slot and the nu update targets (the candidates of column k: the first
- *     ns sit before the pivot in lu.c's arrangement and must stay strictly
- *     smaller);
- *   forward, per row i of the arrangement: its original row, the count of
- *     L entries, then (slot, column) pairs, columns ascending;
+ *   factor: the count of steps with candidates, then per such step k: k,
+ *     its pivot's slot, the strict count ns, the candidate count nc, the
+ *     U count nu, U's slots, then per candidate its slot and the nu update
+ *     targets (the candidates of column k: the first ns sit before the
+ *     pivot in lu.c's arrangement and must stay strictly smaller); then
+ *     the count of steps without candidates and those steps, whose pivots
+ *     are only tested (lone pivots);
+ *   forward, column by column: (row i of the arrangement, slot of l_ij,
+ *     column j) triples;
  *   backward, per row i from the last: the slot of u_ii, the count of U
  *     entries, then (slot, column) pairs, columns ascending.
  * After a fallback the factors of that factorisation are lu.c's (the
@@ -117,7 +119,6 @@ MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const
     f->fprog = f->fwd = f->bwd = f->scratch + 3 * nn;
     f->nslots = nnz;
     f->nfwd = 0;
-    f->spread = 0;
     f->ordered = false;
     f->dense_now = false;
     f->analyses = 0;
@@ -151,15 +152,17 @@ static void lup_arrange(const MechrtLup *f, int *pos, int k)
     }
 }
 
-/* Symbolic elimination in the order of piv: marks the fill in the map and
-   sizes the three programs. False if a pivot falls outside the pattern
+/* Symbolic elimination in the order of piv: marks the fill in the map,
+   sizes the three programs and counts the steps without candidates (lone
+   pivots). False if a pivot falls outside the pattern
    (an entry the pattern calls zero was not). */
-static bool lup_fill(MechrtLup *f, size_t *len)
+static bool lup_fill(MechrtLup *f, size_t *len, int *lone)
 {
     int n = f->n, *pos = f->pos, i, j, k;
 
     lup_arrange(f, pos, 0);
-    len[0] = 1;
+    *lone = 0;
+    len[0] = 2;
     len[1] = 0;
     len[2] = 2 * (size_t)n;
     for (k = 0; k < n; k++) {
@@ -182,9 +185,12 @@ static bool lup_fill(MechrtLup *f, size_t *len)
         }
         if (nc > 0)
             len[0] += 5 + (size_t)nu + (size_t)nc * (1 + (size_t)nu);
+        else
+            ++*lone;
         len[1] += 3 * (size_t)nc;   /* a candidate is an L entry of a later row */
         len[2] += 2 * (size_t)nu;
     }
+    len[0] += (size_t)*lone;   /* the list of lone pivots closes the program */
     return true;
 }
 
@@ -283,25 +289,30 @@ static void lup_prog_solve(MechrtLup *f)
 static void lup_analyse(MechrtLup *f)
 {
     size_t len[3], room = f->liw - LUP_IFIXED(f->n);
-    int *w, k;
+    int *w, k, lone = 0;
 
     f->analyses++;
     f->ordered = false;
     f->nslots = f->nnz;
     lup_reset_map(f);
-    if (!lup_fill(f, len) || len[0] > room || len[1] > room - len[0]
+    if (!lup_fill(f, len, &lone) || len[0] > room || len[1] > room - len[0]
         || len[2] > room - len[0] - len[1]) {
         f->nslots = f->nnz;
         return;
     }
     f->fwd = f->fprog + len[0];
     f->bwd = f->fwd + len[1];
+    f->lone = f->fwd - 1 - lone;   /* the end of the factor program */
+    f->lone[0] = lone;
     f->fprog[0] = 0;   /* the count of steps with candidates */
+    lone = 0;
     lup_arrange(f, f->pos, 0);
     w = f->fprog + 1;
     for (k = 0; k < f->n; k++) {
         int *end = lup_prog_step(f, w, k);
         f->fprog[0] += end != w;
+        if (end == w)
+            f->lone[1 + lone++] = k;
         w = end;
     }
     lup_prog_solve(f);
@@ -313,19 +324,26 @@ static void lup_analyse(MechrtLup *f)
    is 0 for every finite x and NaN otherwise, so one sum checks them all. */
 static MechrtStatus lup_scan(MechrtLup *f, mechrt_real *amax_out)
 {
-    mechrt_real *lu = f->lu, amax = 0, chk = 0;
-    int e;
+    mechrt_real *lu = f->lu, a0 = 0, a1 = 0, c0 = 0, c1 = 0;
+    int e, nnz = f->nnz;
 
-    for (e = 0; e < f->nnz; e++) {
-        mechrt_real x = lu[e], v = MECHRT_LUP_ABS(x);
-        chk += x - x;
-        amax = v > amax ? v : amax;
+    for (e = 0; e + 1 < nnz; e += 2) {   /* two chains: half the loop control */
+        mechrt_real x = lu[e], y = lu[e + 1], u = MECHRT_LUP_ABS(x), v = MECHRT_LUP_ABS(y);
+        c0 += x - x;
+        c1 += y - y;
+        a0 = u > a0 ? u : a0;
+        a1 = v > a1 ? v : a1;
     }
-    if (chk != 0)
+    if (e < nnz) {
+        mechrt_real x = lu[e], u = MECHRT_LUP_ABS(x);
+        c0 += x - x;
+        a0 = u > a0 ? u : a0;
+    }
+    if (c0 + c1 != 0)
         return MECHRT_ENOTFINITE;
-    for (e = f->nnz; e < f->nslots; e++)
+    for (e = nnz; e < f->nslots; e++)
         lu[e] = 0;
-    *amax_out = amax;
+    *amax_out = a1 > a0 ? a1 : a0;
     return MECHRT_OK;
 }
 
@@ -364,26 +382,18 @@ static int lup_replay(MechrtLup *f, mechrt_real thresh)
     return f->n;
 }
 
-/* The pivots of steps 0 .. k-1 against the threshold, in order: the
-   replay tested those of steps with candidates; a step without them, whose
-   pivot is final once the steps before it are done, is where lu.c stops
-   with MECHRT_ESING (its column has no other nonzero). Returns the first
-   such step, or -1, and sets the pivot spread when k == n. */
-static int lup_pivots(MechrtLup *f, int k, mechrt_real thresh)
+/* The pivots of the steps before k that have no candidates, against the
+   threshold: the replay tested the others. Such a pivot is final once the
+   steps before it are done, and where it fails lu.c stops with
+   MECHRT_ESING (its column has no other nonzero). Returns the first such
+   step, or -1. */
+static int lup_lone_pivots(const MechrtLup *f, int k, mechrt_real thresh)
 {
-    const mechrt_real *lu = f->lu;
-    mechrt_real lo = MECHRT_LUP_ABS(lu[f->pslot[0]]), hi = lo;
-    int i;
+    const int *p = f->lone + 1, *end = p + f->lone[0];
 
-    for (i = 0; i < k; i++) {
-        mechrt_real ap = MECHRT_LUP_ABS(lu[f->pslot[i]]);
-        if (!(ap > thresh))
-            return i;
-        lo = ap < lo ? ap : lo;
-        hi = ap > hi ? ap : hi;
-    }
-    if (k == f->n)
-        f->spread = hi / lo;
+    for (; p < end && *p < k; p++)
+        if (!(MECHRT_LUP_ABS(f->lu[f->pslot[*p]]) > thresh))
+            return *p;
     return -1;
 }
 
@@ -398,20 +408,6 @@ static void lup_spread_dense(MechrtLup *f, int k)
         for (j = 0; j < n; j++)
             f->dense[i * n + j] = m[j] >= 0 ? f->lu[m[j]] : 0;
     }
-}
-
-/* The pivot spread of lu.c's factors (analysis.c's an_pivot_spread). */
-static mechrt_real lup_dense_spread(const MechrtLup *f)
-{
-    size_t n = (size_t)f->n, k;
-    mechrt_real lo = MECHRT_LUP_ABS(f->dense[0]), hi = lo;
-
-    for (k = 1; k < n; k++) {
-        mechrt_real u = MECHRT_LUP_ABS(f->dense[k * n + k]);
-        lo = u < lo ? u : lo;
-        hi = u > hi ? u : hi;
-    }
-    return hi / lo;
 }
 
 /* lu.c finishes what the replay began at step k (k = 0 without an order:
@@ -435,10 +431,8 @@ static MechrtStatus lup_fallback(MechrtLup *f, int k, mechrt_real pivot_tol, mec
     }
     f->ordered = false;   /* piv no longer matches the programs */
     f->dense_now = st == MECHRT_OK;
-    if (st == MECHRT_OK) {
-        f->spread = lup_dense_spread(f);
+    if (st == MECHRT_OK)
         lup_analyse(f);
-    }
     return st;
 }
 
@@ -461,7 +455,7 @@ MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_in
     /* lu.c's test |u_kk| <= thresh || u_kk == 0 as one comparison */
     thresh = pivot_tol * amax > 0 ? pivot_tol * amax : 0;
     k = lup_replay(f, thresh);
-    sing = lup_pivots(f, k, thresh);
+    sing = lup_lone_pivots(f, k, thresh);
     if (sing >= 0) {
         if (sing_index)
             *sing_index = sing;
@@ -521,9 +515,28 @@ void mechrt_lup_solve(const MechrtLup *f, const mechrt_real *b, mechrt_real *x)
     }
 }
 
+/* analysis.c's an_pivot_spread, over the pivots in step order. */
 mechrt_real mechrt_lup_spread(const MechrtLup *f)
 {
-    return f->spread;
+    size_t n = (size_t)f->n, k;
+    mechrt_real lo, hi;
+
+    if (f->dense_now) {
+        lo = hi = MECHRT_LUP_ABS(f->dense[0]);
+        for (k = 1; k < n; k++) {
+            mechrt_real u = MECHRT_LUP_ABS(f->dense[k * n + k]);
+            lo = u < lo ? u : lo;
+            hi = u > hi ? u : hi;
+        }
+    } else {
+        lo = hi = MECHRT_LUP_ABS(f->lu[f->pslot[0]]);
+        for (k = 1; k < n; k++) {
+            mechrt_real u = MECHRT_LUP_ABS(f->lu[f->pslot[k]]);
+            lo = u < lo ? u : lo;
+            hi = u > hi ? u : hi;
+        }
+    }
+    return hi / lo;
 }
 
 mechrt_real mechrt_lup_norm1(MechrtLup *f, const mechrt_real *vals)

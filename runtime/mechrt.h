@@ -94,14 +94,14 @@ typedef enum MechrtStatus {
    and its workspaces' lengths for n coordinates, usable as static array
    sizes: reals (the factors' slots n*n, the dense fallback's n*n, 4n
    vectors) and ints (the map n*n and 6n, then programs for the worst
-   fill: 7n + 1, 4 per entry of L and of U, n(n-1)/2 each, and 1 per
+   fill: 8n + 2, 4 per entry of L and of U, n(n-1)/2 each, and 1 per
    update, (n-1)n(2n-1)/6). A sparse Jacobian's programs are far shorter,
    and a shorter array works while they fit (the factorisations stay
    dense otherwise); mechrt_lup_init needs n*n + 6n. */
 #define MECHRT_LUP_MAX_N 46340
 #define MECHRT_LUP_WORK_LEN(n) (2u * (size_t)(n) * (size_t)(n) + 4u * (size_t)(n))
 #define MECHRT_LUP_IWORK_LEN(n)                                                  \
-    ((size_t)(n) * (size_t)(n) + 13u * (size_t)(n) + 1u                          \
+    ((size_t)(n) * (size_t)(n) + 14u * (size_t)(n) + 2u                          \
      + 4u * (size_t)(n) * ((size_t)(n) - 1u)                                     \
      + ((size_t)(n) - 1u) * (size_t)(n) * (2u * (size_t)(n) - 1u) / 6u)
 
@@ -435,9 +435,9 @@ typedef struct MechrtLup {
     int *pslot;             /* n: the slot of u_ii */
     int *pos, *scratch;     /* n and 3n: the analysis' scratch */
     int *fprog, *fwd, *bwd; /* the factor, forward and backward programs */
+    int *lone;              /* the steps without candidates: count, then steps */
     int nslots;             /* nnz + the fill of the recorded order */
     int nfwd;               /* entries of L (the forward program's triples) */
-    mechrt_real spread;     /* max|u_kk| / min|u_kk| of the last factors */
     bool ordered;           /* an order is recorded: factorisations replay it */
     bool dense_now;         /* the current factors are lu.c's, in dense */
     long analyses;          /* orders recorded (factorisations lu.c finished) */

@@ -1281,7 +1281,7 @@ static void test_lup_workspace(void **state)
 
     assert_int_equal(mechrt_lup_work_size(12), MECHRT_LUP_WORK_LEN(12));
     assert_int_equal(mechrt_lup_iwork_size(12), MECHRT_LUP_IWORK_LEN(12));
-    assert_int_equal(mechrt_lup_iwork_size(1), 1 + 13 + 1);
+    assert_int_equal(mechrt_lup_iwork_size(1), 1 + 14 + 2);
     assert_int_equal(mechrt_lup_work_size(0), 0);
     assert_int_equal(mechrt_lup_iwork_size(MECHRT_LUP_MAX_N + 1), 0);
     assert_int_equal(mechrt_lup_init(&f, 3, 2, row, col, work, 99, iwork, 99), MECHRT_EINVAL);
