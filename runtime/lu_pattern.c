@@ -53,9 +53,14 @@
 
 size_t mechrt_lup_work_size(int n)
 {
+    size_t m;
+
     if (n < 1 || n > MECHRT_LUP_MAX_N)
         return 0;
-    return MECHRT_LUP_WORK_LEN(n);
+    m = (size_t)n;
+    if (m > ((size_t)-1 / 4) / m)   /* 2n^2 + 4n on a 32-bit size_t */
+        return 0;
+    return MECHRT_LUP_WORK_LEN(m);
 }
 
 size_t mechrt_lup_iwork_size(int n)
@@ -95,6 +100,8 @@ MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const
         || (nnz > 0 && (!row || !col)) || !work || !iwork)
         return MECHRT_EINVAL;
     nn = (size_t)n;
+    if (mechrt_lup_work_size(n) == 0)
+        return MECHRT_EINVAL;
     if (lwork < MECHRT_LUP_WORK_LEN(nn) || liwork < LUP_IFIXED(nn))
         return MECHRT_EBADLEN;
     for (e = 0; e < nnz; e++)
@@ -109,7 +116,6 @@ MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const
     f->piv = f->dense + nn * nn;
     f->tmp = f->piv + nn;
     f->cwork = f->tmp + nn;
-    f->iw = iwork;
     f->liw = liwork;
     f->map = iwork;
     f->prow = iwork + nn * nn;

@@ -428,8 +428,7 @@ typedef struct MechrtLup {
     mechrt_real *piv;       /* n: the recorded order's interchanges (lu.c's form) */
     mechrt_real *tmp;       /* n: the forward substitution */
     mechrt_real *cwork;     /* 2n: the condition estimate */
-    int *iw;                /* the integer workspace, liw ints */
-    size_t liw;
+    size_t liw;             /* ints in the integer workspace (map is its start) */
     int *map;               /* n*n: slot of entry (r, j), -1 where zero */
     int *prow;              /* n: the original row of pivot i */
     int *pslot;             /* n: the slot of u_ii */
