@@ -404,7 +404,7 @@ static int lup_lone_pivots(const MechrtLup *f, int k, mechrt_real thresh)
 }
 
 /* lu.c's layout of the slots after k steps of the recorded order. */
-static void lup_spread_dense(MechrtLup *f, int k)
+static void lup_to_dense(MechrtLup *f, int k)
 {
     size_t n = (size_t)f->n, i, j;
 
@@ -424,7 +424,7 @@ static MechrtStatus lup_fallback(MechrtLup *f, int k, mechrt_real pivot_tol, mec
     MechrtStatus st;
 
     if (f->ordered) {
-        lup_spread_dense(f, k);
+        lup_to_dense(f, k);
         st = mechrt_lu_resume(f->n, f->dense, f->n, f->piv, k, thresh, sing_index);
     } else {
         size_t i, nn = (size_t)f->n * (size_t)f->n;
@@ -561,7 +561,7 @@ mechrt_real mechrt_lup_norm1(MechrtLup *f, const mechrt_real *vals)
 mechrt_real mechrt_lup_cond1(MechrtLup *f, mechrt_real anorm)
 {
     if (!f->dense_now) {
-        lup_spread_dense(f, f->n);
+        lup_to_dense(f, f->n);
         f->dense_now = true;
     }
     return mechrt_lu_cond1(f->n, f->dense, f->n, f->piv, anorm, f->cwork);
