@@ -12,11 +12,14 @@
 #   all ns         one call of the fused kernel (Phi, Phi_q, nu, gamma)
 #   step/all       the step's cost in calls of that kernel
 # instructions (AOT engine, when valgrind is installed; one run of STEPS/5
-# steps under callgrind, counting only inside mechrt_step, so deterministic
-# where wall times on a shared machine are not):
-#   Ir/step        instructions per mechrt_step call
+# steps under callgrind, counting only inside the runtime's step,
+# mechrt_step_lup (the pattern LU, what run uses up to 100 coordinates)
+# or mechrt_step (the dense LU), so deterministic where wall times on a
+# shared machine are not):
+#   Ir/step        instructions per step call
 #   Ir/all         instructions per call of the AOT `all` kernel
-#   step/all Ir    the step's cost in kernel calls, by instructions
+#   step/all Ir    the step's cost in `all` calls, by instructions
+#   kernels        the kernel calls a step makes, and their instructions
 # Engines that cannot run here are skipped.
 set -u
 if [ $# -lt 1 ]; then
@@ -75,28 +78,35 @@ count_file() {
         echo "instructions: skipped (no valgrind)"
         return
     fi
-    if ! valgrind --tool=callgrind --toggle-collect=mechrt_step \
+    if ! valgrind --tool=callgrind --toggle-collect=mechrt_step --toggle-collect=mechrt_step_lup \
             --callgrind-out-file="$tmp/cg" "$mechc" run "$1" --steps $n --engine aot \
             --csv /dev/null > /dev/null 2>&1; then
         echo "instructions: skipped (the aot engine or valgrind failed)"
         return
     fi
     total=$(sed -n 's/^summary: //p' "$tmp/cg")
-    used=$(awk -v fn=mechc_aot_all -f "$here/callgrind_calls.awk" "$tmp/cg")
-    # the unit: one `all` call, from run --stats' timing loop (Newton itself
-    # calls phi and jac instead when `all` costs much more: engine.h)
+    # the kernels the step called: name, calls and instructions, per step
+    kernels=$(for k in all phi jac jac_nz nu gamma; do
+        set -- $(awk -v fn=mechc_aot_$k -f "$here/callgrind_calls.awk" "$tmp/cg") 0 0
+        [ "$1" -gt 0 ] && echo "$k $1 $2"
+    done)
+    # the unit: one `all` call, from run --stats' timing loop
     if ! valgrind --tool=callgrind --toggle-collect=run_time_all \
             --callgrind-out-file="$tmp/cg2" "$mechc" run "$1" --steps 1 --engine aot --stats \
             --csv /dev/null > /dev/null 2>&1; then
         echo "instructions: skipped (the aot engine or valgrind failed)"
         return
     fi
-    set -- $(awk -v fn=mechc_aot_all -f "$here/callgrind_calls.awk" "$tmp/cg2") ${used:-0 0}
-    # mechrt_step runs once at t0 (h = 0) and once per step
-    awk -v total="$total" -v calls="$1" -v ir="$2" -v used="$3" -v n="$n" 'BEGIN {
-        step = total / (n + 1); all = ir / calls
-        printf "instructions (aot, %d steps): %.0f per step, %.0f per all call (%.2f calls per step): step/all %.2f\n",
-               n, step, all, used / (n + 1), step / all }'
+    set -- $(awk -v fn=mechc_aot_all -f "$here/callgrind_calls.awk" "$tmp/cg2")
+    # the step runs once at t0 (h = 0) and once per step
+    echo "$kernels" | awk -v total="$total" -v calls="$1" -v ir="$2" -v n="$n" '
+        NF == 3 { list = list sprintf("%s%s %.2f", sep, $1, $2 / (n + 1)); sep = ", "; kir += $3 }
+        END {
+            step = total / (n + 1); all = ir / calls
+            printf "instructions (aot, %d steps): %.0f per step, %.0f per all call: step/all %.2f\n",
+                   n, step, all, step / all
+            printf "  kernels per step: %s (%.0f instructions, %.0f%%)\n", list,
+                   kir / (n + 1), 100 * kir / total }'
 }
 
 for f in $files; do

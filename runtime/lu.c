@@ -133,11 +133,11 @@ static MechrtStatus lu_scan(int n, const mechrt_real *a, size_t ld, mechrt_real 
  * to that tolerance, a combination of columns 0..k-1.
  */
 static MechrtStatus lu_eliminate(int n, mechrt_real *a, size_t ld, mechrt_real *piv,
-                                 mechrt_real thresh, int *sing_index)
+                                 int k0, mechrt_real thresh, int *sing_index)
 {
     int i, j, k;
 
-    for (k = 0; k < n; k++) {
+    for (k = k0; k < n; k++) {
         mechrt_real *rk = a + (size_t)k * ld;
         mechrt_real pmax = MECHRT_FABS(rk[k]), pivot;
         int p = k;
@@ -194,7 +194,17 @@ static MechrtStatus lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
     st = lu_scan(n, a, (size_t)lda, &amax, colsum);
     if (st != MECHRT_OK)
         return st;
-    return lu_eliminate(n, a, (size_t)lda, piv, pivot_tol * amax, sing_index);
+    return lu_eliminate(n, a, (size_t)lda, piv, 0, pivot_tol * amax, sing_index);
+}
+
+MechrtStatus mechrt_lu_resume(int n, mechrt_real *a, int lda, mechrt_real *piv, int k0,
+                              mechrt_real thresh, int *sing_index)
+{
+    if (sing_index)
+        *sing_index = -1;
+    if (n < 0 || lda < n || k0 < 0 || k0 > n || (n > 0 && (!a || !piv)))
+        return MECHRT_EINVAL;
+    return lu_eliminate(n, a, (size_t)lda, piv, k0, thresh, sing_index);
 }
 
 MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,

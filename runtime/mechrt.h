@@ -90,6 +90,31 @@ typedef enum MechrtStatus {
         P##_NQ, P##_NH, P##_NV, NULL, p##_mechrt_phi, p##_mechrt_jac,            \
         p##_mechrt_nu, p##_mechrt_gamma, p##_mechrt_all, NULL, NULL}
 
+/* Pattern LU (lu_pattern.c): the largest n (its n*n index map is of int),
+   and its workspaces' lengths for n coordinates, usable as static array
+   sizes: reals (the factors' slots n*n, the dense fallback's n*n, 4n
+   vectors) and ints (the map n*n and 6n, then programs for the worst
+   fill: 8n + 2, 4 per entry of L and of U, n(n-1)/2 each, and 1 per
+   update, (n-1)n(2n-1)/6). A sparse Jacobian's programs are far shorter,
+   and a shorter array works while they fit (the factorisations stay
+   dense otherwise); mechrt_lup_init needs n*n + 6n. */
+#define MECHRT_LUP_MAX_N 46340
+#define MECHRT_LUP_WORK_LEN(n) (2u * (size_t)(n) * (size_t)(n) + 4u * (size_t)(n))
+#define MECHRT_LUP_IWORK_LEN(n)                                                  \
+    ((size_t)(n) * (size_t)(n) + 14u * (size_t)(n) + 2u                          \
+     + 4u * (size_t)(n) * ((size_t)(n) - 1u)                                     \
+     + ((size_t)(n) - 1u) * (size_t)(n) * (2u * (size_t)(n) - 1u) / 6u)
+
+/* MECHRT_DEFINE_JAC_NZ(fb, FB) wraps the sparse Jacobian of `mechc gen
+   --prefix fb` (fb_jac_nz, fb_jac_row, fb_jac_col, FB_NNZ) and defines
+   `static const MechrtJacNz fb_jac_nz_kernel` for mechrt_step_lup. */
+#define MECHRT_DEFINE_JAC_NZ(p, P)                                               \
+    static void p##_mechrt_jac_nz(void *ctx, const mechrt_real *q, mechrt_real t, \
+                                  mechrt_real *vals)                             \
+    { (void)ctx; p##_jac_nz(q, t, vals); }                                       \
+    static const MechrtJacNz p##_jac_nz_kernel = {                               \
+        P##_NNZ, p##_jac_row, p##_jac_col, NULL, p##_mechrt_jac_nz}
+
 #endif /* MECHRT_H_COMMON */
 
 /* ---- Part that depends on the real type ------------------------------- */
@@ -114,6 +139,7 @@ typedef enum MechrtStatus {
 #define mechrt_lu_factor             mechrtf_lu_factor
 #define mechrt_lu_factor_norm1       mechrtf_lu_factor_norm1
 #define mechrt_lu_solve              mechrtf_lu_solve
+#define mechrt_lu_resume             mechrtf_lu_resume
 #define mechrt_lu_solve_t            mechrtf_lu_solve_t
 #define mechrt_lu_cond1              mechrtf_lu_cond1
 #define mechrt_newton_init           mechrtf_newton_init
@@ -126,6 +152,19 @@ typedef enum MechrtStatus {
 #define mechrt_velocity_acceleration mechrtf_velocity_acceleration
 #define mechrt_step                  mechrtf_step
 #define mechrt_report_clear          mechrtf_report_clear
+#define MechrtLup                    MechrtfLup
+#define MechrtJacNz                  MechrtfJacNz
+#define mechrt_lup_work_size         mechrtf_lup_work_size
+#define mechrt_lup_iwork_size        mechrtf_lup_iwork_size
+#define mechrt_lup_init              mechrtf_lup_init
+#define mechrt_lup_factor            mechrtf_lup_factor
+#define mechrt_lup_values            mechrtf_lup_values
+#define mechrt_lup_factor_dense      mechrtf_lup_factor_dense
+#define mechrt_lup_solve             mechrtf_lup_solve
+#define mechrt_lup_spread            mechrtf_lup_spread
+#define mechrt_lup_norm1             mechrtf_lup_norm1
+#define mechrt_lup_cond1             mechrtf_lup_cond1
+#define mechrt_step_lup              mechrtf_step_lup
 typedef float mechrt_real;
 #else
 typedef double mechrt_real;
@@ -277,6 +316,12 @@ MechrtStatus mechrt_lu_factor(int n, mechrt_real *a, int lda, mechrt_real *piv,
 MechrtStatus mechrt_lu_factor_norm1(int n, mechrt_real *a, int lda, mechrt_real *piv,
                                     mechrt_real pivot_tol, int *sing_index,
                                     mechrt_real *anorm, mechrt_real *work);
+
+/* The elimination of mechrt_lu_factor from step k0 on: a holds the matrix
+   after steps 0 .. k0-1 (their interchanges in piv), thresh is pivot_tol
+   times max|a_ij| of the original matrix. The pattern LU's fallback. */
+MechrtStatus mechrt_lu_resume(int n, mechrt_real *a, int lda, mechrt_real *piv, int k0,
+                              mechrt_real thresh, int *sing_index);
 
 /* Solve A x = b with the factors of mechrt_lu_factor; b is overwritten by x. */
 void mechrt_lu_solve(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,
@@ -454,5 +499,110 @@ MechrtStatus mechrt_inverse_dynamics(const MechrtKernels *k, const MechrtDynOpti
 MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions *opts,
                                   const mechrt_real *q, mechrt_real t, unsigned char *active,
                                   mechrt_real *work, size_t lwork, MechrtDynReport *report);
+
+/* |x| in one instruction where the compiler has a builtin for it
+   (MECHRT_FABS is a compare and a branch, as -0 must stay -0 there); for
+   the pattern LU's comparisons, which treat -0 and +0 alike. */
+#undef MECHRT_LUP_ABS
+#if defined(__GNUC__) && defined(MECHRT_REAL_FLOAT)
+#define MECHRT_LUP_ABS(x) __builtin_fabsf(x)
+#elif defined(__GNUC__)
+#define MECHRT_LUP_ABS(x) __builtin_fabs(x)
+#else
+#define MECHRT_LUP_ABS(x) MECHRT_FABS(x)
+#endif
+
+/* ---- Pattern LU (lu_pattern.c) -----------------------------------------
+   The LU of n x n matrices that share a sparsity pattern (entry e at
+   (row[e], col[e]); every entry outside it must be zero), with the dense
+   LU's results bit for bit: the first factorisation is mechrt_lu_factor's,
+   whose pivot order and fill are recorded (on the integer workspace) and
+   replayed by the later ones over the nonzeros only, as long as partial
+   pivoting would choose the same pivots; otherwise that factorisation is
+   the dense one again, and its order is recorded. The state is the
+   caller's; its fields are for reading (counts, tests). */
+typedef struct MechrtLup {
+    int n, nnz;
+    const int *row, *col;   /* the pattern, kept by pointer */
+    mechrt_real *lu;        /* slots: pattern entry e in slot e, fill after */
+    mechrt_real *dense;     /* n*n: lu.c's factors (fallback, estimate) */
+    mechrt_real *piv;       /* n: the recorded order's interchanges (lu.c's form) */
+    mechrt_real *tmp;       /* n: the forward substitution */
+    mechrt_real *cwork;     /* 2n: the condition estimate */
+    size_t liw;             /* ints in the integer workspace (map is its start) */
+    int *map;               /* n*n: slot of entry (r, j), -1 where zero */
+    int *prow;              /* n: the original row of pivot i */
+    int *pslot;             /* n: the slot of u_ii */
+    int *pos, *scratch;     /* n and 3n: the analysis' scratch */
+    int *fprog, *fwd, *bwd; /* the factor, forward and backward programs */
+    int *lone;              /* the steps without candidates: count, then steps */
+    int nslots;             /* nnz + the fill of the recorded order */
+    int nfwd;               /* entries of L (the forward program's triples) */
+    bool ordered;           /* an order is recorded: factorisations replay it */
+    bool dense_now;         /* the current factors are lu.c's, in dense */
+    long analyses;          /* orders recorded (factorisations lu.c finished) */
+    long replays;           /* factorisations done wholly by replaying */
+} MechrtLup;
+
+/* The kernels' sparse Jacobian (spec section 4: P_NNZ, P_jac_row,
+   P_jac_col, P_jac_nz): jac_nz writes the nnz values in the pattern's order. */
+typedef struct MechrtJacNz {
+    int nnz;
+    const int *row, *col;
+    void *ctx;              /* passed unchanged to jac_nz */
+    void (*jac_nz)(void *ctx, const mechrt_real *q, mechrt_real t, mechrt_real *vals);
+} MechrtJacNz;
+
+/* MECHRT_LUP_WORK_LEN(n) and MECHRT_LUP_IWORK_LEN(n) with overflow checks;
+   0 if n < 1, n > MECHRT_LUP_MAX_N or on overflow. */
+size_t mechrt_lup_work_size(int n);
+size_t mechrt_lup_iwork_size(int n);
+
+/* Binds f to the pattern (nnz entries, checked: in range, none repeated)
+   and the workspaces; nothing recorded yet. MECHRT_EINVAL on a bad
+   pattern, MECHRT_EBADLEN when lwork < MECHRT_LUP_WORK_LEN(n) or liwork <
+   n*n + 6n. */
+MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const int *col,
+                             mechrt_real *work, size_t lwork, int *iwork, size_t liwork);
+
+/* Where the pattern's values go (nnz reals, entry e at e) before
+   mechrt_lup_factor, which consumes them. */
+mechrt_real *mechrt_lup_values(MechrtLup *f);
+
+/* Factors the matrix whose pattern values are in mechrt_lup_values(f):
+   status, *sing_index and factors those of mechrt_lu_factor on the dense
+   matrix. sing_index may be NULL. */
+MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_index);
+
+/* The same from a dense row-major matrix (left unchanged), zero outside
+   the pattern. */
+MechrtStatus mechrt_lup_factor_dense(MechrtLup *f, const mechrt_real *a, int lda,
+                                     mechrt_real pivot_tol, int *sing_index);
+
+/* x = A^-1 b with the last successful factorisation; x may be b. */
+void mechrt_lup_solve(const MechrtLup *f, const mechrt_real *b, mechrt_real *x);
+
+/* max|u_kk| / min|u_kk| of the last successful factorisation: the
+   condition estimate's screen (analysis.c's). */
+mechrt_real mechrt_lup_spread(const MechrtLup *f);
+
+/* mechrt_norm1 of the matrix whose pattern values are vals (nnz). */
+mechrt_real mechrt_lup_norm1(MechrtLup *f, const mechrt_real *vals);
+
+/* mechrt_lu_cond1 on the factors, anorm the matrix's 1-norm. */
+mechrt_real mechrt_lup_cond1(MechrtLup *f, mechrt_real anorm);
+
+/* mechrt_step with the pattern LU f (mechrt_lup_init'ed once for the run,
+   its pattern that of the Jacobian): the same predictor, Newton, velocity
+   and acceleration, the same results and report. With jnz, Newton
+   evaluates Phi by the phi kernel and the Jacobian by jnz->jac_nz into the
+   workspace (no n x n matrix formed); with jnz NULL, by `all` (or phi and
+   jac) as mechrt_step does, the dense Jacobian then read at the pattern's
+   entries. work as mechrt_step's. */
+MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, MechrtLup *f,
+                             const MechrtOptions *opts,
+                             mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
+                             mechrt_real t, mechrt_real h,
+                             mechrt_real *work, size_t lwork, MechrtReport *report);
 
 #endif /* real-type part */

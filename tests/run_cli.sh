@@ -305,6 +305,7 @@ check "--stats: exit 0" status_is 0
 check "--stats: Newton iterations per step" err_has "Newton iterations per step"
 check "--stats: ns per step" err_has "ns per step"
 check "--stats: cost in all-kernel calls" err_has "a step costs"
+check "--stats: the pattern LU kept the slider-crank's first pivot order" err_has "pattern LU: 1 of "
 
 # ---- JSON ------------------------------------------------------------------
 run "$ex/slider_crank.mech" --steps 4 --json

@@ -11,6 +11,7 @@
 #include "testutil.h"
 
 #include <stdlib.h>
+#include <string.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_permutation.h>
@@ -1090,6 +1091,341 @@ static void test_kernel_wrappers(void **state)
     assert_near(q[0], CI_R * cos(CI_C + CI_W * (t + h)), 0, 1e-12);
 }
 
+/* ---- pattern LU -----------------------------------------------------------
+ * mechrt_lup_* against lu.c on the same matrices: by design the same
+ * operations in the same order, so the comparisons are exact (==), which
+ * is stronger than the 1e-12 of issue 17. */
+
+/* A random n x n pattern (density about d, the diagonal always in) with
+   values; row-major entries, as the generated kernels list them. */
+typedef struct LupCase {
+    int n, nnz;
+    int row[400], col[400];
+    double val[400];
+} LupCase;
+
+static void lup_case(LupCase *c, int n, double d, uint64_t *seed)
+{
+    c->n = n;
+    c->nnz = 0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            if (i == j || fabs(rnd(seed)) < d) {
+                c->row[c->nnz] = i;
+                c->col[c->nnz] = j;
+                c->val[c->nnz++] = rnd(seed);
+            }
+}
+
+static void lup_dense_of(const LupCase *c, double *a)
+{
+    for (int i = 0; i < c->n * c->n; i++)
+        a[i] = 0;
+    for (int e = 0; e < c->nnz; e++)
+        a[c->row[e] * c->n + c->col[e]] = c->val[e];
+}
+
+/* Factors c's values both ways and checks statuses, sing_index and, when
+   both succeed, the solution of a random right side, bit for bit. */
+static MechrtStatus lup_check(MechrtLup *f, const LupCase *c, uint64_t *seed)
+{
+    int n = c->n, sd, sp;
+    double a[400], piv[20], b[20], xd[20], xp[20];
+
+    lup_dense_of(c, a);
+    for (int e = 0; e < c->nnz; e++)
+        mechrt_lup_values(f)[e] = c->val[e];
+    MechrtStatus std = mechrt_lu_factor(n, a, n, piv, 1e-12, &sd);
+    MechrtStatus stp = mechrt_lup_factor(f, 1e-12, &sp);
+    assert_int_equal(stp, std);
+    assert_int_equal(sp, sd);
+    if (std != MECHRT_OK)
+        return std;
+    for (int i = 0; i < n; i++)
+        xd[i] = b[i] = rnd(seed);
+    mechrt_lu_solve(n, a, n, piv, xd);
+    mechrt_lup_solve(f, b, xp);
+    for (int i = 0; i < n; i++)
+        if (xp[i] != xd[i])
+            fail_msg("n = %d, x[%d]: pattern %.17g, dense %.17g", n, i, xp[i], xd[i]);
+    assert_true(mechrt_lup_spread(f) >= 1);
+    return std;
+}
+
+/* Random sparse systems of sizes 1..20, each factored 30 times with
+   values drifting (the pivot order mostly kept: replays) and jumping
+   (new orders: lu.c finishes and the order is recorded again). */
+static void test_lup_matches_dense(void **state)
+{
+    (void)state;
+    static double work[MECHRT_LUP_WORK_LEN(20)];
+    static int iwork[MECHRT_LUP_IWORK_LEN(20)];
+    uint64_t seed = 17;
+    long replays = 0, analyses = 0;
+
+    for (int n = 1; n <= 20; n++) {
+        LupCase c;
+        MechrtLup f;
+        lup_case(&c, n, 0.2, &seed);
+        assert_int_equal(mechrt_lup_init(&f, n, c.nnz, c.row, c.col, work, MECHRT_LUP_WORK_LEN(n),
+                                         iwork, MECHRT_LUP_IWORK_LEN(n)), MECHRT_OK);
+        for (int rep = 0; rep < 30; rep++) {
+            double jump = rep % 10 == 9 ? 1.0 : 0.01;
+            lup_check(&f, &c, &seed);
+            for (int e = 0; e < c.nnz; e++)
+                c.val[e] += jump * rnd(&seed);
+        }
+        replays += f.replays;
+        analyses += f.analyses;
+    }
+    /* most factorisations replay; random values tie often, so orders
+       change on drift too, besides the 60 jumps */
+    assert_true(replays > 3 * analyses);
+    assert_true(analyses > 60);
+}
+
+/* The recorded pivot vanishes, or is overtaken (also by a tie that lu.c
+   breaks the other way): lu.c finishes the factorisation and the new
+   order is recorded; same results. */
+static void test_lup_pivot_fallback(void **state)
+{
+    (void)state;
+    /* full 3 x 3: column 0's pivot is row 2 first (|3| largest) */
+    LupCase c = {3, 9, {0, 0, 0, 1, 1, 1, 2, 2, 2}, {0, 1, 2, 0, 1, 2, 0, 1, 2},
+                 {1, 2, 3, 2, 1, 4, 3, 5, 1}};
+    double work[MECHRT_LUP_WORK_LEN(3)];
+    int iwork[MECHRT_LUP_IWORK_LEN(3)];
+    uint64_t seed = 5;
+    MechrtLup f;
+
+    assert_int_equal(mechrt_lup_init(&f, 3, c.nnz, c.row, c.col, work, MECHRT_LUP_WORK_LEN(3),
+                                     iwork, MECHRT_LUP_IWORK_LEN(3)), MECHRT_OK);
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(f.analyses, 1);
+    assert_int_equal(f.replays, 0);
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(f.replays, 1);
+    c.val[6] = 0;   /* the pivot of column 0 vanishes */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(f.analyses, 2);
+    assert_int_equal(f.replays, 1);
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);   /* the new order replays */
+    assert_int_equal(f.replays, 2);
+    c.val[6] = 2;   /* ties row 1 (before it): lu.c keeps the first, row 1 */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    c.val[3] = -2;  /* still tied, sign aside */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    long before = f.analyses;
+    c.val[6] = 2.5; /* overtakes */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(f.analyses, before + 1);
+}
+
+/* Singular matrices: MECHRT_ESING at lu.c's step, whether the step has
+   candidates or not, with or without an order; NaN is ENOTFINITE; a
+   regular matrix afterwards factors again. */
+static void test_lup_singular(void **state)
+{
+    (void)state;
+    /* 4 x 4, lower bidiagonal plus a corner: column 3 has one entry */
+    LupCase c = {4, 7, {0, 1, 1, 2, 2, 3, 3}, {0, 0, 1, 1, 2, 2, 3},
+                 {2, 1, 3, 1, 4, 1, 5}};
+    double work[MECHRT_LUP_WORK_LEN(4)];
+    int iwork[MECHRT_LUP_IWORK_LEN(4)];
+    uint64_t seed = 9;
+    MechrtLup f;
+
+    assert_int_equal(mechrt_lup_init(&f, 4, c.nnz, c.row, c.col, work, MECHRT_LUP_WORK_LEN(4),
+                                     iwork, MECHRT_LUP_IWORK_LEN(4)), MECHRT_OK);
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    c.val[6] = 1e-14;   /* a step without candidates: below 1e-12 * max */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_ESING);
+    c.val[6] = 5;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    c.val[2] = 0;   /* column 1 all zero: singular at step 1 (lu.c decides) */
+    c.val[3] = 0;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_ESING);
+    c.val[2] = 3;
+    c.val[3] = 1;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    c.val[0] = 0;
+    c.val[1] = 0;   /* column 0 all zero: the first step */
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_ESING);
+    c.val[0] = 2;
+    c.val[1] = 1;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    c.val[4] = NAN;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_ENOTFINITE);
+    c.val[4] = INFINITY;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_ENOTFINITE);
+    c.val[4] = 4;
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    /* replays: the tiny pivot (ESING without lu.c), the two regular
+       matrices after it; lu.c finished the two with a zero column and the
+       order was recorded anew after each */
+    assert_int_equal(f.replays, 2);
+    assert_int_equal(f.analyses, 3);
+}
+
+/* Sizes, bad patterns and short workspaces; an integer workspace with room
+   for no program keeps every factorisation dense, with the same results. */
+static void test_lup_workspace(void **state)
+{
+    (void)state;
+    LupCase c;
+    uint64_t seed = 3;
+    double work[MECHRT_LUP_WORK_LEN(12)];
+    int iwork[MECHRT_LUP_IWORK_LEN(12)];
+    MechrtLup f;
+    int row[2] = {0, 0}, col[2] = {1, 1}, bad[2] = {0, 3};
+
+    assert_int_equal(mechrt_lup_work_size(12), MECHRT_LUP_WORK_LEN(12));
+    assert_int_equal(mechrt_lup_iwork_size(12), MECHRT_LUP_IWORK_LEN(12));
+    assert_int_equal(mechrt_lup_iwork_size(1), 1 + 14 + 2);
+    assert_int_equal(mechrt_lup_work_size(0), 0);
+    assert_int_equal(mechrt_lup_iwork_size(MECHRT_LUP_MAX_N + 1), 0);
+    assert_int_equal(mechrt_lup_init(&f, 3, 2, row, col, work, 99, iwork, 99), MECHRT_EINVAL);
+    assert_int_equal(mechrt_lup_init(&f, 3, 2, bad, col, work, 99, iwork, 99), MECHRT_EINVAL);
+    assert_int_equal(mechrt_lup_init(&f, 3, 2, col, bad, work, 99, iwork, 99), MECHRT_EINVAL);
+    assert_int_equal(mechrt_lup_init(&f, 3, 1, row, col, work, MECHRT_LUP_WORK_LEN(3) - 1,
+                                     iwork, 99), MECHRT_EBADLEN);
+    assert_int_equal(mechrt_lup_init(&f, 3, 1, row, col, work, 99, iwork, 9 + 17),
+                     MECHRT_EBADLEN);
+    assert_int_equal(mechrt_lup_init(NULL, 3, 1, row, col, work, 99, iwork, 99), MECHRT_EINVAL);
+
+    lup_case(&c, 12, 0.3, &seed);
+    assert_int_equal(mechrt_lup_init(&f, 12, c.nnz, c.row, c.col, work, MECHRT_LUP_WORK_LEN(12),
+                                     iwork, 144 + 72), MECHRT_OK);
+    for (int rep = 0; rep < 3; rep++)
+        assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(f.replays, 0);
+    assert_false(f.ordered);
+    /* from a dense matrix: the same as from the values */
+    double a[144];
+    lup_dense_of(&c, a);
+    assert_int_equal(mechrt_lup_init(&f, 12, c.nnz, c.row, c.col, work, MECHRT_LUP_WORK_LEN(12),
+                                     iwork, MECHRT_LUP_IWORK_LEN(12)), MECHRT_OK);
+    assert_int_equal(lup_check(&f, &c, &seed), MECHRT_OK);
+    assert_int_equal(mechrt_lup_factor_dense(&f, a, 12, 1e-12, NULL), MECHRT_OK);
+    assert_int_equal(f.replays, 1);
+    assert_int_equal(mechrt_lup_factor_dense(&f, a, 11, 1e-12, NULL), MECHRT_EINVAL);
+}
+
+/* The slider crank's Jacobian has zeros at (1, 2), (2, 1) and (2, 2). */
+static const int sc_row[6] = {0, 0, 0, 1, 1, 2}, sc_col[6] = {0, 1, 2, 0, 1, 0};
+
+static void sc_jac_nz(void *ctx, const double *q, double t, double *vals)
+{
+    double jac[9];
+    sc_jac(ctx, q, t, jac);
+    for (int e = 0; e < 6; e++)
+        vals[e] = jac[sc_row[e] * 3 + sc_col[e]];
+}
+
+static const MechrtJacNz sc_jnz = {6, sc_row, sc_col, NULL, sc_jac_nz};
+
+static void report_equal(const MechrtReport *a, const MechrtReport *b)
+{
+    assert_int_equal(a->iterations, b->iterations);
+    assert_true(a->residual == b->residual);
+    assert_true(a->step == b->step);
+    assert_int_equal(a->worst_row, b->worst_row);
+    assert_int_equal(a->sing_index, b->sing_index);
+    assert_true(a->cond == b->cond);
+    assert_int_equal(a->cond_warning, b->cond_warning);
+    assert_int_equal(a->factorisations, b->factorisations);
+}
+
+/* mechrt_step_lup against mechrt_step: the same states and reports, bit
+   for bit, in coarse and fine steps, with the condition estimate always
+   on, through jac_nz, `all` and phi + jac. */
+static void test_step_lup(void **state)
+{
+    (void)state;
+    static double lw[MECHRT_LUP_WORK_LEN(3)];
+    static int liw[MECHRT_LUP_IWORK_LEN(3)];
+    const MechrtJacNz *jn[3] = {&sc_jnz, NULL, NULL};
+    const MechrtKernels *ks[3] = {&sc_kernels_noall, &sc_kernels, &sc_kernels_noall};
+    MechrtOptions o = mechrt_default_options();
+    double work[64], work2[64];
+
+    o.cond_screen = 0;
+    for (int v = 0; v < 3; v++) {
+        for (int steps = 20; steps <= 2000; steps *= 100) {
+            double q[3], qd[3], qdd[3], p[3], pd[3], pdd[3], t = 0, h = 1.0 / steps;
+            MechrtReport rd, rp;
+            MechrtLup f;
+            assert_int_equal(mechrt_lup_init(&f, 3, 6, sc_row, sc_col, lw, MECHRT_LUP_WORK_LEN(3),
+                                             liw, MECHRT_LUP_IWORK_LEN(3)), MECHRT_OK);
+            sc_exact(0, q, qd, qdd);
+            q[0] += 0.1;   /* assembly first: h = 0 */
+            memcpy(p, q, sizeof q), memcpy(pd, qd, sizeof qd), memcpy(pdd, qdd, sizeof qdd);
+            for (int s = 0; s <= steps; s++) {
+                double hh = s == 0 ? 0 : h;
+                assert_int_equal(mechrt_step_lup(ks[v], jn[v], &f, &o, p, pd, pdd, t, hh, work2,
+                                                 64, &rp),
+                                 mechrt_step(ks[v], &o, q, qd, qdd, t, hh, work, 64, &rd));
+                report_equal(&rp, &rd);
+                assert_true(rp.cond > 1);
+                for (int i = 0; i < 3; i++)
+                    assert_true(p[i] == q[i] && pd[i] == qd[i] && pdd[i] == qdd[i]);
+                t += hh;
+            }
+            assert_true(f.replays > f.analyses);
+        }
+    }
+    /* arguments */
+    MechrtLup f;
+    double q[3] = {1, 2, 3}, qd[3] = {0}, qdd[3] = {0};
+    MechrtReport r;
+    assert_int_equal(mechrt_lup_init(&f, 3, 6, sc_row, sc_col, lw, MECHRT_LUP_WORK_LEN(3), liw,
+                                     MECHRT_LUP_IWORK_LEN(3)), MECHRT_OK);
+    assert_int_equal(mechrt_step_lup(&sc_kernels, &sc_jnz, &f, NULL, q, qd, qdd, 0, 0, work, 10,
+                                     &r), MECHRT_EBADLEN);
+    assert_int_equal(mechrt_step_lup(&kn_kernels, NULL, &f, NULL, q, qd, qdd, 0, 0, work, 64, &r),
+                     MECHRT_ENOTSQUARE);
+    assert_int_equal(mechrt_step_lup(&sc_kernels, &sc_jnz, NULL, NULL, q, qd, qdd, 0, 0, work, 64,
+                                     &r), MECHRT_EINVAL);
+    assert_int_equal(mechrt_step_lup(&sc_kernels, &sc_jnz, &f, NULL, q, qd, qdd, 0, NAN, work, 64,
+                                     &r), MECHRT_EINVAL);
+}
+
+/* Through a singular configuration (the circle's dead point at y = 0):
+   the same statuses, reports and iterates as mechrt_step. */
+static void test_step_lup_singular(void **state)
+{
+    (void)state;
+    static const int row[3] = {0, 0, 1}, col[3] = {0, 1, 0};
+    double lw[MECHRT_LUP_WORK_LEN(2)], work[32], work2[32];
+    int liw[MECHRT_LUP_IWORK_LEN(2)];
+    MechrtLup f;
+    /* the dead point at t* = (pi - c) / w, where a step lands */
+    double q[2], qd[2] = {0}, qdd[2] = {0}, p[2], pd[2] = {0}, pdd[2] = {0}, t = 0;
+    double h = (3.14159265358979323846 - CI_C) / CI_W / 46;
+    MechrtReport rd, rp;
+    int fails = 0;
+
+    assert_int_equal(mechrt_lup_init(&f, 2, 3, row, col, lw, MECHRT_LUP_WORK_LEN(2), liw,
+                                     MECHRT_LUP_IWORK_LEN(2)), MECHRT_OK);
+    q[0] = p[0] = CI_R * cos(CI_C);
+    q[1] = p[1] = CI_R * sin(CI_C);
+    for (int s = 0; s < 60; s++) {
+        MechrtStatus sd = mechrt_step(&ci_kernels, NULL, q, qd, qdd, t, h, work, 32, &rd);
+        MechrtStatus sp = mechrt_step_lup(&ci_kernels, NULL, &f, NULL, p, pd, pdd, t, h, work2, 32,
+                                          &rp);
+        assert_int_equal(sp, sd);
+        report_equal(&rp, &rd);
+        assert_true(p[0] == q[0] && p[1] == q[1]);
+        if (sd != MECHRT_OK) {
+            fails++;
+            break;
+        }
+        assert_true(pd[0] == qd[0] && pd[1] == qd[1] && pdd[0] == qdd[0] && pdd[1] == qdd[1]);
+        t += h;
+    }
+    assert_int_equal(fails, 1);   /* it does reach the dead point (EMAXITER) */
+}
+
 /* ---- the float build ---------------------------------------------------
  * The runtime compiled again in this translation unit with
  * MECHRT_REAL_FLOAT: its external names become mechrtf_*, so it links beside
@@ -1100,6 +1436,8 @@ static void test_kernel_wrappers(void **state)
 #include "../runtime/lu.c"
 #include "../runtime/newton.c"
 #include "../runtime/analysis.c"
+#include "../runtime/lu_pattern.c"
+#include "../runtime/step_lup.c"
 
 static void f2d(int n, const float *f, double *d)
 {
@@ -1176,6 +1514,43 @@ static void test_float_build(void **state)
     float cf = mechrt_lu_cond1(N, af, N, pf, 1, wf);
     assert_true(cf > 0);
 
+    /* the pattern LU: lu.c's float factors, bit for bit, replayed */
+    {
+        static float lw[MECHRT_LUP_WORK_LEN(N)];
+        static int liw[MECHRT_LUP_IWORK_LEN(N)];
+        int row[N * N], col[N * N], nnz = 0;
+        float vals[N * N], a[N * N], x[N], y[N], piv[N];
+        MechrtLup f;
+        for (int i = 0; i < N; i++)
+            for (int j = 0; j < N; j++)
+                if (i == j || rnd(&seed) > 0.5) {
+                    row[nnz] = i;
+                    col[nnz] = j;
+                    vals[nnz++] = (float)rnd(&seed);
+                }
+        assert_int_equal(mechrt_lup_init(&f, N, nnz, row, col, lw, MECHRT_LUP_WORK_LEN(N), liw,
+                                         MECHRT_LUP_IWORK_LEN(N)), MECHRT_OK);
+        for (int rep = 0; rep < 3; rep++) {
+            for (int i = 0; i < N * N; i++)
+                a[i] = 0;
+            for (int e = 0; e < nnz; e++) {
+                a[row[e] * N + col[e]] = vals[e];
+                mechrt_lup_values(&f)[e] = vals[e];
+            }
+            assert_int_equal(mechrt_lu_factor(N, a, N, piv, 1e-5f, NULL), MECHRT_OK);
+            assert_int_equal(mechrt_lup_factor(&f, 1e-5f, NULL), MECHRT_OK);
+            for (int i = 0; i < N; i++)
+                x[i] = y[i] = (float)rnd(&seed);
+            mechrt_lu_solve(N, a, N, piv, x);
+            mechrt_lup_solve(&f, y, y);
+            for (int i = 0; i < N; i++)
+                assert_true(x[i] == y[i]);
+            for (int e = 0; e < nnz; e++)
+                vals[e] += 0.001f * (float)rnd(&seed);
+        }
+        assert_true(f.replays >= 1);
+    }
+
     /* assembly and a short run of the slider crank */
     MechrtKernels k = {3, 3, 0, NULL, fsc_phi, fsc_jac, fsc_nu, fsc_gamma, NULL, NULL, NULL};
     float q[3], qd[3] = {0}, qdd[3] = {0}, work[64];
@@ -1225,6 +1600,12 @@ int main(void)
         cmocka_unit_test(test_step_reference),
         cmocka_unit_test(test_lu_factor_norm1),
         cmocka_unit_test(test_kernel_wrappers),
+        cmocka_unit_test(test_lup_matches_dense),
+        cmocka_unit_test(test_lup_pivot_fallback),
+        cmocka_unit_test(test_lup_singular),
+        cmocka_unit_test(test_lup_workspace),
+        cmocka_unit_test(test_step_lup),
+        cmocka_unit_test(test_step_lup_singular),
         cmocka_unit_test(test_float_build),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

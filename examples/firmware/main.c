@@ -3,12 +3,12 @@
  * Turns the slider-crank of examples/slider_crank.mech through one crank
  * revolution in STEPS equal time steps (assembly at t = 0, then predictor,
  * Newton corrector, velocity and acceleration per step, all in
- * mechrt_step) and prints, every PRINT_EVERY steps, the step number, t and
+ * mechrt_step_lup, whose LU works on the Jacobian's nonzeros) and prints, every PRINT_EVERY steps, the step number, t and
  * the slider's position, velocity and acceleration along the guide.
  *
  * What makes it firmware-like: the kernels (sc.c, sc.h) come from
  * `mechc gen examples/slider_crank.mech --prefix sc [--real float]` at build
- * time, the runtime core (runtime/lu.c, newton.c, analysis.c) is compiled
+ * time, the runtime core (the .c files of runtime/) is compiled
  * next to them, and every array lives in static storage sized at compile
  * time: no heap, no recursion, no library call in the numerical code. The
  * only I/O is printf, which newlib sends through semihosting on the target
@@ -27,8 +27,10 @@
 /* The generated real type and the runtime's must agree. */
 typedef char sc_real_matches_mechrt_real[sizeof(sc_real) == sizeof(mechrt_real) ? 1 : -1];
 
-/* Defines `static const MechrtKernels sc_kernels` over sc_phi, sc_jac, ... */
+/* Defines `static const MechrtKernels sc_kernels` over sc_phi, sc_jac, ...
+   and `static const MechrtJacNz sc_jac_nz_kernel` over sc_jac_nz. */
 MECHRT_DEFINE_KERNELS(sc, SC);
+MECHRT_DEFINE_JAC_NZ(sc, SC);
 
 enum {
     STEPS = 200,      /* time steps over one revolution, t = 0 .. PERIOD */
@@ -44,7 +46,7 @@ enum {
 #endif
 
 /* Built with -DSTEP_COUNT (the `count` target of the Makefile, Cortex-M
-   only): SysTick, clocked by the core, times every mechrt_step call after
+   only): SysTick, clocked by the core, times every mechrt_step_lup call after
    the first, and the program prints the mean at the end. Under QEMU with
    -icount shift=0 every instruction takes 1 ns of virtual time and the
    MPS2 core clock is 25 MHz, so one tick is 40 instructions, exactly and
@@ -56,8 +58,13 @@ enum {
 #define SYST_MAX 0xFFFFFFUL /* a 24-bit down counter */
 #endif
 
-/* All the memory the loop uses, reserved at link time (.bss). */
+/* All the memory the loop uses, reserved at link time (.bss): the step's
+   workspace, and the pattern LU's state and workspaces (its pivot order,
+   recorded at the first step, is replayed by the others). */
 static mechrt_real work[MECHRT_WORKSPACE_LEN(SC_NQ, SC_NR)];
+static MechrtLup lup;
+static mechrt_real lup_work[MECHRT_LUP_WORK_LEN(SC_NQ)];
+static int lup_iwork[MECHRT_LUP_IWORK_LEN(SC_NQ)];
 static mechrt_real q[SC_NQ], qd[SC_NQ], qdd[SC_NQ];
 
 /* Index of the coordinate called name, or -1: the program looks the
@@ -89,6 +96,13 @@ int main(void)
         printf("error: no coordinate slider.x\n");
         return 1;
     }
+    st = mechrt_lup_init(&lup, SC_NQ, SC_NNZ, sc_jac_row, sc_jac_col, lup_work,
+                         sizeof lup_work / sizeof lup_work[0], lup_iwork,
+                         sizeof lup_iwork / sizeof lup_iwork[0]);
+    if (st != MECHRT_OK) {
+        printf("error: %s\n", mechrt_strerror(st));
+        return 1;
+    }
     for (i = 0; i < SC_NQ; i++) {
         q[i] = sc_q0[i];
         qd[i] = 0;
@@ -109,8 +123,8 @@ int main(void)
 #ifdef STEP_COUNT
         unsigned long c0 = SYST_CVR;
 #endif
-        st = mechrt_step(&sc_kernels, &opts, q, qd, qdd, t, tn - t, work,
-                         sizeof work / sizeof work[0], &report);
+        st = mechrt_step_lup(&sc_kernels, &sc_jac_nz_kernel, &lup, &opts, q, qd, qdd, t,
+                             tn - t, work, sizeof work / sizeof work[0], &report);
 #ifdef STEP_COUNT
         if (i > 0)
             ticks += (c0 - SYST_CVR) & SYST_MAX;

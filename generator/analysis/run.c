@@ -110,6 +110,8 @@ typedef struct Run {
     double *work;
     size_t lwork;
     MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense */
+    MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
+    MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
@@ -583,6 +585,9 @@ static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
     if (r->sp)
         return mechrt_host_sparse_step(r->sp, r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h,
                                        r->work, r->lwork, rep);
+    if (r->lup)
+        return mechrt_step_lup(r->k, &r->lup_jnz, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
+                               t, h, r->work, r->lwork, rep);
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }
 
@@ -890,6 +895,28 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
     return true;
 }
 
+/* The dense path's factorisation: the pattern LU on the kernels' sparse
+   Jacobian (same results as lu.c's, replayed over the nonzeros), when
+   there is one, the mechanism is stepped (no velocity rows) and its
+   worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
+   One block: the state, then its reals, then its ints. */
+static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz)
+{
+    if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+        return NULL;
+    size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
+    MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
+    double *w = (double *)(f + 1);
+    *jnz = (MechrtJacNz){o->jac_nz->nnz, o->jac_nz->row, o->jac_nz->col, o->jac_nz->ctx,
+                         o->jac_nz->jac_nz};
+    if (mechrt_lup_init(f, m->nq, jnz->nnz, jnz->row, jnz->col, w, lw, (int *)(w + lw), liw)
+        != MECHRT_OK) {
+        free(f);
+        return NULL;
+    }
+    return f;
+}
+
 bool run_rows_match(const Model *m, char *why, size_t size)
 {
     if (m->nr < m->nq) {
@@ -955,6 +982,8 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
                          o->jac_nz->nnz, m->nq, m->nq);
     }
     res->sparse = sparse;
+    if (!sparse)
+        r.lup = run_lup_new(m, o, &r.lup_jnz);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -964,6 +993,11 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     if (r.sp) {
         mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
         mechrt_host_sparse_free(r.sp);
+    }
+    if (r.lup) {
+        res->fresh_factorisations = r.lup->analyses;
+        res->refactorisations = r.lup->replays;
+        free(r.lup);
     }
     if (status == RUN_OK && r.episode)
         notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "

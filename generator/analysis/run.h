@@ -103,8 +103,9 @@ typedef struct RunResult {
     double max_cond;             /* largest condition estimate seen (0: off) */
     bool integrated;             /* positions came from the integrator */
     bool sparse;                 /* the sparse path (KLU) was used */
-    long fresh_factorisations;   /* sparse: KLU factorisations with pivoting... */
-    long refactorisations;       /* ... and with the pivot order kept */
+    long fresh_factorisations;   /* sparse: KLU factorisations with pivoting
+                                    (dense: the pattern LU's finished by lu.c)... */
+    long refactorisations;       /* ... and with the pivot order kept (replayed) */
     MechrtHostStats host;        /* integrator counters when integrated */
 } RunResult;
 

@@ -334,6 +334,10 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
     if (res->sparse)
         fprintf(stderr, "mechc run: stats: sparse LU (KLU): %ld factorisations with pivoting, "
                 "%ld refactorisations\n", res->fresh_factorisations, res->refactorisations);
+    else if (res->fresh_factorisations > 0)   /* the dense path's pattern LU */
+        fprintf(stderr, "mechc run: stats: pattern LU: %ld of %ld factorisations finished by "
+                "the dense LU (a new pivot order), the others replayed\n",
+                res->fresh_factorisations, res->fresh_factorisations + res->refactorisations);
     double ns_all = run_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
     fprintf(stderr, "mechc run: stats: one %s call (Phi, Phi_q, nu, gamma) takes "
             "%.1f ns: a step costs %.2f of them\n",
