@@ -77,6 +77,14 @@
 /* Two subdivision levels agree when their positions at the end of the
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
+/* A step whose Jacobian at the end has a condition estimate above this
+   (or has no LU at all) is redone by the rank-revealing corrector
+   (rank_step): an LU solve there keeps fewer than 16 - 9 digits. */
+#define RUN_RANK_COND 1e9
+/* The rank corrector's velocity and acceleration must satisfy their
+   equations to this share (MechrtReport.inconsistency): otherwise the
+   continued motion is none the mechanism can have there. */
+#define RUN_BRANCH_TOL 1e-6
 
 const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
 
@@ -113,7 +121,15 @@ typedef struct Run {
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
        and a failed step's iterate (fq) */
-    double *sq, *sqd, *sqdd, *iq, *lq, *fq;
+    double *sq, *sqd, *sqdd, *iq, *lq, *fq, *rq;
+    /* through singular positions (rank_step): the QR corrector's workspace
+       (allocated at the first use), and the accelerations of the last two
+       trusted states before the current one, for the predictor */
+    double *rk_work;
+    size_t rk_lwork;
+    int hist_n;
+    double hist_t[2];
+    double *hist_qdd;       /* 2 nq: entry 0 the latest */
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -569,15 +585,124 @@ static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }
 
+/* The state at time t (in sq, sqd, sqdd) was trusted: its acceleration
+   joins the predictor's history (the same time again replaces it). */
+static void push_history(Run *r, double t)
+{
+    size_t bytes = (size_t)r->nq * sizeof(double);
+    if (r->hist_n > 0 && r->hist_t[0] == t) {
+        memcpy(r->hist_qdd, r->sqdd, bytes);
+        return;
+    }
+    memcpy(r->hist_qdd + r->nq, r->hist_qdd, bytes);
+    memcpy(r->hist_qdd, r->sqdd, bytes);
+    r->hist_t[1] = r->hist_t[0];
+    r->hist_t[0] = t;
+    r->hist_n = r->hist_n < 2 ? r->hist_n + 1 : 2;
+}
+
+/* The prediction at t + h from the state at t (sq, sqd, sqdd) into q, qd,
+ * qdd: the acceleration extrapolated by the quadratic through it and the
+ * history's two before it (fewer when there are fewer, down to Taylor's
+ * constant), qd and q its integrals from t. Errors O(h^3) in qdd, O(h^4)
+ * in qd, O(h^5) in q, where the LU step's Taylor predictor has O(h^3) in q:
+ * along the directions a singular Jacobian loses, the prediction is all
+ * there is. History from later times (a subdivision's failed level) or
+ * the other direction is left out. */
+static void predict(Run *r, double t, double h)
+{
+    double s[3] = {0, 0, 0};
+    const double *a[3] = {r->sqdd, NULL, NULL};
+    int used = 1;
+    for (int e = 0; e < r->hist_n && used < 3; e++) {
+        double se = r->hist_t[e] - t;
+        if (se * h < 0 && (used == 1 || fabs(se) > fabs(s[used - 1]))) {
+            s[used] = se;
+            a[used++] = r->hist_qdd + (size_t)e * (size_t)r->nq;
+        }
+    }
+    double h2 = h * h, h3 = h2 * h;
+    for (int i = 0; i < r->nq; i++) {
+        double c1 = 0, c2 = 0;
+        if (used >= 2) {
+            double f01 = (a[1][i] - a[0][i]) / s[1];
+            if (used == 3) {
+                double f12 = (a[2][i] - a[1][i]) / (s[2] - s[1]);
+                c2 = (f12 - f01) / s[2];
+            }
+            c1 = f01 - c2 * s[1];
+        }
+        double a0 = a[0][i];
+        r->qdd[i] = a0 + c1 * h + c2 * h2;
+        r->qd[i] = r->sqd[i] + a0 * h + c1 * h2 / 2 + c2 * h3 / 3;
+        r->q[i] = r->sq[i] + r->sqd[i] * h + a0 * h2 / 2 + c1 * h3 / 6 + c2 * h3 * h / 12;
+    }
+}
+
+/* The LU step ended without a factorisation (singular), or with one too
+   ill-conditioned to trust: the rank-revealing corrector takes over. */
+static bool wants_rank(MechrtStatus st, const MechrtReport *rep)
+{
+    if (st == MECHRT_ESING || st == MECHRT_EMAXITER || st == MECHRT_ENOTFINITE)
+        return true;
+    return st == MECHRT_OK && rep->cond > RUN_RANK_COND;
+}
+
+/* The step from t to t + h again, through a singular position: the
+   history's prediction, corrected by mechrt_rank_correct (dense, on both
+   paths: KLU has no rank-revealing factorisation). When it fails too, or
+   its velocity or acceleration leave a residual (no branch continues the
+   motion there), the LU attempt stands: its status st0, its report in
+   *rep and its iterate (kept in rq) in q, so that its messages are the
+   LU's; the corrector's verdict is kept for the message (rank_note). */
+static MechrtStatus rank_step(Run *r, double t, double h, MechrtStatus st0, MechrtReport *rep)
+{
+    size_t bytes = (size_t)r->nq * sizeof(double);
+    if (!r->rk_work) {
+        r->rk_lwork = mechrt_rank_workspace_size(r->nq);
+        r->rk_work = xcalloc(r->rk_lwork + 1, sizeof *r->rk_work);
+    }
+    MechrtReport rk;
+    memcpy(r->rq, r->q, bytes);
+    predict(r, t, h);
+    MechrtStatus st = mechrt_rank_correct(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t + h,
+                                          r->rk_work, r->rk_lwork, &rk);
+    RunResult *res = r->res;
+    res->rank_steps++;
+    res->newton_iterations += rk.iterations;
+    res->rank_factorisations += rk.factorisations;
+    if (st != MECHRT_OK || rk.inconsistency > RUN_BRANCH_TOL) {
+        res->rank_failed = true;
+        res->rank_t = t + h;
+        res->rank_status = st;
+        res->rank_inconsistency = rk.inconsistency;
+        memcpy(r->q, r->rq, bytes);
+        return st0;
+    }
+    if (rk.rank_deficiency > 0)
+        res->rank_deficient_steps++;
+    if (rk.rank_deficiency > res->max_rank_deficiency)
+        res->max_rank_deficiency = rk.rank_deficiency;
+    rk.cond = st0 == MECHRT_OK ? rep->cond : 0;   /* the condition watch: the LU's estimate */
+    rk.cond_warning = st0 == MECHRT_OK ? rep->cond_warning : false;
+    *rep = rk;
+    return MECHRT_OK;
+}
+
 /* One predictor-corrector step of the runtime from t to t + h, its start
-   kept in sq, sqd, sqdd; *quiet says whether it passed the check. */
+   kept in sq, sqd, sqdd; *quiet says whether it passed the check. A step
+   that meets a singular Jacobian is redone by rank_step. */
 static MechrtStatus checked_step(Run *r, double t, double h, MechrtReport *rep, bool *quiet,
                                  StepCheck *chk)
 {
     memcpy(r->sq, r->q, 3 * (size_t)r->nq * sizeof(double));   /* q | qd | qdd */
     MechrtStatus st = run_step(r, t, h, rep);
     r->res->newton_iterations += rep->iterations;
+    if (h != 0 && wants_rank(st, rep))
+        st = rank_step(r, t, h, st, rep);
     *quiet = st == MECHRT_OK && step_quiet(r, h, rep, chk);
+    if (*quiet)
+        push_history(r, t);
     return st;
 }
 
@@ -697,9 +822,11 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     RunStatus status = RUN_OK;
     size_t nq = (size_t)r->nq;
     double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
-    double *keep = xmalloc(8 * nq * sizeof *keep);
+    double *keep = xmalloc(11 * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
-    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
+    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
+    r->hist_qdd = keep + 9 * nq;
+    r->hist_n = 0;
     place_at_t0(r, q0, start);
     MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
     r->res->assembly_iterations = rep.iterations;
@@ -748,7 +875,9 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 out:
     free(q0);
     free(keep);
-    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = NULL;
+    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = r->rq = r->hist_qdd = NULL;
+    free(r->rk_work);
+    r->rk_work = NULL;
     return status;
 }
 

@@ -328,6 +328,14 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
         if (res->subdivided > 0)
             fprintf(stderr, "mechc run: stats: %d %s redone in substeps (%ld substeps)\n",
                     res->subdivided, res->subdivided == 1 ? "step" : "steps", res->substeps);
+        if (res->rank_steps > 0)
+            fprintf(stderr, "mechc run: stats: %d %s through singular positions by the "
+                    "rank-revealing corrector (dense QR%s: %ld factorisations), %d of them "
+                    "rank-deficient (by up to %d)\n", res->rank_steps,
+                    res->rank_steps == 1 ? "step" : "steps",
+                    res->sparse ? ", where KLU found the Jacobian singular or too "
+                    "ill-conditioned" : "", res->rank_factorisations,
+                    res->rank_deficient_steps, res->max_rank_deficiency);
     }
     fprintf(stderr, "mechc run: stats: %.6g ms of CPU time in the steps: %.0f ns per step\n",
             1e3 * res->step_cpu_seconds, 1e9 * res->step_cpu_seconds / n);
