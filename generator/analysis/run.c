@@ -85,6 +85,9 @@
    equations to this share (MechrtReport.inconsistency): otherwise the
    continued motion is none the mechanism can have there. */
 #define RUN_BRANCH_TOL 1e-6
+/* States before the current one that the rank corrector's predictor
+   extrapolates the acceleration from (a cubic through four). */
+#define RUN_HISTORY 3
 
 const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
 
@@ -123,13 +126,13 @@ typedef struct Run {
        and a failed step's iterate (fq) */
     double *sq, *sqd, *sqdd, *iq, *lq, *fq, *rq;
     /* through singular positions (rank_step): the QR corrector's workspace
-       (allocated at the first use), and the accelerations of the last two
+       (allocated at the first use), and the accelerations of the last RUN_HISTORY
        trusted states before the current one, for the predictor */
     double *rk_work;
     size_t rk_lwork;
     int hist_n;
-    double hist_t[2];
-    double *hist_qdd;       /* 2 nq: entry 0 the latest */
+    double hist_t[RUN_HISTORY];
+    double *hist_qdd;       /* RUN_HISTORY nq: entry 0 the latest */
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -589,53 +592,64 @@ static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
    joins the predictor's history (the same time again replaces it). */
 static void push_history(Run *r, double t)
 {
-    size_t bytes = (size_t)r->nq * sizeof(double);
+    size_t nq = (size_t)r->nq, bytes = nq * sizeof(double);
     if (r->hist_n > 0 && r->hist_t[0] == t) {
         memcpy(r->hist_qdd, r->sqdd, bytes);
         return;
     }
-    memcpy(r->hist_qdd + r->nq, r->hist_qdd, bytes);
+    memmove(r->hist_qdd + nq, r->hist_qdd, (RUN_HISTORY - 1) * bytes);
+    memmove(r->hist_t + 1, r->hist_t, (RUN_HISTORY - 1) * sizeof *r->hist_t);
     memcpy(r->hist_qdd, r->sqdd, bytes);
-    r->hist_t[1] = r->hist_t[0];
     r->hist_t[0] = t;
-    r->hist_n = r->hist_n < 2 ? r->hist_n + 1 : 2;
+    r->hist_n = r->hist_n < RUN_HISTORY ? r->hist_n + 1 : RUN_HISTORY;
 }
 
 /* The prediction at t + h from the state at t (sq, sqd, sqdd) into q, qd,
- * qdd: the acceleration extrapolated by the quadratic through it and the
- * history's two before it (fewer when there are fewer, down to Taylor's
- * constant), qd and q its integrals from t. Errors O(h^3) in qdd, O(h^4)
- * in qd, O(h^5) in q, where the LU step's Taylor predictor has O(h^3) in q:
- * along the directions a singular Jacobian loses, the prediction is all
- * there is. History from later times (a subdivision's failed level) or
- * the other direction is left out. */
+ * qdd: the acceleration extrapolated by the cubic through it and the
+ * history's three before it (fewer when there are fewer, down to Taylor's
+ * constant), qd and q its integrals from t. Errors O(h^4) in qdd, O(h^5)
+ * in qd, O(h^6) in q, where the LU step's Taylor predictor has O(h^3) in
+ * q: along the directions a singular Jacobian loses, the prediction is
+ * all there is. History from later times (a subdivision's failed level)
+ * or the other direction is left out. */
 static void predict(Run *r, double t, double h)
 {
-    double s[3] = {0, 0, 0};
-    const double *a[3] = {r->sqdd, NULL, NULL};
+    double s[RUN_HISTORY + 1] = {0};
+    const double *a[RUN_HISTORY + 1] = {r->sqdd};
     int used = 1;
-    for (int e = 0; e < r->hist_n && used < 3; e++) {
+    for (int e = 0; e < r->hist_n; e++) {
         double se = r->hist_t[e] - t;
         if (se * h < 0 && (used == 1 || fabs(se) > fabs(s[used - 1]))) {
             s[used] = se;
             a[used++] = r->hist_qdd + (size_t)e * (size_t)r->nq;
         }
     }
-    double h2 = h * h, h3 = h2 * h;
+    double hk[6] = {1, h, h * h, h * h * h, h * h * h * h, h * h * h * h * h};
     for (int i = 0; i < r->nq; i++) {
-        double c1 = 0, c2 = 0;
-        if (used >= 2) {
-            double f01 = (a[1][i] - a[0][i]) / s[1];
-            if (used == 3) {
-                double f12 = (a[2][i] - a[1][i]) / (s[2] - s[1]);
-                c2 = (f12 - f01) / s[2];
-            }
-            c1 = f01 - c2 * s[1];
+        /* divided differences, then the Newton form as c0 + c1 s + ... */
+        double d[RUN_HISTORY + 1] = {a[0][i]}, c[4] = {0, 0, 0, 0};
+        double f[RUN_HISTORY + 1];
+        for (int j = 0; j < used; j++)
+            f[j] = a[j][i];
+        for (int l = 1; l < used; l++) {
+            for (int j = used - 1; j >= l; j--)
+                f[j] = (f[j] - f[j - 1]) / (s[j] - s[j - l]);
+            d[l] = f[l];
         }
-        double a0 = a[0][i];
-        r->qdd[i] = a0 + c1 * h + c2 * h2;
-        r->qd[i] = r->sqd[i] + a0 * h + c1 * h2 / 2 + c2 * h3 / 3;
-        r->q[i] = r->sq[i] + r->sqd[i] * h + a0 * h2 / 2 + c1 * h3 / 6 + c2 * h3 * h / 12;
+        c[0] = d[0];
+        if (used > 1)
+            c[1] = d[1];
+        if (used > 2)
+            c[1] -= d[2] * s[1], c[2] = d[2];
+        if (used > 3)
+            c[1] += d[3] * s[1] * s[2], c[2] -= d[3] * (s[1] + s[2]), c[3] = d[3];
+        double qdd = 0, qd = r->sqd[i], q = r->sq[i] + r->sqd[i] * h;
+        for (int k = 0; k < 4; k++) {
+            qdd += c[k] * hk[k];
+            qd += c[k] * hk[k + 1] / (k + 1);
+            q += c[k] * hk[k + 2] / ((k + 1) * (k + 2));
+        }
+        r->qdd[i] = qdd, r->qd[i] = qd, r->q[i] = q;
     }
 }
 
@@ -813,6 +827,24 @@ static bool subdivide(Run *r, double t, double tn, MechrtStatus st0, MechrtRepor
     return false;
 }
 
+/* A failed step after which the rank-revealing corrector could not go on
+   either: what it found, after the LU's message. */
+static void note_rank_failure(Run *r)
+{
+    const RunResult *res = r->res;
+    msgf(r, "; the rank-revealing corrector found no motion that continues the branch "
+         "either (at t = %.10g: ", res->rank_t);
+    if (res->rank_status == MECHRT_OK)
+        msgf(r, "no velocity or acceleration near the continued ones satisfies their "
+             "equations, %.2g of them is left", res->rank_inconsistency);
+    else
+        msgf(r, "%s", mechrt_strerror(res->rank_status));
+    msgf(r, "): where the Jacobian loses rank the motion cannot go on (a limit position "
+         "that the driver pushes past), or branches meet that the motion so far cannot "
+         "tell apart (a bifurcation); drive another coordinate, or end the run there and "
+         "start another on the branch you want");
+}
+
 /* Holonomic rows only: the runtime's predictor-corrector step, checked and
    subdivided when needed (see the top of this file). */
 static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
@@ -822,7 +854,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     RunStatus status = RUN_OK;
     size_t nq = (size_t)r->nq;
     double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
-    double *keep = xmalloc(11 * nq * sizeof *keep);
+    double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
     r->hist_qdd = keep + 9 * nq;
@@ -860,8 +892,11 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         clock_t cpu0 = clock();
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
+        r->res->rank_failed = false;
         st = checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
+        if (!ok && r->res->rank_failed)
+            note_rank_failure(r);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
