@@ -411,7 +411,8 @@ int mechrt_qr_row(const MechrtQr *f, int i);
    Jacobian is regular the result is mechrt_step's. Holonomic rows only
    (nh == nq, nv == 0). */
 
-/* Workspace length in reals: 2 nq^2 + 5 nq (QR) + 4 nq; 0 on overflow. */
+/* Workspace length in reals: 2 nq^2 + 12 nq (the QR's nq^2 + 8 nq among them);
+   0 on overflow. */
 size_t mechrt_rank_workspace_size(int nq);
 
 /* q, qd, qdd: on entry the prediction at t (e.g. the Taylor predictor

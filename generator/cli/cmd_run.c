@@ -50,6 +50,11 @@ static const char usage[] =
     "their positions integrated (GSL, adaptive step) and projected back onto the\n"
     "holonomic rows after every step. Needs as many rows as coordinates. The\n"
     "file's `output` statements are reported beside the coordinates.\n"
+    "Where the Jacobian loses rank (a parallelogram folding flat, coupled wheels\n"
+    "at a dead centre, a toggle) a step is redone by a rank-revealing corrector:\n"
+    "each correction the least one from the motion the previous steps predict,\n"
+    "so the run keeps to the branch it is on; where no motion continues it (a\n"
+    "driver pushing past a dead centre) the run stops with exit 1 and says so.\n"
     "\n";
 
 static const char *const ode_methods[] = {"rk8pd", "rkf45", NULL};
@@ -104,8 +109,10 @@ static const CliOption options[] = {
     {"--ode-tol", CLI_REAL_AT(RunCli, ro.ode.tol), POSITIVE, .metavar = "X",
      .help = "its error per step, absolute and relative (default 1e-10)"},
     {"--stats", CLI_FLAG_AT(RunCli, stats),
-     .help = "print time per step, Newton iterations per step and the\n"
-             "step's cost in evaluations of the fused `all` kernel"},
+     .help = "print time per step, Newton iterations per step, the\n"
+             "step's cost in evaluations of the fused `all` kernel and\n"
+             "the steps through singular positions (dense QR, also on\n"
+             "the sparse path)"},
     {"--svg", CLI_STRING_AT(RunCli, svg_path), .metavar = "FILE",
      .help = "write an animated SVG of the motion (plays in any browser)"},
     {"--trace", CLI_LIST_AT(RunCli, traces, MAX_TRACES), .what = "points", .metavar = "B(sx,sy)",
