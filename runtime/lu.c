@@ -49,7 +49,7 @@ MechrtOptions mechrt_default_options(void)
     o.pivot_tol = 1e-12;
     o.cond_warn = 1e10;
     o.cond_screen = 1e-4;
-    o.rank_tol = 1e-7;
+    o.rank_tol = 1e-5;
 #endif
     o.max_iter = 25;
     return o;

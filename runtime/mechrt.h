@@ -209,7 +209,7 @@ typedef struct MechrtOptions {
     /* mechrt_rank_correct (singular positions): a pivot of the
        rank-revealing QR at or below rank_tol times the first (the largest
        row norm) ends the rank; the directions beyond it are taken from the
-       prediction (dimensionless). default 1e-7 / 1e-3 */
+       prediction (dimensionless). default 1e-5 / 1e-3 */
     mechrt_real rank_tol;
 } MechrtOptions;
 
@@ -418,8 +418,10 @@ size_t mechrt_rank_workspace_size(int nq);
 /* q, qd, qdd: on entry the prediction at t (e.g. the Taylor predictor
    q + h qd + h^2/2 qdd, qd + h qdd, qdd from the last state, better from
    more of them), on return the state at t. One QR at the predicted q
-   serves Newton (a chord iteration, refactored when it stalls) and the
-   velocity and acceleration (refined with the Jacobian at the solution). report: iterations,
+   serves Newton (a chord iteration, refactored when it stalls) and, when
+   Newton moved q by at most 100 tol_dq, the velocity and acceleration
+   (refined with the Jacobian at the solution); else one more at the
+   solution. report: iterations,
    residual, step, worst_row, factorisations (QRs), rank_deficiency and
    inconsistency. Statuses as mechrt_step's (no MECHRT_ESING). */
 MechrtStatus mechrt_rank_correct(const MechrtKernels *k, const MechrtOptions *opts,

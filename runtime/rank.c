@@ -132,26 +132,29 @@ static MechrtStatus rk_newton(const MechrtKernels *k, const MechrtOptions *o, me
 
 /* x <- x + pinv(J0) (rhs - J x), twice: J0 the factored Jacobian, J
    (in w->jac) the one at the solution, which differ by Newton's last
-   steps; the second pass takes up what that difference left. Returns the residual's share
-   ||rhs - J x|| / (||rhs|| + ||J x||) after it. */
+   steps; the second pass takes up what that difference left. Returns the
+   residual's share ||rhs - J x|| / (||rhs|| + ||J|| (||x|| + extra)) after
+   it (extra: what else the right side scales with, ||qd||^2 for gamma). */
 static mechrt_real rk_nearest(int n, RankWork *w, const MechrtQr *f, const mechrt_real *rhs,
-                              mechrt_real *x)
+                              mechrt_real *x, mechrt_real extra)
 {
-    mechrt_real res = 0, scale = 0;
+    mechrt_real res = 0, jnorm = 0;
     int pass, i, j;
 
     for (pass = 0; pass < 3; pass++) {
-        res = scale = 0;
+        res = jnorm = 0;
         for (i = 0; i < n; i++) {
             const mechrt_real *row = w->jac + (size_t)i * (size_t)n;
-            mechrt_real jx = 0;
-            for (j = 0; j < n; j++)
+            mechrt_real jx = 0, rs = 0;
+            for (j = 0; j < n; j++) {
                 jx += row[j] * x[j];
+                rs += MECHRT_FABS(row[j]);
+            }
             w->rhs[i] = rhs[i] - jx;
             if (!(MECHRT_FABS(w->rhs[i]) <= res))
                 res = MECHRT_FABS(w->rhs[i]);
-            if (!(MECHRT_FABS(rhs[i]) + MECHRT_FABS(jx) <= scale))
-                scale = MECHRT_FABS(rhs[i]) + MECHRT_FABS(jx);
+            if (rs > jnorm)
+                jnorm = rs;
         }
         if (pass == 2)
             break;
@@ -159,7 +162,9 @@ static mechrt_real rk_nearest(int n, RankWork *w, const MechrtQr *f, const mechr
         for (i = 0; i < n; i++)
             x[i] += w->dq[i];
     }
-    return scale > 0 ? res / scale : res;
+    extra += rk_norm(n, x);
+    extra = rk_norm(n, rhs) + jnorm * extra;
+    return extra > 0 ? res / extra : res;
 }
 
 MechrtStatus mechrt_rank_correct(const MechrtKernels *k, const MechrtOptions *opts,
@@ -175,6 +180,7 @@ MechrtStatus mechrt_rank_correct(const MechrtKernels *k, const MechrtOptions *op
     MechrtStatus st;
     size_t need, n;
     mechrt_real a, b;
+    int i;
 
     mechrt_report_clear(r);
     if (!k || k->nq < 1 || !k->phi || !k->jac || !k->nu || !k->gamma || !q || !qd || !qdd
@@ -196,18 +202,28 @@ MechrtStatus mechrt_rank_correct(const MechrtKernels *k, const MechrtOptions *op
     w.qr = w.dq + n;
     w.lqr = need - (n * n + 4u * n);
 
+    for (i = 0; i < k->nq; i++)
+        w.x[i] = q[i];
     st = rk_newton(k, &o, q, t, &w, &f, r);
     if (st != MECHRT_OK)
         return st;
-    /* the factors stay those of Newton's last factorisation, a few
-       tolerances away: the passes of rk_nearest take up the difference
-       with the Jacobian at the solution, which is what the residuals use */
-    k->jac(k->ctx, q, t, w.jac);
+    /* The factors are those of Newton's last factorisation; when Newton
+       moved q by little from there (the prediction was good) the passes
+       of rk_nearest take up the difference with the Jacobian at the
+       solution, which the residuals use; else the solution's own. */
+    for (i = 0; i < k->nq; i++)
+        w.x[i] -= q[i];
+    if (rk_norm(k->nq, w.x) > 100 * o.tol_dq) {
+        if ((st = rk_factor(k, &o, q, t, &w, &f, r)) != MECHRT_OK)
+            return st;
+    } else {
+        k->jac(k->ctx, q, t, w.jac);
+    }
     r->rank_deficiency = k->nq - f.rank;
     k->nu(k->ctx, q, t, w.x);
-    a = rk_nearest(k->nq, &w, &f, w.x, qd);
+    a = rk_nearest(k->nq, &w, &f, w.x, qd, 0);
     k->gamma(k->ctx, q, qd, t, w.x);
-    b = rk_nearest(k->nq, &w, &f, w.x, qdd);
+    b = rk_nearest(k->nq, &w, &f, w.x, qdd, rk_norm(k->nq, qd) * rk_norm(k->nq, qd));
     r->inconsistency = a > b ? a : b;
     if (!isfinite(rk_norm(k->nq, qd)) || !isfinite(rk_norm(k->nq, qdd)) || !isfinite(a + b))
         return MECHRT_ENOTFINITE;

@@ -1,7 +1,8 @@
 /* test_branch.c - kinematic analysis through change points and dead centres (runtime/rank.c, runtime/qr.c, run.c).
  *
- * The rank-revealing QR against known minimum-norm solutions (double and
- * float); then `run` through singular positions, every state against the
+ * The rank-revealing QR against known minimum-norm solutions, and the
+ * corrector on a hand-written parallelogram at its fold (double and, at
+ * the end of the file, float); then `run` through singular positions, every state against the
  * closed form, the folded states on the grid included: the IFToMM A02
  * chain of 40 parallelograms (sparse path), the same chain of 5 on the
  * dense path, a locomotive's coupled wheels and a parallelogram four-bar;
@@ -115,6 +116,86 @@ static void test_qr_banded(void **state)
     mechrt_qr_solve(&f, b, y);
     for (int i = 0; i < N; i++)
         assert_near(y[i], x[i], 0, 1e-13);
+}
+
+/* ---- the corrector on hand-written kernels -------------------------------
+ * A parallelogram in two angles: crank theta = omega t (row 0), rocker psi
+ * with the coupler's length 2 (row 1); ground 2, cranks 1:
+ *   Phi1 = 4 (cos psi - cos theta) + 2 - 2 cos(psi - theta) = 0,
+ *   J1 = [4 sin theta - 2 sin d, -4 sin psi + 2 sin d], d = psi - theta,
+ *   gamma1 = 4 cos psi psi'^2 - 4 cos theta theta'^2 - 2 cos d d'^2.
+ * Branches psi = theta and the crossed one meet at theta = 0, pi, where
+ * J1 = 0: rank 1 of 2. */
+#define PG_OMEGA 6.283185307179586
+
+static void pg_phi(void *ctx, const double *q, double t, double *phi)
+{
+    (void)ctx;
+    phi[0] = q[0] - PG_OMEGA * t;
+    phi[1] = 4 * (cos(q[1]) - cos(q[0])) + 2 - 2 * cos(q[1] - q[0]);
+}
+
+static void pg_jac(void *ctx, const double *q, double t, double *jac)
+{
+    (void)ctx, (void)t;
+    double sd = sin(q[1] - q[0]);
+    jac[0] = 1, jac[1] = 0;
+    jac[2] = 4 * sin(q[0]) - 2 * sd, jac[3] = -4 * sin(q[1]) + 2 * sd;
+}
+
+static void pg_nu(void *ctx, const double *q, double t, double *nu)
+{
+    (void)ctx, (void)q, (void)t;
+    nu[0] = PG_OMEGA, nu[1] = 0;
+}
+
+static void pg_gamma(void *ctx, const double *q, const double *qd, double t, double *g)
+{
+    (void)ctx, (void)t;
+    double dd = qd[1] - qd[0];
+    g[0] = 0;
+    g[1] = 4 * cos(q[1]) * qd[1] * qd[1] - 4 * cos(q[0]) * qd[0] * qd[0]
+           - 2 * cos(q[1] - q[0]) * dd * dd;
+}
+
+/* From the exact state h before the fold (theta = pi), Taylor's
+   prediction, then the corrector: on the branch psi = theta, with the
+   rocker's rate omega; regular Jacobians give mechrt_step's answer. */
+static void test_rank_correct_fold(void **state)
+{
+    (void)state;
+    const MechrtKernels k = {2, 2, 0, NULL, pg_phi, pg_jac, pg_nu, pg_gamma, NULL, NULL, NULL};
+    double work[64];
+    assert_true(mechrt_rank_workspace_size(2) <= 64);
+    double h = 0.0025, t1 = 0.5, th = PG_OMEGA * (t1 - h);
+    double q[2] = {th + PG_OMEGA * h, th + PG_OMEGA * h};  /* Taylor: qdd = 0 */
+    double qd[2] = {PG_OMEGA, PG_OMEGA}, qdd[2] = {0, 0};
+    q[1] += 1e-7;       /* a prediction a little off along the lost direction */
+    MechrtReport rep;
+    assert_int_equal(mechrt_rank_correct(&k, NULL, q, qd, qdd, t1, work, 64, &rep), MECHRT_OK);
+    assert_near(q[0], M_PI, 0, 1e-15);
+    /* the Jacobian's second singular value there, about 6e-7, is under
+       rank_tol (1e-5): that direction is the prediction's, in q as in qd */
+    assert_near(q[1], M_PI + 1e-7, 0, 1e-12);
+    assert_near(qd[1], PG_OMEGA, 0, 1e-6);
+    assert_near(qdd[1], 0, 0, 1e-4);
+    assert_int_equal(rep.rank_deficiency, 1);
+    assert_true(rep.inconsistency < 1e-6);
+    assert_true(rep.factorisations >= 1);
+    /* away from the fold: full rank, the plain solution */
+    double q2[2] = {1.0, 1.0 + 1e-3}, qd2[2] = {0, 0}, qdd2[2] = {0, 0};
+    assert_int_equal(mechrt_rank_correct(&k, NULL, q2, qd2, qdd2, 1.0 / PG_OMEGA, work, 64, &rep),
+                     MECHRT_OK);
+    assert_int_equal(rep.rank_deficiency, 0);
+    assert_near(q2[1], 1.0, 0, 1e-12);
+    assert_near(qd2[1], PG_OMEGA, 0, 1e-9);
+    assert_near(qdd2[1], 0, 0, 1e-7);
+    /* a short workspace, a non-square system */
+    assert_int_equal(mechrt_rank_correct(&k, NULL, q2, qd2, qdd2, 0, work, 8, &rep),
+                     MECHRT_EBADLEN);
+    const MechrtKernels k1 = {2, 1, 0, NULL, pg_phi, pg_jac, pg_nu, pg_gamma, NULL, NULL, NULL};
+    assert_int_equal(mechrt_rank_correct(&k1, NULL, q2, qd2, qdd2, 0, work, 64, &rep),
+                     MECHRT_ENOTSQUARE);
 }
 
 /* ---- runs through singular positions ------------------------------------ */
@@ -478,11 +559,82 @@ static void test_examples_never_switch(void **state)
     assert_true(ran >= 12);
 }
 
+/* ---- the float build ------------------------------------------------------
+ * The runtime compiled a second time with MECHRT_REAL_FLOAT: its external
+ * names become mechrtf_*, so it links beside the double library; past
+ * this point mechrt_* names the float functions. */
+#define MECHRT_REAL_FLOAT
+#include "../runtime/lu.c"
+#include "../runtime/newton.c"
+#include "../runtime/analysis.c"
+#include "../runtime/qr.c"
+#include "../runtime/rank.c"
+
+static void fpg_phi(void *ctx, const float *q, float t, float *phi)
+{
+    (void)ctx;
+    phi[0] = q[0] - (float)PG_OMEGA * t;
+    phi[1] = 4 * (cosf(q[1]) - cosf(q[0])) + 2 - 2 * cosf(q[1] - q[0]);
+}
+
+static void fpg_jac(void *ctx, const float *q, float t, float *jac)
+{
+    (void)ctx, (void)t;
+    float sd = sinf(q[1] - q[0]);
+    jac[0] = 1, jac[1] = 0;
+    jac[2] = 4 * sinf(q[0]) - 2 * sd, jac[3] = -4 * sinf(q[1]) + 2 * sd;
+}
+
+static void fpg_nu(void *ctx, const float *q, float t, float *nu)
+{
+    (void)ctx, (void)q, (void)t;
+    nu[0] = (float)PG_OMEGA, nu[1] = 0;
+}
+
+static void fpg_gamma(void *ctx, const float *q, const float *qd, float t, float *g)
+{
+    (void)ctx, (void)t;
+    float dd = qd[1] - qd[0];
+    g[0] = 0;
+    g[1] = 4 * cosf(q[1]) * qd[1] * qd[1] - 4 * cosf(q[0]) * qd[0] * qd[0]
+           - 2 * cosf(q[1] - q[0]) * dd * dd;
+}
+
+/* The QR and the corrector in float: the same answers to float's digits. */
+static void test_float_build(void **state)
+{
+    (void)state;
+    assert_int_equal(sizeof(mechrt_real), sizeof(float));
+    const float a[12] = {1, 2, 1, 0, 1, 1, 1, 3, 2, 2, 4, 2};
+    const float b[4] = {0.3f - 1.4f + 1.1f, -0.7f + 1.1f, 0.3f - 2.1f + 2.2f,
+                        0.6f - 2.8f + 2.2f};
+    float x[3], work[64];
+    MechrtQr f;
+    assert_int_equal(mechrt_qr_factor(&f, 4, 3, a, 3, 1e-4f, work, 64), MECHRT_OK);
+    assert_int_equal(f.rank, 2);
+    mechrt_qr_solve(&f, b, x);
+    assert_near(x[0], -0.4, 0, 1e-5);
+    assert_near(x[1], 0, 0, 1e-5);
+    assert_near(x[2], 0.4, 0, 1e-5);
+
+    const MechrtfKernels k = {2, 2, 0, NULL, fpg_phi, fpg_jac, fpg_nu, fpg_gamma, NULL, NULL,
+                              NULL};
+    float q[2] = {(float)M_PI, (float)M_PI}, qd[2] = {(float)PG_OMEGA, (float)PG_OMEGA};
+    float qdd[2] = {0, 0};
+    MechrtfReport rep;
+    assert_int_equal(mechrt_rank_correct(&k, NULL, q, qd, qdd, 0.5f, work, 64, &rep), MECHRT_OK);
+    assert_int_equal(rep.rank_deficiency, 1);
+    assert_near(q[1], M_PI, 0, 1e-5);
+    assert_near(qd[1], PG_OMEGA, 0, 1e-3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_qr_min_norm),
         cmocka_unit_test(test_qr_banded),
+        cmocka_unit_test(test_rank_correct_fold),
+        cmocka_unit_test(test_float_build),
         cmocka_unit_test(test_a02_chain),
         cmocka_unit_test(test_chain_dense_near),
         cmocka_unit_test(test_locomotive),
