@@ -88,6 +88,10 @@
 /* States before the current one that the rank corrector's predictor
    extrapolates the acceleration from (a cubic through four). */
 #define RUN_HISTORY 3
+/* The rank corrector is dense: two nq x nq matrices and O(nq^3) work per
+   call. Above this many coordinates (16 MB) a singular step fails as the
+   LU's does. */
+#define RUN_RANK_MAX_NQ 1000
 
 const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
 
@@ -712,7 +716,7 @@ static MechrtStatus checked_step(Run *r, double t, double h, MechrtReport *rep, 
     memcpy(r->sq, r->q, 3 * (size_t)r->nq * sizeof(double));   /* q | qd | qdd */
     MechrtStatus st = run_step(r, t, h, rep);
     r->res->newton_iterations += rep->iterations;
-    if (h != 0 && wants_rank(st, rep))
+    if (h != 0 && r->nq <= RUN_RANK_MAX_NQ && wants_rank(st, rep))
         st = rank_step(r, t, h, st, rep);
     *quiet = st == MECHRT_OK && step_quiet(r, h, rep, chk);
     if (*quiet)
