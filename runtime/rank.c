@@ -13,7 +13,7 @@
  * Along the directions the Jacobian does see, that is the exact solution,
  * as mechrt_step's; along the lost ones, the prediction's value. How good
  * the prediction is decides the accuracy there: the caller's job (mechc
- * run extrapolates the acceleration quadratically from three states).
+ * run extrapolates the acceleration by a cubic through four states).
  * The residual the solves leave (`inconsistency`) says whether the
  * continued velocity was one the mechanism can have: small on a branch,
  * large where the motion cannot go on (or the prediction is far off).
