@@ -35,6 +35,8 @@ void mechrt_report_clear(MechrtReport *r)
     r->cond = 0;
     r->cond_warning = false;
     r->factorisations = 0;
+    r->rank_deficiency = 0;
+    r->inconsistency = 0;
 }
 
 static bool an_kernels_ok(const MechrtKernels *k)

@@ -42,12 +42,14 @@ MechrtOptions mechrt_default_options(void)
     o.pivot_tol = MECHRT_R(1e-5);
     o.cond_warn = MECHRT_R(1e5);
     o.cond_screen = MECHRT_R(1e-2);
+    o.rank_tol = MECHRT_R(1e-3);
 #else
     o.tol_phi = 1e-8;
     o.tol_dq = 1e-8;
     o.pivot_tol = 1e-12;
     o.cond_warn = 1e10;
     o.cond_screen = 1e-4;
+    o.rank_tol = 1e-5;
 #endif
     o.max_iter = 25;
     return o;

@@ -165,6 +165,13 @@ typedef enum MechrtStatus {
 #define mechrt_lup_norm1             mechrtf_lup_norm1
 #define mechrt_lup_cond1             mechrtf_lup_cond1
 #define mechrt_step_lup              mechrtf_step_lup
+#define MechrtQr                     MechrtfQr
+#define mechrt_qr_work_len           mechrtf_qr_work_len
+#define mechrt_qr_factor             mechrtf_qr_factor
+#define mechrt_qr_solve              mechrtf_qr_solve
+#define mechrt_qr_row                mechrtf_qr_row
+#define mechrt_rank_workspace_size   mechrtf_rank_workspace_size
+#define mechrt_rank_correct          mechrtf_rank_correct
 typedef float mechrt_real;
 #else
 typedef double mechrt_real;
@@ -238,6 +245,11 @@ typedef struct MechrtOptions {
        warning is due (dimensionless; 0 always estimates).
        default 1e-4 / 1e-2 */
     mechrt_real cond_screen;
+    /* mechrt_rank_correct (singular positions): a pivot of the
+       rank-revealing QR at or below rank_tol times the first (the largest
+       row norm) ends the rank; the directions beyond it are taken from the
+       prediction (dimensionless). default 1e-5 / 1e-3 */
+    mechrt_real rank_tol;
 } MechrtOptions;
 
 /* What an assembly or an analysis step did, for messages and logs. The
@@ -254,6 +266,13 @@ typedef struct MechrtReport {
     bool cond_warning;     /* cond > cond_warn */
     int factorisations;    /* LU factorisations the call did (Newton's and the
                               analysis'): mechrt_step's cost in O(n^3) work */
+    /* mechrt_rank_correct only (0 elsewhere): nq minus the numerical rank
+       of the Jacobian at the solution, and the largest relative residual
+       ||rhs - Phi_q x||_inf / (||rhs||_inf + ||Phi_q x||_inf) of its
+       velocity and acceleration: near 0 when the continued velocity is
+       one of the branch's, large when no velocity near it satisfies them */
+    int rank_deficiency;
+    mechrt_real inconsistency;
 } MechrtReport;
 
 /* A report with nothing done yet: counts 0, step and rows -1. NULL is ignored. */
@@ -604,5 +623,61 @@ MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, Mec
                              mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
                              mechrt_real t, mechrt_real h,
                              mechrt_real *work, size_t lwork, MechrtReport *report);
+
+/* ---- Rank-revealing QR (qr.c) -----------------------------------------
+   Householder QR with column pivoting of A^T for an m x n matrix A (m
+   rows): its numerical rank, and x = the least-norm solution of the rank's
+   rows of A x = b (pinv(A) b when b is in A's range). Workspace of
+   mechrt_qr_work_len(m, n) reals, which the factors live in. */
+typedef struct MechrtQr {
+    int m, n;               /* the matrix factored */
+    int rank;               /* pivots above rtol times the first */
+    mechrt_real *w, *tau, *rdiag, *perm, *cn, *cn_ref, *lo, *hi;   /* in the workspace */
+} MechrtQr;
+
+/* m n + 8 m; 0 when m or n < 1 or on overflow. */
+size_t mechrt_qr_work_len(int m, int n);
+
+/* Factors the m x n row-major a (not modified); the rank ends at the first
+   pivot (a row's remaining norm) <= rtol times the first pivot.
+   MECHRT_ENOTFINITE for NaN or Inf, MECHRT_EBADLEN, MECHRT_EINVAL. */
+MechrtStatus mechrt_qr_factor(MechrtQr *f, int m, int n, const mechrt_real *a, int lda,
+                              mechrt_real rtol, mechrt_real *work, size_t lwork);
+
+/* x (n) = the least-norm solution of the rank's rows of A x = b (b: m). */
+void mechrt_qr_solve(const MechrtQr *f, const mechrt_real *b, mechrt_real *x);
+
+/* The row of A chosen at step i < rank (pivot order), or -1. */
+int mechrt_qr_row(const MechrtQr *f, int i);
+
+/* ---- Through singular positions (rank.c) -------------------------------
+   Where the Jacobian loses rank (a parallelogram folding flat, the coupled
+   wheels of a locomotive, a dead centre) mechrt_step's LU fails or its
+   solves lose their digits. mechrt_rank_correct takes the state predicted
+   at t from the previous steps and makes every correction the least one:
+   Newton with minimum-norm steps from rank-revealing QR, then
+       qd  = qd_pred  + pinv(Phi_q) (nu    - Phi_q qd_pred),
+       qdd = qdd_pred + pinv(Phi_q) (gamma - Phi_q qdd_pred),
+   so the motion keeps to the branch the prediction follows, and where the
+   Jacobian is regular the result is mechrt_step's. Holonomic rows only
+   (nh == nq, nv == 0). */
+
+/* Workspace length in reals: 2 nq^2 + 12 nq (the QR's nq^2 + 8 nq among them);
+   0 on overflow. */
+size_t mechrt_rank_workspace_size(int nq);
+
+/* q, qd, qdd: on entry the prediction at t (e.g. the Taylor predictor
+   q + h qd + h^2/2 qdd, qd + h qdd, qdd from the last state, better from
+   more of them), on return the state at t. One QR at the predicted q
+   serves Newton (a chord iteration, refactored when it stalls) and, when
+   Newton moved q by at most 100 tol_dq, the velocity and acceleration
+   (refined with the Jacobian at the solution); else one more at the
+   solution. report: iterations,
+   residual, step, worst_row, factorisations (QRs), rank_deficiency and
+   inconsistency. Statuses as mechrt_step's (no MECHRT_ESING). */
+MechrtStatus mechrt_rank_correct(const MechrtKernels *k, const MechrtOptions *opts,
+                                 mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
+                                 mechrt_real t, mechrt_real *work, size_t lwork,
+                                 MechrtReport *report);
 
 #endif /* real-type part */

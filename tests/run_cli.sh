@@ -324,28 +324,88 @@ else
     skip "python3 missing: JSON checks"
 fi
 
+# ---- through singular positions (issue 19) ----------------------------------
+# The toggle slider-crank (r = l) meets the branch x = 0 at t = 0.25 and
+# 0.75 and goes on along the smooth one it came on, x = 2 r cos(2 pi t).
+run "$ex/slider_crank_toggle.mech" --stats
+check "toggle: exit 0, through t = 0.25 and 0.75" status_is 0
+check "toggle: 101 states (header + 101)" out_lines 102
+check "toggle: slider.x = 0 at t = 0.25" near "$(value_at 0.25 slider.x "$tmp/out")" 0 1e-9
+check "toggle: slider.x = -2 r at t = 0.5" near "$(value_at 0.5 slider.x "$tmp/out")" -0.4 1e-12
+check "toggle: d(slider.x) = -2 r omega at t = 0.25" \
+    near "$(value_at 0.25 'd(slider.x)' "$tmp/out")" -2.5132741228718345 1e-6
+check "toggle --stats: the two steps by the rank-revealing corrector" \
+    err_has "2 steps through singular positions by the rank-revealing corrector"
+
+# IFToMM A02, the issue's reproduction: a chain of 40 parallelograms
+# turned through a full turn, flat at t = 0.25 and 0.75 (on the grid).
+sh "$ex/chain.sh" 40 "$tmp/c40.mech"
+sed -e 's/^driver drive: rod0.phi = .*/driver drive: rod0.phi = pi\/2 - 2*pi*t/' "$tmp/c40.mech" \
+    > "$tmp/a02.mech"
+run "$tmp/a02.mech" --steps 400 --stats
+check "A02: exit 0" status_is 0
+check "A02: 401 states" out_lines 402
+check "A02 --stats: sparse, with the dense fallback at the two flat states" \
+    err_has "2 steps through singular positions by the rank-revealing corrector (dense QR, where KLU found the Jacobian singular or too ill-conditioned"
+check "A02 --stats: rank-deficient by 40 there" err_has "rank-deficient (by up to 40)"
+# every rod at rod0's angle pi/2 - 2 pi t, every coupler horizontal; rates
+# -2 pi and 0, accelerations 0: to 1e-8, 1e-6, 1e-4 in every state
+check "A02: every angle, rate and acceleration on the parallelogram branch" awk -F, '
+    function abs(x) { return x < 0 ? -x : x }
+    NR == 1 { for (i = 2; i <= NF; i++) {
+                  if ($i ~ /^rod[0-9]*\.phi$/) rod[i] = 1
+                  if ($i ~ /^cpl[0-9]*\.phi$/) cpl[i] = 1 }
+              nq = (NF - 1) / 3; next }
+    { pi = 3.141592653589793; t = $1
+      for (i in rod) { if (!(abs($i - (pi / 2 - 2 * pi * t)) <= 1e-8)) bad = bad " " t
+                       if (!(abs($(i + nq) + 2 * pi) <= 1e-6)) bad = bad " d" t
+                       if (!(abs($(i + 2 * nq)) <= 1e-4)) bad = bad " dd" t }
+      for (i in cpl) { if (!(abs($i) <= 1e-8) || !(abs($(i + nq)) <= 1e-6) \
+                           || !(abs($(i + 2 * nq)) <= 1e-4)) bad = bad " c" t }
+      n++ }
+    END { if (bad != "") print "off the branch at" bad > "/dev/stderr"; exit bad != "" || n != 401 }
+' "$tmp/out"
+cp "$tmp/out" "$tmp/a02.csv"
+run "$ex/a02_chain.mech" --steps 400
+check "examples/a02_chain.mech: the same run" cmp -s "$tmp/out" "$tmp/a02.csv"
+
 # ---- failures ------------------------------------------------------------
-run "$ex/slider_crank_toggle.mech"
-check "toggle: exit 1" status_is 1
-check "toggle: the message names t = 0.25" err_matches "error: t = 0\.25: "
-check "toggle: singular, or no convergence" err_matches "singular\|no convergence"
-check "toggle: names slider.x" err_matches "slider\.x"
-check "toggle: the 25 states before are written (header + 25)" out_lines 26
-check "toggle: the last row written is t = 0.24" \
-    [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.24" ]
-run "$ex/slider_crank_toggle.mech" --json
-check "toggle --json: exit 1" status_is 1
+# A slider pushed to its dead centre (crank 0.1, rod 0.3: x <= 0.4 at t = 1)
+# and past it: no motion continues; the message says so, with the time.
+cat > "$tmp/limit.mech" <<'EOF'
+param r = 0.1
+param l = 0.3
+body crank  x = 0.05 y = 0 phi = 0
+body rod    x = 0.25 y = 0 phi = 0
+body slider x = 0.4  y = 0 phi = 0
+revolute O: ground(0, 0) crank(-r/2, 0)
+revolute A: crank(r/2, 0) rod(-l/2, 0)
+revolute B: rod(l/2, 0) slider(0, 0)
+prismatic P: ground(0, 0) slider(0, 0) axis(1, 0)
+driver D: slider.x = 0.3 + 0.1*t
+EOF
+run "$tmp/limit.mech" --t1 2 --steps 20
+check "dead centre passed: exit 1" status_is 1
+check "dead centre passed: the message names t = 1" err_matches "error: t = 1: "
+check "dead centre passed: names crank.phi" err_matches "crank\.phi"
+check "dead centre passed: the corrector's verdict" \
+    err_has "the rank-revealing corrector found no motion that continues the branch either (at t = 1: "
+check "dead centre passed: the 10 states before are written (header + 10)" out_lines 11
+check "dead centre passed: the last row written is t = 0.9" \
+    [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.9" ]
+run "$tmp/limit.mech" --t1 2 --steps 20 --json
+check "dead centre passed --json: exit 1" status_is 1
 if have python3; then
-    check "toggle --json: valid, 25 states, ok false, the error's time" python3 -c '
+    check "dead centre passed --json: valid, 10 states, ok false, the error's time" python3 -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert len(d["t"]) == 25 and len(d["q"]) == 25 and d["t"][-1] == 0.24
-assert d["ok"] is False and d["error"]["t"] == 0.25
-assert d["error"]["message"].startswith("t = 0.25: ")
+assert len(d["t"]) == 10 and len(d["q"]) == 10 and d["t"][-1] == 0.9
+assert d["ok"] is False and d["error"]["t"] == 1
+assert d["error"]["message"].startswith("t = 1: ")
 ' "$tmp/out"
 fi
-run "$ex/slider_crank_toggle.mech" --t1 0.2
-check "toggle, t1 = 0.2: exit 0" status_is 0
+run "$tmp/limit.mech" --t1 0.9 --steps 9
+check "dead centre, t1 = 0.9: exit 0" status_is 0
 
 cat > "$tmp/reach.mech" <<'EOF'
 # a point on the unit circle pulled along x past its reach (x = 1 at t = 0.45)
@@ -392,7 +452,7 @@ for f in "$ex"/*.mech; do
     name=$(basename "$f" .mech)
     case $name in
         pendulum_distance|pendulum_constraint|pendulum_dynamics) want=2 ;;
-        parallelogram_redundant|slider_crank_toggle|bricard) want=1 ;;
+        parallelogram_redundant|bricard) want=1 ;;
         *) want=0 ;;
     esac
     run "$f" --csv /dev/null
@@ -482,6 +542,10 @@ for f in "$ex"/*.mech; do
     sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/; s/^(point +[A-Za-z_0-9]+).*/\1/' "$f" > "$tmp/all0.mech"
     run "$tmp/angles0.mech" --steps 0 --csv /dev/null
     check "$name with angle guesses 0 assembles" status_is 0
+    # (a02_chain: with no values at all the construction does not place
+    # chains of 30 or more loops, chain.sh's as well: Newton then starts
+    # from a singular guess; its angle guesses 0 are enough, above)
+    [ "$name" = a02_chain ] && continue
     run "$tmp/all0.mech" --steps 0 --csv /dev/null
     check "$name with every guess 0 assembles" status_is 0
 done

@@ -4,7 +4,7 @@
 # absolute) and the same exit status, including the states written before a
 # failure; a chain of 50 four-bar loops goes sparse under auto and matches
 # the dense run; bad values, velocity-level rows and the generic engine are
-# refused with exit 2; the toggle's sparse failure names its time, row and
+# refused with exit 2; a singular sparse failure names its time, row and
 # coordinate. gen --sparse writes PREFIX_all_nz (and only then), a C99 file
 # whose all_nz agrees with phi, jac_nz, nu and gamma; the dense-Jacobian
 # limit (--max-jac-entries) binds only runs that form one, and a chain of
@@ -18,15 +18,15 @@ suite_begin sparse_cli "${1:-build/mechc}"
 
 run() { run_mechc run "$@"; }
 
-# same_csv A B: same shape, every number within 1e-10 * max(1, |a|).
+# same_csv A B [TOL]: same shape, every number within TOL (1e-10) * max(1, |a|).
 same_csv() {
     awk -F, 'NR == FNR { n1 = FNR; w1 = NF; for (i = 1; i <= NF; i++) a[FNR, i] = $i; next }
         FNR == 1 { n2 = 1; if ($0 != hdr) bad = 1; next }
         { n2 = FNR; if (NF != w1) bad = 1
           for (i = 1; i <= NF; i++) { x = a[FNR, i] + 0; d = x - $i; if (d < 0) d = -d
                                       s = x < 0 ? -x : x; if (s < 1) s = 1
-                                      if (!(d <= 1e-10 * s)) bad = 1 } }
-        END { exit bad || n1 != n2 }' "$1" hdr="$(head -1 "$1")" "$2"
+                                      if (!(d <= tol * s)) bad = 1 } }
+        END { exit bad || n1 != n2 }' "$1" hdr="$(head -1 "$1")" tol="${3:-1e-10}" "$2"
 }
 
 # ---- every example, dense against sparse ------------------------------------
@@ -42,8 +42,14 @@ for f in "$ex"/*.mech; do
         continue
     fi
     check "$b: same exit status dense ($rd) and sparse ($rs)" test "$rd" = "$rs"
+    # through singular positions the directions the Jacobian loses come
+    # from the prediction: there the two paths' roundings differ more
+    case $b in
+        a02_chain|locomotive|parallelogram_four_bar) tol=1e-6 ;;
+        *) tol=1e-10 ;;
+    esac
     if [ -s "$tmp/$b.d.csv" ]; then
-        check "$b: dense and sparse states agree to 1e-10" same_csv "$tmp/$b.d.csv" "$tmp/$b.s.csv"
+        check "$b: dense and sparse states agree to $tol" same_csv "$tmp/$b.d.csv" "$tmp/$b.s.csv" $tol
         compared=$((compared + 1))
     fi
 done
@@ -147,13 +153,17 @@ else
     skip "the build does not start within 250 MB of address space"
 fi
 
-# ---- the toggle, sparse ------------------------------------------------------
-run "$ex/slider_crank_toggle.mech" --linear sparse
-check "toggle sparse: exit 1" status_is 1
-check "toggle sparse: at t = 0.25" err_matches "error: t = 0\.25: "
-check "toggle sparse: singular" err_has "singular Jacobian"
-check "toggle sparse: names the pivot's row and coordinate" \
-    err_matches "sparse LU found no pivot for [a-z]*\.[a-z]* in row [A-Z]*\.[a-z]*"
-check "toggle sparse: the 25 states before are written" out_lines 26
+# ---- singular, sparse ---------------------------------------------------------
+# the toggle passes on the sparse path too (the dense rank-revealing
+# fallback, tests/test_branch.c); a redundant row at t0 names KLU's pivot
+run "$ex/slider_crank_toggle.mech" --linear sparse --stats
+check "toggle sparse: exit 0, through t = 0.25" status_is 0
+check "toggle sparse: the fallback is counted" err_has "where KLU found the Jacobian singular"
+run "$ex/parallelogram_redundant.mech" --linear sparse
+check "redundant sparse: exit 1" status_is 1
+check "redundant sparse: at t = 0" err_matches "error: t = 0: "
+check "redundant sparse: singular" err_has "singular Jacobian"
+check "redundant sparse: names the pivot's row and coordinate" \
+    err_matches "sparse LU found no pivot for [a-z0-9]*\.[a-z]* in row [A-Z0-9]*\.[a-z]*"
 
 suite_end

@@ -469,25 +469,17 @@ static void test_substep_limit(void **state)
 
 /* ---- failures ---------------------------------------------------------- */
 
-/* slider_crank_toggle.mech (r = l) reaches its toggle at t = 0.25: the run
-   stops there with exit status 1, the 25 states before it delivered. */
+/* slider_crank_toggle.mech (r = l) reaches its toggle at t = 0.25, where
+   two branches cross: the run goes on along the smooth one it came on
+   (tests/test_branch.c checks it against the closed form). */
 static void test_toggle(void **state)
 {
     (void)state;
     Mech *mech = load_file("examples/slider_crank_toggle.mech");
     Collected c;
     run_with(mech, ENGINE_JIT, run_default_options(), &c);
-    assert_int_equal(c.status, RUN_FAILED);
-    assert_near(c.res.t_fail, 0.25, 0, 0);
-    assert_int_equal(c.res.states, 25);
-    assert_int_equal((int)c.trace.rows, 25);
-    assert_non_null(strstr(c.res.message, "t = 0.25:"));
-    assert_true(c.res.cause == MECHRT_ESING || c.res.cause == MECHRT_EMAXITER);
-    if (c.res.cause == MECHRT_ESING)
-        assert_non_null(strstr(c.res.message, "singular"));
-    /* the dependency names the slider and the rod */
-    assert_non_null(strstr(c.res.message, "slider.x"));
-    assert_non_null(strstr(c.res.message, "rod.phi"));
+    expect_ok(&c, 100);
+    assert_int_equal(c.res.rank_deficient_steps, 2);
     collected_free(&c);
 
     /* clear of the toggle, it runs */

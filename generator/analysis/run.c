@@ -77,6 +77,21 @@
 /* Two subdivision levels agree when their positions at the end of the
    interval differ by at most RUN_AGREE * tol_dq in every coordinate. */
 #define RUN_AGREE 10
+/* A step whose Jacobian at the end has a condition estimate above this
+   (or has no LU at all) is redone by the rank-revealing corrector
+   (rank_step): an LU solve there keeps fewer than 16 - 9 digits. */
+#define RUN_RANK_COND 1e9
+/* The rank corrector's velocity and acceleration must satisfy their
+   equations to this share (MechrtReport.inconsistency): otherwise the
+   continued motion is none the mechanism can have there. */
+#define RUN_BRANCH_TOL 1e-6
+/* States before the current one that the rank corrector's predictor
+   extrapolates the acceleration from (a cubic through four). */
+#define RUN_HISTORY 3
+/* The rank corrector is dense: two nq x nq matrices and O(nq^3) work per
+   call. Above this many coordinates (16 MB) a singular step fails as the
+   LU's does. */
+#define RUN_RANK_MAX_NQ 1000
 
 const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
 
@@ -116,7 +131,15 @@ typedef struct Run {
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
        and a failed step's iterate (fq) */
-    double *sq, *sqd, *sqdd, *iq, *lq, *fq;
+    double *sq, *sqd, *sqdd, *iq, *lq, *fq, *rq;
+    /* through singular positions (rank_step): the QR corrector's workspace
+       (allocated at the first use), and the accelerations of the last RUN_HISTORY
+       trusted states before the current one, for the predictor */
+    double *rk_work;
+    size_t rk_lwork;
+    int hist_n;
+    double hist_t[RUN_HISTORY];
+    double *hist_qdd;       /* RUN_HISTORY nq: entry 0 the latest */
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -591,15 +614,135 @@ static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }
 
+/* The state at time t (in sq, sqd, sqdd) was trusted: its acceleration
+   joins the predictor's history (the same time again replaces it). */
+static void push_history(Run *r, double t)
+{
+    size_t nq = (size_t)r->nq, bytes = nq * sizeof(double);
+    if (r->hist_n > 0 && r->hist_t[0] == t) {
+        memcpy(r->hist_qdd, r->sqdd, bytes);
+        return;
+    }
+    memmove(r->hist_qdd + nq, r->hist_qdd, (RUN_HISTORY - 1) * bytes);
+    memmove(r->hist_t + 1, r->hist_t, (RUN_HISTORY - 1) * sizeof *r->hist_t);
+    memcpy(r->hist_qdd, r->sqdd, bytes);
+    r->hist_t[0] = t;
+    r->hist_n = r->hist_n < RUN_HISTORY ? r->hist_n + 1 : RUN_HISTORY;
+}
+
+/* The prediction at t + h from the state at t (sq, sqd, sqdd) into q, qd,
+ * qdd: the acceleration extrapolated by the cubic through it and the
+ * history's three before it (fewer when there are fewer, down to Taylor's
+ * constant), qd and q its integrals from t. Errors O(h^4) in qdd, O(h^5)
+ * in qd, O(h^6) in q, where the LU step's Taylor predictor has O(h^3) in
+ * q: along the directions a singular Jacobian loses, the prediction is
+ * all there is. History from later times (a subdivision's failed level)
+ * or the other direction is left out. */
+static void predict(Run *r, double t, double h)
+{
+    double s[RUN_HISTORY + 1] = {0};
+    const double *a[RUN_HISTORY + 1] = {r->sqdd};
+    int used = 1;
+    for (int e = 0; e < r->hist_n; e++) {
+        double se = r->hist_t[e] - t;
+        if (se * h < 0 && (used == 1 || fabs(se) > fabs(s[used - 1]))) {
+            s[used] = se;
+            a[used++] = r->hist_qdd + (size_t)e * (size_t)r->nq;
+        }
+    }
+    double hk[6] = {1, h, h * h, h * h * h, h * h * h * h, h * h * h * h * h};
+    for (int i = 0; i < r->nq; i++) {
+        /* divided differences, then the Newton form as c0 + c1 s + ... */
+        double d[RUN_HISTORY + 1] = {a[0][i]}, c[4] = {0, 0, 0, 0};
+        double f[RUN_HISTORY + 1];
+        for (int j = 0; j < used; j++)
+            f[j] = a[j][i];
+        for (int l = 1; l < used; l++) {
+            for (int j = used - 1; j >= l; j--)
+                f[j] = (f[j] - f[j - 1]) / (s[j] - s[j - l]);
+            d[l] = f[l];
+        }
+        c[0] = d[0];
+        if (used > 1)
+            c[1] = d[1];
+        if (used > 2)
+            c[1] -= d[2] * s[1], c[2] = d[2];
+        if (used > 3)
+            c[1] += d[3] * s[1] * s[2], c[2] -= d[3] * (s[1] + s[2]), c[3] = d[3];
+        double qdd = 0, qd = r->sqd[i], q = r->sq[i] + r->sqd[i] * h;
+        for (int k = 0; k < 4; k++) {
+            qdd += c[k] * hk[k];
+            qd += c[k] * hk[k + 1] / (k + 1);
+            q += c[k] * hk[k + 2] / ((k + 1) * (k + 2));
+        }
+        r->qdd[i] = qdd, r->qd[i] = qd, r->q[i] = q;
+    }
+}
+
+/* The LU step ended without a factorisation (singular), or with one too
+   ill-conditioned to trust: the rank-revealing corrector takes over. */
+static bool wants_rank(MechrtStatus st, const MechrtReport *rep)
+{
+    if (st == MECHRT_ESING || st == MECHRT_EMAXITER || st == MECHRT_ENOTFINITE)
+        return true;
+    return st == MECHRT_OK && rep->cond > RUN_RANK_COND;
+}
+
+/* The step from t to t + h again, through a singular position: the
+   history's prediction, corrected by mechrt_rank_correct (dense, on both
+   paths: KLU has no rank-revealing factorisation). When it fails too, or
+   its velocity or acceleration leave a residual (no branch continues the
+   motion there), the LU attempt stands: its status st0, its report in
+   *rep and its iterate (kept in rq) in q, so that its messages are the
+   LU's; the corrector's verdict is kept for the message (rank_note). */
+static MechrtStatus rank_step(Run *r, double t, double h, MechrtStatus st0, MechrtReport *rep)
+{
+    size_t bytes = (size_t)r->nq * sizeof(double);
+    if (!r->rk_work) {
+        r->rk_lwork = mechrt_rank_workspace_size(r->nq);
+        r->rk_work = xcalloc(r->rk_lwork + 1, sizeof *r->rk_work);
+    }
+    MechrtReport rk;
+    memcpy(r->rq, r->q, bytes);
+    predict(r, t, h);
+    MechrtStatus st = mechrt_rank_correct(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t + h,
+                                          r->rk_work, r->rk_lwork, &rk);
+    RunResult *res = r->res;
+    res->rank_steps++;
+    res->newton_iterations += rk.iterations;
+    res->rank_factorisations += rk.factorisations;
+    if (st != MECHRT_OK || rk.inconsistency > RUN_BRANCH_TOL) {
+        res->rank_failed = true;
+        res->rank_t = t + h;
+        res->rank_status = st;
+        res->rank_inconsistency = rk.inconsistency;
+        memcpy(r->q, r->rq, bytes);
+        return st0;
+    }
+    if (rk.rank_deficiency > 0)
+        res->rank_deficient_steps++;
+    if (rk.rank_deficiency > res->max_rank_deficiency)
+        res->max_rank_deficiency = rk.rank_deficiency;
+    rk.cond = st0 == MECHRT_OK ? rep->cond : 0;   /* the condition watch: the LU's estimate */
+    rk.cond_warning = st0 == MECHRT_OK ? rep->cond_warning : false;
+    *rep = rk;
+    return MECHRT_OK;
+}
+
 /* One predictor-corrector step of the runtime from t to t + h, its start
-   kept in sq, sqd, sqdd; *quiet says whether it passed the check. */
+   kept in sq, sqd, sqdd; *quiet says whether it passed the check. A step
+   that meets a singular Jacobian is redone by rank_step. */
 static MechrtStatus checked_step(Run *r, double t, double h, MechrtReport *rep, bool *quiet,
                                  StepCheck *chk)
 {
     memcpy(r->sq, r->q, 3 * (size_t)r->nq * sizeof(double));   /* q | qd | qdd */
     MechrtStatus st = run_step(r, t, h, rep);
     r->res->newton_iterations += rep->iterations;
+    if (h != 0 && r->nq <= RUN_RANK_MAX_NQ && wants_rank(st, rep))
+        st = rank_step(r, t, h, st, rep);
     *quiet = st == MECHRT_OK && step_quiet(r, h, rep, chk);
+    if (*quiet)
+        push_history(r, t);
     return st;
 }
 
@@ -710,6 +853,24 @@ static bool subdivide(Run *r, double t, double tn, MechrtStatus st0, MechrtRepor
     return false;
 }
 
+/* A failed step after which the rank-revealing corrector could not go on
+   either: what it found, after the LU's message. */
+static void note_rank_failure(Run *r)
+{
+    const RunResult *res = r->res;
+    msgf(r, "; the rank-revealing corrector found no motion that continues the branch "
+         "either (at t = %.10g: ", res->rank_t);
+    if (res->rank_status == MECHRT_OK)
+        msgf(r, "no velocity or acceleration near the continued ones satisfies their "
+             "equations, %.2g of them is left", res->rank_inconsistency);
+    else
+        msgf(r, "%s", mechrt_strerror(res->rank_status));
+    msgf(r, "): where the Jacobian loses rank the motion cannot go on (a limit position "
+         "that the driver pushes past), or branches meet that the motion so far cannot "
+         "tell apart (a bifurcation); drive another coordinate, or end the run there and "
+         "start another on the branch you want");
+}
+
 /* Holonomic rows only: the runtime's predictor-corrector step, checked and
    subdivided when needed (see the top of this file). */
 static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
@@ -719,9 +880,11 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     RunStatus status = RUN_OK;
     size_t nq = (size_t)r->nq;
     double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
-    double *keep = xmalloc(8 * nq * sizeof *keep);
+    double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
-    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq;
+    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
+    r->hist_qdd = keep + 9 * nq;
+    r->hist_n = 0;
     place_at_t0(r, q0, start);
     MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
     r->res->assembly_iterations = rep.iterations;
@@ -755,8 +918,11 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         clock_t cpu0 = clock();
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
+        r->res->rank_failed = false;
         st = checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
+        if (!ok && r->res->rank_failed)
+            note_rank_failure(r);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
@@ -770,7 +936,9 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 out:
     free(q0);
     free(keep);
-    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = NULL;
+    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = r->rq = r->hist_qdd = NULL;
+    free(r->rk_work);
+    r->rk_work = NULL;
     return status;
 }
 

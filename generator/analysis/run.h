@@ -107,6 +107,23 @@ typedef struct RunResult {
                                     (dense: the pattern LU's finished by lu.c)... */
     long refactorisations;       /* ... and with the pivot order kept (replayed) */
     MechrtHostStats host;        /* integrator counters when integrated */
+    /* through singular positions (holonomic runs): steps redone by the
+       rank-revealing corrector (mechrt_rank_correct) because the LU found
+       the Jacobian singular or too ill-conditioned, those of them where it
+       was rank-deficient, the largest deficiency, and its QR
+       factorisations (dense, also on the sparse path) */
+    int rank_steps;
+    int rank_deficient_steps;
+    int max_rank_deficiency;
+    long rank_factorisations;
+    /* the last time the corrector could not continue the motion: when,
+       its status (MECHRT_OK: it converged, but no velocity or acceleration
+       near the continued one satisfies their equations), and the residual
+       share it left */
+    bool rank_failed;
+    double rank_t;
+    MechrtStatus rank_status;
+    double rank_inconsistency;
 } RunResult;
 
 /* Receives each state as soon as it is computed. */

@@ -50,6 +50,11 @@ static const char usage[] =
     "their positions integrated (GSL, adaptive step) and projected back onto the\n"
     "holonomic rows after every step. Needs as many rows as coordinates. The\n"
     "file's `output` statements are reported beside the coordinates.\n"
+    "Where the Jacobian loses rank (a parallelogram folding flat, coupled wheels\n"
+    "at a dead centre, a toggle) a step is redone by a rank-revealing corrector:\n"
+    "each correction the least one from the motion the previous steps predict,\n"
+    "so the run keeps to the branch it is on; where no motion continues it (a\n"
+    "driver pushing past a dead centre) the run stops with exit 1 and says so.\n"
     "\n";
 
 static const char *const ode_methods[] = {"rk8pd", "rkf45", NULL};
@@ -104,8 +109,10 @@ static const CliOption options[] = {
     {"--ode-tol", CLI_REAL_AT(RunCli, ro.ode.tol), POSITIVE, .metavar = "X",
      .help = "its error per step, absolute and relative (default 1e-10)"},
     {"--stats", CLI_FLAG_AT(RunCli, stats),
-     .help = "print time per step, Newton iterations per step and the\n"
-             "step's cost in evaluations of the fused `all` kernel"},
+     .help = "print time per step, Newton iterations per step, the\n"
+             "step's cost in evaluations of the fused `all` kernel and\n"
+             "the steps through singular positions (dense QR, also on\n"
+             "the sparse path)"},
     {"--svg", CLI_STRING_AT(RunCli, svg_path), .metavar = "FILE",
      .help = "write an animated SVG of the motion (plays in any browser)"},
     {"--trace", CLI_LIST_AT(RunCli, traces, MAX_TRACES), .what = "points", .metavar = "B(sx,sy)",
@@ -328,6 +335,14 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
         if (res->subdivided > 0)
             fprintf(stderr, "mechc run: stats: %d %s redone in substeps (%ld substeps)\n",
                     res->subdivided, res->subdivided == 1 ? "step" : "steps", res->substeps);
+        if (res->rank_steps > 0)
+            fprintf(stderr, "mechc run: stats: %d %s through singular positions by the "
+                    "rank-revealing corrector (dense QR%s: %ld factorisations), %d of them "
+                    "rank-deficient (by up to %d)\n", res->rank_steps,
+                    res->rank_steps == 1 ? "step" : "steps",
+                    res->sparse ? ", where KLU found the Jacobian singular or too "
+                    "ill-conditioned" : "", res->rank_factorisations,
+                    res->rank_deficient_steps, res->max_rank_deficiency);
     }
     fprintf(stderr, "mechc run: stats: %.6g ms of CPU time in the steps: %.0f ns per step\n",
             1e3 * res->step_cpu_seconds, 1e9 * res->step_cpu_seconds / n);

@@ -188,7 +188,7 @@ static MechrtStatus min_norm_step(MechrtHost *h, const MechrtOptions *o, const d
 static MechrtStatus project(MechrtHost *h, const MechrtOptions *o, double *q, double t,
                             MechrtReport *r)
 {
-    MechrtReport rep = {0, 0, -1, -1, -1, 0, false, 0};
+    MechrtReport rep = {0, 0, -1, -1, -1, 0, false, 0, 0, 0};
     MechrtStatus st;
     h->stats.projections++;
     if (h->nh == 0) {
@@ -276,7 +276,7 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
     if (!(oo->tol > 0))
         return MECHRT_EINVAL;
     if (report)
-        *report = (MechrtReport){0, 0, -1, -1, -1, 0, false, 0};
+        *report = (MechrtReport){0, 0, -1, -1, -1, 0, false, 0, 0, 0};
     if (*t == t_end)
         return MECHRT_OK;
 
