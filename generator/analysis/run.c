@@ -44,6 +44,11 @@
  * dependency (a toggle, a dead centre, redundant rows). Stretches where the
  * condition estimate exceeds MechrtOptions.cond_warn are warned about once,
  * when they begin, with a note when they end.
+ *
+ * run_analysis_forces adds inverse dynamics (`run --forces`): at every
+ * state, lambda from Phi_q^T lambda = Q - M qdd by the runtime's
+ * mechrt_inverse_dynamics, inside the step's timing so that --stats
+ * measures what the reactions cost.
  */
 #include "run.h"
 
@@ -140,6 +145,11 @@ typedef struct Run {
     int hist_n;
     double hist_t[RUN_HISTORY];
     double *hist_qdd;       /* RUN_HISTORY nq: entry 0 the latest */
+    /* run_analysis_forces: the state callback with lambda, the dynamics
+       workspace and the multipliers of the last state (nr) */
+    RunForcesFn fstate;
+    double *dyn_work, *lambda;
+    size_t dyn_lwork;
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -532,8 +542,37 @@ static void watch_condition(Run *r, double t, const MechrtReport *rep)
 static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
 {
     watch_condition(r, t, rep);
-    state(ctx, t, r->q, r->qd, r->qdd);
+    if (r->fstate)
+        r->fstate(ctx, t, r->q, r->qd, r->qdd, r->lambda);
+    else
+        state(ctx, t, r->q, r->qd, r->qdd);
     r->res->states++;
+}
+
+/* Inverse dynamics at the state just computed (t, r->q, r->qd, r->qdd),
+   into r->lambda; nothing without run_analysis_forces. False, with the
+   failure in r->res, when the solve fails. */
+static bool inverse_at(Run *r, double t)
+{
+    if (!r->fstate)
+        return true;
+    MechrtDynReport rep;
+    MechrtStatus st = mechrt_inverse_dynamics(r->k, NULL, r->q, r->qd, r->qdd, t, r->lambda,
+                                              r->dyn_work, r->dyn_lwork, &rep);
+    if (rep.residual > r->res->force_residual)
+        r->res->force_residual = rep.residual;
+    if (rep.redundant > r->res->force_redundant)
+        r->res->force_redundant = rep.redundant;
+    if (st == MECHRT_OK)
+        return true;
+    r->res->status = RUN_FAILED;
+    r->res->cause = st;
+    r->res->t_fail = t;
+    r->res->message[0] = '\0';
+    msgf(r, "t = %.10g: inverse dynamics failed: %s", t,
+         st == MECHRT_ENOTFINITE ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
+                                 : mechrt_strerror(st));
+    return false;
 }
 
 static double time_at(const RunOptions *o, int i)
@@ -909,6 +948,10 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         goto out;
     }
     note_move(r, q0);
+    if (!inverse_at(r, o->t0)) {
+        status = RUN_FAILED;
+        goto out;
+    }
     put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0;
@@ -923,6 +966,8 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         bool ok = quiet || subdivide(r, t, tn, st, &rep, &chk);
         if (!ok && r->res->rank_failed)
             note_rank_failure(r);
+        if (ok && !inverse_at(r, tn))
+            ok = false;
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
@@ -983,6 +1028,10 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         status = RUN_FAILED;
         goto out;
     }
+    if (!inverse_at(r, o->t0)) {
+        status = RUN_FAILED;
+        goto out;
+    }
     put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
@@ -1003,10 +1052,15 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         }
         st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
                                           r->lwork, &rep);
+        bool forces_ok = st != MECHRT_OK || inverse_at(r, tn);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (st != MECHRT_OK) {
             fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
+            status = RUN_FAILED;
+            goto out;
+        }
+        if (!forces_ok) {
             status = RUN_FAILED;
             goto out;
         }
@@ -1106,8 +1160,9 @@ bool run_rows_match(const Model *m, char *why, size_t size)
     return true;
 }
 
-RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                       RunStateFn state, void *state_ctx, RunResult *res)
+/* run_analysis and run_analysis_forces: one of state and fstate. */
+static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                         RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
@@ -1155,6 +1210,12 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
+    if (fstate) {
+        r.fstate = fstate;
+        r.dyn_lwork = mechrt_dynamics_workspace_size(m->nq, m->nr);
+        r.dyn_work = xcalloc(r.dyn_lwork + 1, sizeof *r.dyn_work);
+        r.lambda = xcalloc((size_t)m->nr + 1, sizeof *r.lambda);
+    }
 
     RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
                                   : run_integrated(&r, state, state_ctx);
@@ -1171,8 +1232,27 @@ RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions 
         notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
-    free(r.q), free(r.work);
+    free(r.q), free(r.work), free(r.dyn_work), free(r.lambda);
     return status;
+}
+
+RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                       RunStateFn state, void *state_ctx, RunResult *res)
+{
+    return analyse(m, k, o, state, NULL, state_ctx, res);
+}
+
+RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                              RunForcesFn state, void *state_ctx, RunResult *res)
+{
+    if (!k->mass || !k->force) {
+        memset(res, 0, sizeof *res);
+        res->t_fail = NAN;
+        return bad_input(res, "inverse dynamics needs masses: the mechanism has no `mass` "
+                         "statements (run --forces reports the reactions of a file with "
+                         "masses)");
+    }
+    return analyse(m, k, o, NULL, state, state_ctx, res);
 }
 
 double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const double *q,

@@ -124,11 +124,22 @@ typedef struct RunResult {
     double rank_t;
     MechrtStatus rank_status;
     double rank_inconsistency;
+    /* run_analysis_forces: the largest part of Q - M qdd the rows could
+       not carry (mechrt_inverse_dynamics' residual; above round-off only
+       where the Jacobian lost rank) and the most rows found dependent */
+    double force_residual;
+    int force_redundant;
 } RunResult;
 
 /* Receives each state as soon as it is computed. */
 typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *qd,
                            const double *qdd);
+
+/* The same with the multipliers of inverse dynamics (nr values, signed as
+   in M qdd + Phi_q^T lambda = Q): run_analysis_forces' states, and the
+   shape of sim's (SimStateFn). */
+typedef void (*RunForcesFn)(void *ctx, double t, const double *q, const double *qd,
+                            const double *qdd, const double *lambda);
 
 /* True when m has one row per coordinate, as a run needs; otherwise false
    with why (size bytes) saying how many degrees of freedom are not driven
@@ -140,6 +151,15 @@ bool run_rows_match(const Model *m, char *why, size_t size);
    degrees of freedom are not driven (or how many rows are too many). */
 RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
                        RunStateFn state, void *state_ctx, RunResult *res);
+
+/* run_analysis with inverse dynamics at every state: lambda from
+   Phi_q^T lambda = Q(q, qd, t) - M(q) qdd (mechrt_inverse_dynamics,
+   minimum-norm where rows are dependent), computed inside each step's
+   timing, handed to state with the state. Needs k->mass and k->force (a
+   file with masses): RUN_BAD_INPUT otherwise. A failed solve (NaN in M or
+   Q) fails the run at that time. */
+RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                              RunForcesFn state, void *state_ctx, RunResult *res);
 
 /* Nanoseconds per call of the fused `all` kernel (or phi + jac + nu + gamma
    when there is none; with jnz, phi + jac_nz + nu + gamma, the sparse

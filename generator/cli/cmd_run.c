@@ -11,9 +11,7 @@
 #include "../analysis/outputs.h"
 #include "../analysis/run.h"
 #include "../base/arena.h"
-#include "../render/progress.h"
-#include "../render/svg_anim.h"
-#include "../render/svg_plot.h"
+#include "run_output.h"
 #include "run_table.h"
 
 #include <errno.h>
@@ -21,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { MAX_TRACES = CLI_LIST_MAX, MAX_PLOT_VARS = 64 };
+enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 
 /* What the command line asked for. */
 typedef struct RunCli {
@@ -34,7 +32,7 @@ typedef struct RunCli {
     int engine, ode, digits;
     int view;               /* --view: an SvgView; -1: not given (iso) */
     int linear;             /* --linear, a RunLinear */
-    bool json, stats;
+    bool json, stats, forces;
     bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
 
@@ -82,6 +80,12 @@ static const CliOption options[] = {
     {"--json", CLI_FLAG_AT(RunCli, json),
      .help = "print {\"coords\", \"t\", \"q\", \"qd\", \"qdd\", \"ok\"[, \"error\"]}\n"
              "(with output statements also \"outputs\", \"y\", \"yd\", \"ydd\")"},
+    {"--forces", CLI_FLAG_AT(RunCli, forces),
+     .help = "inverse dynamics along the motion (a file with masses):\n"
+             "the multipliers lambda(ROW) of every row and the effort(D)\n"
+             "= -lambda(D) of every driver, as CSV columns after the\n"
+             "others and JSON \"rows\", \"lambda\", \"drivers\", \"efforts\";\n"
+             "--svg draws the joints' reaction forces as arrows"},
     {"--digits", CLI_INT_AT(RunCli, digits, 1, 17), .metavar = "N",
      .help = "significant digits of numbers (default: the fewest that\n"
              "read back exactly, at most 17)"},
@@ -128,7 +132,8 @@ static const CliOption options[] = {
      .help = "write an SVG chart of variables against time"},
     {"--plot-vars", CLI_STRING_AT(RunCli, plot_list), .metavar = "LIST",
      .help = "what --plot shows: coordinate or output names, d(NAME)\n"
-             "for a velocity, dd(NAME) for an acceleration (default:\n"
+             "for a velocity, dd(NAME) for an acceleration, with\n"
+             "--forces lambda(ROW) and effort(DRIVER) (default:\n"
              "every coordinate and output)"},
 };
 
@@ -136,57 +141,16 @@ static const char epilogue[] =
     "\n"
     "CSV columns: t, then every coordinate by name (crank.x, ...) and every\n"
     "output, then the velocities d(crank.x), ..., then the accelerations\n"
-    "dd(crank.x), ...\n"
+    "dd(crank.x), ...; with --forces then lambda(ROW) for every row and\n"
+    "effort(D) for every driver (the force or torque it applies along its\n"
+    "coordinate: the motor torque of `driver D: crank.phi = ...`).\n"
     "Exit status: 0 done; 1 the analysis failed (the message names t = VALUE,\n"
     "the cause and the rows and coordinates involved; the states before the\n"
     "failure are written); 2 bad usage or input, or not as many rows as\n"
     "coordinates.\n";
 
-/* Where the states go. */
-typedef struct Output {
-    FILE *csv;              /* NULL: no CSV */
-    MechrtTrace trace;      /* kept rows, for JSON and pictures */
-    bool json, trace_full;
-    Progress progress;
-    double t0, t1;
-    int digits;
-    int nq;                 /* coordinates */
-    int nv;                 /* reported variables: the coordinates, then the outputs */
-    OutputEval outputs;
-    double *v;              /* a state's variables: v | vd | vdd, 3 nv */
-    const char **names;     /* the variables' names, nv */
-    double *w;              /* a spatial state's angular velocities, outputs.nw */
-    const char *file;       /* for warnings */
-    bool warned;            /* an output was not finite (said once) */
-} Output;
-
-/* Sets up out for m's coordinates and outputs; output_close frees it. */
-static void output_open(Output *out, const Model *m)
-{
-    out->nq = m->nq;
-    out->nv = m->nq + m->nout;
-    outputs_init(&out->outputs, m);
-    out->v = xcalloc(3 * (size_t)out->nv, sizeof *out->v);
-    out->names = xcalloc((size_t)out->nv, sizeof *out->names);
-    for (int i = 0; i < out->nv; i++)
-        out->names[i] = i < m->nq ? m->coord_names[i] : m->outputs[i - m->nq].name;
-    mechrt_trace_init(&out->trace, out->nv);
-    out->w = xcalloc((size_t)out->outputs.nw + 1, sizeof *out->w);
-    mechrt_trace_set_omega(&out->trace, out->outputs.nw,
-                           (const char *const *)out->outputs.wnames);
-}
-
-static void output_close(Output *out)
-{
-    outputs_free(&out->outputs);
-    free(out->v);
-    free(out->w);
-    free(out->names);
-    mechrt_trace_free(&out->trace);
-}
-
 /* --steps 0 without --csv or --json: the one state as a table. */
-static void print_table(const Model *m, const Output *out, const RunResult *res, int digits)
+static void print_table(const Model *m, const RunOutput *out, const RunResult *res, int digits)
 {
     const double *row = out->trace.data;
     size_t nv = (size_t)out->nv, nq = (size_t)out->nq;
@@ -209,99 +173,6 @@ static void print_table(const Model *m, const Output *out, const RunResult *res,
     s.wnames = (const char *const *)out->outputs.wnames;
     run_table_print(stdout, m, &s, digits);
     free(w);
-}
-
-/* The state's coordinates followed by the outputs' values, in out->v. */
-static void fill_variables(Output *out, double t, const double *q, const double *qd,
-                           const double *qdd)
-{
-    size_t nq = (size_t)out->nq, nv = (size_t)out->nv;
-    const double *src[3] = {q, qd, qdd};
-    for (size_t k = 0; k < 3; k++)
-        memcpy(out->v + k * nv, src[k], nq * sizeof *out->v);
-    outputs_eval(&out->outputs, q, qd, qdd, t, out->v + nq, out->v + nv + nq,
-                 out->v + 2 * nv + nq);
-}
-
-/* An output that is NaN or infinite (sqrt of a negative, ...) is written
-   as such; the first one is said on stderr, with its time. */
-static void warn_nonfinite(Output *out, double t)
-{
-    for (int k = 0; k < 3 && !out->warned; k++)
-        for (int i = out->nq; i < out->nv && !out->warned; i++)
-            if (!isfinite(out->v[k * out->nv + i])) {
-                fprintf(stderr, "%s: warning: output '%s' is not finite at t = %.10g (later "
-                        "ones are not reported)\n", out->file, out->names[i], t);
-                out->warned = true;
-            }
-}
-
-static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
-{
-    Output *out = ctx;
-    outputs_omega(&out->outputs, q, qd, out->w);
-    if (out->nv > out->nq) {
-        fill_variables(out, t, q, qd, qdd);
-        q = out->v, qd = out->v + out->nv, qdd = out->v + 2 * out->nv;
-        warn_nonfinite(out, t);
-    }
-    if (out->csv)
-        mechrt_csv_row_omega(out->csv, out->nv, t, q, qd, qdd, out->outputs.nw, out->w,
-                             out->digits);
-    if (out->json && !mechrt_trace_push_omega(&out->trace, t, q, qd, qdd, out->w))
-        out->trace_full = true;
-    if (out->t1 != out->t0)
-        progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
-}
-
-/* The animation and the chart, from the kept rows [t, q, qd, qdd]. */
-static bool write_pictures(const Model *m, const MechrtTrace *tr, const char *svg_path,
-                           const SvgTrace *traces, int ntraces, int view, const char *plot_path,
-                           const SvgPlotVar *vars, int nvars)
-{
-    SvgAnimOptions ao = svg_anim_default_options();
-    if (view >= 0)
-        ao.view = (SvgView)view;
-    size_t n = tr->rows, nq = (size_t)m->nq, nv = (size_t)tr->nq, w = 1 + 3 * nv;
-    bool ok = true;
-    if (n == 0)
-        return true;
-    double *t = xcalloc(n, sizeof *t), *q = xcalloc(n * nq, sizeof *q);
-    for (size_t k = 0; k < n; k++) {
-        t[k] = tr->data[k * w];
-        memcpy(q + k * nq, tr->data + k * w + 1, nq * sizeof *q);
-    }
-    const char *paths[2] = {svg_path, plot_path};
-    for (int which = 0; which < 2; which++) {
-        if (!paths[which])
-            continue;
-        FILE *f = fopen(paths[which], "w");
-        if (!f) {
-            fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", paths[which], strerror(errno));
-            ok = false;
-            continue;
-        }
-        bool wrote;
-        if (which == 0) {
-            wrote = svg_write_animation_opt(f, m, t, q, (int)n, traces, ntraces, m->name, &ao);
-        } else {
-            SvgSeries series[MAX_PLOT_VARS];
-            char names[MAX_PLOT_VARS][96];
-            for (int i = 0; i < nvars; i++) {
-                svg_plot_var_name(m, vars[i], names[i], sizeof names[i]);
-                series[i] = (SvgSeries){names[i], tr->data + 1 + (size_t)vars[i].order * nv
-                                                  + (size_t)vars[i].coord, (int)w};
-            }
-            wrote = svg_write_plot(f, m->name, t, (int)n, series, nvars);
-        }
-        if (fclose(f) != 0 || !wrote) {
-            fprintf(stderr, "mechc run: error: writing '%s' failed\n", paths[which]);
-            ok = false;
-        }
-    }
-    free(t);
-    free(q);
-    return ok;
 }
 
 static void print_stats(const RunResult *res, const MechrtKernels *k,
@@ -365,19 +236,25 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
 
 /* The last state seen, for --stats' kernel timing. */
 typedef struct LastState {
-    Output *out;
+    RunOutput *out;
     double t;
     double *q, *qd;
 } LastState;
 
 static void on_state_keep(void *ctx, double t, const double *q, const double *qd,
-                          const double *qdd)
+                          const double *qdd, const double *lambda)
 {
     LastState *ls = ctx;
-    on_state(ls->out, t, q, qd, qdd);
+    run_output_state(ls->out, t, q, qd, qdd, lambda);
     ls->t = t;
     memcpy(ls->q, q, (size_t)ls->out->nq * sizeof *q);
     memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
+}
+
+static void on_state_kinematic(void *ctx, double t, const double *q, const double *qd,
+                               const double *qdd)
+{
+    on_state_keep(ctx, t, q, qd, qdd, NULL);
 }
 
 /* Checks the options together and fills what they imply; false when
@@ -436,66 +313,24 @@ static bool finish(Args *a, void *opts)
 
 /* The --trace points and --plot variables by name; false (reported) when
    one is unknown. */
-static bool resolve_pictures(const Model *m, const RunCli *c, SvgTrace *traces, int *ntraces,
-                             SvgPlotVar *vars, int *nvars)
+static bool resolve_pictures(const Model *m, const RunCli *c, RunPictures *p)
 {
-    char err[256];
-    *nvars = 0;
     if (!m->spatial && c->view >= 0) {
         fprintf(stderr, "%s: error: --view chooses how a spatial mechanism is seen, and this "
                 "one is planar (drawn as it is, x right, y up)\n", m->file);
         return false;
     }
-    for (int i = 0; i < c->traces.n; i++) {
-        if (!svg_parse_trace(m, c->traces.items[i], &traces[i], err, sizeof err)) {
-            fprintf(stderr, "mechc run: error: %s\n", err);
-            return false;
-        }
-    }
-    *ntraces = c->traces.n;
-    int dropped = 0;
-    for (int k = 0; k < m->nout; k++) {
-        const ModelOutput *o = &m->outputs[k];
-        if (!o->point || o->at.q < 0)    /* a point output's path; ground's stays put */
-            continue;
-        if (*ntraces < MAX_TRACES)
-            traces[(*ntraces)++] = (SvgTrace){o->at.q, o->at.has_phi || o->at.has_p, o->at.sx,
-                                              o->at.sy, o->point, o->at.spatial, o->at.sz};
-        else
-            dropped++;
-    }
-    if (dropped > 0 && c->svg_path)
-        fprintf(stderr, "%s: note: the paths of %d point output%s are not drawn (at most %d "
-                "paths)\n", m->file, dropped, dropped == 1 ? "" : "s", MAX_TRACES);
-    if (c->plot_path && c->plot_list) {
-        *nvars = svg_plot_resolve(m, c->plot_list, vars, MAX_PLOT_VARS, err, sizeof err);
-        if (*nvars <= 0) {
-            fprintf(stderr, "mechc run: error: %s\n", err);
-            return false;
-        }
-    } else if (c->plot_path) {
-        for (int i = 0; i < m->nq + m->nout && *nvars < MAX_PLOT_VARS; i++)
-            vars[(*nvars)++] = (SvgPlotVar){i, 0};
-        if (m->nq + m->nout > MAX_PLOT_VARS)
-            fprintf(stderr, "%s: note: --plot shows the first %d of %d variables; choose "
-                    "them with --plot-vars\n", m->file, MAX_PLOT_VARS, m->nq + m->nout);
-    }
-    return true;
+    p->svg_path = c->svg_path;
+    p->plot_path = c->plot_path;
+    p->view = c->view;
+    return run_output_resolve_pictures("run", m, &c->traces, c->plot_list, c->forces, p);
 }
 
-/* The --trace points and --plot variables, resolved. */
-typedef struct Pictures {
-    SvgTrace traces[MAX_TRACES];
-    int ntraces;            /* --trace points, then point outputs */
-    SvgPlotVar vars[MAX_PLOT_VARS];
-    int nvars;
-} Pictures;
-
 /* Before any state: rows against coordinates (before the engine's
-   compile), the pictures' names, the engine. false when one fails
-   (reported). */
-static bool prepare(const Args *a, const RunCli *c, const Mech *mech, Pictures *pics, Engine *e,
-                    Diag *diag)
+   compile), the pictures' names, the engine, and the masses --forces
+   needs. false when one fails (reported; the engine closed). */
+static bool prepare(const Args *a, const RunCli *c, const Mech *mech, RunPictures *pics,
+                    Engine *e, Diag *diag)
 {
     const Model *m = mech->model;
     char why[300];
@@ -504,12 +339,21 @@ static bool prepare(const Args *a, const RunCli *c, const Mech *mech, Pictures *
         diag_print(diag, stderr);
         return false;
     }
-    return resolve_pictures(m, c, pics->traces, &pics->ntraces, pics->vars, &pics->nvars)
-           && cli_engine_open(a, e, (EngineKind)c->engine, mech, NULL, diag);
+    if (!resolve_pictures(m, c, pics) || !cli_engine_open(a, e, (EngineKind)c->engine, mech,
+                                                          NULL, diag))
+        return false;
+    if (c->forces && (!e->k.mass || !e->k.force)) {
+        diag_error(diag, m->last_pos, "the mechanism has no masses: `run --forces` needs `mass` "
+                   "statements (with `gravity`, forces or springs) for its inverse dynamics");
+        diag_print(diag, stderr);
+        engine_close(e);
+        return false;
+    }
+    return true;
 }
 
 /* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
-static int report(const RunCli *c, const Model *m, const Output *out, const Pictures *pics,
+static int report(const RunCli *c, const Model *m, const RunOutput *out, const RunPictures *pics,
                   RunStatus rs, const RunResult *res, const MechrtKernels *k,
                   const MechrtHostJacNz *jnz, const LastState *last)
 {
@@ -518,12 +362,10 @@ static int report(const RunCli *c, const Model *m, const Output *out, const Pict
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         return EXIT_USAGE;
     }
-    if (c->pictures && !write_pictures(m, &out->trace, c->svg_path, pics->traces, pics->ntraces,
-                                       c->view, c->plot_path, pics->vars, pics->nvars))
+    if (c->pictures && !run_output_pictures(out, pics))
         status = EXIT_USAGE;
     if (c->json)
-        mechrt_json_write_outputs(stdout, &out->trace, m->nq, out->names, c->digits,
-                                  rs == RUN_FAILED ? res->message : NULL, res->t_fail);
+        run_output_json(stdout, out, rs == RUN_FAILED ? res->message : NULL, res->t_fail);
     if (c->table && rs == RUN_OK && out->trace.rows == 1)
         print_table(m, out, res, c->digits);
     if (rs == RUN_FAILED) {
@@ -534,7 +376,7 @@ static int report(const RunCli *c, const Model *m, const Output *out, const Pict
                     res->states == 1 ? "is" : "are");
         status = EXIT_ANALYSIS;
     }
-    if (out->trace_full) {
+    if (out->full) {
         fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
         status = EXIT_ANALYSIS;
     }
@@ -560,37 +402,37 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
 }
 
 /* Runs the analysis with the open engine, the states going where c says. */
-static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *pics)
+static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics)
 {
-    Output out = {.csv = NULL, .json = c->json || c->pictures || c->table, .digits = c->digits,
-                  .t0 = c->ro.t0, .t1 = c->ro.t1, .file = m->file};
+    RunOutput out = {.cmd = "run", .keep = c->json || c->pictures || c->table,
+                     .lambda_use = c->forces ? RUN_OUTPUT_FORCES : RUN_OUTPUT_NO_LAMBDA,
+                     .digits = c->digits, .t0 = c->ro.t0, .t1 = c->ro.t1};
     if (c->csv_stdout) {
         out.csv = stdout;
     } else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
         fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
         return EXIT_USAGE;
     }
-    output_open(&out, m);
+    run_output_open(&out, m);
     MechrtKernels k = e->k;
     MechrtHostJacNz jnz;
     RunResult res;
     c->ro.notes = stderr;
     c->ro.linear = (RunLinear)c->linear;
     c->ro.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
-    if (out.csv)
-        mechrt_csv_header_omega(out.csv, out.nv, out.names, out.outputs.nw,
-                                (const char *const *)out.outputs.wnames);
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
     progress_start(&out.progress, "run", 1000);
     MechrtKernels newton = engine_newton_kernels(e);
-    RunStatus rs = run_analysis(m, &newton, &c->ro, on_state_keep, &last, &res);
+    RunStatus rs = c->forces
+                   ? run_analysis_forces(m, &newton, &c->ro, on_state_keep, &last, &res)
+                   : run_analysis(m, &newton, &c->ro, on_state_kinematic, &last, &res);
     progress_finish(&out.progress);
     int status = report(c, m, &out, pics, rs, &res, &k, &jnz, &last);
     status = finish_output(c, out.csv, status);
     free(last.q), free(last.qd);
-    output_close(&out);
+    run_output_close(&out);
     return status;
 }
 
@@ -598,7 +440,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const Pictures *p
 static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
     RunCli *c = opts;
-    Pictures pics;
+    RunPictures pics;
     Engine e;
     if (!prepare(a, c, mech, &pics, &e, diag))
         return EXIT_USAGE;

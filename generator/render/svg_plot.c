@@ -399,7 +399,62 @@ static void unknown_name(const Model *m, const char *name, size_t len, char *err
     }
 }
 
-int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max, char *err, size_t errlen)
+/* The row named [a, b) (wanting a driver when driver), or -1. */
+static int find_row(const Model *m, const char *a, size_t len, bool driver)
+{
+    for (int i = 0; i < m->nr; i++)
+        if (strlen(m->rows[i].name) == len && strncmp(m->rows[i].name, a, len) == 0
+            && (!driver || m->rows[i].kind == JOINT_DRIVER))
+            return i;
+    return -1;
+}
+
+/* [a, b) without the blanks at either end. */
+static void trim(const char **a, const char **b)
+{
+    while (*a < *b && (**a == ' ' || **a == '\t'))
+        (*a)++;
+    while (*b > *a && ((*b)[-1] == ' ' || (*b)[-1] == '\t'))
+        (*b)--;
+}
+
+/* One item [a, b) of a --plot-vars list into *v; false with the reason. */
+static bool parse_item(const Model *m, const char *a, const char *b, bool forces, SvgPlotVar *v,
+                       char *err, size_t errlen)
+{
+    static const char *const prefix[] = {"", "d(", "dd(", "lambda(", "effort("};
+    int order = 0;
+    for (int k = 1; k <= SVG_PLOT_EFFORT; k++) {
+        size_t n = strlen(prefix[k]);
+        if ((size_t)(b - a) > n && strncmp(a, prefix[k], n) == 0 && (k < 3 || forces))
+            order = k;
+    }
+    if (order > 0) {
+        if (b[-1] != ')') {
+            snprintf(err, errlen, "--plot-vars: missing ')' in '%.*s'", (int)(b - a), a);
+            return false;
+        }
+        a += strlen(prefix[order]);
+        b--;
+        trim(&a, &b);
+    }
+    int c = order >= SVG_PLOT_LAMBDA ? find_row(m, a, (size_t)(b - a), order == SVG_PLOT_EFFORT)
+                                     : find_coord(m, a, (size_t)(b - a));
+    if (c < 0 && order >= SVG_PLOT_LAMBDA) {
+        snprintf(err, errlen, "--plot-vars: unknown %s '%.*s'",
+                 order == SVG_PLOT_EFFORT ? "driver" : "row", (int)(b - a), a);
+        return false;
+    }
+    if (c < 0) {
+        unknown_name(m, a, (size_t)(b - a), err, errlen);
+        return false;
+    }
+    *v = (SvgPlotVar){c, order};
+    return true;
+}
+
+int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPlotVar *out,
+                            int max, char *err, size_t errlen)
 {
     if (!list) {
         snprintf(err, errlen, "--plot-vars: no names given");
@@ -412,49 +467,30 @@ int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
         if (!end)
             end = p + strlen(p);
         const char *a = p, *b = end;
-        while (a < b && (*a == ' ' || *a == '\t'))
-            a++;
-        while (b > a && (b[-1] == ' ' || b[-1] == '\t'))
-            b--;
+        trim(&a, &b);
         if (a == b) {
             snprintf(err, errlen, "--plot-vars '%s': empty name (expected NAME, d(NAME) or dd(NAME), "
                                   "comma-separated)", list);
             return -1;
         }
-        int order = 0;
-        if ((size_t)(b - a) > 3 && strncmp(a, "dd(", 3) == 0)
-            order = 2;
-        else if ((size_t)(b - a) > 2 && strncmp(a, "d(", 2) == 0)
-            order = 1;
-        if (order > 0) {
-            if (b[-1] != ')') {
-                snprintf(err, errlen, "--plot-vars: missing ')' in '%.*s'", (int)(b - a), a);
-                return -1;
-            }
-            a += order + 1;
-            b--;
-            while (a < b && (*a == ' ' || *a == '\t'))
-                a++;
-            while (b > a && (b[-1] == ' ' || b[-1] == '\t'))
-                b--;
-        }
-        int c = find_coord(m, a, (size_t)(b - a));
-        if (c < 0) {
-            unknown_name(m, a, (size_t)(b - a), err, errlen);
+        SvgPlotVar v;
+        if (!parse_item(m, a, b, forces, &v, err, errlen))
             return -1;
-        }
         if (count >= max) {
             snprintf(err, errlen, "--plot-vars: more than %d names", max);
             return -1;
         }
-        out[count].coord = c;
-        out[count].order = order;
-        count++;
+        out[count++] = v;
         if (*end == '\0')
             break;
         p = end + 1;
     }
     return count;
+}
+
+int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max, char *err, size_t errlen)
+{
+    return svg_plot_resolve_forces(m, list, false, out, max, err, errlen);
 }
 
 const char *svg_plot_var_label(const Model *m, int coord)
@@ -468,6 +504,11 @@ const char *svg_plot_var_label(const Model *m, int coord)
 
 void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len)
 {
+    if (v.order >= SVG_PLOT_LAMBDA) {
+        snprintf(buf, len, "%s(%s)", v.order == SVG_PLOT_LAMBDA ? "lambda" : "effort",
+                 v.coord >= 0 && v.coord < m->nr ? m->rows[v.coord].name : "?");
+        return;
+    }
     const char *name = svg_plot_var_label(m, v.coord);
     if (v.order == 1)
         snprintf(buf, len, "d(%s)", name);

@@ -35,11 +35,15 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
                         const SvgSeries *series, int nseries, const SvgPlotOptions *opt);
 
 /* A quantity to plot: coordinate coord (nq + k: the model's output k),
-   derivative order 0 (q), 1 (qd) or 2 (qdd). */
+   derivative order 0 (q), 1 (qd) or 2 (qdd); or (run --forces) the
+   multiplier of row coord (SVG_PLOT_LAMBDA) or the effort of the driver
+   whose row is coord (SVG_PLOT_EFFORT). */
 typedef struct SvgPlotVar {
     int coord;
     int order;
 } SvgPlotVar;
+
+enum { SVG_PLOT_LAMBDA = 3, SVG_PLOT_EFFORT = 4 };
 
 /* Parses a --plot-vars list: comma-separated NAME (a coordinate or an output), d(NAME)
    (its velocity) or dd(NAME) (its acceleration), blanks allowed around
@@ -48,11 +52,16 @@ typedef struct SvgPlotVar {
    coordinates that exist). */
 int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
                      char *err, size_t errlen);
+/* The same, also taking lambda(ROW) (a row's name) and effort(DRIVER) (a
+   driver's name) when forces is true. */
+int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPlotVar *out,
+                            int max, char *err, size_t errlen);
 
 /* The name of coordinate coord, or of output coord - nq. */
 const char *svg_plot_var_label(const Model *m, int coord);
 
-/* The display name of a variable: "crank.phi", "d(crank.phi)", "dd(crank.phi)". */
+/* The display name of a variable: "crank.phi", "d(crank.phi)", "dd(crank.phi)",
+   "lambda(O.x)", "effort(D)". */
 void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len);
 
 #endif

@@ -234,6 +234,13 @@ void mechrt_csv_header_omega(FILE *out, int nq, const char *const *names, int nw
                              const char *const *wnames);
 void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
                           const double *qdd, int nw, const double *w, int digits);
+/* The same with nx further columns at the end of each row (run --forces:
+   lambda(ROW) and effort(DRIVER)); nx = 0 is the _omega form. */
+void mechrt_csv_header_extra(FILE *out, int nq, const char *const *names, int nw,
+                             const char *const *wnames, int nx, const char *const *xnames);
+void mechrt_csv_row_extra(FILE *out, int nq, double t, const double *q, const double *qd,
+                          const double *qdd, int nw, const double *w, int nx, const double *x,
+                          int digits);
 
 /* The rows of a run kept for JSON (which cannot be streamed key by key):
    each row is t, q[nq], qd[nq], qdd[nq]. */
@@ -275,5 +282,23 @@ void mechrt_json_write(FILE *out, const MechrtTrace *tr, const char *const *name
 void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
                                const char *const *names, int digits,
                                const char *error_message, double error_t);
+
+/* The multipliers of dynamics kept beside a trace, one set per trace row:
+   lambda (rows x nr, the rows named rows) and, when nd > 0, the efforts
+   of the nd drivers (rows x nd, named drivers). */
+typedef struct MechrtJsonLambda {
+    int nr;
+    const char *const *rows;
+    const double *lambda;
+    int nd;
+    const char *const *drivers;
+    const double *efforts;
+} MechrtJsonLambda;
+
+/* mechrt_json_write_outputs, then (lam not NULL) "rows" and "lambda" and,
+   with drivers, "drivers" and "efforts", after "ok" and "error". */
+void mechrt_json_write_lambda(FILE *out, const MechrtTrace *tr, int ncoords,
+                              const char *const *names, int digits, const char *error_message,
+                              double error_t, const MechrtJsonLambda *lam);
 
 #endif

@@ -1,4 +1,4 @@
-/* output.c - the CSV and JSON of `mechc run`, and numbers printed to round-trip.
+/* output.c - the CSV and JSON of `mechc run` and `mechc sim`, and numbers printed to round-trip.
  *
  * CSV streams: a header row, then one row per time as the analysis
  * produces it, so a failed run still leaves every row computed before the
@@ -27,6 +27,12 @@ void mechrt_csv_header(FILE *out, int nq, const char *const *names)
 void mechrt_csv_header_omega(FILE *out, int nq, const char *const *names, int nw,
                              const char *const *wnames)
 {
+    mechrt_csv_header_extra(out, nq, names, nw, wnames, 0, NULL);
+}
+
+void mechrt_csv_header_extra(FILE *out, int nq, const char *const *names, int nw,
+                             const char *const *wnames, int nx, const char *const *xnames)
+{
     fputs("t", out);
     for (int i = 0; i < nq; i++)
         fprintf(out, ",%s", names[i]);
@@ -36,6 +42,8 @@ void mechrt_csv_header_omega(FILE *out, int nq, const char *const *names, int nw
         fprintf(out, ",%s", wnames[i]);
     for (int i = 0; i < nq; i++)
         fprintf(out, ",dd(%s)", names[i]);
+    for (int i = 0; i < nx; i++)
+        fprintf(out, ",%s", xnames[i]);
     fputc('\n', out);
 }
 
@@ -67,6 +75,13 @@ static void rowbuf_real(RowBuf *rb, char sep, double v, int digits)
 void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
                           const double *qdd, int nw, const double *w, int digits)
 {
+    mechrt_csv_row_extra(out, nq, t, q, qd, qdd, nw, w, 0, NULL, digits);
+}
+
+void mechrt_csv_row_extra(FILE *out, int nq, double t, const double *q, const double *qd,
+                          const double *qdd, int nw, const double *w, int nx, const double *x,
+                          int digits)
+{
     RowBuf rb;
     rb.out = out;
     rb.len = 0;
@@ -78,6 +93,8 @@ void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const do
         for (int i = 0; k == 1 && i < nw; i++)
             rowbuf_real(&rb, ',', w[i], digits);
     }
+    for (int i = 0; i < nx; i++)
+        rowbuf_real(&rb, ',', x[i], digits);
     rb.buf[rb.len++] = '\n';
     fwrite(rb.buf, 1, rb.len, out);
 }
@@ -230,6 +247,34 @@ void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
                                const char *const *names, int digits,
                                const char *error_message, double error_t)
 {
+    mechrt_json_write_lambda(out, tr, ncoords, names, digits, error_message, error_t, NULL);
+}
+
+/* "NAMES_KEY": [names], "KEY": [[n values] per trace row]. */
+static void json_table(FILE *out, const char *names_key, const char *const *names, int n,
+                       const char *key, const double *data, size_t rows, int digits)
+{
+    fprintf(out, ",\n \"%s\": [", names_key);
+    for (int i = 0; i < n; i++) {
+        fputs(i ? ", " : "", out);
+        mechrt_json_string(out, names[i]);
+    }
+    fprintf(out, "],\n \"%s\": [", key);
+    for (size_t r = 0; r < rows; r++) {
+        fputs(r ? ",\n   [" : "[", out);
+        for (int i = 0; i < n; i++) {
+            fputs(i ? ", " : "", out);
+            json_num(out, data[r * (size_t)n + (size_t)i], digits);
+        }
+        fputs("]", out);
+    }
+    fputs("]", out);
+}
+
+void mechrt_json_write_lambda(FILE *out, const MechrtTrace *tr, int ncoords,
+                              const char *const *names, int digits, const char *error_message,
+                              double error_t, const MechrtJsonLambda *lam)
+{
     static const char *const qkeys[3] = {"q", "qd", "qdd"}, *const ykeys[3] = {"y", "yd", "ydd"};
     size_t w = 1 + 3 * (size_t)tr->nq, nc = (size_t)ncoords;
     fputs("{\"coords\": [", out);
@@ -256,6 +301,12 @@ void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
         fputs(", \"message\": ", out);
         mechrt_json_string(out, error_message);
         fputs("}", out);
+    }
+    if (lam) {
+        json_table(out, "rows", lam->rows, lam->nr, "lambda", lam->lambda, tr->rows, digits);
+        if (lam->nd > 0)
+            json_table(out, "drivers", lam->drivers, lam->nd, "efforts", lam->efforts, tr->rows,
+                       digits);
     }
     fputs("}\n", out);
 }
