@@ -2,28 +2,24 @@
  *
  * Parses the options, loads the mechanism, opens the engine and hands the
  * rest to sim_run (generator/analysis/sim.c). The states go out as run's
- * do: the same CSV columns and JSON keys (runtime/host/output.c), the
- * file's outputs beside the coordinates, the same animation and chart
- * writers; JSON adds the multipliers ("rows", "lambda"). On a failure the
+ * do, through run's output module (run_output.c): the same CSV columns and
+ * JSON keys, the file's outputs beside the coordinates, the same animation
+ * and chart writers; JSON adds the multipliers ("rows", "lambda"). On a failure the
  * states computed before it are still written, and the message goes to
  * stderr.
  */
 #include "cli.h"
 
-#include "../analysis/outputs.h"
 #include "../analysis/sim.h"
 #include "../base/arena.h"
-#include "../render/progress.h"
-#include "../render/svg_anim.h"
-#include "../render/svg_plot.h"
-#include "../../runtime/host/mechrt_host.h"
+#include "run_output.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { MAX_TRACES = CLI_LIST_MAX, MAX_PLOT_VARS = 64 };
+enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 
 /* What the command line asked for. */
 typedef struct SimCli {
@@ -105,203 +101,13 @@ static const char epilogue[] =
     "message names t = VALUE and the cause; the states before it are written);\n"
     "2 bad usage or input, or a file without masses.\n";
 
-/* Where the states go; the same shapes as run's. */
-typedef struct Output {
-    FILE *csv;
-    MechrtTrace trace;      /* rows for JSON and pictures */
-    double *lambda;         /* nr per kept row, for JSON */
-    size_t lcap;
-    int nq, nv, nr;         /* coordinates; variables (coordinates, outputs); rows */
-    OutputEval outputs;
-    double *v;              /* v | vd | vdd, 3 nv */
-    const char **names;
-    double *w;              /* spatial angular velocities */
-    bool keep, full;
-    int digits;
-    Progress progress;
-    double t0, t1;
-} Output;
-
-static void output_open(Output *out, const Model *m)
-{
-    out->nq = m->nq;
-    out->nv = m->nq + m->nout;
-    out->nr = m->nr;
-    outputs_init(&out->outputs, m);
-    out->v = xcalloc(3 * (size_t)out->nv, sizeof *out->v);
-    out->names = xcalloc((size_t)out->nv, sizeof *out->names);
-    for (int i = 0; i < out->nv; i++)
-        out->names[i] = i < m->nq ? m->coord_names[i] : m->outputs[i - m->nq].name;
-    mechrt_trace_init(&out->trace, out->nv);
-    out->w = xcalloc((size_t)out->outputs.nw + 1, sizeof *out->w);
-    mechrt_trace_set_omega(&out->trace, out->outputs.nw, (const char *const *)out->outputs.wnames);
-}
-
-static void output_close(Output *out)
-{
-    outputs_free(&out->outputs);
-    free(out->v), free(out->w), free(out->names), free(out->lambda);
-    mechrt_trace_free(&out->trace);
-}
-
-/* Keeps a state's multipliers; false when out of memory. */
-static bool keep_lambda(Output *out, const double *lambda)
-{
-    size_t nr = (size_t)out->nr, row = out->trace.rows;
-    if ((row + 1) * nr > out->lcap) {
-        size_t cap = out->lcap ? 2 * out->lcap : 64 * (nr + 1);
-        double *p = realloc(out->lambda, cap * sizeof *p);
-        if (!p)
-            return false;
-        out->lambda = p, out->lcap = cap;
-    }
-    memcpy(out->lambda + row * nr, lambda, nr * sizeof *lambda);
-    return true;
-}
-
-static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd,
-                     const double *lambda)
-{
-    Output *out = ctx;
-    size_t nq = (size_t)out->nq, nv = (size_t)out->nv;
-    const double *src[3] = {q, qd, qdd};
-    for (size_t k = 0; k < 3; k++)
-        memcpy(out->v + k * nv, src[k], nq * sizeof *out->v);
-    outputs_eval(&out->outputs, q, qd, qdd, t, out->v + nq, out->v + nv + nq,
-                 out->v + 2 * nv + nq);
-    outputs_omega(&out->outputs, q, qd, out->w);
-    if (out->csv)
-        mechrt_csv_row_omega(out->csv, out->nv, t, out->v, out->v + nv, out->v + 2 * nv,
-                             out->outputs.nw, out->w, out->digits);
-    if (out->keep && (!keep_lambda(out, lambda)
-                      || !mechrt_trace_push_omega(&out->trace, t, out->v, out->v + nv,
-                                                  out->v + 2 * nv, out->w)))
-        out->full = true;
-    progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
-}
-
-/* run's JSON, then "rows" and "lambda" before its closing brace. */
-static bool write_json(const Model *m, const Output *out, int digits, const SimResult *res)
-{
-    char *text = NULL;
-    size_t len = 0;
-    FILE *mem = open_memstream(&text, &len);
-    if (!mem)
-        return false;
-    mechrt_json_write_outputs(mem, &out->trace, m->nq, out->names, digits,
-                              res->status == SIM_FAILED ? res->message : NULL, res->t_fail);
-    if (fclose(mem) != 0 || len < 2) {
-        free(text);
-        return false;
-    }
-    fwrite(text, 1, len - 2, stdout);          /* without "}\n" */
-    free(text);
-    fputs(",\n \"rows\": [", stdout);
-    for (int i = 0; i < m->nr; i++) {
-        fputs(i ? ", " : "", stdout);
-        mechrt_json_string(stdout, m->rows[i].name);
-    }
-    fputs("],\n \"lambda\": [", stdout);
-    for (size_t r = 0; r < out->trace.rows; r++) {
-        fputs(r ? ",\n   [" : "[", stdout);
-        for (int i = 0; i < m->nr; i++) {
-            char buf[40];
-            double v = out->lambda[r * (size_t)m->nr + (size_t)i];
-            if (isfinite(v))
-                mechrt_format_real(buf, sizeof buf, v, digits);
-            fprintf(stdout, "%s%s", i ? ", " : "", isfinite(v) ? buf : "null");
-        }
-        fputs("]", stdout);
-    }
-    fputs("]}\n", stdout);
-    return true;
-}
-
 /* The --trace points and --plot variables, resolved against the model. */
-typedef struct Pictures {
-    SvgTrace traces[MAX_TRACES];
-    int ntraces;
-    SvgPlotVar vars[MAX_PLOT_VARS];
-    int nvars;
-} Pictures;
-
-static bool resolve_pictures(const Model *m, const SimCli *c, Pictures *p)
+static bool resolve_pictures(const Model *m, const SimCli *c, RunPictures *p)
 {
-    char err[256];
-    p->ntraces = p->nvars = 0;
-    for (int i = 0; i < c->traces.n; i++)
-        if (!svg_parse_trace(m, c->traces.items[i], &p->traces[p->ntraces++], err, sizeof err)) {
-            fprintf(stderr, "mechc sim: error: %s\n", err);
-            return false;
-        }
-    for (int k = 0; k < m->nout && p->ntraces < MAX_TRACES; k++) {
-        const ModelOutput *o = &m->outputs[k];
-        if (o->point && o->at.q >= 0)
-            p->traces[p->ntraces++] = (SvgTrace){o->at.q, o->at.has_phi || o->at.has_p,
-                                                 o->at.sx, o->at.sy, o->point, o->at.spatial,
-                                                 o->at.sz};
-    }
-    if (c->plot_path && c->plot_list) {
-        p->nvars = svg_plot_resolve(m, c->plot_list, p->vars, MAX_PLOT_VARS, err, sizeof err);
-        if (p->nvars <= 0) {
-            fprintf(stderr, "mechc sim: error: %s\n", err);
-            return false;
-        }
-    } else if (c->plot_path) {
-        for (int i = 0; i < m->nq + m->nout && p->nvars < MAX_PLOT_VARS; i++)
-            p->vars[p->nvars++] = (SvgPlotVar){i, 0};
-    }
-    return true;
-}
-
-/* One picture file: the animation (which 0) or the chart (1). */
-static bool write_picture(const Model *m, const MechrtTrace *tr, const Pictures *p,
-                          const char *path, int which, const double *t, const double *q)
-{
-    size_t n = tr->rows, nv = (size_t)tr->nq, w = 1 + 3 * nv;
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "mechc sim: error: cannot write '%s': %s\n", path, strerror(errno));
-        return false;
-    }
-    bool wrote;
-    if (which == 0) {
-        wrote = svg_write_animation_opt(f, m, t, q, (int)n, p->traces, p->ntraces, m->name, NULL);
-    } else {
-        SvgSeries series[MAX_PLOT_VARS];
-        char names[MAX_PLOT_VARS][96];
-        for (int i = 0; i < p->nvars; i++) {
-            svg_plot_var_name(m, p->vars[i], names[i], sizeof names[i]);
-            series[i] = (SvgSeries){names[i], tr->data + 1 + (size_t)p->vars[i].order * nv
-                                              + (size_t)p->vars[i].coord, (int)w};
-        }
-        wrote = svg_write_plot(f, m->name, t, (int)n, series, p->nvars);
-    }
-    if (fclose(f) != 0 || !wrote) {
-        fprintf(stderr, "mechc sim: error: writing '%s' failed\n", path);
-        return false;
-    }
-    return true;
-}
-
-static bool write_pictures(const Model *m, const SimCli *c, const MechrtTrace *tr,
-                           const Pictures *p)
-{
-    size_t n = tr->rows, nq = (size_t)m->nq, w = 1 + 3 * (size_t)tr->nq;
-    bool ok = true;
-    if (n == 0)
-        return true;
-    double *t = xcalloc(n, sizeof *t), *q = xcalloc(n * nq, sizeof *q);
-    for (size_t k = 0; k < n; k++) {
-        t[k] = tr->data[k * w];
-        memcpy(q + k * nq, tr->data + k * w + 1, nq * sizeof *q);
-    }
-    if (c->svg_path)
-        ok = write_picture(m, tr, p, c->svg_path, 0, t, q) && ok;
-    if (c->plot_path)
-        ok = write_picture(m, tr, p, c->plot_path, 1, t, q) && ok;
-    free(t), free(q);
-    return ok;
+    p->svg_path = c->svg_path;
+    p->plot_path = c->plot_path;
+    p->view = -1;
+    return run_output_resolve_pictures("sim", m, &c->traces, c->plot_list, false, p);
 }
 
 static void print_stats(const SimResult *r, int nr)
@@ -366,7 +172,7 @@ static bool finish(Args *a, void *opts)
 }
 
 /* After the simulation: pictures, JSON, the failure, --stats; the exit status. */
-static int report(const SimCli *c, const Model *m, const Output *out, const Pictures *p,
+static int report(const SimCli *c, const Model *m, const RunOutput *out, const RunPictures *p,
                   SimStatus st, const SimResult *res)
 {
     int status = EXIT_OK;
@@ -374,10 +180,10 @@ static int report(const SimCli *c, const Model *m, const Output *out, const Pict
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         return EXIT_USAGE;
     }
-    if (c->pictures && !write_pictures(m, c, &out->trace, p))
+    if (c->pictures && !run_output_pictures(out, p))
         status = EXIT_USAGE;
-    if (c->json && !write_json(m, out, c->digits, res))
-        status = EXIT_ANALYSIS;
+    if (c->json)
+        run_output_json(stdout, out, st == SIM_FAILED ? res->message : NULL, res->t_fail);
     if (st == SIM_FAILED) {
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         if (res->states > 0)
@@ -396,24 +202,22 @@ static int report(const SimCli *c, const Model *m, const Output *out, const Pict
 }
 
 /* The simulation with the open engine, the states going where c says. */
-static int simulate(SimCli *c, const Model *m, const Engine *e, const Pictures *p)
+static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p)
 {
-    Output out = {.keep = c->json || c->pictures, .digits = c->digits, .t0 = c->so.t0,
-                  .t1 = c->so.t1};
+    RunOutput out = {.cmd = "sim", .keep = c->json || c->pictures,
+                     .lambda_use = RUN_OUTPUT_LAMBDA_JSON, .digits = c->digits, .t0 = c->so.t0,
+                     .t1 = c->so.t1};
     if (c->csv_stdout)
         out.csv = stdout;
     else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
         fprintf(stderr, "mechc sim: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
         return EXIT_USAGE;
     }
-    output_open(&out, m);
-    if (out.csv)
-        mechrt_csv_header_omega(out.csv, out.nv, out.names, out.outputs.nw,
-                                (const char *const *)out.outputs.wnames);
+    run_output_open(&out, m);
     c->so.notes = stderr;
     SimResult res;
     progress_start(&out.progress, "sim", 1000);
-    SimStatus st = sim_run(m, &e->k, &c->so, on_state, &out, &res);
+    SimStatus st = sim_run(m, &e->k, &c->so, run_output_state, &out, &res);
     progress_finish(&out.progress);
     int status = report(c, m, &out, p, st, &res);
     if (out.csv && out.csv != stdout && fclose(out.csv) != 0) {
@@ -423,7 +227,7 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const Pictures *
         fprintf(stderr, "mechc sim: error: writing the output: %s\n", strerror(errno));
         status = status == EXIT_OK ? EXIT_USAGE : status;
     }
-    output_close(&out);
+    run_output_close(&out);
     return status;
 }
 
@@ -432,7 +236,7 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
     SimCli *c = opts;
     const Model *m = mech->model;
-    Pictures pics;
+    RunPictures pics;
     Engine e;
     double *qd0 = xcalloc((size_t)m->nq, sizeof *qd0);
     int status = EXIT_USAGE;
