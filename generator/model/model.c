@@ -915,8 +915,10 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             break;
         }
     }
-    /* M is dense nq x nq in the engines and the generated P_mass */
-    if (m->nmasses > 0 && (long long)m->nq * m->nq > b->limits->max_jac_entries)
+    /* M is dense nq x nq in the engines and the generated P_mass (a limit
+       of 0: run's sparse path, which asks for no check here) */
+    if (m->nmasses > 0 && b->limits->max_jac_entries > 0
+        && (long long)m->nq * m->nq > b->limits->max_jac_entries)
         diag_fail(b->diag, m->masses[0].pos, "the dense mass matrix would have %d x %d = %lld "
                   "entries, more than the limit of %d (--max-jac-entries)", m->nq, m->nq,
                   (long long)m->nq * m->nq, b->limits->max_jac_entries);
