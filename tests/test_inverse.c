@@ -9,8 +9,10 @@
  * generic engines both. The compound pendulum driven with an angular
  * acceleration: the motor torque (J + m a^2) phi'' + m g a cos(phi) and
  * the revolute's reaction on the rod, m a_G - m g, against their closed
- * forms. The slider-crank's reactions balance the weights. A file
- * without masses is refused.
+ * forms. The slider-crank's reactions balance the weights; run's square
+ * solve equals the runtime's rank-revealing one; through the flat
+ * positions of a parallelogram the runtime's minimum-norm lambda takes
+ * over. A file without masses is refused.
  */
 #include "testutil.h"
 #include "testload.h"
@@ -25,15 +27,15 @@
 /* Every state and its multipliers. */
 typedef struct Kept {
     int nq, nr, n;
-    double t[256], q[256][16], qdd[256][16], lambda[256][16];
+    double t[256], q[256][16], qd[256][16], qdd[256][16], lambda[256][16];
 } Kept;
 
 static void keep(void *ctx, double t, const double *q, const double *qd, const double *qdd,
                  const double *lambda)
 {
     Kept *k = ctx;
-    (void)qd;
     assert_true(k->n < 256);
+    memcpy(k->qd[k->n], qd, (size_t)k->nq * sizeof *qd);
     k->t[k->n] = t;
     memcpy(k->q[k->n], q, (size_t)k->nq * sizeof *q);
     memcpy(k->qdd[k->n], qdd, (size_t)k->nq * sizeof *qdd);
@@ -229,6 +231,76 @@ static void test_driven_pendulum(void **state)
     pipeline_free(mech);
 }
 
+/* run's square solve (one LU of Phi_q, a transposed solve) against the
+   runtime's rank-revealing mechrt_inverse_dynamics at every state. */
+static void test_same_as_runtime(void **state)
+{
+    (void)state;
+    Mech *mech = load_torque_example(9.81);
+    const Model *m = mech->model;
+    Kept k;
+    run_forces(mech, ENGINE_JIT, 1, 36, &k);
+    Engine e;
+    Diag diag;
+    assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
+    size_t lw = mechrt_dynamics_workspace_size(m->nq, m->nr);
+    double *work = xcalloc(lw, sizeof *work), lambda[16];
+    for (int i = 0; i <= 36; i++) {
+        MechrtDynReport dr;
+        assert_int_equal(mechrt_inverse_dynamics(&e.k, NULL, k.q[i], k.qd[i], k.qdd[i], k.t[i],
+                                                 lambda, work, lw, &dr), MECHRT_OK);
+        assert_int_equal(dr.rank, m->nr);
+        for (int r = 0; r < m->nr; r++)
+            assert_near(k.lambda[i][r], lambda[r], 1e-10, 1e-10);
+    }
+    free(work);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+/* The parallelogram four-bar folds flat at t = 0.25 and 0.75 (run passes
+   there by the rank-revealing corrector): with masses, lambda there is
+   the runtime's minimum-norm one, one row found dependent, finite. */
+static const char parallelogram_masses[] =
+    "param omega = 2*pi\n"
+    "body crank   x = 0  y = 0.5  phi = pi/2\n"
+    "body coupler x = 1  y = 1    phi = 0\n"
+    "body rocker  x = 2  y = 0.5  phi = pi/2\n"
+    "revolute O1: ground(0, 0)    crank(-0.5, 0)\n"
+    "revolute A:  crank(0.5, 0)   coupler(-1, 0)\n"
+    "revolute B:  coupler(1, 0)   rocker(0.5, 0)\n"
+    "revolute O2: ground(2, 0)    rocker(-0.5, 0)\n"
+    "driver drive: crank.phi = pi/2 + omega*t\n"
+    "mass crank m = 1 J = 1/12\nmass coupler m = 2 J = 2*4/12\nmass rocker m = 1 J = 1/12\n"
+    "gravity (0, -9.81)\n";
+
+static void test_through_singular(void **state)
+{
+    (void)state;
+    Mech *mech = load_text(parallelogram_masses, "parallelogram_masses.mech");
+    Engine e;
+    Diag diag;
+    assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
+    RunOptions o = run_default_options();
+    o.steps = 100;
+    RunResult res;
+    Kept k;
+    memset(&k, 0, sizeof k);
+    k.nq = mech->model->nq, k.nr = mech->model->nr;
+    assert_int_equal(run_analysis_forces(mech->model, &e.k, &o, keep, &k, &res), RUN_OK);
+    assert_int_equal(k.n, 101);
+    assert_int_equal(res.force_redundant, 1);
+    for (int i = 0; i <= 100; i++)
+        for (int r = 0; r < k.nr; r++)
+            assert_true(isfinite(k.lambda[i][r]));
+    /* away from the flat positions the driver holds the weights: the
+       effort is odd about t = 0.5 (the crank at pi/2 + pi) */
+    int d = row_of(mech->model, "drive");
+    assert_near(-k.lambda[10][d], k.lambda[90][d], 1e-9, 1e-9);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
 static void test_no_masses_refused(void **state)
 {
     (void)state;
@@ -256,6 +328,8 @@ int main(void)
         cmocka_unit_test(test_crank_torque_formula),
         cmocka_unit_test(test_slider_crank_balance),
         cmocka_unit_test(test_driven_pendulum),
+        cmocka_unit_test(test_same_as_runtime),
+        cmocka_unit_test(test_through_singular),
         cmocka_unit_test(test_no_masses_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

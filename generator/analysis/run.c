@@ -150,6 +150,7 @@ typedef struct Run {
     RunForcesFn fstate;
     double *dyn_work, *lambda;
     size_t dyn_lwork;
+    double dyn_rank_tol;     /* mechrt_dyn_default_options()' */
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
@@ -549,12 +550,46 @@ static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn stat
     r->res->states++;
 }
 
+/* A run has one row per coordinate, so where Phi_q is regular lambda is
+   the solution of the square system Phi_q^T lambda = Q - M qdd: one LU
+   with partial pivoting (lu.c) and a transposed solve, a third of the
+   complete-pivoting elimination's work. False when a pivot is below the
+   dynamics' rank tolerance (a singular position, where this would give
+   lambda to few digits) or a value is not finite: then the
+   rank-revealing mechrt_inverse_dynamics decides. Workspace: dyn_work's first
+   nq*nq + nq*nq + 2 nq entries (M, the LU, the pivots, Q). */
+static bool inverse_square(Run *r, double t)
+{
+    const MechrtKernels *k = r->k;
+    size_t n = (size_t)r->nq;
+    double *mass = r->dyn_work, *lu = mass + n * n, *piv = lu + n * n, *rhs = piv + n;
+    k->mass(k->ctx, r->q, mass);
+    k->force(k->ctx, r->q, r->qd, t, rhs);
+    k->jac(k->ctx, r->q, t, lu);
+    if (mechrt_lu_factor(r->nq, lu, r->nq, piv, r->dyn_rank_tol, NULL) != MECHRT_OK)
+        return false;
+    for (size_t i = 0; i < n; i++) {
+        double s = rhs[i];
+        const double *mi = mass + i * n;
+        for (size_t j = 0; j < n; j++)
+            s -= mi[j] * r->qdd[j];
+        rhs[i] = s;
+    }
+    mechrt_lu_solve_t(r->nq, lu, r->nq, piv, rhs);
+    bool finite = true;
+    for (size_t i = 0; i < n; i++)
+        finite = finite && isfinite(rhs[i]);
+    if (finite)
+        memcpy(r->lambda, rhs, n * sizeof *rhs);
+    return finite;
+}
+
 /* Inverse dynamics at the state just computed (t, r->q, r->qd, r->qdd),
    into r->lambda; nothing without run_analysis_forces. False, with the
    failure in r->res, when the solve fails. */
 static bool inverse_at(Run *r, double t)
 {
-    if (!r->fstate)
+    if (!r->fstate || inverse_square(r, t))
         return true;
     MechrtDynReport rep;
     MechrtStatus st = mechrt_inverse_dynamics(r->k, NULL, r->q, r->qd, r->qdd, t, r->lambda,
@@ -1212,6 +1247,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     memcpy(r.q, m->q0, nq * sizeof *r.q);
     if (fstate) {
         r.fstate = fstate;
+        r.dyn_rank_tol = mechrt_dyn_default_options().rank_tol;
         r.dyn_lwork = mechrt_dynamics_workspace_size(m->nq, m->nr);
         r.dyn_work = xcalloc(r.dyn_lwork + 1, sizeof *r.dyn_work);
         r.lambda = xcalloc((size_t)m->nr + 1, sizeof *r.lambda);

@@ -176,7 +176,8 @@ static void print_table(const Model *m, const RunOutput *out, const RunResult *r
 }
 
 static void print_stats(const RunResult *res, const MechrtKernels *k,
-                        const MechrtHostJacNz *jnz, const double *q, const double *qd, double t)
+                        const MechrtHostJacNz *jnz, const double *q, const double *qd, double t,
+                        bool forces)
 {
     int n = res->steps_done;
     if (n == 0) {           /* one instant: only the assembly */
@@ -232,6 +233,11 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
             ns_all > 0 ? ns_step / ns_all : 0);
     if (res->max_cond > 0)
         fprintf(stderr, "mechc run: stats: largest condition estimate %.3g\n", res->max_cond);
+    if (forces)
+        fprintf(stderr, "mechc run: stats: inverse dynamics at every state (in the steps' "
+                "time): up to %d dependent %s, largest part of Q - M qdd the rows could not "
+                "carry %.3g\n", res->force_redundant, res->force_redundant == 1 ? "row" : "rows",
+                res->force_residual);
 }
 
 /* The last state seen, for --stats' kernel timing. */
@@ -381,7 +387,7 @@ static int report(const RunCli *c, const Model *m, const RunOutput *out, const R
         status = EXIT_ANALYSIS;
     }
     if (c->stats)
-        print_stats(res, k, jnz, last->q, last->qd, last->t);
+        print_stats(res, k, jnz, last->q, last->qd, last->t, c->forces);
     return status;
 }
 
