@@ -639,4 +639,78 @@ else
     skip "cc missing: firmware build"
 fi
 
+# ---- inverse dynamics: run --forces (issue 16) -----------------------------
+# slider_crank_torque.mech: effort(D) = -lambda(D) at theta = 30 k degrees
+# (t = k/12) is the crank torque of its header's reference table (REFS.md
+# section 3), with gravity and, with g set to 0, without; to 1e-9 relative
+# (1e-12 absolute at the zeros).
+torque_table() {   # FILE.csv COLUMN "v0 v30 ... v330": the worst mismatch, or FAIL
+    awk -F, -v col="$2" -v want="$3" '
+    NR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; n = split(want, w, " "); next }
+    NR >= 2 && NR <= 13 { k = NR - 1; d = $c - w[k]; if (d < 0) d = -d
+                           tol = 1e-9 * (w[k] < 0 ? -w[k] : w[k]) + 1e-12
+                           if (!(d <= tol)) bad = bad " t=" $1 ":" $c "!=" w[k]; rows++ }
+    END { if (!c || rows != 12 || bad != "") { print "FAIL" bad; exit 1 } }' "$1"
+}
+tau_g="1.4715 1.99288516501141 1.13103964241246 -0.348943209981944 -1.26630317393169 -1.56866853899195 -1.4715 -0.980044224345654 -0.205196826068313 0.348943209981944 0.340460357587543 0.555827598326197"
+tau_0="0 0.718528783342604 0.395289642412457 -0.348943209981944 -0.530553173931687 -0.294312157323148 0 0.294312157323148 0.530553173931687 0.348943209981944 -0.395289642412457 -0.718528783342604"
+run "$ex/slider_crank_torque.mech" --forces --steps 12 --csv "$tmp/sct.csv"
+check "run --forces: exit 0" status_is 0
+check "run --forces: the crank torque table with gravity to 1e-9" \
+    torque_table "$tmp/sct.csv" "effort(D)" "$tau_g"
+sed 's/^param g .*/param g     = 0/' "$ex/slider_crank_torque.mech" > "$tmp/sct0.mech"
+run "$tmp/sct0.mech" --forces --steps 12 --csv "$tmp/sct0.csv"
+check "run --forces: the crank torque table without gravity to 1e-9" \
+    torque_table "$tmp/sct0.csv" "effort(D)" "$tau_0"
+check "run --forces: the reference values are the example's header's" \
+    sh -c "grep -q '^#    30            0.718528783342604       1.99288516501141' '$ex/slider_crank_torque.mech'"
+check "run --forces: lambda(ROW) and effort(DRIVER) columns after the dd() ones" \
+    sh -c "head -1 '$tmp/sct.csv' | grep -q ',dd(slider.phi),lambda(O.x),lambda(O.y),lambda(A.x),lambda(A.y),lambda(B.x),lambda(B.y),lambda(P.n),lambda(P.phi),lambda(D),effort(D)\$'"
+check "run --forces: effort(D) = -lambda(D) in every row" \
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "lambda(D)") l = i; if ($i == "effort(D)") e = i }; next }
+             { if ($e != -$l) exit 1 }' "$tmp/sct.csv"
+# the pin O's force on the crank plus the guide's on the slider carry the
+# weights (1 + 2 + 1.5) 9.81 at the dead centres, where no body's
+# centre of mass accelerates vertically
+check "run --forces: lambda(O.y) - lambda(P.n) = 44.145 at theta = 0 and 180 deg" \
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "lambda(O.y)") a = i; if ($i == "lambda(P.n)") b = i }; next }
+             NR == 2 || NR == 8 { d = $a - $b - 44.145; if (d < 0) d = -d; if (d > 1e-9) exit 1; n++ }
+             END { exit n != 2 }' "$tmp/sct.csv"
+run "$ex/slider_crank_torque.mech" --forces --steps 4 --json
+check "run --forces --json: rows, lambda, drivers and efforts" \
+    sh -c "grep -q -F '\"rows\": [\"O.x\", \"O.y\", \"A.x\"' '$tmp/out' && grep -q -F '\"lambda\": [[-19.08123517543' '$tmp/out' && grep -q -F '\"drivers\": [\"D\"]' '$tmp/out' && grep -q -F '\"efforts\": [[1.47150000000' '$tmp/out'"
+if have python3; then
+    check "run --forces --json: valid JSON, one lambda per row and state" python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["ok"] and len(d["rows"]) == 9 and len(d["lambda"]) == 5 == len(d["efforts"])
+assert all(len(l) == 9 for l in d["lambda"]) and d["drivers"] == ["D"]
+assert all(abs(e[0] + l[8]) == 0 for e, l in zip(d["efforts"], d["lambda"]))' "$tmp/out"
+fi
+run "$ex/slider_crank_torque.mech" --steps 4 --json
+check "run without --forces: no lambda keys" sh -c "! grep -q '\"lambda\"' '$tmp/out'"
+run "$ex/slider_crank_torque.mech" --forces --at 0.25
+check "run --forces --at: the table with lambda and effort" \
+    sh -c "grep -q '^D  *-0.34894321\$' '$tmp/out' && grep -q '^P.n  *-24.27825989\$' '$tmp/out'"
+run "$ex/slider_crank.mech" --forces
+check "run --forces without masses: exit 2" status_is 2
+check "run --forces without masses: says so at the file's last statement" \
+    err_matches 'slider_crank.mech:[0-9]*:1: error: the mechanism has no masses: `run --forces`'
+run "$ex/slider_crank_torque.mech" --forces --plot "$tmp/eff.svg" --plot-vars 'effort(D), lambda(O.x)'
+check "run --forces --plot-vars effort(D), lambda(O.x): exit 0" status_is 0
+check "run --forces --plot: the curves named" \
+    sh -c "grep -q 'effort(D)' '$tmp/eff.svg' && grep -q 'lambda(O.x)' '$tmp/eff.svg'"
+run "$ex/slider_crank_torque.mech" --plot "$tmp/eff.svg" --plot-vars 'effort(D)'
+check "run --plot-vars effort(D) without --forces: exit 2" status_is 2
+run "$ex/slider_crank_torque.mech" --forces --plot "$tmp/eff.svg" --plot-vars 'effort(O.x)'
+check "run --forces --plot-vars effort(NOT A DRIVER): exit 2, named" \
+    sh -c "[ $rc = 2 ] && grep -q \"unknown driver 'O.x'\" '$tmp/err'"
+for e in generic aot; do
+    [ "$e" = aot ] && ! have cc && continue
+    run "$ex/slider_crank_torque.mech" --forces --steps 12 --engine $e --csv "$tmp/sct_$e.csv"
+    check "run --forces --engine $e: the torque table" torque_table "$tmp/sct_$e.csv" "effort(D)" "$tau_g"
+done
+run "$ex/slider_crank_torque.mech" --forces --steps 12 --linear sparse --csv "$tmp/sct_sp.csv"
+check "run --forces --linear sparse: the torque table" torque_table "$tmp/sct_sp.csv" "effort(D)" "$tau_g"
+
 suite_end

@@ -149,6 +149,25 @@ static const char epilogue[] =
     "failure are written); 2 bad usage or input, or not as many rows as\n"
     "coordinates.\n";
 
+/* --forces at one instant: every row's multiplier, every driver's effort. */
+static void print_forces(const Model *m, const RunOutput *out, int digits)
+{
+    int dg = digits > 0 ? digits : 10, width = 10;
+    for (int i = 0; i < m->nr; i++)
+        if ((int)strlen(m->rows[i].name) > width)
+            width = (int)strlen(m->rows[i].name);
+    printf("\nrow%*s  %17s\n", width - 3, "", "lambda");
+    for (int i = 0; i < m->nr; i++)
+        printf("%-*s  %17.*g\n", width, m->rows[i].name, dg, out->lambda[i]);
+    if (out->nd > 0)
+        printf("\ndriver%*s  %17s\n", width - 6, "", "effort");
+    for (int i = 0; i < out->nd; i++)
+        printf("%-*s  %17.*g\n", width, out->dnames[i], dg, out->efforts[i]);
+    printf("\nlambda as in M qdd + Phi_q^T lambda = Q; a driver's effort is -lambda (the force\n"
+           "or torque it applies along its coordinate); a revolute's (lambda(J.x), lambda(J.y))\n"
+           "is the force on its second body: examples/README.md, Reactions\n");
+}
+
 /* --steps 0 without --csv or --json: the one state as a table. */
 static void print_table(const Model *m, const RunOutput *out, const RunResult *res, int digits)
 {
@@ -173,6 +192,8 @@ static void print_table(const Model *m, const RunOutput *out, const RunResult *r
     s.wnames = (const char *const *)out->outputs.wnames;
     run_table_print(stdout, m, &s, digits);
     free(w);
+    if (out->lambda_use == RUN_OUTPUT_FORCES)
+        print_forces(m, out, digits);
 }
 
 static void print_stats(const RunResult *res, const MechrtKernels *k,
