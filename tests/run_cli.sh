@@ -713,4 +713,19 @@ done
 run "$ex/slider_crank_torque.mech" --forces --steps 12 --linear sparse --csv "$tmp/sct_sp.csv"
 check "run --forces --linear sparse: the torque table" torque_table "$tmp/sct_sp.csv" "effort(D)" "$tau_g"
 
+run "$ex/slider_crank_torque.mech" --forces --svg "$tmp/sct.svg"
+check "run --forces --svg: an arrow at each of O, A, B and P, and the scale's legend" \
+    sh -c "[ \$(grep -c '<polyline class=\"force\" marker-end=\"url(#force)\" points=\"[0-9.,]* [0-9.,]*\"><title>reaction at' '$tmp/sct.svg') = 4 ] && grep -q 'this arrow is 27.37 (the largest)' '$tmp/sct.svg'"
+# the first frame's arrow at O points along the pin's force on the crank,
+# (lambda(O.x), lambda(O.y)) = (-19.08, 19.62) at t = 0 (pixels: y down)
+check "run --forces --svg: the arrow at O along (lambda(O.x), lambda(O.y))" \
+    awk '/<title>reaction at O</ { split($0, a, "points=\""); split(a[2], b, "\""); split(b[1], p, "[ ,]")
+         dx = p[3] - p[1]; dy = p[2] - p[4]; r = dx / dy - (-19.081235175439428 / 19.62)
+         found = 1; exit !(dx < 0 && dy > 0 && r < 0.01 && r > -0.01) } END { if (!found) exit 1 }' "$tmp/sct.svg"
+run "$ex/slider_crank_torque.mech" --svg "$tmp/sct_nf.svg"
+check "run --svg without --forces: no arrows" sh -c "! grep -q 'force' '$tmp/sct_nf.svg'"
+if have xmllint; then
+    check "run --forces --svg: well-formed XML" xmllint --noout "$tmp/sct.svg"
+fi
+
 suite_end

@@ -1288,6 +1288,13 @@ RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunO
                          "statements (run --forces reports the reactions of a file with "
                          "masses)");
     }
+    if (o->max_dense_entries > 0 && (long long)m->nq * m->nq > o->max_dense_entries) {
+        memset(res, 0, sizeof *res);
+        res->t_fail = NAN;
+        return bad_input(res, "inverse dynamics is dense (M and Phi_q as %d x %d matrices, "
+                         "%lld entries), more than the limit of %lld (--max-jac-entries)",
+                         m->nq, m->nq, (long long)m->nq * m->nq, o->max_dense_entries);
+    }
     return analyse(m, k, o, NULL, state, state_ctx, res);
 }
 

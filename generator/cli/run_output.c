@@ -11,6 +11,7 @@
 #include "run_output.h"
 
 #include "../base/arena.h"
+#include "../render/reactions.h"
 
 #include <errno.h>
 #include <math.h>
@@ -253,9 +254,17 @@ static bool write_picture(const RunOutput *out, const RunPictures *p, int which,
     bool wrote;
     if (which == 0) {
         SvgAnimOptions ao = svg_anim_default_options();
+        SvgForce forces[RUN_OUTPUT_MAX_FORCES];
+        double *fvals = NULL;
         if (p->view >= 0)
             ao.view = (SvgView)p->view;
+        if (out->lambda_use == RUN_OUTPUT_FORCES && out->lambda) {
+            ao.nforces = reactions_compute(m, q, out->lambda, n, forces, RUN_OUTPUT_MAX_FORCES,
+                                           &fvals);
+            ao.forces = forces;
+        }
         wrote = svg_write_animation_opt(f, m, t, q, n, p->traces, p->ntraces, m->name, &ao);
+        free(fvals);
     } else {
         SvgSeries series[RUN_OUTPUT_MAX_PLOT_VARS];
         char names[RUN_OUTPUT_MAX_PLOT_VARS][96];

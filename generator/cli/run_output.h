@@ -13,7 +13,9 @@
 #include "../../runtime/host/mechrt_host.h"
 #include "cli.h"
 
-enum { RUN_OUTPUT_MAX_TRACES = CLI_LIST_MAX, RUN_OUTPUT_MAX_PLOT_VARS = 64 };
+/* The animation draws the reactions of at most RUN_OUTPUT_MAX_FORCES joints. */
+enum { RUN_OUTPUT_MAX_TRACES = CLI_LIST_MAX, RUN_OUTPUT_MAX_PLOT_VARS = 64,
+       RUN_OUTPUT_MAX_FORCES = 256 };
 
 /* What happens to the multipliers of the states (the last argument of
    run_output_state). */

@@ -665,3 +665,32 @@ void scene_build(Scene *sc)
     build_pins(sc);
     build_trace_dots(sc);
 }
+
+/* ---- forces (run --forces) ---- */
+
+void scene_scale_forces(Scene *sc)
+{
+    sc->force_max = 0;
+    sc->force_scale = 0;
+    for (int i = 0; i < sc->nforces; i++)
+        for (int f = 0; f < sc->nf; f++) {
+            const double *v = sc->forces[i].f + (size_t)sc->frames[f] * (size_t)sc->forces[i].stride;
+            double len = hypot(v[0], v[1]);
+            if (isfinite(len) && len > sc->force_max)
+                sc->force_max = len;
+        }
+    if (sc->force_max > 0)
+        sc->force_scale = SVG_FORCE_PX * sc->px / sc->force_max;
+}
+
+void scene_force_arrow(const Scene *sc, int i, int f, double *x0, double *y0, double *x1,
+                       double *y1)
+{
+    const SvgForce *F = &sc->forces[i];
+    int k = sc->frames[f];
+    const double *v = F->f + (size_t)k * (size_t)F->stride;
+    double fx = isfinite(v[0]) ? v[0] : 0, fy = isfinite(v[1]) ? v[1] : 0;
+    attach_world(sc, F->at, k, x0, y0);
+    *x1 = *x0 + sc->force_scale * fx;
+    *y1 = *y0 + sc->force_scale * fy;
+}

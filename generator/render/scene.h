@@ -72,6 +72,10 @@ typedef struct Scene {
                                symbols are sized (the final scale is a
                                little smaller: symbols come out a little
                                smaller than asked) */
+    const SvgForce *forces; /* arrows (SvgAnimOptions.forces); planar only */
+    int nforces;
+    double force_max;       /* the largest |f| over the kept frames (0: none drawn) */
+    double force_scale;     /* model units per unit of force */
 } Scene;
 
 /* Starts a scene of frames t[k], q[k*nq + i] (checked by the caller):
@@ -84,6 +88,13 @@ void scene_free(Scene *sc);
 /* Keeps at most max frames (2 at least) of the n given: all when n <= max,
    else about max indices including the first and the last. */
 void scene_keep_frames(Scene *sc, int max);
+
+/* The forces' scale: the largest over the kept frames SVG_FORCE_PX
+   pixels long at sc->px; sc->force_max 0 when there is nothing to draw. */
+void scene_scale_forces(Scene *sc);
+/* Force i's arrow at kept frame f: from (*x0, *y0) to (*x1, *y1), world. */
+void scene_force_arrow(const Scene *sc, int i, int f, double *x0, double *y0, double *x1,
+                       double *y1);
 
 /* Adds every shape and ground symbol, in drawing order; sc->L and sc->px
    must be set. */

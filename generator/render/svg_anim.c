@@ -25,6 +25,8 @@ SvgAnimOptions svg_anim_default_options(void)
         .height = 520,
         .max_bytes = 4000000,
         .view = SVG_VIEW_ISO,
+        .forces = NULL,
+        .nforces = 0,
     };
     return o;
 }
@@ -75,6 +77,10 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
     Scene sc;
     scene_init(&sc, m, t, q, nframes, traces, ntraces, o.max_frames);
     sc.view = o.view;
+    if (!m->spatial && o.nforces > 0 && o.forces) {
+        sc.forces = o.forces;
+        sc.nforces = o.nforces;
+    }
     SvgBox b = svg_scene_extent(&sc, false);
     sc.L = fmax(b.x1 - b.x0, b.y1 - b.y0);
     if (!(sc.L > 0))
@@ -83,11 +89,12 @@ bool svg_write_animation_opt(FILE *out, const Model *m, const double *t, const d
     scene_build(&sc);
     fit_byte_budget(&sc, &o);
 
+    scene_scale_forces(&sc);
     SvgBox all = svg_scene_extent(&sc, true);
     SvgBox first = svg_scene_extent(&sc, false);
     svg_box_add(&all, first.x0, first.y0);
     svg_box_add(&all, first.x1, first.y1);
-    int footer = ntraces;
+    int footer = ntraces + (sc.force_max > 0);
     for (int j = 0; j < m->njoints; j++)
         footer += m->joints[j].kind == JOINT_DRIVER;
     SvgPixelMap pm = svg_pixel_map(all, &o, footer);

@@ -22,6 +22,16 @@ typedef struct SvgTrace {
     double sz;
 } SvgTrace;
 
+/* A force drawn as an arrow (run --forces: a joint's reaction on its
+   second body): applied at attachment `at` (a planar mechanism's), global
+   components f[k*stride], f[k*stride + 1] at frame k of the run. */
+typedef struct SvgForce {
+    Attach at;
+    const double *f;
+    int stride;
+    const char *name;       /* tooltip */
+} SvgForce;
+
 /* Tunables with their defaults (svg_anim_default_options). */
 typedef struct SvgAnimOptions {
     int max_frames;         /* frames kept after subsampling; default 200 */
@@ -34,7 +44,14 @@ typedef struct SvgAnimOptions {
                                fewer frames (10 at least); default 4000000 */
     SvgView view;           /* a spatial mechanism's projection (view.h);
                                default iso; planar ones ignore it */
+    /* forces drawn as arrows from their points, all to one scale: the
+       largest over the run SVG_FORCE_PX pixels long, with a legend line
+       giving the scale; planar only; default none */
+    const SvgForce *forces;
+    int nforces;
 } SvgAnimOptions;
+
+#define SVG_FORCE_PX 60
 
 SvgAnimOptions svg_anim_default_options(void);
 

@@ -106,6 +106,12 @@ SvgBox svg_scene_extent(const Scene *sc, bool shapes)
             svg_box_add(&b, x, y);
         }
     }
+    for (int i = 0; shapes && sc->force_max > 0 && i < sc->nforces; i++)
+        for (int f = 0; f < sc->nf; f++) {
+            double x0, y0, x1, y1;
+            scene_force_arrow(sc, i, f, &x0, &y0, &x1, &y1);
+            svg_box_add(&b, x1, y1);
+        }
     for (int i = 0; shapes && i < sc->nground; i++) {
         const Ground *g = &sc->ground[i];
         svg_box_add(&b, g->x, g->y);
@@ -437,6 +443,46 @@ static void write_time(const Writer *w)
     fputs("</rect>\n</g>\n", out);
 }
 
+/* The forces' arrows (run --forces): one polyline each from its point,
+   the arrowhead a marker, animated like a shape. */
+static void write_forces(const Writer *w)
+{
+    const Scene *sc = w->sc;
+    FILE *out = w->out;
+    double *xy = xmalloc((size_t)sc->nf * 4 * sizeof *xy);
+    for (int i = 0; sc->force_max > 0 && i < sc->nforces; i++) {
+        for (int f = 0; f < sc->nf; f++) {
+            double x0, y0, x1, y1;
+            scene_force_arrow(sc, i, f, &x0, &y0, &x1, &y1);
+            xy[4 * f] = round(px_x(w->pm, x0) * 10) / 10;
+            xy[4 * f + 1] = round(px_y(w->pm, y0) * 10) / 10;
+            xy[4 * f + 2] = round(px_x(w->pm, x1) * 10) / 10;
+            xy[4 * f + 3] = round(px_y(w->pm, y1) * 10) / 10;
+        }
+        fputs("<polyline class=\"force\" marker-end=\"url(#force)\" points=\"", out);
+        put_points(out, xy, 2);
+        fputs("\"><title>reaction at ", out);
+        svg_put_escaped(out, sc->forces[i].name ? sc->forces[i].name : "a joint");
+        fputs("</title>", out);
+        Shape sh = {.kind = SHAPE_POLYLINE, .nv = 2};
+        if (shape_moves(sc, &sh, xy))
+            put_animation(w, &sh, xy);
+        fputs("</polyline>\n", out);
+    }
+    free(xy);
+}
+
+/* The legend line of the forces' scale: an arrow as long as the largest. */
+static void put_force_line(FILE *out, const Scene *sc, const SvgPixelMap *pm, double y)
+{
+    char buf[SVG_NUM_MAX];
+    double len = sc->force_max * sc->force_scale * pm->s;
+    fprintf(out, "<g class=\"legend\"><polyline class=\"force\" marker-end=\"url(#force)\" "
+                 "points=\"10,%.1f %.1f,%.1f\"/><text x=\"%.1f\" y=\"%.1f\">reaction forces on "
+                 "the joints' second bodies: this arrow is %s (the largest)</text></g>\n",
+            y - 4, 10 + len, y - 4, 20 + len, y, svg_fmt_sig(buf, sc->force_max, 4));
+}
+
 /* One legend line per driver, naming the coordinates its row depends on. */
 static void put_driver_line(FILE *out, const Model *m, const Joint *jt, double y, int *cols)
 {
@@ -465,7 +511,7 @@ static void write_legend(FILE *out, const Scene *sc, const SvgPixelMap *pm)
     int nlines = 0;
     for (int j = 0; j < m->njoints; j++)
         nlines += m->joints[j].kind == JOINT_DRIVER;
-    nlines += sc->ntraces;
+    nlines += sc->ntraces + (sc->force_max > 0);
     int l = 0;
     int *cols = xmalloc(((size_t)m->nq + 1) * sizeof *cols);
     for (int j = 0; j < m->njoints; j++) {
@@ -482,6 +528,8 @@ static void write_legend(FILE *out, const Scene *sc, const SvgPixelMap *pm)
         svg_put_escaped(out, label ? label : "a point");
         fputs("</text></g>\n", out);
     }
+    if (sc->force_max > 0)
+        put_force_line(out, sc, pm, pm->height - 8 - LINE_PX * (nlines - 1 - l++));
 }
 
 /* keyTimes from the times of the kept frames (kt, rounded as printed):
@@ -537,6 +585,8 @@ static const char style_sheet[] =
     ".drive{fill:none;stroke:" SCENE_DRIVE_COLOUR ";stroke-width:2}\n"
     ".bar{fill:#bbb}\n"
     "</style>\n";
+/* run --forces only, so that other pictures keep every byte */
+static const char force_style[] = "<style>.force{fill:none;stroke:#1f5fbf;stroke-width:2.5}</style>\n";
 
 void svg_write_scene(FILE *out, const Scene *sc, const SvgPixelMap *pm, const char *title,
                      const SvgAnimOptions *o)
@@ -559,9 +609,16 @@ void svg_write_scene(FILE *out, const Scene *sc, const SvgPixelMap *pm, const ch
     else
         fputs("(y up, equal scales).</desc>\n", out);
     fputs(style_sheet, out);
+    if (sc->force_max > 0)
+        fputs(force_style, out);
     fputs("<defs><marker id=\"arrow\" viewBox=\"0 0 10 10\" refX=\"5\" refY=\"5\" markerWidth=\"5\" "
           "markerHeight=\"5\" orient=\"auto\"><path d=\"M0,0 L10,5 L0,10 z\" fill=\"" SCENE_DRIVE_COLOUR
-          "\"/></marker></defs>\n", out);
+          "\"/></marker>", out);
+    if (sc->force_max > 0)
+        fputs("<marker id=\"force\" viewBox=\"0 0 10 10\" refX=\"9\" refY=\"5\" markerWidth=\"4\" "
+              "markerHeight=\"4\" orient=\"auto\"><path d=\"M0,0 L10,5 L0,10 z\" fill=\"#1f5fbf\"/>"
+              "</marker>", out);
+    fputs("</defs>\n", out);
     fprintf(out, "<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n", pm->width, pm->height);
     fputs("<text class=\"title\" x=\"10\" y=\"22\">", out);
     svg_put_escaped(out, title);
@@ -571,6 +628,7 @@ void svg_write_scene(FILE *out, const Scene *sc, const SvgPixelMap *pm, const ch
     write_trace_paths(out, sc, pm);
     for (int s = 0; s < sc->nsh; s++)
         write_shape(&w, &sc->sh[s]);
+    write_forces(&w);
     write_legend(out, sc, pm);
     fputs("</svg>\n", out);
     free(w.key_times);
