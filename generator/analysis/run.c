@@ -1022,6 +1022,42 @@ out:
     return status;
 }
 
+/* Velocity-level rows, at t0: the positions projected onto the holonomic
+   rows (assembled robustly when that fails), the velocities and
+   accelerations solved there, the inverse dynamics asked for. False with
+   the failure in r->res. */
+static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
+{
+    const RunOptions *o = r->o;
+    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
+    bool ok = false;
+    place_at_t0(r, q0, start);
+    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
+    r->res->assembly_iterations = rep->iterations;
+    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
+        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
+        if (!assemble_robustly(r))
+            goto out;
+        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
+        r->res->assembly_iterations += rep->iterations;
+    }
+    if (st != MECHRT_OK) {
+        fail(r, st, o->t0, r->q, rep, "assembly (minimum-norm Newton)");
+        goto out;
+    }
+    note_move(r, q0);
+    st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, o->t0, r->qd, r->qdd, r->work,
+                                      r->lwork, rep);
+    if (st != MECHRT_OK) {
+        fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
+        goto out;
+    }
+    ok = inverse_at(r, o->t0);
+out:
+    free(q0);
+    return ok;
+}
+
 /* Velocity-level rows: integrate the positions between output times. */
 static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
 {
@@ -1037,33 +1073,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         return RUN_FAILED;
     }
     r->res->integrated = true;
-    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
-    place_at_t0(r, q0, start);
-    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
-    r->res->assembly_iterations = rep.iterations;
-    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
-        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
-        if (!assemble_robustly(r)) {
-            status = RUN_FAILED;
-            goto out;
-        }
-        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, &rep);
-        r->res->assembly_iterations += rep.iterations;
-    }
-    if (st != MECHRT_OK) {
-        fail(r, st, o->t0, r->q, &rep, "assembly (minimum-norm Newton)");
-        status = RUN_FAILED;
-        goto out;
-    }
-    note_move(r, q0);
-    st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, o->t0, r->qd, r->qdd, r->work,
-                                      r->lwork, &rep);
-    if (st != MECHRT_OK) {
-        fail(r, st, o->t0, r->q, &rep, "velocity and acceleration analysis");
-        status = RUN_FAILED;
-        goto out;
-    }
-    if (!inverse_at(r, o->t0)) {
+    if (!integrated_start(r, host, &rep)) {
         status = RUN_FAILED;
         goto out;
     }
@@ -1074,7 +1084,8 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         double tn = time_at(o, i), c0 = pipeline_now();
         clock_t cpu0 = clock();
         long it0 = mechrt_host_stats(host)->project_iterations;
-        st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep, &rep);
+        MechrtStatus st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep,
+                                                &rep);
         r->res->newton_iterations += mechrt_host_stats(host)->project_iterations - it0;
         if (st != MECHRT_OK) {
             double tf;
@@ -1090,12 +1101,9 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         bool forces_ok = st != MECHRT_OK || inverse_at(r, tn);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
-        if (st != MECHRT_OK) {
+        if (st != MECHRT_OK)
             fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
-            status = RUN_FAILED;
-            goto out;
-        }
-        if (!forces_ok) {
+        if (st != MECHRT_OK || !forces_ok) {
             status = RUN_FAILED;
             goto out;
         }
@@ -1106,7 +1114,6 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
 out:
     r->res->host = *mechrt_host_stats(host);
     mechrt_host_free(host);
-    free(q0);
     return status;
 }
 
