@@ -4,9 +4,9 @@
  * rest to sim_run (generator/analysis/sim.c). The states go out as run's
  * do, through run's output module (run_output.c): the same CSV columns and
  * JSON keys, the file's outputs beside the coordinates, the same animation
- * and chart writers; JSON adds the multipliers ("rows", "lambda"). On a failure the
- * states computed before it are still written, and the message goes to
- * stderr.
+ * and chart writers; JSON adds the multipliers ("rows", "lambda"). On a
+ * failure the states computed before it are still written, and the
+ * message goes to stderr.
  */
 #include "cli.h"
 
@@ -15,7 +15,6 @@
 #include "run_output.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
