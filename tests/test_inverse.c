@@ -12,7 +12,9 @@
  * forms. The slider-crank's reactions balance the weights; run's square
  * solve equals the runtime's rank-revealing one; through the flat
  * positions of a parallelogram the runtime's minimum-norm lambda takes
- * over. A file without masses is refused.
+ * over. The arrows' forces (render/reactions.c) of a revolute, a
+ * prismatic and a distance from given multipliers. A file without masses
+ * is refused.
  */
 #include "testutil.h"
 #include "testload.h"
@@ -23,6 +25,7 @@
 #include "../generator/analysis/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/engine/engine.h"
+#include "../generator/render/reactions.h"
 
 /* Every state and its multipliers. */
 typedef struct Kept {
@@ -301,6 +304,45 @@ static void test_through_singular(void **state)
     pipeline_free(mech);
 }
 
+/* The arrows' forces (render/reactions.c) from given states and
+   multipliers: a revolute's +lambda, a prismatic's -lambda n_A with A's
+   normal turned by phi_A, a distance's -2 lambda (P_B - P_A). */
+static void test_reaction_forces(void **state)
+{
+    (void)state;
+    Mech *mech = load_text("body a phi = 0.3\nbody b x = 1\npoint p x = 3 y = 4\n"
+                           "revolute R: ground a\nprismatic P: a(0.5, 0) b axis(2, 0)\n"
+                           "distance D: ground(1, 1) p length = 2\n"
+                           "driver d1: a.phi = 0.3\ndriver d2: b.x = 1\ndriver d3: p.x = 3\n",
+                           "reactions.mech");
+    const Model *m = mech->model;
+    double q[2][8] = {{0, 0, 0.3, 1, 0, 0.3, 3, 4}, {0, 0, -0.7, 2, 1, -0.7, -1, 2}};
+    double lambda[2][8] = {{1, 2, 3, 4, 0.5, 0, 0, 0}, {-1, 5, -2, 0, -0.25, 0, 0, 0}};
+    assert_int_equal(m->nq, 8);
+    assert_int_equal(m->nr, 8);
+    SvgForce f[8];
+    double *vals;
+    int n = reactions_compute(m, &q[0][0], &lambda[0][0], 2, f, 8, &vals);
+    assert_int_equal(n, 3);
+    assert_string_equal(f[0].name, "R");
+    assert_string_equal(f[1].name, "P");
+    assert_string_equal(f[2].name, "D");
+    for (int k = 0; k < 2; k++) {
+        const double *r = f[0].f + k * f[0].stride, *p = f[1].f + k * f[1].stride;
+        const double *d = f[2].f + k * f[2].stride, *l = lambda[k];
+        assert_near(r[0], l[0], 0, 1e-15);
+        assert_near(r[1], l[1], 0, 1e-15);
+        /* n_A = A(phi_a) (0, 2) */
+        double phi = q[k][2];
+        assert_near(p[0], -l[2] * (-2 * sin(phi)), 1e-15, 1e-15);
+        assert_near(p[1], -l[2] * (2 * cos(phi)), 1e-15, 1e-15);
+        assert_near(d[0], -2 * l[4] * (q[k][6] - 1), 1e-15, 1e-15);
+        assert_near(d[1], -2 * l[4] * (q[k][7] - 1), 1e-15, 1e-15);
+    }
+    free(vals);
+    pipeline_free(mech);
+}
+
 static void test_no_masses_refused(void **state)
 {
     (void)state;
@@ -330,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_driven_pendulum),
         cmocka_unit_test(test_same_as_runtime),
         cmocka_unit_test(test_through_singular),
+        cmocka_unit_test(test_reaction_forces),
         cmocka_unit_test(test_no_masses_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
