@@ -728,4 +728,17 @@ if have xmllint; then
     check "run --forces --svg: well-formed XML" xmllint --noout "$tmp/sct.svg"
 fi
 
+# velocity-level rows (positions integrated): knife_cart with a mass runs a
+# circle of radius v/w = 1 at speed pi; the blade carries the centripetal
+# force m v^2 / R = 2 pi^2 (lambda(blade) = -2 pi^2: the force -lambda n_A
+# on the cart points to the centre), the drivers nothing
+{ cat "$ex/knife_cart.mech"; echo 'mass cart m = 2 J = 0.1'; } > "$tmp/kcm.mech"
+run "$tmp/kcm.mech" --forces --steps 8 --csv "$tmp/kcm.csv"
+check "run --forces, velocity-level rows: lambda(blade) = -2 pi^2, efforts 0" \
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+             { d = $(c["lambda(blade)"]) + 2 * atan2(0, -1)^2; if (d < 0) d = -d
+               e = $(c["effort(fwd)"]); if (e < 0) e = -e; f = $(c["effort(turn)"]); if (f < 0) f = -f
+               if (d > 1e-9 || e > 1e-9 || f > 1e-9) exit 1; n++ }
+             END { exit n != 9 }' "$tmp/kcm.csv"
+
 suite_end
