@@ -391,6 +391,10 @@ check "dead centre passed: names crank.phi" err_matches "crank\.phi"
 check "dead centre passed: the corrector's verdict" \
     err_has "the rank-revealing corrector found no motion that continues the branch either (at t = 1: "
 check "dead centre passed: the 10 states before are written (header + 10)" out_lines 11
+run "$tmp/limit.mech" --t1 2 --steps 20 --linear sparse
+check "dead centre passed, sparse: exit 1" status_is 1
+check "dead centre passed, sparse: the dependent rows and the free direction named" \
+    err_matches "singular along rows [A-Z., ]* and coordinates crank\.phi and rod\.phi"
 check "dead centre passed: the last row written is t = 0.9" \
     [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.9" ]
 run "$tmp/limit.mech" --t1 2 --steps 20 --json

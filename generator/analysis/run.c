@@ -223,13 +223,11 @@ static double describe_pivot(Run *r)
     return -1;
 }
 
-/* The rows and coordinates of the Jacobian's (near) dependency at (q, t),
-   over the first `rows` rows; nothing when the Jacobian is well conditioned.
-   Returns sigma_min / sigma_max, or -1 when it could not be computed. */
-static double describe_dependency(Run *r, const double *q, double t, int rows, bool always)
+/* describe_dependency's dense part: the smallest singular direction of the
+   dense Jacobian (at most RUN_SVD_MAX_NQ coordinates). */
+static double describe_dense_dependency(Run *r, const double *q, double t, int rows,
+                                        bool always)
 {
-    if (r->sp)
-        return describe_pivot(r);
     if (r->nq > RUN_SVD_MAX_NQ)
         return -1;
     size_t nq = (size_t)r->nq;
@@ -250,6 +248,16 @@ static double describe_dependency(Run *r, const double *q, double t, int rows, b
     }
     free(jac), free(roww), free(colw), free(row_names);
     return ratio;
+}
+
+/* The rows and coordinates of the Jacobian's (near) dependency at (q, t),
+   over the first `rows` rows; nothing when the Jacobian is well conditioned.
+   Returns sigma_min / sigma_max, or -1 when it could not be computed. */
+static double describe_dependency(Run *r, const double *q, double t, int rows, bool always)
+{
+    if (r->sp)
+        return describe_pivot(r);
+    return describe_dense_dependency(r, q, t, rows, always);
 }
 
 /* After the assembly at t0: a configuration reached only approximately
@@ -939,7 +947,10 @@ static void note_rank_failure(Run *r)
              "equations, %.2g of them is left", res->rank_inconsistency);
     else
         msgf(r, "%s", mechrt_strerror(res->rank_status));
-    msgf(r, "): where the Jacobian loses rank the motion cannot go on (a limit position "
+    msgf(r, ")");
+    if (r->sp)      /* the LU's message named a pivot only: the dependency, densely */
+        describe_dense_dependency(r, r->q, res->rank_t, r->nr, true);
+    msgf(r, ": where the Jacobian loses rank the motion cannot go on (a limit position "
          "that the driver pushes past), or branches meet that the motion so far cannot "
          "tell apart (a bifurcation); drive another coordinate, or end the run there and "
          "start another on the branch you want");
