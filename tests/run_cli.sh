@@ -394,7 +394,7 @@ check "dead centre passed: the 10 states before are written (header + 10)" out_l
 run "$tmp/limit.mech" --t1 2 --steps 20 --linear sparse
 check "dead centre passed, sparse: exit 1" status_is 1
 check "dead centre passed, sparse: the dependent rows and the free direction named" \
-    err_matches "singular along rows [A-Z., ]* and coordinates crank\.phi and rod\.phi"
+    err_matches "singular along rows .* and coordinates crank\.phi and rod\.phi"
 check "dead centre passed: the last row written is t = 0.9" \
     [ "$(tail -1 "$tmp/out" | cut -d, -f1)" = "0.9" ]
 run "$tmp/limit.mech" --t1 2 --steps 20 --json
