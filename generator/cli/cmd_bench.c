@@ -9,7 +9,8 @@
  * A file with masses adds the dynamics kernels: mass (M, dense), force
  * (Q), m+q (both, what a forward-dynamics step needs of them) and eom
  * (M, Q, Phi_q and gamma: the generated P_eom, which shares sin and cos;
- * for the generic engine, which has no fused kernel, its four calls).
+ * for the generic engine, which has no fused kernel, its four calls) and
+ * mass_nz (M's nonzeros: generated code only).
  */
 #include "cli.h"
 
@@ -51,9 +52,15 @@ static const CliOption options[] = {
 /* jac_nz (the sparse Jacobian) exists only in generated code; the
    dynamics rows only for a file with masses. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_MASS, FN_FORCE, FN_MQ, FN_EOM,
-       FN_COUNT };
+       FN_MASS_NZ, FN_COUNT };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz",
-                                               "mass", "force", "m+q", "eom"};
+                                               "mass", "force", "m+q", "eom", "mass_nz"};
+
+/* Functions only generated code has (no generic counterpart, no ratio). */
+static bool generated_only(int fn)
+{
+    return fn == FN_JAC_NZ || fn == FN_MASS_NZ;
+}
 static const EngineKind order[ENGINE_KIND_COUNT] = {ENGINE_GENERIC, ENGINE_JIT, ENGINE_AOT};
 
 typedef struct Bench {
@@ -75,6 +82,8 @@ static void call_dynamics(Bench *b, const Engine *e, int fn)
         k->mass(k->ctx, b->q, b->mass);
     if (fn == FN_FORCE || fn == FN_MQ)
         k->force(k->ctx, b->q, b->qd, b->t, b->force);
+    if (fn == FN_MASS_NZ)
+        e->kernels.mass_nz(b->q, b->mass);
     if (fn != FN_EOM)
         return;
     if (e->kind != ENGINE_GENERIC) {
@@ -117,7 +126,8 @@ static int compare_doubles(const void *x, const void *y)
 
 static bool has_fn(const Bench *b, int k, int fn)
 {
-    return b->open[k] && (fn != FN_JAC_NZ || k != ENGINE_GENERIC) && (fn < FN_MASS || b->dynamics);
+    return b->open[k] && (!generated_only(fn) || k != ENGINE_GENERIC)
+           && (fn < FN_MASS || b->dynamics);
 }
 
 /* A row of the tables: every function but the dynamics ones without masses. */
@@ -179,7 +189,8 @@ static const EmitResult *emitted(const Bench *b)
 static int ops_of(const EmitResult *er, int fn)
 {
     static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL,
-                                      EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM};
+                                      EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM,
+                                      EMIT_MASS_NZ};
     if (fn == FN_MQ)
         return er->ops[EMIT_MASS] + er->ops[EMIT_FORCE];
     return er->ops[map[fn]];
@@ -215,7 +226,7 @@ static void print_json(const Model *m, const Bench *b, int repeat)
         printf("%s\"%s\": {", first ? "" : ", ", engine_names[k]);
         first = false;
         for (int fn = 0; fn < FN_COUNT; fn++) {
-            if (fn == FN_JAC_NZ || !shown(b, fn))
+            if (generated_only(fn) || !shown(b, fn))
                 continue;
             printf("%s\"%s\": ", fn ? ", " : "", fn_names[fn]);
             json_number(stdout, b->median[ENGINE_GENERIC][fn] / b->median[k][fn]);
@@ -273,7 +284,7 @@ static void print_text(const Model *m, const Bench *b, int repeat)
             else if (b->open[order[i]])
                 printf("  %10s", "-");
         for (int i = 1; i < ENGINE_KIND_COUNT; i++)
-            if (b->open[order[i]] && b->open[ENGINE_GENERIC] && fn != FN_JAC_NZ)
+            if (b->open[order[i]] && b->open[ENGINE_GENERIC] && !generated_only(fn))
                 printf("  %14.2fx", b->median[ENGINE_GENERIC][fn] / b->median[order[i]][fn]);
             else if (b->open[order[i]] && b->open[ENGINE_GENERIC])
                 printf("  %15s", "-");
