@@ -37,7 +37,7 @@ static const char usage[] =
     "by the system compiler, $CC or cc, with " AOT_FLAGS "). Reports ns per call\n"
     "(median of interleaved repeats), the speed-up against generic, generation and\n"
     "compile times, code size and operation counts. With masses in the file also\n"
-    "mass, force, m+q (both) and eom (M, Q, Phi_q and gamma in one call).\n"
+    "mass, force, m+q (both), eom (M, Q, Phi_q and gamma in one call) and mass_nz.\n"
     "\n";
 
 static const CliOption options[] = {
