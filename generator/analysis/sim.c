@@ -339,7 +339,10 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
         return MECHRT_ENOTFINITE;
     if (!(sv.sigma_max > 0))
         return MECHRT_OK;   /* Phi_q = 0: nothing constrains the velocities */
-    mechrt_svd_truncate(s->svd, s->o->dyn.rank_tol * sv.sigma_max);
+    /* as the rows of the step (row_tol): near a rank drop the direction
+       becoming dependent is left alone; a small singular value there would
+       turn the integration's error into a large change of speed (energy) */
+    mechrt_svd_truncate(s->svd, fmax(s->o->dyn.rank_tol, s->o->row_tol) * sv.sigma_max);
     mechrt_svd_pinv_solve(s->svd, s->resid, s->dqd);
     for (int j = 0; j < n; j++) {
         qd[j] -= s->dqd[j];
@@ -354,7 +357,9 @@ static bool project_state(Sim *s, double *y, double t)
 {
     MechrtOptions po = s->o->mechrt;
     MechrtReport rep;
-    po.pivot_tol = s->o->dyn.rank_tol;      /* redundant rows are dependent only so far */
+    /* redundant rows, and near a rank drop the row becoming dependent, are
+       left alone as in the velocities (row_tol) */
+    po.pivot_tol = fmax(s->o->dyn.rank_tol, s->o->row_tol);
     s->res->projections++;
     MechrtStatus st = mechrt_host_project(s->host, &po, y, t, &rep);
     s->res->projection_iterations += rep.iterations;

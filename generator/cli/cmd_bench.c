@@ -5,6 +5,12 @@
  * interleaved (repeat 1 of every pair, then repeat 2, ...), so a change
  * of machine load touches all engines alike, and the median of the
  * repeats is reported. All buffers are allocated before timing.
+ *
+ * A file with masses adds the dynamics kernels: mass (M, dense), force
+ * (Q), m+q (both, what a forward-dynamics step needs of them) and eom
+ * (M, Q, Phi_q and gamma: the generated P_eom, which shares sin and cos;
+ * for the generic engine, which has no fused kernel, its four calls) and
+ * mass_nz (M's nonzeros: generated code only).
  */
 #include "cli.h"
 
@@ -30,7 +36,8 @@ static const char usage[] =
     "code generation), jit (generated C compiled by libtcc) and aot (the same C built\n"
     "by the system compiler, $CC or cc, with " AOT_FLAGS "). Reports ns per call\n"
     "(median of interleaved repeats), the speed-up against generic, generation and\n"
-    "compile times, code size and operation counts.\n"
+    "compile times, code size and operation counts. With masses in the file also\n"
+    "mass, force, m+q (both), eom (M, Q, Phi_q and gamma in one call) and mass_nz.\n"
     "\n";
 
 static const CliOption options[] = {
@@ -42,20 +49,52 @@ static const CliOption options[] = {
              "gen_s, tcc_s, cc_s, ops{...}, speedup{...}"},
 };
 
-/* jac_nz (the sparse Jacobian) exists only in generated code. */
-enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_COUNT };
-static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz"};
+/* jac_nz (the sparse Jacobian) exists only in generated code; the
+   dynamics rows only for a file with masses. */
+enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_MASS, FN_FORCE, FN_MQ, FN_EOM,
+       FN_MASS_NZ, FN_COUNT };
+static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz",
+                                               "mass", "force", "m+q", "eom", "mass_nz"};
+
+/* Functions only generated code has (no generic counterpart, no ratio). */
+static bool generated_only(int fn)
+{
+    return fn == FN_JAC_NZ || fn == FN_MASS_NZ;
+}
 static const EngineKind order[ENGINE_KIND_COUNT] = {ENGINE_GENERIC, ENGINE_JIT, ENGINE_AOT};
 
 typedef struct Bench {
     Engine eng[ENGINE_KIND_COUNT];
     bool open[ENGINE_KIND_COUNT];
     double *q, *qd, t;
-    double *phi, *jac, *nu, *gamma;
+    double *phi, *jac, *nu, *gamma, *mass, *force;
+    bool dynamics;                              /* the file has masses */
     long batch[ENGINE_KIND_COUNT][FN_COUNT];
     double *ns[ENGINE_KIND_COUNT][FN_COUNT];    /* one per repeat */
     double median[ENGINE_KIND_COUNT][FN_COUNT];
 } Bench;
+
+/* One call of a dynamics function; the generic engine's eom is its four calls. */
+static void call_dynamics(Bench *b, const Engine *e, int fn)
+{
+    const MechrtKernels *k = &e->k;
+    if (fn == FN_MASS || fn == FN_MQ)
+        k->mass(k->ctx, b->q, b->mass);
+    if (fn == FN_FORCE || fn == FN_MQ)
+        k->force(k->ctx, b->q, b->qd, b->t, b->force);
+    if (fn == FN_MASS_NZ)
+        e->kernels.mass_nz(b->q, b->mass);
+    if (fn != FN_EOM)
+        return;
+    if (e->kind != ENGINE_GENERIC) {
+        e->kernels.eom(b->q, b->qd, b->t, b->mass, b->force, b->jac, b->gamma);
+        return;
+    }
+    k->mass(k->ctx, b->q, b->mass);
+    k->force(k->ctx, b->q, b->qd, b->t, b->force);
+    k->jac(k->ctx, b->q, b->t, b->jac);
+    k->gamma(k->ctx, b->q, b->qd, b->t, b->gamma);
+}
 
 /* Seconds taken by n calls of one function. */
 static double time_batch(Bench *b, EngineKind k, int fn, long n)
@@ -63,6 +102,10 @@ static double time_batch(Bench *b, EngineKind k, int fn, long n)
     const Engine *e = &b->eng[k];
     double t0 = pipeline_now();
     for (long i = 0; i < n; i++) {
+        if (fn >= FN_MASS) {
+            call_dynamics(b, e, fn);
+            continue;
+        }
         switch (fn) {
         case FN_PHI:   engine_phi(e, b->q, b->t, b->phi); break;
         case FN_JAC:   engine_jac(e, b->q, b->t, b->jac); break;
@@ -83,7 +126,14 @@ static int compare_doubles(const void *x, const void *y)
 
 static bool has_fn(const Bench *b, int k, int fn)
 {
-    return b->open[k] && (fn != FN_JAC_NZ || k != ENGINE_GENERIC);
+    return b->open[k] && (!generated_only(fn) || k != ENGINE_GENERIC)
+           && (fn < FN_MASS || b->dynamics);
+}
+
+/* A row of the tables: every function but the dynamics ones without masses. */
+static bool shown(const Bench *b, int fn)
+{
+    return fn < FN_MASS || b->dynamics;
 }
 
 static void measure(Bench *b, int repeat)
@@ -135,10 +185,15 @@ static const EmitResult *emitted(const Bench *b)
     return NULL;
 }
 
-static int emit_index(int fn)
+/* The operation count of a row (m+q: mass and force together). */
+static int ops_of(const EmitResult *er, int fn)
 {
-    static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_JAC_NZ};
-    return map[fn];
+    static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL,
+                                      EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM,
+                                      EMIT_MASS_NZ};
+    if (fn == FN_MQ)
+        return er->ops[EMIT_MASS] + er->ops[EMIT_FORCE];
+    return er->ops[map[fn]];
 }
 
 static void print_json(const Model *m, const Bench *b, int repeat)
@@ -170,7 +225,9 @@ static void print_json(const Model *m, const Bench *b, int repeat)
             continue;
         printf("%s\"%s\": {", first ? "" : ", ", engine_names[k]);
         first = false;
-        for (int fn = 0; fn < FN_ALL + 1; fn++) {
+        for (int fn = 0; fn < FN_COUNT; fn++) {
+            if (generated_only(fn) || !shown(b, fn))
+                continue;
             printf("%s\"%s\": ", fn ? ", " : "", fn_names[fn]);
             json_number(stdout, b->median[ENGINE_GENERIC][fn] / b->median[k][fn]);
         }
@@ -195,7 +252,8 @@ static void print_json(const Model *m, const Bench *b, int repeat)
     if (er) {
         printf(",\n \"code_bytes\": %zu, \"ops\": {", strlen(er->c_text));
         for (int fn = 0; fn < FN_COUNT; fn++)
-            printf("%s\"%s\": %d", fn ? ", " : "", fn_names[fn], er->ops[emit_index(fn)]);
+            if (shown(b, fn))
+                printf("%s\"%s\": %d", fn ? ", " : "", fn_names[fn], ops_of(er, fn));
         printf("}");
     }
     printf("}\n");
@@ -217,6 +275,8 @@ static void print_text(const Model *m, const Bench *b, int repeat)
         printf("  %8s", "ops");
     printf("\n");
     for (int fn = 0; fn < FN_COUNT; fn++) {
+        if (!shown(b, fn))
+            continue;
         printf("%-6s", fn_names[fn]);
         for (int i = 0; i < ENGINE_KIND_COUNT; i++)
             if (has_fn(b, order[i], fn))
@@ -224,12 +284,12 @@ static void print_text(const Model *m, const Bench *b, int repeat)
             else if (b->open[order[i]])
                 printf("  %10s", "-");
         for (int i = 1; i < ENGINE_KIND_COUNT; i++)
-            if (b->open[order[i]] && b->open[ENGINE_GENERIC] && fn != FN_JAC_NZ)
+            if (b->open[order[i]] && b->open[ENGINE_GENERIC] && !generated_only(fn))
                 printf("  %14.2fx", b->median[ENGINE_GENERIC][fn] / b->median[order[i]][fn]);
             else if (b->open[order[i]] && b->open[ENGINE_GENERIC])
                 printf("  %15s", "-");
         if (er)
-            printf("  %8d", er->ops[emit_index(fn)]);
+            printf("  %8d", ops_of(er, fn));
         printf("\n");
     }
     printf("\n");
@@ -271,6 +331,11 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
     b->jac = xcalloc(nr * nq + 1, sizeof *b->jac);
     b->nu = xcalloc(nr + 1, sizeof *b->nu);
     b->gamma = xcalloc(nr + 1, sizeof *b->gamma);
+    b->mass = xcalloc(nq * nq, sizeof *b->mass);
+    b->force = xcalloc(nq, sizeof *b->force);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        if (b->open[k])
+            b->dynamics = b->eng[k].k.mass != NULL && b->eng[k].k.force != NULL;
     for (size_t i = 0; i < nq; i++) {
         b->q[i] = m->q0[i] + 0.01 * (double)((i * 7) % 5);
         b->qd[i] = 0.3 + 0.1 * (double)((i * 3) % 7);
@@ -288,6 +353,7 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
         for (int fn = 0; fn < FN_COUNT; fn++)
             free(b->ns[k][fn]);
     free(b->q), free(b->qd), free(b->phi), free(b->jac), free(b->nu), free(b->gamma);
+    free(b->mass), free(b->force);
 }
 
 /* The engines timed and reported. */

@@ -1,0 +1,99 @@
+#!/bin/sh
+# bench/dynamics.sh MECHC - forward dynamics timed: Andrews' squeezer to t = 0.03, IFToMM A02 over 20 s, and the dynamics kernels per engine.
+#
+#   sh bench/dynamics.sh build/mechc                  (part of `make bench`)
+#   A02_N=40 A02_T1=2 REPEAT=3 sh bench/dynamics.sh build/mechc
+#
+# 1. Andrews (examples/andrews.mech, jit, rk8pd, --rtol/--atol 1e-8: the
+#    loosest tolerance that keeps 7 correct digits with a margin): the CPU
+#    time of the integration alone (`sim --stats`: no parsing, generation
+#    or compilation), best and median of REPEAT runs, and beta's relative
+#    error against the Test Set's reference at t = 0.03.
+# 2. A02 (sh examples/a02_four_bar.sh A02_N, default 40: 243 coordinates)
+#    over A02_T1 seconds (default the benchmark's 20) with 400 output steps
+#    per 20 s, rk8pd at 1e-7: the integration's CPU time, the largest error
+#    of B0's position and velocity against the exact solution of the
+#    published definition (the one-angle equation of the parallelogram
+#    branch; the benchmark's data file was not available), and the energy.
+# 3. `mechc bench` on Andrews, the double pendulum and A02: ns per call of
+#    mass, force, m+q (both) and eom for generic, jit and aot, and the
+#    speed-ups generated / generic against the issue's targets (3x jit,
+#    5x aot).
+# POSIX sh and awk only.
+set -u
+mechc=${1:-build/mechc}
+repeat=${REPEAT:-5}
+a02_n=${A02_N:-40}
+a02_t1=${A02_T1:-20}
+if [ ! -x "$mechc" ]; then
+    echo "usage: sh bench/dynamics.sh MECHC   ('$mechc' is not an executable; run make first)" >&2
+    exit 2
+fi
+root=$(cd "$(dirname "$0")/.." && pwd)
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mechc_dynbench.XXXXXX") || exit 2
+trap 'rm -rf "$tmp"' EXIT
+
+# cpu_ms: the integration's CPU milliseconds in a `sim --stats` stderr ($1)
+cpu_ms() { sed -n 's/.* ms of integration (\([0-9.e+-]*\) ms CPU).*/\1/p' "$1"; }
+
+echo "== Andrews' squeezing mechanism to t = 0.03 (jit, rk8pd, --rtol 1e-8 --atol 1e-8)"
+i=0
+: > "$tmp/andrews.ms"
+while [ "$i" -lt "$repeat" ]; do
+    "$mechc" sim "$root/examples/andrews.mech" --t1 0.03 --steps 1 --rtol 1e-8 --atol 1e-8 \
+        --stats --csv "$tmp/andrews.csv" 2> "$tmp/andrews.err" || { cat "$tmp/andrews.err" >&2; exit 1; }
+    cpu_ms "$tmp/andrews.err" >> "$tmp/andrews.ms"
+    i=$((i + 1))
+done
+sort -g "$tmp/andrews.ms" | awk '{ v[NR] = $1 } END {
+    printf "integration CPU: best %.3f ms, median %.3f ms of %d runs (target: under 20 ms)\n",
+           v[1], v[int((NR + 1) / 2)], NR }'
+awk -F, 'NR == 3 { d = ($2 - 15.81077119629904) / 15.81077119629904; if (d < 0) d = -d
+                   printf "beta(0.03) = %s, relative error against the Test Set %.2g\n", $2, d }' \
+    "$tmp/andrews.csv"
+grep 'integrator steps' "$tmp/andrews.err" | sed 's/^mechc sim: stats: /  /'
+
+echo
+echo "== IFToMM A02, N = $a02_n, ${a02_t1} s (jit, rk8pd, --rtol 1e-7 --atol 1e-7)"
+sh "$root/examples/a02_four_bar.sh" "$a02_n" "$tmp/a02.mech"
+steps=$(awk -v t="$a02_t1" 'BEGIN { s = int(t * 20 + 0.5); print s < 1 ? 1 : s }')
+"$mechc" sim "$tmp/a02.mech" --t1 "$a02_t1" --steps "$steps" --rtol 1e-7 --atol 1e-7 \
+    --qd "$(sh "$root/examples/a02_four_bar.sh" --qd "$a02_n")" --stats --csv "$tmp/a02.csv" \
+    2> "$tmp/a02.err" || { tail -3 "$tmp/a02.err" >&2; exit 1; }
+printf 'integration CPU: %s ms (target: under 100 ms for 20 s at N = 40)\n' "$(cpu_ms "$tmp/a02.err")"
+grep 'integrator steps\|dependent row' "$tmp/a02.err" | sed 's/^mechc sim: stats: /  /'
+awk -F, -v n="$a02_n" '
+    BEGIN { pi = atan2(0, -1); ii = (n + 1) / 3 + n; k = 9.81 * ((n + 1) / 2 + n)
+            th = pi / 2; w = -1; tt = 0; h = 1e-4 }
+    function acc(a) { return -k * cos(a) / ii }
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    {
+        while (tt < $1 - 1e-12) {
+            hh = ($1 - tt < h) ? $1 - tt : h
+            k1 = w; l1 = acc(th); k2 = w + hh / 2 * l1; l2 = acc(th + hh / 2 * k1)
+            k3 = w + hh / 2 * l2; l3 = acc(th + hh / 2 * k2); k4 = w + hh * l3; l4 = acc(th + hh * k3)
+            th += hh / 6 * (k1 + 2 * k2 + 2 * k3 + k4); w += hh / 6 * (l1 + 2 * l2 + 2 * l3 + l4); tt += hh
+        }
+        e[1] = $(c["B0.x"]) - cos(th); e[2] = $(c["B0.y"]) - sin(th)
+        e[3] = $(c["d(B0.x)"]) + sin(th) * w; e[4] = $(c["d(B0.y)"]) - cos(th) * w
+        for (j = 1; j <= 4; j++) { d = e[j] < 0 ? -e[j] : e[j]; if (d > worst) worst = d }
+        en = 0
+        for (i = 0; i <= n; i++) en += body("rod" i)
+        for (i = 0; i < n; i++) en += body("cpl" i)
+        d = en - (ii / 2 + k); if (d < 0) d = -d; if (d > we) we = d
+    }
+    function body(b) {
+        return 0.5 * ($(c["d(" b ".x)"])^2 + $(c["d(" b ".y)"])^2) + 0.5 / 12 * $(c["d(" b ".phi)"])^2 \
+               + 9.81 * $(c[b ".y"])
+    }
+    END { printf "B0 against the exact solution: largest error %.3g over %d states (benchmark: 1e-3)\n", worst, NR - 1
+          printf "energy: largest |E - E0| %.3g J of E0 = %.12g J\n", we, ii / 2 + k }' "$tmp/a02.csv"
+
+echo
+echo "== dynamics kernels per call (mechc bench; target: generated / generic >= 3x jit, 5x aot)"
+for f in "$root/examples/andrews.mech" "$root/examples/double_pendulum.mech" "$tmp/a02.mech"; do
+    "$mechc" bench "$f" --repeat "$repeat" > "$tmp/bench.txt" 2> "$tmp/bench.err" \
+        || { cat "$tmp/bench.err" >&2; exit 1; }
+    sed -n '1p' "$tmp/bench.txt"
+    awk 'NR == 3 || /^(mass|force|m\+q|eom) / { print "  " $0 }' "$tmp/bench.txt"
+done

@@ -1,0 +1,303 @@
+#!/bin/sh
+# tests/sim_cli.sh MECHC - `mechc sim` from the outside, against references no one here wrote.
+#
+#   sh tests/sim_cli.sh build/mechc
+#
+# Andrews' squeezer against the Test Set for IVP Solvers (angles, rates,
+# consistent accelerations and multipliers); IFToMM benchmarks A01 (simple
+# pendulum, 2000 s) and A02 (N four-bar, through its singular positions)
+# against the exact solutions of their published definitions (the
+# benchmark's own data files were not available); the free double
+# pendulum's energy; a stiff spring's closed form with the implicit
+# methods; the engines agreeing; a redundant parallelogram with masses
+# through its flat positions; exit statuses and messages of bad use.
+# The last line is "sim_cli: N passed, M failed".
+set -u
+# shellcheck source=tests/lib.sh
+. "$(dirname "$0")/lib.sh"
+suite_begin sim_cli "${1:-build/mechc}"
+
+# run ARGS...: mechc sim ARGS (tests/lib.sh).
+run() { run_mechc sim "$@"; }
+
+# value_at T NAME FILE: column NAME of the CSV row whose t is T.
+value_at() {
+    awk -F, -v t="$1" -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
+                                    $1 == t && c { print $c }' "$3"
+}
+
+# close_rel A B TOL: |A - B| <= TOL |B| (A not empty); says the error on stderr when not.
+close_rel() {
+    awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN {
+        d = a - b; if (d < 0) d = -d; s = b < 0 ? -b : b
+        ok = a != "" && d <= tol * s
+        if (!ok) printf "  got %s, want %s (relative error %.3g > %s)\n", a, b, s ? d / s : d, tol > "/dev/stderr"
+        exit !ok }'
+}
+
+# close_abs A B TOL: |A - B| <= TOL.
+close_abs() {
+    awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN {
+        d = a - b; if (d < 0) d = -d
+        ok = a != "" && d <= tol
+        if (!ok) printf "  got %s, want %s (error %.3g > %s)\n", a, b, d, tol > "/dev/stderr"
+        exit !ok }'
+}
+
+# energy_drift_ratio: the relative drift `--stats` printed in $tmp/err.
+energy_drift_ratio() {
+    sed -n 's/.*energy balance T - W drifted by [^ ]* (\([^ ]*\) of the.*/\1/p' "$tmp/err"
+}
+
+# ---- Andrews' squeezing mechanism (Test Set for IVP Solvers, `andrews`) ----
+# Reference at t = 0.03 (andrews.f, subroutine solut); the Test Set's own
+# values are good to about 1e-10 relative in the angles and 3e-8 in the
+# rates, so: angles 1e-7, rates 1e-6 relative.
+run "$ex/andrews.mech" --t1 0.03 --steps 1 --rtol 1e-8 --atol 1e-8 --csv "$tmp/andrews.csv" --stats
+check "andrews: exit 0" status_is 0
+for pair in beta:0.1581077119629904e+2 Theta:-0.1575637105984298e+2 \
+            gamma:0.4082224013073101e-1 Phi:-0.5347301163226948e+0 \
+            delta:0.5244099658805304e+0 Omega:0.5347301163226948e+0 \
+            epsilon:0.1048080741042263e+1; do
+    name=${pair%%:*}
+    check "andrews: $name(0.03) = Test Set to 1e-7" \
+        close_rel "$(value_at 0.03 "$name" "$tmp/andrews.csv")" "${pair#*:}" 1e-7
+done
+for pair in beta:0.1139920302151208e+4 Theta:-0.1424379294994111e+4 \
+            gamma:0.1103291221937134e+2 Phi:0.1929337464421385e+2 \
+            delta:0.5735699284790808e+0 Omega:-0.1929337464421385e+2 \
+            epsilon:0.3231791658026955e+0; do
+    name=${pair%%:*}
+    check "andrews: d($name)(0.03) = Test Set to 1e-6" \
+        close_rel "$(value_at 0.03 "d($name)" "$tmp/andrews.csv")" "${pair#*:}" 1e-6
+done
+# E = T + V - mom beta is conserved: the energy balance's drift
+check "andrews: energy balance within 1e-8" \
+    close_abs "$(energy_drift_ratio)" 0 1e-8
+# the consistent initial accelerations and multipliers (andrews.f, init)
+check "andrews: dd(beta)(0) = Test Set" \
+    close_rel "$(value_at 0 "dd(beta)" "$tmp/andrews.csv")" 14222.4439199541138705911625887 1e-10
+check "andrews: dd(Theta)(0) = Test Set" \
+    close_rel "$(value_at 0 "dd(Theta)" "$tmp/andrews.csv")" -10666.8329399655854029433719415 1e-10
+for name in gamma Phi delta Omega epsilon; do
+    check "andrews: dd($name)(0) = 0" close_abs "$(value_at 0 "dd($name)" "$tmp/andrews.csv")" 0 1e-8
+done
+run "$ex/andrews.mech" --t1 0.03 --steps 1 --rtol 1e-8 --atol 1e-8 --json
+check "andrews --json: exit 0" status_is 0
+check "andrews --json: the rows in the Test Set's order" \
+    out_has '"rows": ["EB_x", "EB_y", "EA1_x", "EA1_y", "EA2_x", "EA2_y"]'
+# the first "lambda" row: t = 0
+sed -n 's/^ "lambda": \[\[\(.*\)\],$/\1/p' "$tmp/out" | tr -d ' ' | tr ',' '\n' > "$tmp/lambda0"
+check "andrews: six multipliers at t = 0" test "$(wc -l < "$tmp/lambda0")" = 6
+check "andrews: lambda1(0) = Test Set" \
+    close_rel "$(sed -n 1p "$tmp/lambda0")" 98.5668703962410896057654982170 1e-10
+check "andrews: lambda2(0) = Test Set" \
+    close_rel "$(sed -n 2p "$tmp/lambda0")" -6.12268834425566265503114393122 1e-10
+for i in 3 4 5 6; do
+    check "andrews: lambda$i(0) = 0" close_abs "$(sed -n ${i}p "$tmp/lambda0")" 0 1e-10
+done
+
+# ---- IFToMM A01, simple pendulum: 2000 s, 4000 output steps ----------------
+# exact solution (Jacobi elliptic; examples/a01_pendulum.mech)
+run "$ex/a01_pendulum.mech" --t1 2000 --steps 4000 --csv "$tmp/a01.csv"
+check "a01: exit 0" status_is 0
+check "a01: 4001 states" test "$(wc -l < "$tmp/a01.csv")" = 4002
+for row in "1 -0.9862917511318753 -0.1650108531255412 1e-8" \
+           "10 0.2750874625761169 -0.9614192050991251 1e-8" \
+           "20 -0.9969071739909918 -0.07858808080933375 1e-7" \
+           "2000 -0.8146030685890322 -0.5800188278369355 1e-3"; do
+    set -- $row
+    check "a01: P1 at t = $1 within $4" \
+        sh -c 'awk -v x="$1" -v y="$2" -v x0="$3" -v y0="$4" -v tol="$5" "BEGIN {
+            dx = x - x0; dy = y - y0; if (dx < 0) dx = -dx; if (dy < 0) dy = -dy
+            if (dx > tol || dy > tol) printf \"  error %.3g, %.3g\\n\", dx, dy > \"/dev/stderr\"
+            exit !(x != \"\" && dx <= tol && dy <= tol) }"' - \
+        "$(value_at "$1" P1.x "$tmp/a01.csv")" "$(value_at "$1" P1.y "$tmp/a01.csv")" "$2" "$3" "$4"
+done
+# the rod keeps its length and the energy (zero at the pivot) stays 0
+check "a01: |P1| = 1 and E = 0 throughout" awk -F, '
+    NR > 1 { r = sqrt($2 * $2 + $3 * $3) - 1; e = 0.5 * ($4 * $4 + $5 * $5) + 9.81 * $3
+             if (r < 0) r = -r; if (e < 0) e = -e
+             if (r > wr) wr = r; if (e > we) we = e }
+    END { exit !(NR == 4002 && wr < 1e-12 && we < 1e-5) }' "$tmp/a01.csv"
+
+# ---- IFToMM A02, N four-bar (examples/a02_four_bar.sh) ----------------------
+# N = 4 over the benchmark's 20 s (about 20 flat positions, where the
+# Jacobian loses 4 ranks), against the one-angle equation of the
+# parallelogram branch I th'' = -K cos th (RK4, h = 1e-4, in awk): B0's
+# position and velocity within the benchmark's 1e-3 (we see 3e-8); every
+# rod keeps rod0's angle and every coupler stays level (the branch); the
+# energy stays I/2 + K. (N = 40: bench/dynamics.sh; 6 s of CPU a second.)
+sh "$ex/a02_four_bar.sh" 4 "$tmp/a02_4.mech"
+run "$tmp/a02_4.mech" --t1 20 --steps 400 --rtol 1e-7 --atol 1e-7 \
+    --qd "$(sh "$ex/a02_four_bar.sh" --qd 4)" --csv "$tmp/a02.csv" --stats
+check "a02 N = 4: exit 0" status_is 0
+check "a02 N = 4: came to singular positions (pivot ratio of Phi_q below 1e-3)" awk -v r="$(
+    sed -n 's/.*smallest pivot ratio of Phi_q \([^ ]*\) .*/\1/p' "$tmp/err")" 'BEGIN { exit !(r != "" && r < 1e-3) }'
+a02_exact() {
+    awk -F, -v n=4 '
+    BEGIN { pi = atan2(0, -1); ii = (n + 1) / 3 + n; k = 9.81 * ((n + 1) / 2 + n)
+            th = pi / 2; w = -1; tt = 0; h = 1e-4 }
+    function acc(a) { return -k * cos(a) / ii }
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    {
+        while (tt < $1 - 1e-12) {
+            hh = ($1 - tt < h) ? $1 - tt : h
+            k1 = w; l1 = acc(th); k2 = w + hh / 2 * l1; l2 = acc(th + hh / 2 * k1)
+            k3 = w + hh / 2 * l2; l3 = acc(th + hh / 2 * k2); k4 = w + hh * l3; l4 = acc(th + hh * k3)
+            th += hh / 6 * (k1 + 2 * k2 + 2 * k3 + k4); w += hh / 6 * (l1 + 2 * l2 + 2 * l3 + l4); tt += hh
+        }
+        e[1] = $(c["B0.x"]) - cos(th); e[2] = $(c["B0.y"]) - sin(th)
+        e[3] = $(c["d(B0.x)"]) + sin(th) * w; e[4] = $(c["d(B0.y)"]) - cos(th) * w
+        for (j = 1; j <= 4; j++) { d = e[j] < 0 ? -e[j] : e[j]; if (d > worst) worst = d }
+    }
+    END { printf "  a02: largest error of B0 %.3g\n", worst > "/dev/stderr"; exit !(NR == 402 && worst <= 1e-3) }' "$tmp/a02.csv"
+}
+check "a02 N = 4: B0 and its velocity = the exact solution within 1e-3, 20 s" a02_exact
+check "a02 N = 4: on the parallelogram branch throughout, energy I/2 + K" awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    { p = $(c["rod0.phi"]); e = 0
+      for (i = 0; i <= 4; i++) { d = $(c["rod" i ".phi"]) - p; if (d < 0) d = -d; if (d > wb) wb = d }
+      for (i = 0; i < 4; i++) { d = $(c["cpl" i ".phi"]); if (d < 0) d = -d; if (d > wb) wb = d }
+      split("rod0 rod1 rod2 rod3 rod4 cpl0 cpl1 cpl2 cpl3", b, " ")
+      for (j = 1; j <= 9; j++)
+          e += 0.5 * ($(c["d(" b[j] ".x)"])^2 + $(c["d(" b[j] ".y)"])^2) \
+               + 0.5 / 12 * $(c["d(" b[j] ".phi)"])^2 + 9.81 * $(c[b[j] ".y"])
+      d = e - (5 / 3 + 4) / 2 - 9.81 * (2.5 + 4); if (d < 0) d = -d; if (d > we) we = d }
+    END { exit !(NR == 402 && wb < 1e-6 && we < 1e-5) }' "$tmp/a02.csv"
+
+# ---- the free double pendulum: energy over 10 s ----------------------------
+run "$ex/double_pendulum.mech" --t1 10 --steps 1000 --csv "$tmp/dp.csv" --stats
+check "double pendulum: exit 0" status_is 0
+check "double pendulum: E from the states within 1e-8 of E0 = 0 over 10 s" awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    { e = 0
+      for (j = 1; j <= 2; j++) { b = "rod" j
+          e += 0.5 * ($(c["d(" b ".x)"])^2 + $(c["d(" b ".y)"])^2) + 0.5 / 12 * $(c["d(" b ".phi)"])^2 \
+               + 9.81 * $(c[b ".y"]) }
+      if (e < 0) e = -e; if (e > w) w = e }
+    END { printf "  double pendulum: max |E - E0| %.3g\n", w > "/dev/stderr"; exit !(NR == 1002 && w <= 1e-8) }' "$tmp/dp.csv"
+check "double pendulum: --stats energy balance within 1e-8" close_abs "$(energy_drift_ratio)" 0 1e-8
+# th = phi + pi/2 at t = 1 (the example's header; RK4 and mpmath agree to 1e-12)
+check "double pendulum: th1(1)" close_abs "$(value_at 1 rod1.phi "$tmp/dp.csv")" \
+    -2.7785125649854966 1e-9
+check "double pendulum: th2(1)" close_abs "$(value_at 1 rod2.phi "$tmp/dp.csv")" \
+    -2.3851873498861966 1e-9
+check "double pendulum: th1'(1)" close_abs "$(value_at 1 "d(rod1.phi)" "$tmp/dp.csv")" \
+    -3.406517532972 1e-8
+check "double pendulum: th2'(1)" close_abs "$(value_at 1 "d(rod2.phi)" "$tmp/dp.csv")" \
+    -0.51604547210521 1e-8
+
+# ---- engines agree ---------------------------------------------------------
+for e in jit generic aot; do
+    run "$ex/double_pendulum.mech" --t1 2 --steps 4 --engine "$e" --csv "$tmp/dp_$e.csv"
+    if [ "$e" = aot ] && ! status_is 0 && err_has "compiler"; then
+        skip "no C compiler: aot engine"
+        cp "$tmp/dp_jit.csv" "$tmp/dp_aot.csv"
+        continue
+    fi
+    check "double pendulum --engine $e: exit 0" status_is 0
+done
+engines_agree() {
+    paste -d, "$tmp/dp_jit.csv" "$tmp/dp_$1.csv" | awk -F, '
+        NR > 1 { n = NF / 2; for (i = 1; i <= n; i++) { d = $i - $(i + n); if (d < 0) d = -d; if (d > w) w = d } }
+        END { exit !(NR == 6 && w <= 1e-9) }'
+}
+check "jit and generic: the same states to 1e-9" engines_agree generic
+check "jit and aot: the same states to 1e-9" engines_agree aot
+
+# ---- a stiff spring: the implicit methods against the closed form ----------
+# x = 0.25 + 0.05 cos(1000 t) (k = 1e6, m = 1)
+cat > "$tmp/stiff.mech" <<'EOF'
+body s x = 0.3
+prismatic P: ground(0, 0) s(0, 0) axis(1, 0)
+mass s m = 1 J = 0.01
+spring K: ground(0, 0) s k = 1e6 length = 0.25
+EOF
+for mt in rk8pd:1e-9 rk4imp:1e-8 msbdf:1e-7; do
+    m=${mt%%:*}
+    run "$tmp/stiff.mech" --t1 0.01 --steps 10 --method "$m" --csv "$tmp/stiff_$m.csv"
+    check "stiff spring --method $m: exit 0" status_is 0
+    check "stiff spring --method $m: the closed form within ${mt#*:}" awk -F, -v tol="${mt#*:}" '
+        NR > 1 { d = $2 - (0.25 + 0.05 * cos(1000 * $1)); if (d < 0) d = -d; if (d > w) w = d }
+        END { exit !(NR == 12 && w <= tol) }' "$tmp/stiff_$m.csv"
+done
+check "stiff spring: msbdf and rk4imp end where rk8pd does (1e-7)" close_abs \
+    "$(value_at 0.01 s.x "$tmp/stiff_msbdf.csv")" "$(value_at 0.01 s.x "$tmp/stiff_rk8pd.csv")" 1e-7
+check "stiff spring: rk4imp ends where rk8pd does (1e-8)" close_abs \
+    "$(value_at 0.01 s.x "$tmp/stiff_rk4imp.csv")" "$(value_at 0.01 s.x "$tmp/stiff_rk8pd.csv")" 1e-8
+
+# ---- redundant rows and flat positions: parallelogram_redundant with masses --
+# Released from pi/3 under gravity it swings through the two flat positions
+# (phi = 0 and -pi: the rank drops) and back; the cranks keep one angle,
+# the coupler stays level, and the energy is conserved.
+{ grep -v '^#' "$ex/parallelogram_redundant.mech"
+  printf 'gravity (0, -9.81)\nmass c1 m = 1 J = 1/12\nmass c2 m = 1 J = 1/12\n'
+  printf 'mass c3 m = 1 J = 1/12\nmass coupler m = 2 J = 2*4/12\n'; } > "$tmp/pr.mech"
+run "$tmp/pr.mech" --t1 3 --steps 300 --csv "$tmp/pr.csv" --stats
+check "parallelogram with masses: exit 0" status_is 0
+check "parallelogram with masses: a redundant row found" err_matches 'up to [12] dependent row'
+check "parallelogram with masses: energy balance within 1e-9" close_abs "$(energy_drift_ratio)" 0 1e-9
+check "parallelogram with masses: passes phi = 0 and -pi on its branch, energy kept" awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    { p = $(c["c1.phi"]); if (p < lo) lo = p; if (p > hi) hi = p
+      for (k = 2; k <= 3; k++) { d = $(c["c" k ".phi"]) - p; if (d < 0) d = -d; if (d > wb) wb = d }
+      d = $(c["coupler.phi"]); if (d < 0) d = -d; if (d > wb) wb = d
+      e = 0
+      split("c1 c2 c3 coupler", b, " ")
+      for (j = 1; j <= 4; j++) { m = j == 4 ? 2 : 1
+          e += 0.5 * m * ($(c["d(" b[j] ".x)"])^2 + $(c["d(" b[j] ".y)"])^2) \
+               + 0.5 * m * (j == 4 ? 4 : 1) / 12 * $(c["d(" b[j] ".phi)"])^2 + 9.81 * m * $(c[b[j] ".y"]) }
+      if (NR == 2) e0 = e
+      d = e - e0; if (d < 0) d = -d; if (d > we) we = d }
+    END { pi = atan2(0, -1); exit !(NR == 302 && lo < -pi && hi > 1 && wb < 1e-8 && we < 1e-7) }' "$tmp/pr.csv"
+
+# ---- CSV and JSON shapes ---------------------------------------------------
+run_mechc run "$ex/slider_crank_dynamics.mech" --steps 2 --csv "$tmp/run.csv"
+check "slider_crank_dynamics: run exit 0" status_is 0
+run "$ex/slider_crank_dynamics.mech" --t1 0.1 --steps 2 --csv "$tmp/sim.csv"
+check "slider_crank_dynamics: sim exit 0" status_is 0
+check "sim's CSV header is run's for the same file" \
+    test "$(head -1 "$tmp/run.csv")" = "$(head -1 "$tmp/sim.csv")"
+check "sim: steps + 1 CSV rows" test "$(wc -l < "$tmp/sim.csv")" = 4
+run "$ex/slider_crank_dynamics.mech" --t1 0.1 --steps 2 --json
+check "sim --json: exit 0" status_is 0
+for key in '"coords": [' '"t": [0, 0.05, 0.1]' '"q": [[' '"qd": [[' '"qdd": [[' '"ok": true' \
+           '"rows": ["O.x", "O.y"' '"lambda": [['; do
+    check "sim --json has $key" out_has "$key"
+done
+
+# ---- bad use -----------------------------------------------------------------
+run "$ex/four_bar.mech" --t1 1
+check "no masses: exit 2" status_is 2
+check "no masses: says so" err_has "the mechanism has no masses"
+check "no masses: FILE:LINE:COL" err_matches 'four_bar.mech:[0-9]*:[0-9]*: error:'
+check "no masses: with the caret" err_matches '^ *\^$'
+run "$ex/double_pendulum.mech" --qd 1,2,3
+check "--qd with 3 values for 6 coordinates: exit 2" status_is 2
+run "$ex/double_pendulum.mech" --baumgarte 5
+check "--baumgarte 5 (not A,B): exit 2" status_is 2
+run "$ex/double_pendulum.mech" --baumgarte 5,x
+check "--baumgarte 5,x: exit 2" status_is 2
+run "$ex/double_pendulum.mech" --t0 1 --t1 1
+check "--t0 = --t1: exit 2" status_is 2
+check "--t0 = --t1: says so" err_has "nothing to simulate"
+run "$ex/double_pendulum.mech" --rtol 0 --atol 0
+check "both tolerances 0: exit 2" status_is 2
+run "$ex/double_pendulum.mech" --trace 'rod2(0.5, 0)'
+check "--trace without --svg: exit 2" status_is 2
+check "--trace without --svg: says so" err_has "--trace goes with --svg"
+run "$ex/double_pendulum.mech" --method euler
+check "--method euler: exit 2" status_is 2
+cat > "$tmp/free.mech" <<'EOF'
+body rod phi = -pi/3
+revolute O: ground rod
+mass rod m = 2 J = 2/12 com(0.5, 0)
+coord z = 0
+gravity (0, -9.81)
+EOF
+run "$tmp/free.mech" --t1 1
+check "a massless free coordinate: exit 1" status_is 1
+check "a massless free coordinate: t = 0 and singular" err_matches 't = 0: .*singular'
+
+suite_end
