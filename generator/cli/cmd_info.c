@@ -510,16 +510,17 @@ static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at
     *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
     if (at->follow && m->nv > 0) {
         fprintf(stderr, "mechc info: error: --at follows the holonomic rows only, and %s has "
-                "velocity-level rows, whose positions run integrates: write the state with "
-                "`mechc run FILE --at T --csv STATE.csv` and give it with --state STATE.csv\n",
+                "velocity-level rows, whose positions run integrates: write the motion with "
+                "`mechc run FILE --t1 T --csv STATE.csv` and give it with "
+                "--state STATE.csv --at T\n",
                 m->name);
         return false;
     }
     if (!c->state)
         return true;
-    char err[300];
-    if (!state_csv_read(c->state, m, c->at, q, t, err, sizeof err)) {
-        fprintf(stderr, "mechc info: error: %s: %s\n", c->state, err);
+    Diag diag;
+    if (!state_csv_read(c->state, m, c->at, q, t, &diag)) {
+        diag_print(&diag, stderr);
         return false;
     }
     at->q = q;
