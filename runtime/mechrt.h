@@ -143,6 +143,7 @@ typedef enum MechrtStatus {
 #define mechrt_lu_solve_t            mechrtf_lu_solve_t
 #define mechrt_lu_cond1              mechrtf_lu_cond1
 #define mechrt_newton_init           mechrtf_newton_init
+#define mechrt_residual_inf          mechrtf_residual_inf
 #define mechrt_newton_iterate        mechrtf_newton_iterate
 #define mechrt_newton_test           mechrtf_newton_test
 #define mechrt_newton_run            mechrtf_newton_run
@@ -360,6 +361,12 @@ mechrt_real mechrt_lu_cond1(int n, const mechrt_real *lu, int lda, const mechrt_
    Square case only: the nh holonomic rows must number nq (velocity-level
    rows are ignored); otherwise MECHRT_ENOTSQUARE, and the host does
    minimum-norm Newton. opts may be NULL for defaults; report may be NULL. */
+
+/* max |phi[i]| over the nh values into *residual, its row into *worst_row
+   (-1 when nh is 0); MECHRT_ENOTFINITE at the first NaN or infinity (then
+   *residual is it). The residual scan every Newton-type solver shares. */
+MechrtStatus mechrt_residual_inf(const mechrt_real *phi, int nh, mechrt_real *residual,
+                                 int *worst_row);
 
 /* Binds the state to q (updated in place) and the workspace; evaluates Phi
    and Phi_q at q. */
