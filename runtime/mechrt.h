@@ -528,7 +528,9 @@ MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions
 
 /* |x| in one instruction where the compiler has a builtin for it
    (MECHRT_FABS is a compare and a branch, as -0 must stay -0 there); for
-   the pattern LU's comparisons, which treat -0 and +0 alike. */
+   the pattern LU's and the residual scan's comparisons, which treat -0
+   and +0 alike. Not a setting: this part is read once per real type and
+   each defines it for its own, so a definition made before is replaced. */
 #undef MECHRT_LUP_ABS
 #if defined(__GNUC__) && defined(MECHRT_REAL_FLOAT)
 #define MECHRT_LUP_ABS(x) __builtin_fabsf(x)
