@@ -24,35 +24,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-static char cache_dir[256];
-static bool have_cc;
+static TestCache cache;
 
 static int setup(void **state)
 {
     (void)state;
-    if (!testcache_make(cache_dir, sizeof cache_dir, "dynamics"))
-        return -1;
-    have_cc = aot_compiler_available();
-    return 0;
+    return testcache_setup(&cache, "dynamics");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    testcache_remove(cache_dir, 2);
-    return 0;
-}
-
-static Mech *load_example(const char *name)
-{
-    const char *dir = getenv("MECHC_EXAMPLES");
-    char path[600];
-    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
-    return load_file(path);
+    return testcache_teardown(&cache);
 }
 
 /* The engines a test runs: jit, generic, and aot with a compiler. */
-static int engine_count(void) { return have_cc ? ENGINE_KIND_COUNT : 2; }
+static int engine_count(void) { return cache.have_cc ? ENGINE_KIND_COUNT : 2; }
 
 static void open_engine(Engine *e, EngineKind kind, const Mech *mech)
 {
