@@ -67,11 +67,34 @@ static void assert_matrix(const char *what, const double *got, const double *wan
             fail_msg("%s[%d] = %.17g, expected %.17g", what, i, got[i], want[i]);
 }
 
+/* M and Q of a 3-coordinate file, written by hand. */
+typedef void ClosedForm(const double *q, const double *qd, double t, double *M, double *Q);
+
+/* Every engine's M and Q at 25 random states against the closed form. */
+static void assert_closed_form(const Mech *mech, uint64_t rng, ClosedForm *closed)
+{
+    for (int k = 0; k < engine_count(); k++) {
+        Engine e;
+        open_engine(&e, (EngineKind)k, mech);
+        for (int s = 0; s < 25; s++) {
+            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
+            random_state(&rng, 3, NULL, q, qd, &t);
+            e.k.mass(e.k.ctx, q, M);
+            e.k.force(e.k.ctx, q, qd, t, Q);
+            closed(q, qd, t, Mw, Qw);
+            assert_matrix(engine_names[k], M, Mw, 9);
+            assert_matrix(engine_names[k], Q, Qw, 3);
+        }
+        engine_close(&e);
+    }
+}
+
 /* ---- the compound pendulum: one body, centre of mass at (a, 0) ---- */
 
 /* pendulum_dynamics.mech's closed forms (its header): L = 1, m = 2, g = 9.81. */
-static void pendulum_closed(const double *q, const double *qd, double *M, double *Q)
+static void pendulum_closed(const double *q, const double *qd, double t, double *M, double *Q)
 {
+    (void)t;
     const double L = 1, m = 2, g = 9.81, a = L / 2, J = m * L * L / 12;
     double s = sin(q[2]), c = cos(q[2]), w = qd[2];
     double Mw[9] = {m, 0, -m * a * s, 0, m, m * a * c, -m * a * s, m * a * c, J + m * a * a};
@@ -86,21 +109,7 @@ static void test_compound_pendulum(void **state)
     Mech *mech = load_example("pendulum_dynamics.mech");
     assert_int_equal(mech->model->nmasses, 1);
     assert_true(mech->kin.dyn.present);
-    uint64_t rng = 7;
-    for (int k = 0; k < engine_count(); k++) {
-        Engine e;
-        open_engine(&e, (EngineKind)k, mech);
-        for (int s = 0; s < 25; s++) {
-            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
-            random_state(&rng, 3, NULL, q, qd, &t);
-            e.k.mass(e.k.ctx, q, M);
-            e.k.force(e.k.ctx, q, qd, t, Q);
-            pendulum_closed(q, qd, Mw, Qw);
-            assert_matrix(engine_names[k], M, Mw, 9);
-            assert_matrix(engine_names[k], Q, Qw, 3);
-        }
-        engine_close(&e);
-    }
+    assert_closed_form(mech, 7, pendulum_closed);
     pipeline_free(mech);
 }
 
@@ -140,21 +149,7 @@ static void test_double_pendulum(void **state)
     Mech *mech = load_text(double_pendulum, "double_pendulum.mech");
     assert_int_equal(mech->model->nmasses, 2);
     assert_int_equal(mech->model->nforces, 2);
-    uint64_t rng = 11;
-    for (int k = 0; k < engine_count(); k++) {
-        Engine e;
-        open_engine(&e, (EngineKind)k, mech);
-        for (int s = 0; s < 25; s++) {
-            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
-            random_state(&rng, 3, NULL, q, qd, &t);
-            e.k.mass(e.k.ctx, q, M);
-            e.k.force(e.k.ctx, q, qd, t, Q);
-            double_closed(q, qd, t, Mw, Qw);
-            assert_matrix(engine_names[k], M, Mw, 9);
-            assert_matrix(engine_names[k], Q, Qw, 3);
-        }
-        engine_close(&e);
-    }
+    assert_closed_form(mech, 11, double_closed);
     pipeline_free(mech);
 }
 
