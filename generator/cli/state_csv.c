@@ -67,7 +67,7 @@ static bool map_header(char *line, const Model *m, int *col, int *tcol, Diag *di
 static bool parse_row(char *line, int offset, double *v, int ncols, const bool *used, Diag *diag)
 {
     char *start = line, *f;
-    int k = 0;
+    int k = 0, end_col = (int)strlen(line);     /* before next_field cuts it */
     while ((f = next_field(&line)) != NULL) {
         SrcPos pos = {offset + (int)(f - start)};
         if (k == ncols) {
@@ -87,7 +87,7 @@ static bool parse_row(char *line, int offset, double *v, int ncols, const bool *
         k++;
     }
     if (k < ncols) {
-        diag_error(diag, (SrcPos){offset + (int)strlen(start)},
+        diag_error(diag, (SrcPos){offset + end_col},
                    "%d fields where the header has %d", k, ncols);
         return false;
     }
