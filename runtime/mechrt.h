@@ -143,6 +143,7 @@ typedef enum MechrtStatus {
 #define mechrt_lu_solve_t            mechrtf_lu_solve_t
 #define mechrt_lu_cond1              mechrtf_lu_cond1
 #define mechrt_newton_init           mechrtf_newton_init
+#define mechrt_residual_inf          mechrtf_residual_inf
 #define mechrt_newton_iterate        mechrtf_newton_iterate
 #define mechrt_newton_test           mechrtf_newton_test
 #define mechrt_newton_run            mechrtf_newton_run
@@ -361,6 +362,12 @@ mechrt_real mechrt_lu_cond1(int n, const mechrt_real *lu, int lda, const mechrt_
    rows are ignored); otherwise MECHRT_ENOTSQUARE, and the host does
    minimum-norm Newton. opts may be NULL for defaults; report may be NULL. */
 
+/* max |phi[i]| over the nh values into *residual, its row into *worst_row
+   (-1 when nh is 0); MECHRT_ENOTFINITE at the first NaN or infinity (then
+   *residual is it). The residual scan every Newton-type solver shares. */
+MechrtStatus mechrt_residual_inf(const mechrt_real *phi, int nh, mechrt_real *residual,
+                                 int *worst_row);
+
 /* Binds the state to q (updated in place) and the workspace; evaluates Phi
    and Phi_q at q. */
 MechrtStatus mechrt_newton_init(MechrtNewton *s, const MechrtKernels *k,
@@ -521,7 +528,9 @@ MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions
 
 /* |x| in one instruction where the compiler has a builtin for it
    (MECHRT_FABS is a compare and a branch, as -0 must stay -0 there); for
-   the pattern LU's comparisons, which treat -0 and +0 alike. */
+   the pattern LU's and the residual scan's comparisons, which treat -0
+   and +0 alike. Not a setting: this part is read once per real type and
+   each defines it for its own, so a definition made before is replaced. */
 #undef MECHRT_LUP_ABS
 #if defined(__GNUC__) && defined(MECHRT_REAL_FLOAT)
 #define MECHRT_LUP_ABS(x) __builtin_fabsf(x)

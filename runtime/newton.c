@@ -18,14 +18,35 @@
 
 #include "mechrt.h"
 
+MechrtStatus mechrt_residual_inf(const mechrt_real *phi, int nh, mechrt_real *residual,
+                                 int *worst_row)
+{
+    int i;
+
+    *residual = 0;
+    *worst_row = nh > 0 ? 0 : -1;
+    for (i = 0; i < nh; i++) {
+        /* only magnitudes are compared: the one-instruction |x| will do */
+        mechrt_real a = MECHRT_LUP_ABS(phi[i]);
+        if (!isfinite(a)) {
+            *residual = a;
+            *worst_row = i;
+            return MECHRT_ENOTFINITE;
+        }
+        if (a > *residual) {
+            *residual = a;
+            *worst_row = i;
+        }
+    }
+    return MECHRT_OK;
+}
+
 /* Phi and Phi_q at s->q: the `all` kernel when there is one (it shares sin,
    cos and products between them; nu comes for free), else phi then jac.
    Sets the residual norm and the worst row; NaN/Inf in Phi is an error. */
 static MechrtStatus newton_eval(MechrtNewton *s)
 {
     const MechrtKernels *k = s->k;
-    int i;
-
     if (k->all) {
         k->all(k->ctx, s->q, s->qd0, s->t, s->phi, s->jac, s->nu, s->gamma);
         s->have_nu = true;
@@ -34,21 +55,7 @@ static MechrtStatus newton_eval(MechrtNewton *s)
         k->jac(k->ctx, s->q, s->t, s->jac);
         s->have_nu = false;
     }
-    s->residual = 0;
-    s->worst_row = k->nh > 0 ? 0 : -1;
-    for (i = 0; i < k->nh; i++) {
-        mechrt_real a = MECHRT_FABS(s->phi[i]);
-        if (!isfinite(a)) {
-            s->residual = a;
-            s->worst_row = i;
-            return MECHRT_ENOTFINITE;
-        }
-        if (a > s->residual) {
-            s->residual = a;
-            s->worst_row = i;
-        }
-    }
-    return MECHRT_OK;
+    return mechrt_residual_inf(s->phi, k->nh, &s->residual, &s->worst_row);
 }
 
 MechrtStatus mechrt_newton_init(MechrtNewton *s, const MechrtKernels *k,

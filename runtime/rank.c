@@ -60,24 +60,8 @@ static mechrt_real rk_norm(int n, const mechrt_real *v)
 static MechrtStatus rk_phi(const MechrtKernels *k, const mechrt_real *q, mechrt_real t,
                            RankWork *w, MechrtReport *r)
 {
-    int i;
-
     k->phi(k->ctx, q, t, w->phi);
-    r->residual = 0;
-    r->worst_row = 0;
-    for (i = 0; i < k->nh; i++) {
-        mechrt_real a = MECHRT_FABS(w->phi[i]);
-        if (!isfinite(a)) {
-            r->residual = a;
-            r->worst_row = i;
-            return MECHRT_ENOTFINITE;
-        }
-        if (a > r->residual) {
-            r->residual = a;
-            r->worst_row = i;
-        }
-    }
-    return MECHRT_OK;
+    return mechrt_residual_inf(w->phi, k->nh, &r->residual, &r->worst_row);
 }
 
 /* Phi_q at q, factored by rank-revealing QR. */

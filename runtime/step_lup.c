@@ -35,8 +35,6 @@ static MechrtStatus ls_eval(Ls *s)
 {
     const MechrtKernels *k = s->k;
     MechrtReport *r = s->r;
-    int i;
-
     if (s->jnz) {
         k->phi(k->ctx, s->q, s->t, s->phi);
         s->jnz->jac_nz(s->jnz->ctx, s->q, s->t, mechrt_lup_values(s->f));
@@ -49,21 +47,7 @@ static MechrtStatus ls_eval(Ls *s)
         k->jac(k->ctx, s->q, s->t, s->jac);
         s->have_nu = false;
     }
-    r->residual = 0;
-    r->worst_row = k->nh > 0 ? 0 : -1;
-    for (i = 0; i < k->nh; i++) {
-        mechrt_real a = MECHRT_LUP_ABS(s->phi[i]);
-        if (!isfinite(a)) {
-            r->residual = a;
-            r->worst_row = i;
-            return MECHRT_ENOTFINITE;
-        }
-        if (a > r->residual) {
-            r->residual = a;
-            r->worst_row = i;
-        }
-    }
-    return MECHRT_OK;
+    return mechrt_residual_inf(s->phi, k->nh, &r->residual, &r->worst_row);
 }
 
 /* The Jacobian last evaluated, factored; counted in the report. */

@@ -193,7 +193,8 @@ check "A02 --at 0.25: exit 0" status_is 0
 check "A02 --at 0.25: the motion followed from t = 0" out_has "the motion followed from t = 0"
 check "A02 --at 0.25: rank 203 against 243" \
     out_has "rank 203 of the holonomic rows (drivers included) against 243 generically"
-check "A02 --at 0.25: a drop of 40" out_has "(at t = 0 or just before): a drop of 40 (singular values above 3.27e-08 count)"
+check "A02 --at 0.25: a drop of 40 (sparse QR: pivots, not singular values)" \
+    out_has "(at t = 0 or just before): a drop of 40 (sparse QR pivots above 3.27e-08 count)"
 check "A02 --at 0.25: 40 rows became dependent, b0.x first" out_has "rows that became dependent (40): b0.x, b1.x"
 check "A02 --at 0.25: ... and b39.x last" grep -q "dependent (40): .*b38.x, b39.x$" "$tmp/out"
 check "A02 --at 0.25: 40 free directions" out_has "directions the rows leave free (40;"
@@ -223,6 +224,7 @@ check "parallelogram four-bar folded, sparse: the same drop" out_has "rows that 
 run info "$ex/four_bar.mech" --at 0.3
 check "four_bar --at 0.3: a drop of 0" out_has "rank 9 of the holonomic rows (drivers included) against 9"
 check "four_bar --at 0.3: no free direction" out_has "directions the rows leave free: none"
+check "four_bar --at 0.3: dense, so singular values" out_has "a drop of 0 (singular values above"
 # --state: the row run writes, read back
 "$mechc" run "$tmp/pg.mech" --t0 0 --t1 0.2 --steps 8 --csv "$tmp/pg.csv" > /dev/null 2>&1
 "$mechc" run "$ex/four_bar.mech" --at 0.3 --csv "$tmp/fb.csv" > /dev/null 2>&1
@@ -242,13 +244,48 @@ run info "$tmp/pg.mech" --state "$tmp/pg.csv" --at 0.21
 check "--state --at 0.2: no such row, exit 2" status_is 2
 run info "$ex/four_bar.mech" --state "$tmp/nothing.csv"
 check "--state on a missing file: exit 2" status_is 2
+run info "$ex/four_bar.mech" --state "$tmp"
+check "--state on a folder: exit 2" status_is 2
+check "--state on a folder: says why" err_has "$tmp: error: cannot read: Is a directory"
+# a number that is not finite, where it is read: FILE:LINE:COL and a caret
+sed '2s/^[^,]*/inf/' "$tmp/fb.csv" > "$tmp/fb_inf.csv"
+run info "$ex/four_bar.mech" --state "$tmp/fb_inf.csv"
+check "--state with t = inf: exit 2" status_is 2
+check "--state with t = inf: at line 2, column 1" \
+    err_has "fb_inf.csv:2:1: error: field 1 ('inf') is not a finite number"
+check "--state with t = inf: nothing printed" out_empty
+# nan as the third field (the CSV's second coordinate): its byte column
+awk -F, -v OFS=, 'NR == 2 { $3 = "nan" } { print }' "$tmp/fb.csv" > "$tmp/fb_nan.csv"
+col=$(awk -F, 'NR == 2 { print length($1) + length($2) + 3 }' "$tmp/fb_nan.csv")
+name=$(awk -F, 'NR == 1 { print $3 }' "$tmp/fb_nan.csv")
+run info "$ex/four_bar.mech" --state "$tmp/fb_nan.csv"
+check "--state with $name = nan: exit 2" status_is 2
+check "--state with $name = nan: at line 2, column $col" \
+    err_has "fb_nan.csv:2:$col: error: field 3 ('nan') is not a finite number"
+check "--state with $name = nan: the caret under it" \
+    err_matches "^    $(printf "%${col}s" "^")\$"
+# a field short, and a bad number
+sed '2s/,[^,]*$//' "$tmp/fb.csv" > "$tmp/fb_short.csv"
+run info "$ex/four_bar.mech" --state "$tmp/fb_short.csv"
+check "--state with a field short: exit 2" status_is 2
+col=$(awk 'NR == 2 { print length($0) + 1 }' "$tmp/fb_short.csv")
+check "--state with a field short: counts the fields, at the line's end" \
+    err_matches "fb_short.csv:2:$col: error: [0-9]* fields where the header has"
+awk -F, -v OFS=, 'NR == 2 { $2 = "1.5x" } { print }' "$tmp/fb.csv" > "$tmp/fb_bad.csv"
+run info "$ex/four_bar.mech" --state "$tmp/fb_bad.csv"
+check "--state with a bad number: names it" err_matches "fb_bad.csv:2:[0-9]*: error: field 2 ('1.5x') is not a number"
 # velocity-level rows: run integrates the positions, --at does not follow them
 run info "$ex/knife_cart.mech" --at 0.5
 check "--at with velocity-level rows: exit 2" status_is 2
 check "--at with velocity-level rows: points to --state" err_has "give it with --state"
-"$mechc" run "$ex/knife_cart.mech" --at 0.5 --csv "$tmp/knife.csv" > /dev/null 2>&1
-run info "$ex/knife_cart.mech" --state "$tmp/knife.csv"
+# run --at T would put the initial positions at T: the advice integrates to T
+check "--at with velocity-level rows: the advice integrates to T" \
+    err_has "mechc run FILE --t1 T --csv STATE.csv"
+"$mechc" run "$ex/knife_cart.mech" --t1 0.5 --csv "$tmp/knife.csv" > /dev/null 2>&1
+run info "$ex/knife_cart.mech" --state "$tmp/knife.csv" --at 0.5
 check "--state with velocity-level rows: exit 0" status_is 0
+check "--state with velocity-level rows: the integrated state (cart.y = 1, not 0)" \
+    grep -q "^  cart.y  *0  *1$" "$tmp/out"
 check "--state with velocity-level rows: the knife is free in 3 directions" \
     out_has "directions the rows leave free (3;"
 

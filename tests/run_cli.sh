@@ -462,6 +462,7 @@ for f in "$ex"/*.mech; do
     esac
     run "$f" --csv /dev/null
     check "example $name: exit $want" status_is "$want"
+    if [ "$name" = pendulum_dynamics ]; then check "pendulum_dynamics: exit 2 because undriven" err_has "is not driven"; fi
 done
 
 # ---- one instant, outputs, rough guesses (textbook problems) ---------------

@@ -24,35 +24,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-static char cache_dir[256];
-static bool have_cc;
+static TestCache cache;
 
 static int setup(void **state)
 {
     (void)state;
-    if (!testcache_make(cache_dir, sizeof cache_dir, "dynamics"))
-        return -1;
-    have_cc = aot_compiler_available();
-    return 0;
+    return testcache_setup(&cache, "dynamics");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    testcache_remove(cache_dir, 2);
-    return 0;
-}
-
-static Mech *load_example(const char *name)
-{
-    const char *dir = getenv("MECHC_EXAMPLES");
-    char path[600];
-    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
-    return load_file(path);
+    return testcache_teardown(&cache);
 }
 
 /* The engines a test runs: jit, generic, and aot with a compiler. */
-static int engine_count(void) { return have_cc ? ENGINE_KIND_COUNT : 2; }
+static int engine_count(void) { return cache.have_cc ? ENGINE_KIND_COUNT : 2; }
 
 static void open_engine(Engine *e, EngineKind kind, const Mech *mech)
 {
@@ -80,11 +67,34 @@ static void assert_matrix(const char *what, const double *got, const double *wan
             fail_msg("%s[%d] = %.17g, expected %.17g", what, i, got[i], want[i]);
 }
 
+/* M and Q of a 3-coordinate file, written by hand. */
+typedef void ClosedForm(const double *q, const double *qd, double t, double *M, double *Q);
+
+/* Every engine's M and Q at 25 random states against the closed form. */
+static void assert_closed_form(const Mech *mech, uint64_t rng, ClosedForm *closed)
+{
+    for (int k = 0; k < engine_count(); k++) {
+        Engine e;
+        open_engine(&e, (EngineKind)k, mech);
+        for (int s = 0; s < 25; s++) {
+            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
+            random_state(&rng, 3, NULL, q, qd, &t);
+            e.k.mass(e.k.ctx, q, M);
+            e.k.force(e.k.ctx, q, qd, t, Q);
+            closed(q, qd, t, Mw, Qw);
+            assert_matrix(engine_names[k], M, Mw, 9);
+            assert_matrix(engine_names[k], Q, Qw, 3);
+        }
+        engine_close(&e);
+    }
+}
+
 /* ---- the compound pendulum: one body, centre of mass at (a, 0) ---- */
 
 /* pendulum_dynamics.mech's closed forms (its header): L = 1, m = 2, g = 9.81. */
-static void pendulum_closed(const double *q, const double *qd, double *M, double *Q)
+static void pendulum_closed(const double *q, const double *qd, double t, double *M, double *Q)
 {
+    (void)t;
     const double L = 1, m = 2, g = 9.81, a = L / 2, J = m * L * L / 12;
     double s = sin(q[2]), c = cos(q[2]), w = qd[2];
     double Mw[9] = {m, 0, -m * a * s, 0, m, m * a * c, -m * a * s, m * a * c, J + m * a * a};
@@ -99,21 +109,7 @@ static void test_compound_pendulum(void **state)
     Mech *mech = load_example("pendulum_dynamics.mech");
     assert_int_equal(mech->model->nmasses, 1);
     assert_true(mech->kin.dyn.present);
-    uint64_t rng = 7;
-    for (int k = 0; k < engine_count(); k++) {
-        Engine e;
-        open_engine(&e, (EngineKind)k, mech);
-        for (int s = 0; s < 25; s++) {
-            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
-            random_state(&rng, 3, NULL, q, qd, &t);
-            e.k.mass(e.k.ctx, q, M);
-            e.k.force(e.k.ctx, q, qd, t, Q);
-            pendulum_closed(q, qd, Mw, Qw);
-            assert_matrix(engine_names[k], M, Mw, 9);
-            assert_matrix(engine_names[k], Q, Qw, 3);
-        }
-        engine_close(&e);
-    }
+    assert_closed_form(mech, 7, pendulum_closed);
     pipeline_free(mech);
 }
 
@@ -153,21 +149,7 @@ static void test_double_pendulum(void **state)
     Mech *mech = load_text(double_pendulum, "double_pendulum.mech");
     assert_int_equal(mech->model->nmasses, 2);
     assert_int_equal(mech->model->nforces, 2);
-    uint64_t rng = 11;
-    for (int k = 0; k < engine_count(); k++) {
-        Engine e;
-        open_engine(&e, (EngineKind)k, mech);
-        for (int s = 0; s < 25; s++) {
-            double q[3], qd[3], t, M[9], Q[3], Mw[9], Qw[3];
-            random_state(&rng, 3, NULL, q, qd, &t);
-            e.k.mass(e.k.ctx, q, M);
-            e.k.force(e.k.ctx, q, qd, t, Q);
-            double_closed(q, qd, t, Mw, Qw);
-            assert_matrix(engine_names[k], M, Mw, 9);
-            assert_matrix(engine_names[k], Q, Qw, 3);
-        }
-        engine_close(&e);
-    }
+    assert_closed_form(mech, 11, double_closed);
     pipeline_free(mech);
 }
 
@@ -364,6 +346,14 @@ static const BadCase bad_cases[] = {
     {PRE "mass a m = 1\nforce F: q (1, 0)\n", 6, 10, "unknown name 'q'"},
     {PRE "mass a m = 1\nforce F: ground (1, 0)\n", 6, 10, "acts on ground only: it does no work"},
     {PRE "mass a m = 1\nrspring R: a p(1, 0) k = 1\n", 6, 15, "acts on bodies' angles"},
+    {PRE "mass a m = 1\nrspring R: at(1, 2) ground k = 1\n", 6, 12, "at(x, y) is a point; name a body or ground"},
+    {PRE "mass a m = 1\ntorque T: at(1, 2) = 1\n", 6, 11, "at(x, y) is a point; name a body or ground"},
+    {PRE "mass a m = 1\nforce F: at(1, 2) (1, 0)\n", 6, 10, "force 'F' is applied at a fixed point"},
+    {PRE "mass a m = 1\nforce F: at(2 * t, 1) (1, 0)\n", 6, 10, "it does no work"},
+    {PRE "mass a m = 1\ntorque T: angle(t) = 1\n", 6, 17, "torque 'T' acts on an angle that depends on no coordinate"},
+    {PRE "mass a m = 1\nspring S: a a k = 1\n", 6, 13, "spring 'S' joins a point to itself"},
+    {PRE "mass a m = 1\nspring S: p at(p.x, p.y) k = 1\n", 6, 13, "spring 'S' joins a point to itself"},
+    {PRE "mass a m = 1\nspring S: ground at(1, 0) k = 1\n", 6, 11, "spring 'S' joins two fixed points"},
     {PRE "mass a m = 1\ngforce G: a = 1\n", 6, 11, "'a' is a body: write a.x, a.y or a.phi"},
     {PRE "mass a m = 1\ngravity (0, -9.81)\ngravity (0, 1)\n", 7, 1, "a second gravity statement"},
     {PRE "gravity (0, -9.81)\n", 5, 1, "gravity without masses"},

@@ -10,6 +10,7 @@
  */
 #include "testutil.h"
 #include "testcache.h"
+#include "testload.h"
 #include "testout.h"
 
 #include "../generator/base/arena.h"
@@ -21,36 +22,18 @@
 #include <string.h>
 #include <unistd.h>
 
-static char cache_dir[256];
-static bool have_cc;
+static TestCache cache;
 
 static int setup(void **state)
 {
     (void)state;
-    if (!testcache_make(cache_dir, sizeof cache_dir, "engine"))
-        return -1;
-    have_cc = aot_compiler_available();
-    return 0;
+    return testcache_setup(&cache, "engine");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    testcache_remove(cache_dir, 2);
-    return 0;
-}
-
-static Mech *load_example(const char *name)
-{
-    const char *dir = getenv("MECHC_EXAMPLES");
-    char path[600];
-    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
-    MechLimits limits = mech_default_limits();
-    Diag diag;
-    Mech *mech = pipeline_load(path, &limits, &diag);
-    if (!mech)
-        fail_msg("%s: %s", path, diag.message);
-    return mech;
+    return testcache_teardown(&cache);
 }
 
 static void evaluate(const MechrtKernels *k, const double *q, const double *qd, double t, Out *o)
@@ -109,7 +92,7 @@ static void state(const Model *m, double *q, double *qd, double *t)
 
 static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
 {
-    if (kind == ENGINE_AOT && !have_cc)
+    if (kind == ENGINE_AOT && !cache.have_cc)
         return false;
     Diag diag;
     if (!engine_open(e, kind, mech, &diag))

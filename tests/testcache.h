@@ -2,6 +2,8 @@
 #ifndef MECHC_TESTCACHE_H
 #define MECHC_TESTCACHE_H
 
+#include "../generator/engine/aot.h"
+
 #include <dirent.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -39,6 +41,27 @@ static inline void testcache_remove(const char *dir, int depth)
     }
     closedir(d);
     rmdir(dir);
+}
+
+/* A suite's cache and whether a C compiler is there (the aot engine's
+   tests run only then), for its cmocka setup and teardown. */
+typedef struct TestCache {
+    char dir[256];
+    bool have_cc;
+} TestCache;
+
+static inline int testcache_setup(TestCache *c, const char *suite)
+{
+    if (!testcache_make(c->dir, sizeof c->dir, suite))
+        return -1;
+    c->have_cc = aot_compiler_available();
+    return 0;
+}
+
+static inline int testcache_teardown(TestCache *c)
+{
+    testcache_remove(c->dir, 2);
+    return 0;
 }
 
 #endif

@@ -4,6 +4,9 @@
 
 #include "../generator/pipeline/pipeline.h"
 
+#include <stdio.h>
+#include <stdlib.h>
+
 static inline Mech *load_file(const char *path)
 {
     static Diag diag;   /* must outlive the Mech on failure paths only */
@@ -12,6 +15,15 @@ static inline Mech *load_file(const char *path)
     if (!m)
         fail_msg("%s: %s", path, diag.message);
     return m;
+}
+
+/* examples/NAME, or $MECHC_EXAMPLES/NAME when the suite runs elsewhere. */
+static inline Mech *load_example(const char *name)
+{
+    const char *dir = getenv("MECHC_EXAMPLES");
+    char path[600];
+    snprintf(path, sizeof path, "%s/%s", dir ? dir : "examples", name);
+    return load_file(path);
 }
 
 static inline Mech *load_text(const char *text, const char *name)

@@ -24,10 +24,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Equal steps from t = 0 to t1, each halved at most 6 times. */
 /* Equal steps from t = 0 to t1, each halved at most 6 times; the last
    steps before t1 are FOLLOW_FINE times shorter. */
 enum { FOLLOW_STEPS = 100, FOLLOW_HALVINGS = 6, FOLLOW_FINE = 16 };
+
+/* The tolerances of the path followed. A coordinate's scale is 1 + the
+   largest |q| of the state stepped from (metres, radians: whatever the
+   file uses), so a mechanism drawn in mm or in km is judged alike. */
+/* the first step's correction (no prediction yet), in scales */
+#define FOLLOW_FIRST_JUMP 0.1
+/* a later step's correction: half the predicted motion plus this, in
+   scales (Newton leaves about tol_phi; this is well above it) */
+#define FOLLOW_SLACK 1e-6
+/* the end time is reached within this times max(1, |t_end|) (seconds) */
+#define FOLLOW_T_EPS 1e-12
+/* a step "equal" to h0 or to the rest within this fraction of itself */
+#define FOLLOW_H_EPS 1e-9
 
 static double dist_inf(const double *a, const double *b, int n)
 {
@@ -92,14 +104,12 @@ static bool follow_step(MechEval *me, MechrtSvd *w, const int *hrows, int nh, do
                 : assemble_sparse(me, nh, t, trial, opt, res);
     if (!ok)
         return false;
-    double corr = dist_inf(trial, pred, nq), moved = dist_inf(pred, q, nq);
-    if (hist->n == 1) {             /* the first step: no prediction to judge by */
-        double size = 0.0;
-        for (int i = 0; i < nq; i++)
-            size = fmax(size, fabs(q[i]));
-        return corr <= 0.1 * (1.0 + size);
-    }
-    return corr <= 0.5 * moved + 1e-6;
+    double corr = dist_inf(trial, pred, nq), moved = dist_inf(pred, q, nq), size = 0.0;
+    for (int i = 0; i < nq; i++)
+        size = fmax(size, fabs(q[i]));
+    if (hist->n == 1)               /* the first step: no prediction to judge by */
+        return corr <= FOLLOW_FIRST_JUMP * (1.0 + size);
+    return corr <= 0.5 * moved + FOLLOW_SLACK * (1.0 + size);
 }
 
 /* Steps from the newest state of hist to t_end, h at a time (halved
@@ -110,15 +120,15 @@ static bool follow_to(MechEval *me, MechrtSvd *w, const int *hrows, int nh, doub
 {
     int nq = me->nq;
     double h = h0, t = hist->t[hist->n - 1];
-    while (fabs(t_end - t) > 1e-12 * fmax(1.0, fabs(t_end))) {
-        double tn = fabs(t_end - t) <= fabs(h) * (1 + 1e-9) ? t_end : t + h;
+    while (fabs(t_end - t) > FOLLOW_T_EPS * fmax(1.0, fabs(t_end))) {
+        double tn = fabs(t_end - t) <= fabs(h) * (1 + FOLLOW_H_EPS) ? t_end : t + h;
         if (follow_step(me, w, hrows, nh, tn, hist, trial, pred, opt, res)) {
             history_push(hist, tn, trial, nq);
             t = tn;
             ++*steps;
             if (fabs(h) < fabs(h0))
                 h *= 2;             /* back towards the equal steps */
-        } else if (fabs(h) > fabs(h0) / (1 << FOLLOW_HALVINGS) * (1 + 1e-9)) {
+        } else if (fabs(h) > fabs(h0) / (1 << FOLLOW_HALVINGS) * (1 + FOLLOW_H_EPS)) {
             h /= 2;
         } else {
             return false;

@@ -6,9 +6,9 @@
 
 /* The shortest of %.15g, %.16g, %.17g that reads back as v (0.3 stays
    "0.3"); -0 is "0"; NaN and infinities are "nan", "inf", "-inf". Returns
-   the length written. The same text as mechrt_format_real(buf, size, v, 0)
-   of the host runtime, which keeps its own copy because runtime/ must not
-   depend on generator/ (tests/test_dag.c checks that they agree). */
+   the length written. It is mechrt_format_real(buf, size, v, 0) of the
+   host runtime: runtime/ must not depend on generator/, so the one copy
+   lives there. */
 int realfmt_shortest(char *buf, size_t size, double v);
 
 #endif

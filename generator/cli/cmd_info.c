@@ -167,23 +167,29 @@ static void json_joints(const Model *m)
     printf("]");
 }
 
+/* A direction's components are rates against its free coordinate (which
+   is 1): below TOP_ZERO one is rounding, not motion; two within a
+   fraction TOP_TIE of each other are equal (both dimensionless). */
+#define TOP_ZERO 1e-12
+#define TOP_TIE 1e-9
+
 /* The largest components of a null-space direction, up to `most`, by
-   decreasing size (equal to 1e-9, as rounding leaves them: coordinate
+   decreasing size (equal to TOP_TIE, as rounding leaves them: coordinate
    order); returns how many are kept. */
 static int top_components(const double *v, int nq, int most, int *idx)
 {
     int n = 0;
     for (int j = 0; j < nq; j++) {
-        if (fabs(v[j]) < 1e-12)
+        if (fabs(v[j]) < TOP_ZERO)
             continue;
         int k;
         if (n < most)
             k = n++;
-        else if (fabs(v[j]) * (1 - 1e-9) > fabs(v[idx[most - 1]]))
+        else if (fabs(v[j]) * (1 - TOP_TIE) > fabs(v[idx[most - 1]]))
             k = most - 1;           /* the smallest kept gives way */
         else
             continue;
-        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j]) * (1 - 1e-9)) {
+        while (k > 0 && fabs(v[idx[k - 1]]) < fabs(v[j]) * (1 - TOP_TIE)) {
             idx[k] = idx[k - 1];
             k--;
         }
@@ -443,8 +449,9 @@ static void print_state(const InfoReport *rep)
         return;
     }
     printf("  rank %d of the holonomic rows (drivers included) against %d generically\n"
-           "  (at t = 0%s): a drop of %d (singular values above %.3g count)\n", rep->rank,
-           st->ref_rank, st->given ? "" : " or just before", st->drop, rep->rank_tol);
+           "  (at t = 0%s): a drop of %d (%s above %.3g count)\n", rep->rank,
+           st->ref_rank, st->given ? "" : " or just before", st->drop,
+           rep->dense ? "singular values" : "sparse QR pivots", rep->rank_tol);
     printf("  rows that became dependent (%d): ", st->ndependent);
     for (int k = 0; k < st->ndependent; k++)
         printf("%s%s", k ? ", " : "", m->rows[st->dependent[k]].name);
@@ -510,16 +517,17 @@ static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at
     *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
     if (at->follow && m->nv > 0) {
         fprintf(stderr, "mechc info: error: --at follows the holonomic rows only, and %s has "
-                "velocity-level rows, whose positions run integrates: write the state with "
-                "`mechc run FILE --at T --csv STATE.csv` and give it with --state STATE.csv\n",
+                "velocity-level rows, whose positions run integrates: write the motion with "
+                "`mechc run FILE --t1 T --csv STATE.csv` and give it with "
+                "--state STATE.csv --at T\n",
                 m->name);
         return false;
     }
     if (!c->state)
         return true;
-    char err[300];
-    if (!state_csv_read(c->state, m, c->at, q, t, err, sizeof err)) {
-        fprintf(stderr, "mechc info: error: %s: %s\n", c->state, err);
+    Diag diag;
+    if (!state_csv_read(c->state, m, c->at, q, t, &diag)) {
+        diag_print(&diag, stderr);
         return false;
     }
     at->q = q;

@@ -3,7 +3,13 @@
 
 #include "../base/arena.h"
 
+/* A row is at time `at` when their times differ by at most this times
+   max(1, |at|) (a relative tolerance on seconds): it absorbs the rounding
+   between a time run computed (t0 + k h) and the decimal one typed. */
+#define STATE_CSV_T_MATCH 1e-9
+
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,8 +33,9 @@ static char *next_field(char **s)
     return f;
 }
 
-/* Column of every coordinate (col[i]) and of t, from the header line. */
-static bool map_header(char *line, const Model *m, int *col, int *tcol, char *err, size_t errlen)
+/* Column of every coordinate (col[i]) and of t, from the header line
+   (line starts at offset 0 of the file). */
+static bool map_header(char *line, const Model *m, int *col, int *tcol, Diag *diag)
 {
     *tcol = -1;
     for (int i = 0; i < m->nq; i++)
@@ -42,33 +49,53 @@ static bool map_header(char *line, const Model *m, int *col, int *tcol, char *er
                 col[i] = k;
     }
     if (*tcol < 0) {
-        snprintf(err, errlen, "no column named t in the header");
+        diag_error(diag, (SrcPos){0}, "no column named t in the header");
         return false;
     }
     for (int i = 0; i < m->nq; i++)
         if (col[i] < 0) {
-            snprintf(err, errlen, "no column named %s in the header", m->coord_names[i]);
+            diag_error(diag, (SrcPos){0}, "no column named %s in the header",
+                       m->coord_names[i]);
             return false;
         }
     return true;
 }
 
-/* The row's fields as numbers into v (ncols); false on a bad number. */
-static bool parse_row(char *line, double *v, int ncols)
+/* The row's fields as numbers into v (ncols), line at byte offset `offset`
+   of the file; a field used (used[k]) must be finite. false with the
+   error, at its field, in diag. */
+static bool parse_row(char *line, int offset, double *v, int ncols, const bool *used, Diag *diag)
 {
-    char *f;
-    int k = 0;
-    while ((f = next_field(&line)) != NULL && k < ncols) {
-        char *end;
-        errno = 0;
-        v[k++] = strtod(f, &end);
-        if (end == f || *end != '\0')
+    char *start = line, *f;
+    int k = 0, end_col = (int)strlen(line);     /* before next_field cuts it */
+    while ((f = next_field(&line)) != NULL) {
+        SrcPos pos = {offset + (int)(f - start)};
+        if (k == ncols) {
+            diag_error(diag, pos, "%d fields where the header has %d", k + 1, ncols);
             return false;
+        }
+        char *end;
+        v[k] = strtod(f, &end);
+        if (end == f || *end != '\0') {
+            diag_error(diag, pos, "field %d ('%s') is not a number", k + 1, f);
+            return false;
+        }
+        if (used[k] && !isfinite(v[k])) {
+            diag_error(diag, pos, "field %d ('%s') is not a finite number", k + 1, f);
+            return false;
+        }
+        k++;
     }
-    return k == ncols;
+    if (k < ncols) {
+        diag_error(diag, (SrcPos){offset + end_col},
+                   "%d fields where the header has %d", k, ncols);
+        return false;
+    }
+    return true;
 }
 
-static char *read_all(const char *path)
+/* The whole file, NUL-terminated, its length in *len; NULL with errno set. */
+static char *read_all(const char *path, int *len)
 {
     FILE *in = fopen(path, "rb");
     if (!in)
@@ -81,56 +108,96 @@ static char *read_all(const char *path)
         if (cap - n < 2)
             buf = xrealloc(buf, cap *= 2, 1);
     }
+    /* a directory opens, then fails to read (EISDIR): not an empty file */
+    if (ferror(in) || n > INT_MAX) {
+        int e = ferror(in) ? errno : EFBIG;
+        fclose(in);
+        free(buf);
+        errno = e;
+        return NULL;
+    }
     fclose(in);
     buf[n] = '\0';
+    *len = (int)n;
     return buf;
 }
 
-bool state_csv_read(const char *path, const Model *m, double at, double *q, double *t,
-                    char *err, size_t errlen)
+/* Which fields are read: t and the coordinates. */
+static bool *used_fields(const int *col, int nq, int tcol, int ncols)
 {
-    char *text = read_all(path);
-    if (!text) {
-        snprintf(err, errlen, "cannot read: %s", strerror(errno));
-        return false;
-    }
-    int *col = xmalloc(((size_t)m->nq + 1) * sizeof *col), tcol;
-    char *rest = text, *line = strsep(&rest, "\n");
-    int ncols = 1;
-    for (const char *c = line; *c; c++)
-        ncols += *c == ',';
+    bool *used = xmalloc((size_t)ncols * sizeof *used);
+    for (int k = 0; k < ncols; k++)
+        used[k] = k == tcol;
+    for (int i = 0; i < nq; i++)
+        used[col[i]] = true;
+    return used;
+}
+
+/* The data rows: the one nearest `at` (the first if at is NaN) into q and
+   *t, their count in *rows, the distance of the chosen one in *best. */
+static bool scan_rows(char *rest, const char *work, const Model *m, const int *col, int tcol,
+                      int ncols, double at, double *q, double *t, int *rows, double *best,
+                      Diag *diag)
+{
     double *v = xmalloc((size_t)ncols * sizeof *v);
-    bool ok = map_header(line, m, col, &tcol, err, errlen);
-    int rows = 0, lineno = 1;
-    double best = INFINITY;
-    while (ok && (line = strsep(&rest, "\n")) != NULL) {
-        lineno++;
+    bool *used = used_fields(col, m->nq, tcol, ncols), ok = true;
+    char *line;
+    *rows = 0;
+    *best = INFINITY;
+    while ((line = strsep(&rest, "\n")) != NULL) {
         if (line[0] == '\0' || line[0] == '\r')
             continue;
-        if (!parse_row(line, v, ncols)) {
-            snprintf(err, errlen, "line %d: expected %d numbers", lineno, ncols);
+        if (!parse_row(line, (int)(line - work), v, ncols, used, diag)) {
             ok = false;
             break;
         }
-        rows++;
+        ++*rows;
         double d = isnan(at) ? 0.0 : fabs(v[tcol] - at);
-        if (d < best || (isnan(at) && rows == 1)) {
-            best = d;
+        if (d < *best || (isnan(at) && *rows == 1)) {
+            *best = d;
             *t = v[tcol];
             for (int i = 0; i < m->nq; i++)
                 q[i] = v[col[i]];
         }
     }
+    free(v), free(used);
+    return ok;
+}
+
+bool state_csv_read(const char *path, const Model *m, double at, double *q, double *t,
+                    Diag *diag)
+{
+    int len = 0;
+    char *text = read_all(path, &len);
+    if (!text) {
+        diag_init(diag, path, NULL, 0);
+        diag_error_nopos(diag, "cannot read: %s", strerror(errno));
+        return false;
+    }
+    /* work is cut in place by strsep and next_field; text stays whole
+       for the line echoed under an error */
+    diag_init(diag, path, text, len);
+    char *work = xmalloc((size_t)len + 1);
+    memcpy(work, text, (size_t)len + 1);
+    int *col = xmalloc(((size_t)m->nq + 1) * sizeof *col), tcol, rows = 0;
+    char *rest = work, *line = strsep(&rest, "\n");
+    int ncols = 1;
+    for (const char *c = line; *c; c++)
+        ncols += *c == ',';
+    double best = INFINITY;
+    bool ok = map_header(line, m, col, &tcol, diag)
+              && scan_rows(rest, work, m, col, tcol, ncols, at, q, t, &rows, &best, diag);
     if (ok && rows == 0) {
-        snprintf(err, errlen, "no data row");
+        diag_error_nopos(diag, "no data row");
         ok = false;
     } else if (ok && isnan(at) && rows > 1) {
-        snprintf(err, errlen, "%d rows: give --at T to choose one", rows);
+        diag_error_nopos(diag, "%d rows: give --at T to choose one", rows);
         ok = false;
-    } else if (ok && !isnan(at) && best > 1e-9 * fmax(1.0, fabs(at))) {
-        snprintf(err, errlen, "no row at t = %g (the nearest is t = %.17g)", at, *t);
+    } else if (ok && !isnan(at) && best > STATE_CSV_T_MATCH * fmax(1.0, fabs(at))) {
+        diag_error_nopos(diag, "no row at t = %g (the nearest is t = %.17g)", at, *t);
         ok = false;
     }
-    free(text), free(col), free(v);
+    free(text), free(work), free(col);
+    diag->text = NULL, diag->text_len = 0;   /* the message and its line are copies */
     return ok;
 }

@@ -797,6 +797,13 @@ static void put_some_macros(const Emitter *e, StrBuf *opt, StrBuf *plain)
               "     (void)((used) & 8 ? *(c1) = cos(x1) : 0))\n", e->sincos2_some_name);
 }
 
+/* Every placeholder of a template is given a value: one without is a bug. */
+static _Noreturn void placeholder_bug(const char *name)
+{
+    fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", name);
+    abort();
+}
+
 /* What the kernels call for math: libm declared (JIT) or included, and
    the sincos functions the emitter used, for written files chosen by the
    compiler (templates/trig.tmpl). parts and bodies: the written functions. */
@@ -852,14 +859,13 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     int nsv = (int)(sizeof sv / sizeof *sv);
     StrBuf sincos;
     sb_init(&sincos);
-    /* every placeholder of the templates is given: they render */
-    if (template_render(&sincos, template_sincos, sv, nsv))
-        abort();
-    if (e->sincos2_used) {
+    const char *bad = template_render(&sincos, template_sincos, sv, nsv);
+    if (!bad && e->sincos2_used) {
         sb_puts(&sincos, "\n");
-        if (template_render(&sincos, template_sincos2, sv, nsv))
-            abort();
+        bad = template_render(&sincos, template_sincos2, sv, nsv);
     }
+    if (bad)
+        placeholder_bug(bad);
     StrBuf single;
     sb_init(&single);
     sb_puts(&single, "");
@@ -868,8 +874,9 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
     template_set(sv, nsv, "SINGLE", single.data);
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");
-    if (template_render(math, template_trig, sv, nsv))
-        abort();
+    bad = template_render(math, template_trig, sv, nsv);
+    if (bad)
+        placeholder_bug(bad);
     sb_free(&sincos);
     sb_free(&single);
 }
@@ -919,12 +926,6 @@ static const char *put_dynamics(const Emitter *e, TemplateVar *vars, int nvars, 
     return NULL;
 }
 
-static _Noreturn void placeholder_bug(const char *name)
-{
-    fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", name);
-    abort();
-}
-
 /* PREFIX_all_nz's declaration and definition (templates/all_nz*.tmpl);
    both empty unless asked for, so that other files keep their bytes. */
 static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodies, StrBuf *decl,
@@ -937,10 +938,30 @@ static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodi
         {"ALL_NZ_PARTS", parts[EMIT_ALL_NZ].data}, {"ALL_NZ_BODY", bodies[EMIT_ALL_NZ].data},
     };
     int nv = (int)(sizeof v / sizeof *v);
-    /* every placeholder of the templates is given: they render */
-    if (template_render(decl, template_all_nz_decl, v, nv) || template_render(def, template_all_nz, v, nv))
-        abort();
+    const char *bad = template_render(decl, template_all_nz_decl, v, nv);
+    if (!bad)
+        bad = template_render(def, template_all_nz, v, nv);
+    if (bad)
+        placeholder_bug(bad);
     def->data[--def->len] = '\0';   /* mech.c.tmpl ends the line after it */
+}
+
+/* The sizes and the include guard, as text for the templates. */
+typedef struct EmitSizes {
+    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
+} EmitSizes;
+
+static void put_sizes(const Emitter *e, EmitSizes *z)
+{
+    const Model *m = e->kin->model;
+    snprintf(z->nq, sizeof z->nq, "%d", m->nq);
+    snprintf(z->nh, sizeof z->nh, "%d", m->nh);
+    snprintf(z->nv, sizeof z->nv, "%d", m->nv);
+    /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
+       placeholder entry (row 0, column 0, value 0). */
+    snprintf(z->nnz, sizeof z->nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
+    snprintf(z->mnnz, sizeof z->mnnz, "%d", e->kin->dyn.nnz > 0 ? e->kin->dyn.nnz : 1);
+    snprintf(z->guard, sizeof z->guard, "%s_MECHC_H", e->prefix_upper);
 }
 
 /* Fills the templates with the written functions: out's source and header. */
@@ -968,19 +989,12 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     put_math(&math, e, parts, bodies);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
 
-    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
-    snprintf(nq, sizeof nq, "%d", m->nq);
-    snprintf(nh, sizeof nh, "%d", m->nh);
-    snprintf(nv, sizeof nv, "%d", m->nv);
-    /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
-       placeholder entry (row 0, column 0, value 0). */
-    snprintf(nnz, sizeof nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
-    snprintf(mnnz, sizeof mnnz, "%d", e->kin->dyn.nnz > 0 ? e->kin->dyn.nnz : 1);
-    snprintf(guard, sizeof guard, "%s_MECHC_H", upper);
+    EmitSizes z;
+    put_sizes(e, &z);
     TemplateVar vars[] = {
         {"BANNER", banner.data}, {"OPS", ops.data}, {"P", out->prefix}, {"PU", upper},
-        {"REAL", opt->real_float ? "float" : "double"}, {"NQ", nq}, {"NH", nh}, {"NV", nv},
-        {"NNZ", nnz}, {"GUARD", guard}, {"MATH", math.data}, {"INTERFACE", ""},
+        {"REAL", opt->real_float ? "float" : "double"}, {"NQ", z.nq}, {"NH", z.nh}, {"NV", z.nv},
+        {"NNZ", z.nnz}, {"GUARD", z.guard}, {"MATH", math.data}, {"INTERFACE", ""},
         {"Q0", q0.data}, {"COORD_NAMES", coords.data}, {"ROW_NAMES", rows.data},
         {"JAC_ROW", jrow.data}, {"JAC_COL", jcol.data},
         {"PHI_PARTS", parts[EMIT_PHI].data}, {"PHI_BODY", bodies[EMIT_PHI].data},
@@ -990,7 +1004,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"ALL_PARTS", parts[EMIT_ALL].data}, {"ALL_BODY", bodies[EMIT_ALL].data},
         {"JAC_PARTS", parts[EMIT_JAC].data}, {"JAC_BODY", bodies[EMIT_JAC].data},
         {"ZERO_JAC", zero.data}, {"JAC_MOVES", moves.data}, {"JAC", ""},
-        {"ALL_NZ_DECL", nzd.data}, {"ALL_NZ", nzf.data}, {"M_NNZ", mnnz},
+        {"ALL_NZ_DECL", nzd.data}, {"ALL_NZ", nzf.data}, {"M_NNZ", z.mnnz},
         {"MASS_ROW", mrow.data}, {"MASS_COL", mcol.data}, {"DYNAMICS", ""}, {"DYN_INTERFACE", ""},
         {"MASS_PARTS", parts[EMIT_MASS].data}, {"MASS_BODY", bodies[EMIT_MASS].data},
         {"MASS_NZ_PARTS", parts[EMIT_MASS_NZ].data}, {"MASS_NZ_BODY", bodies[EMIT_MASS_NZ].data},

@@ -16,6 +16,11 @@ static int placeholder_length(const char *p)
 const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *vars, int nvars)
 {
     const char *p = tmpl;
+    /* a first line "@@ ..." says what the template is for: not output */
+    if (p[0] == '@' && p[1] == '@') {
+        const char *nl = strchr(p, '\n');
+        p = nl ? nl + 1 : p + strlen(p);
+    }
     while (*p) {
         const char *at = strchr(p, '@');
         if (!at) {

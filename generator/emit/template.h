@@ -9,8 +9,10 @@ typedef struct TemplateVar {
     const char *value;
 } TemplateVar;
 
-/* Appends tmpl to out with every @NAME@ replaced. A placeholder with no
-   value is a bug in mechc: returns its name so the caller can report it. */
+/* Appends tmpl to out with every @NAME@ replaced, without a first line
+   that starts with "@@" (the template's own one-line header). A
+   placeholder with no value is a bug in mechc: returns its name so the
+   caller can report it. */
 const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *vars, int nvars);
 
 /* Gives the variable called name its value. A name not in vars is a bug

@@ -9,6 +9,7 @@
 #include "model.h"
 
 #include "../base/hashmap.h"
+#include "../dag/support.h"
 #include "../parse/parse.h"
 #include "orient.h"
 
@@ -806,6 +807,43 @@ static void refuse_ground(Builder *b, const Stmt *s, int n)
                       dyn_keywords[s->dyn], s->name);
 }
 
+/* Whether any of the n expressions depends on a coordinate. A point or
+   angle that depends on none has no virtual displacement (t is held), so
+   a force applied there does no work: the same mistake as ground. */
+static bool depends_on_q(Builder *b, const NodeId *e, int n)
+{
+    SupportScan scan;
+    support_init(&scan);
+    int *out = xmalloc(((size_t)b->model->nq + 1) * sizeof *out), found = 0;
+    for (int i = 0; i < n && !found; i++)
+        found = support_collect(&scan, &b->model->dag, e[i], OP_VAR, out);
+    free(out);
+    support_free(&scan);
+    return found > 0;
+}
+
+/* The checks that need the lowered attachments: a force must move with
+   the coordinates (refuse_ground catches ground by name), a spring needs
+   two distinct points (nodes are hash-consed: the same point is the same
+   ids, and its length would be 0 at every state). */
+static void refuse_idle(Builder *b, const Stmt *s, const AppliedForce *f)
+{
+    const char *kw = dyn_keywords[s->dyn];
+    NodeId a[2] = {f->ax, f->ay}, ab[4] = {f->ax, f->ay, f->bx, f->by};
+    if (s->dyn == DYN_FORCE && !depends_on_q(b, a, 2))
+        diag_fail(b->diag, s->attach[0].pos, "%s '%s' is applied at a fixed point (it depends "
+                  "on no coordinate): it does no work", kw, s->name);
+    if (s->dyn == DYN_TORQUE && s->lhs && !depends_on_q(b, a, 1))
+        diag_fail(b->diag, s->lhs->pos, "%s '%s' acts on an angle that depends on no "
+                  "coordinate: it does no work", kw, s->name);
+    if (s->dyn == DYN_SPRING && f->ax == f->bx && f->ay == f->by)
+        diag_fail(b->diag, s->attach[1].pos, "%s '%s' joins a point to itself: its length is "
+                  "always 0", kw, s->name);
+    if (s->dyn == DYN_SPRING && !depends_on_q(b, ab, 4))
+        diag_fail(b->diag, s->attach[0].pos, "%s '%s' joins two fixed points (they depend on no "
+                  "coordinate): it does no work", kw, s->name);
+}
+
 /* force, torque, spring, rspring, gforce: one applied force. */
 static void build_force(Builder *b, const Stmt *s)
 {
@@ -821,11 +859,13 @@ static void build_force(Builder *b, const Stmt *s)
     case DYN_FORCE:
         dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
         f->ax = xy[0], f->ay = xy[1];
+        refuse_idle(b, s, f);
         f->fy = dyn_expr(b, s->vec[1]);
         f->fx = dyn_expr(b, s->vec[0]);
         return;
     case DYN_TORQUE:
         f->ax = s->lhs ? lower(b, s->lhs, EXPR_HOLONOMIC) : dyn_angle(b, &s->attach[0], kw);
+        refuse_idle(b, s, f);
         f->fx = dyn_expr(b, s->value);
         return;
     case DYN_SPRING: case DYN_RSPRING:
@@ -837,6 +877,7 @@ static void build_force(Builder *b, const Stmt *s)
             f->ax = xy[0], f->ay = xy[1];
             dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
             f->bx = xy[0], f->by = xy[1];
+            refuse_idle(b, s, f);
             f->fx = dyn_expr(b, s->key[DKEY_FORCE]);
         } else {
             f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);

@@ -738,7 +738,7 @@ static const unsigned dyn_allowed[DYN_KIND_COUNT] = {
     [DYN_RSPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_ANGLE) | KEYBIT(DKEY_TORQUE),
 };
 
-/* The keys of allowed as "m, J or com", for messages. */
+/* The keys in `allowed`, listed as "m, J or com" for messages. */
 static void list_keys(char *buf, size_t size, unsigned allowed, const char *extra)
 {
     const char *words[DKEY_COUNT + 1];
@@ -778,6 +778,9 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
     Token name = p->tok;
     Lexer saved = p->lx;
     advance(p);
+    if (frame_only && lex_is_word(&name, "at") && p->tok.kind == TOK_LPAREN)
+        diag_fail(p->diag, name.pos, "%s '%s' acts on bodies' angles: at(x, y) is a point; "
+                  "name a body or ground", kw, s->name);
     if (!frame_only && lex_is_word(&name, "at") && p->tok.kind == TOK_LPAREN) {
         p->lx = saved;      /* back to 'at' for at_point */
         p->tok = name;

@@ -35,21 +35,7 @@ static MechrtStatus sp_eval(MechrtHostSparse *s, const MechrtKernels *k, const d
         k->phi(k->ctx, q, t, phi);
         mechrt_host_sparse_eval(s, q, t);
     }
-    r->residual = 0;
-    r->worst_row = k->nh > 0 ? 0 : -1;
-    for (int i = 0; i < k->nh; i++) {
-        double a = fabs(phi[i]);
-        if (!isfinite(a)) {
-            r->residual = a;
-            r->worst_row = i;
-            return MECHRT_ENOTFINITE;
-        }
-        if (a > r->residual) {
-            r->residual = a;
-            r->worst_row = i;
-        }
-    }
-    return MECHRT_OK;
+    return mechrt_residual_inf(phi, k->nh, &r->residual, &r->worst_row);
 }
 
 /* A factorisation counted in r; a failing pivot's column in sing_index. */
