@@ -279,6 +279,23 @@ run "$ex/double_pendulum.mech" --baumgarte 5
 check "--baumgarte 5 (not A,B): exit 2" status_is 2
 run "$ex/double_pendulum.mech" --baumgarte 5,x
 check "--baumgarte 5,x: exit 2" status_is 2
+run "$ex/double_pendulum.mech" --baumgarte -1,-1
+check "--baumgarte -1,-1: exit 2" status_is 2
+check "--baumgarte -1,-1: says why" err_has "must not be negative"
+run "$ex/double_pendulum.mech" --rtol 10
+check "--rtol 10: exit 2" status_is 2
+check "--rtol 10: says why" err_has "is not below 1"
+cat > "$tmp/over.mech" <<'EOF'
+point p x = 1 y = 0
+constraint a: p.x = 1
+constraint b: p.y = 0
+constraint c: p.x + p.y = 1
+mass p m = 1
+EOF
+run "$tmp/over.mech"
+check "more rows than coordinates: exit 2" status_is 2
+check "more rows than coordinates: FILE:LINE:COL" err_matches "over\.mech:4:1: error: 3 holonomic rows for 2 coordinates"
+check "more rows than coordinates: nothing on stdout" out_lines 0
 run "$ex/double_pendulum.mech" --t0 1 --t1 1
 check "--t0 = --t1: exit 2" status_is 2
 check "--t0 = --t1: says so" err_has "nothing to simulate"

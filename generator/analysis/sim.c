@@ -642,8 +642,10 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
 {
     res->constructed = construct_with_kernels(m, k, o->t0, q);
     MechrtHost *host = mechrt_host_new(k);
-    if (!host)
+    if (!host) {
+        snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
         return false;
+    }
     double *start = xmalloc((size_t)m->nq * sizeof *start);
     memcpy(start, q, (size_t)m->nq * sizeof *q);
     MechrtReport rep;

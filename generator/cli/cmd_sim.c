@@ -145,6 +145,10 @@ static bool finish(Args *a, void *opts)
                 c->so.t0);
         return false;
     }
+    if (c->so.rtol >= 1) {      /* a relative error of 100 % or more: a misplaced exponent */
+        fprintf(stderr, "mechc sim: error: --rtol %g is not below 1 (e.g. 1e-8)\n", c->so.rtol);
+        return false;
+    }
     if (c->so.rtol == 0 && c->so.atol == 0) {
         fprintf(stderr, "mechc sim: error: --rtol and --atol cannot both be 0\n");
         return false;
@@ -153,6 +157,11 @@ static bool finish(Args *a, void *opts)
     if (c->baumgarte) {
         if (!args_vector("sim", "--baumgarte", c->baumgarte, 2, ab))
             return false;
+        if (!(ab[0] >= 0) || !(ab[1] >= 0)) {
+            fprintf(stderr, "mechc sim: error: --baumgarte gains must not be negative (a negative "
+                    "one makes the drift grow), got %g,%g\n", ab[0], ab[1]);
+            return false;
+        }
         c->so.dyn.baumgarte_alpha = ab[0];
         c->so.dyn.baumgarte_beta = ab[1];
     }
@@ -180,7 +189,7 @@ static int report(const SimCli *c, const Model *m, const RunOutput *out, const R
         return EXIT_USAGE;
     }
     if (c->pictures && !run_output_pictures(out, p))
-        status = EXIT_USAGE;
+        status = EXIT_USAGE;        /* as run: a file that cannot be written */
     if (c->json)
         run_output_json(stdout, out, st == SIM_FAILED ? res->message : NULL, res->t_fail);
     if (st == SIM_FAILED) {
@@ -252,6 +261,10 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     if (!sim_has_masses(&e.k)) {
         diag_error(diag, m->last_pos, "the mechanism has no masses: `mechc sim` needs `mass` "
                    "statements (with `gravity`, forces or springs) to simulate its dynamics");
+        diag_print(diag, stderr);
+    } else if (m->nh > m->nq) {     /* before any output: sim_run would refuse it later */
+        diag_error(diag, m->last_pos, "%d holonomic rows for %d coordinates: sim's position "
+                   "projection needs at most one row per coordinate", m->nh, m->nq);
         diag_print(diag, stderr);
     } else {
         status = simulate(c, m, &e, &pics);
