@@ -154,9 +154,24 @@ static void dyn_swap(mechrt_real *a, mechrt_real *b)
     *b = t;
 }
 
+/* max |a_ij| over j >= k of row i (-1 without columns): the pivot
+   search's row maxima, kept up to date instead of a full scan per step. */
+static mechrt_real dyn_row_max(const DynWork *w, int i, int k)
+{
+    mechrt_real best = -1;
+    int j;
+
+    for (j = k; j < w->n; j++)
+        if (MECHRT_FABS(AT(w->a, i, j, w->n)) > best)
+            best = MECHRT_FABS(AT(w->a, i, j, w->n));
+    return best;
+}
+
 /* Step k of the complete-pivoting elimination: the largest |a_ij|, i, j >= k,
-   into (*p, *c), its magnitude returned. */
-static mechrt_real dyn_pivot_search(const DynWork *w, int k, int *p, int *c)
+   into (*p, *c), its magnitude returned; the first in row-major order, as a
+   full scan would find it, from the row maxima rmax. */
+static mechrt_real dyn_pivot_search(const DynWork *w, const mechrt_real *rmax, int k, int *p,
+                                    int *c)
 {
     mechrt_real best = -1;
     int i, j;
@@ -164,54 +179,77 @@ static mechrt_real dyn_pivot_search(const DynWork *w, int k, int *p, int *c)
     *p = k;
     *c = k;
     for (i = k; i < w->m; i++)
-        for (j = k; j < w->n; j++) {
-            mechrt_real v = MECHRT_FABS(AT(w->a, i, j, w->n));
-            if (v > best) {
-                best = v;
-                *p = i;
-                *c = j;
-            }
+        if (rmax[i] > best) {
+            best = rmax[i];
+            *p = i;
+        }
+    for (j = k; j < w->n; j++)
+        if (MECHRT_FABS(AT(w->a, *p, j, w->n)) == best) {
+            *c = j;
+            break;
         }
     return best;
+}
+
+/* Rows k+1.. minus their multiple of pivot row k, over the pivot row's
+   nonzeros only (listed in nz: Jacobians are sparse); rows touched get
+   their maxima over the columns after k again. */
+static void dyn_eliminate(DynWork *w, int k, mechrt_real *rmax, mechrt_real *nz)
+{
+    int m = w->m, n = w->n, i, j, len = 0, t;
+    mechrt_real pivot = AT(w->a, k, k, n);
+
+    for (j = k + 1; j < n; j++)
+        if (AT(w->a, k, j, n) != 0)
+            nz[len++] = (mechrt_real)j;
+    for (i = k + 1; i < m; i++) {
+        mechrt_real aik = AT(w->a, i, k, n), l = aik / pivot;
+        AT(w->a, i, k, n) = l;
+        if (l != 0)
+            for (t = 0; t < len; t++) {
+                j = (int)nz[t];
+                AT(w->a, i, j, n) -= l * AT(w->a, k, j, n);
+            }
+        if (aik != 0)
+            rmax[i] = dyn_row_max(w, i, k + 1);
+    }
 }
 
 /* P Phi_q Qc = L U in place (LAPACK-style interchanges: at step k row k
    with rpiv[k], column k with cpiv[k]), stopped at the first pivot
    <= rank_tol * max|a_ij|. Returns the rank r; *ratio = smallest pivot /
-   max|a_ij| (1 without rows or with a zero matrix). */
+   max|a_ij| (1 without rows or with a zero matrix). Scratch: kb holds the
+   row maxima (m), h the pivot row's nonzero columns (n); both are free
+   until the null-space steps. */
 static int dyn_factor(DynWork *w, mechrt_real rank_tol, mechrt_real *ratio)
 {
     int m = w->m, n = w->n, kmax = m < n ? m : n, i, j, k, p, c;
-    mechrt_real amax = 0, thresh;
+    mechrt_real amax = 0, thresh, *rmax = w->kb;
 
-    for (i = 0; i < m; i++)
-        for (j = 0; j < n; j++)
-            if (MECHRT_FABS(AT(w->a, i, j, n)) > amax)
-                amax = MECHRT_FABS(AT(w->a, i, j, n));
+    for (i = 0; i < m; i++) {
+        rmax[i] = dyn_row_max(w, i, 0);
+        if (rmax[i] > amax)
+            amax = rmax[i];
+    }
     *ratio = 1;
     thresh = rank_tol * amax;
     for (k = 0; k < kmax; k++) {
-        mechrt_real best = dyn_pivot_search(w, k, &p, &c), pivot;
+        mechrt_real best = dyn_pivot_search(w, rmax, k, &p, &c);
         if (!(best > thresh) || best == 0)
             break;
         if (best / amax < *ratio)
             *ratio = best / amax;
         w->rpiv[k] = (mechrt_real)p;
         w->cpiv[k] = (mechrt_real)c;
-        if (p != k)
+        if (p != k) {
             for (j = 0; j < n; j++)
                 dyn_swap(&AT(w->a, k, j, n), &AT(w->a, p, j, n));
+            dyn_swap(&rmax[k], &rmax[p]);
+        }
         if (c != k)
             for (i = 0; i < m; i++)
                 dyn_swap(&AT(w->a, i, k, n), &AT(w->a, i, c, n));
-        pivot = AT(w->a, k, k, n);
-        for (i = k + 1; i < m; i++) {
-            mechrt_real l = AT(w->a, i, k, n) / pivot;
-            AT(w->a, i, k, n) = l;
-            if (l != 0)
-                for (j = k + 1; j < n; j++)
-                    AT(w->a, i, j, n) -= l * AT(w->a, k, j, n);
-        }
+        dyn_eliminate(w, k, rmax, w->h);
     }
     return k;
 }

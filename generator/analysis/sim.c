@@ -101,8 +101,8 @@ typedef struct Sim {
     int nq, nr, dim;             /* dim: 2 nq (+1 with energy) */
     double *work;                /* mechrt_forward_dynamics' workspace */
     size_t lwork;
-    MechrtHost *host;            /* position projection */
-    MechrtSvd *svd;              /* velocity projection, nr x nq */
+    double *qrw;                 /* the projections' QR workspace (nr x nq) */
+    size_t lqrw;
     double *jac, *nu, *resid, *dqd, *lambda, *mass, *mass2, *qs, *f0, *f1, *y;
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *drv;
@@ -320,11 +320,22 @@ static int sim_jacobian(double t, const double y[], double *dfdy, double dfdt[],
 
 /* ---- projection ------------------------------------------------------------- */
 
-/* qd <- qd - pinv(Phi_q) (Phi_q qd - nu): the nearest velocities the rows allow. */
+/* The rows' tolerance of both projections (row_tol): redundant rows, and
+   near a rank drop the row becoming dependent, are left alone; a small
+   pivot there would turn the integration's error into a large change of
+   position or speed (energy). */
+static double project_tol(const Sim *s)
+{
+    return fmax(s->o->dyn.rank_tol, s->o->row_tol);
+}
+
+/* qd <- qd - x, x the least-norm solution of the rank's rows of
+   Phi_q x = Phi_q qd - nu (rank-revealing QR, runtime/qr.c): the nearest
+   velocities the rows allow. */
 static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, double t)
 {
     int n = s->nq, m = s->nr;
-    MechrtSvdResult sv;
+    MechrtQr f;
     if (m == 0)
         return MECHRT_OK;
     s->kc.jac(s->kc.ctx, q, t, s->jac);
@@ -335,15 +346,12 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
             a += s->jac[(size_t)i * (size_t)n + (size_t)j] * qd[j];
         s->resid[i] = a;
     }
-    if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
-        return MECHRT_ENOTFINITE;
-    if (!(sv.sigma_max > 0))
+    MechrtStatus st = mechrt_qr_factor(&f, m, n, s->jac, n, project_tol(s), s->qrw, s->lqrw);
+    if (st != MECHRT_OK)
+        return st;
+    if (f.rank == 0)
         return MECHRT_OK;   /* Phi_q = 0: nothing constrains the velocities */
-    /* as the rows of the step (row_tol): near a rank drop the direction
-       becoming dependent is left alone; a small singular value there would
-       turn the integration's error into a large change of speed (energy) */
-    mechrt_svd_truncate(s->svd, fmax(s->o->dyn.rank_tol, s->o->row_tol) * sv.sigma_max);
-    mechrt_svd_pinv_solve(s->svd, s->resid, s->dqd);
+    mechrt_qr_solve(&f, s->resid, s->dqd);
     for (int j = 0; j < n; j++) {
         qd[j] -= s->dqd[j];
         if (!isfinite(qd[j]))
@@ -352,16 +360,76 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
     return MECHRT_OK;
 }
 
+/* ||Phi(q, t)||_inf over the holonomic rows into rep (Phi in s->resid). */
+static MechrtStatus eval_phi(Sim *s, const double *q, double t, MechrtReport *rep)
+{
+    s->kc.phi(s->kc.ctx, q, t, s->resid);
+    rep->residual = 0;
+    rep->worst_row = 0;
+    for (int i = 0; i < s->inner->nh; i++) {
+        double a = fabs(s->resid[i]);
+        if (!isfinite(a)) {
+            rep->residual = a;
+            rep->worst_row = i;
+            return MECHRT_ENOTFINITE;
+        }
+        if (a > rep->residual) {
+            rep->residual = a;
+            rep->worst_row = i;
+        }
+    }
+    return MECHRT_OK;
+}
+
+/* Minimum-norm Newton onto Phi(q, t) = 0: dq = the least-norm solution of
+   the rank's rows of Phi_q dq = -Phi (QR as for the velocities), at least
+   one step, until |Phi| <= tol_phi and |dq| <= tol_dq. */
+static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q, double t,
+                                      MechrtReport *rep)
+{
+    int n = s->nq, nh = s->inner->nh;
+    memset(rep, 0, sizeof *rep);
+    rep->step = -1;
+    rep->worst_row = -1;
+    rep->sing_index = -1;
+    if (nh == 0)
+        return MECHRT_OK;
+    for (;;) {
+        MechrtStatus st = eval_phi(s, q, t, rep);
+        if (st != MECHRT_OK)
+            return st;
+        if (rep->step >= 0 && rep->residual <= o->tol_phi && rep->step <= o->tol_dq)
+            return MECHRT_OK;
+        if (rep->iterations >= o->max_iter)
+            return MECHRT_EMAXITER;
+        MechrtQr f;
+        s->kc.jac(s->kc.ctx, q, t, s->jac);
+        st = mechrt_qr_factor(&f, nh, n, s->jac, n, o->pivot_tol, s->qrw, s->lqrw);
+        if (st != MECHRT_OK)
+            return st;
+        if (f.rank == 0)
+            return MECHRT_ESING;   /* Phi_q = 0: no direction to move in */
+        mechrt_qr_solve(&f, s->resid, s->dqd);
+        double step = 0;
+        for (int j = 0; j < n; j++) {
+            if (!isfinite(s->dqd[j]))
+                return MECHRT_ENOTFINITE;
+            q[j] -= s->dqd[j];
+            step = fmax(step, fabs(s->dqd[j]));
+        }
+        rep->step = step;
+        rep->iterations++;
+    }
+}
+
 /* Positions onto Phi = 0, then velocities onto Phi_q qd = nu; fails with the message set. */
 static bool project_state(Sim *s, double *y, double t)
 {
     MechrtOptions po = s->o->mechrt;
     MechrtReport rep;
-    /* redundant rows, and near a rank drop the row becoming dependent, are
-       left alone as in the velocities (row_tol) */
-    po.pivot_tol = fmax(s->o->dyn.rank_tol, s->o->row_tol);
+    po.pivot_tol = project_tol(s);
     s->res->projections++;
-    MechrtStatus st = mechrt_host_project(s->host, &po, y, t, &rep);
+    MechrtStatus st = project_positions(s, &po, y, t, &rep);
     s->res->projection_iterations += rep.iterations;
     if (st != MECHRT_OK) {
         fail(s, st, t, "position projection");
@@ -446,10 +514,8 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->active = xcalloc(m + 1, sizeof *s->active);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
-    s->host = mechrt_host_new(&s->kc);
-    s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
-    if (!s->host || (m > 0 && !s->svd))
-        return false;
+    s->lqrw = m > 0 ? mechrt_qr_work_len((int)m, k->nq) : 0;
+    s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
     /* W's error must not steer the step: its absolute scale is huge */
     double *scale = xcalloc((size_t)s->dim, sizeof *scale);
     for (int i = 0; i < s->dim; i++)
@@ -470,8 +536,7 @@ static void sim_close(Sim *s)
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
     free(s->y), free(s->active);
-    mechrt_host_free(s->host);
-    mechrt_svd_free(s->svd);
+    free(s->qrw);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
 }
