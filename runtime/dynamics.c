@@ -52,6 +52,7 @@ typedef struct DynWork {
     mechrt_real *kb, *gm;       /* K (r x d); K^T K + I (d x d) */
     mechrt_real *force, *cpiv, *hpiv, *v1, *v2, *v3;
     mechrt_real *g, *phi, *nu, *rpiv, *y, *ypiv;
+    long mnz;                   /* M's nonzeros packed in kb.., -1: use M dense */
 } DynWork;
 
 /* Entry (i, j) of a row-major matrix with leading dimension ld. */
@@ -144,6 +145,7 @@ static MechrtStatus dyn_setup(const MechrtKernels *k, mechrt_real *work, size_t 
     w->rpiv = w->nu + m;
     w->y = w->rpiv + m;
     w->ypiv = w->y + m;
+    w->mnz = -1;
     return MECHRT_OK;
 }
 
@@ -320,11 +322,46 @@ static void dyn_null_basis(const DynWork *w, int r)
     }
 }
 
-/* y = M x (n). */
+/* M's nonzeros, row by row, as (i n + j, m_ij) pairs into kb and gm (2 m^2
+   reals, free from the end of dyn_factor until dyn_min_norm) when they fit:
+   a mass matrix is mostly zeros (diagonal for planar bodies about their
+   centres), and dyn_reduced multiplies by it n - r times. */
+static void dyn_mass_pack(DynWork *w)
+{
+    size_t n = (size_t)w->n, cap = 2u * (size_t)w->m * (size_t)w->m, cnt = 0, i;
+
+    w->mnz = -1;
+    for (i = 0; i < n * n; i++)
+        if (w->mass[i] != 0)
+            cnt++;
+    if (2u * cnt > cap || (size_t)(mechrt_real)(n * n) != n * n)
+        return;     /* no room, or an index a float cannot hold */
+    cnt = 0;
+    for (i = 0; i < n * n; i++)
+        if (w->mass[i] != 0) {
+            w->kb[2u * cnt] = (mechrt_real)i;
+            w->kb[2u * cnt + 1u] = w->mass[i];
+            cnt++;
+        }
+    w->mnz = (long)cnt;
+}
+
+/* y = M x (n): from the packed nonzeros when there are, summed in the same
+   order as the dense rows (the zeros add nothing). */
 static void dyn_mass_times(const DynWork *w, const mechrt_real *x, mechrt_real *y)
 {
     int i, j;
+    long t;
 
+    if (w->mnz >= 0) {
+        for (i = 0; i < w->n; i++)
+            y[i] = 0;
+        for (t = 0; t < w->mnz; t++) {
+            long ij = (long)w->kb[2 * t];
+            y[ij / w->n] += w->kb[2 * t + 1] * x[ij % w->n];
+        }
+        return;
+    }
     for (i = 0; i < w->n; i++) {
         mechrt_real s = 0;
         for (j = 0; j < w->n; j++)
@@ -551,6 +588,7 @@ MechrtStatus mechrt_forward_dynamics(const MechrtKernels *k, const MechrtDynOpti
     if (st != MECHRT_OK)
         return st;
     r = dyn_factor(&w, o.rank_tol, &ratio);
+    dyn_mass_pack(&w);      /* until dyn_lambda's dyn_min_norm */
     inconsistency = dyn_solve_l(&w, r, w.g);
     for (i = 0; i < w.n; i++)
         qdd[i] = i < r ? w.g[i] : MECHRT_R(0.0);

@@ -238,16 +238,21 @@ static double half_mdot(Sim *s, const double *q, const double *qd)
     return 0.25 * sum / eps;    /* 1/2 * (quad+ - quad-) / (2 eps) */
 }
 
-/* qd^T M x with M at q (one mass call). */
-static double mass_form(Sim *s, const double *q, const double *qd, const double *x)
+/* qd^T M x for the n x n row-major M. */
+static double quad_form(int n, const double *m, const double *qd, const double *x)
 {
-    int n = s->nq;
-    s->kc.mass(s->kc.ctx, q, s->mass);
     double sum = 0;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
-            sum += qd[i] * s->mass[(size_t)i * (size_t)n + (size_t)j] * x[j];
+            sum += qd[i] * m[(size_t)i * (size_t)n + (size_t)j] * x[j];
     return sum;
+}
+
+/* qd^T M x with M at q (one mass call). */
+static double mass_form(Sim *s, const double *q, const double *qd, const double *x)
+{
+    s->kc.mass(s->kc.ctx, q, s->mass);
+    return quad_form(s->nq, s->mass, qd, x);
 }
 
 /* E = T - W at the state y, and the drift against E(t0). */
@@ -266,6 +271,14 @@ static void watch_energy(Sim *s, const double *y, bool first)
 
 /* ---- right-hand side -------------------------------------------------------- */
 
+/* M at the state of the last mechrt_forward_dynamics: its workspace holds
+   it after Phi_q (runtime/dynamics.c: "a nr*nq | mass nq*nq | ..."),
+   which saves the energy balance a mass call per right-hand side. */
+static const double *dyn_mass(const Sim *s)
+{
+    return s->work + (size_t)s->nr * (size_t)s->nq;
+}
+
 static int sim_rhs(double t, const double y[], double f[], void *params)
 {
     Sim *s = params;
@@ -282,7 +295,7 @@ static int sim_rhs(double t, const double y[], double f[], void *params)
         if (s->nr > 0 && rep.pivot_ratio < s->res->min_pivot_ratio)
             s->res->min_pivot_ratio = rep.pivot_ratio;
         if (s->o->energy)
-            f[2 * n] = mass_form(s, q, qd, f + n) + half_mdot(s, q, qd);
+            f[2 * n] = quad_form(n, dyn_mass(s), qd, f + n) + half_mdot(s, q, qd);
         return GSL_SUCCESS;
     }
     if (s->fail_status == MECHRT_OK) {
