@@ -59,6 +59,9 @@
 
 /* Relative displacement of the central difference for Mdot qd. */
 #define SIM_MDOT_STEP 1e-5
+/* QR stands in for the projections' SVD where every pivot ratio exceeds
+   this many times their truncation tolerance (see min_norm_solve). */
+#define SIM_QR_MARGIN 100.0
 /* The step size is said to underflow below this share of |t1 - t0|. */
 #define SIM_HMIN_SHARE 1e-14
 
@@ -103,6 +106,7 @@ typedef struct Sim {
     size_t lwork;
     double *qrw;                 /* the projections' QR workspace (nr x nq) */
     size_t lqrw;
+    MechrtSvd *svd;              /* the same near a rank drop */
     double *jac, *nu, *resid, *dqd, *lambda, *mass, *mass2, *qs, *f0, *f1, *y;
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *drv;
@@ -342,13 +346,45 @@ static double project_tol(const Sim *s)
     return fmax(s->o->dyn.rank_tol, s->o->row_tol);
 }
 
-/* qd <- qd - x, x the least-norm solution of the rank's rows of
-   Phi_q x = Phi_q qd - nu (rank-revealing QR, runtime/qr.c): the nearest
-   velocities the rows allow. */
+/* x = the minimum-norm solution of A x = b, A the first m rows of s->jac,
+   with singular values below tol * sigma_max left alone (the projections'
+   semantics). Far from a rank drop nothing is truncated and the
+   rank-revealing QR (runtime/qr.c) gives the same x at a fraction of the
+   cost: taken when every row's pivot exceeds SIM_QR_MARGIN * tol times the
+   first (the pivots bound the singular values within modest factors);
+   otherwise the SVD. *zero: A = 0 (x untouched). */
+static MechrtStatus min_norm_solve(Sim *s, int m, double tol, const double *b, double *x,
+                                   bool *zero)
+{
+    int n = s->nq;
+    MechrtQr f;
+    MechrtSvdResult sv;
+    *zero = false;
+    MechrtStatus st = mechrt_qr_factor(&f, m, n, s->jac, n, fmin(0.5, SIM_QR_MARGIN * tol),
+                                       s->qrw, s->lqrw);
+    if (st != MECHRT_OK)
+        return st;
+    if (f.rank == m) {
+        s->res->qr_solves++;
+        mechrt_qr_solve(&f, b, x);
+        return MECHRT_OK;
+    }
+    if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
+        return MECHRT_ENOTFINITE;
+    if (!(sv.sigma_max > 0)) {
+        *zero = true;
+        return MECHRT_OK;
+    }
+    mechrt_svd_truncate(s->svd, tol * sv.sigma_max);
+    mechrt_svd_pinv_solve(s->svd, b, x);
+    return MECHRT_OK;
+}
+
+/* qd <- qd - pinv(Phi_q) (Phi_q qd - nu): the nearest velocities the rows allow. */
 static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, double t)
 {
     int n = s->nq, m = s->nr;
-    MechrtQr f;
+    bool zero;
     if (m == 0)
         return MECHRT_OK;
     s->kc.jac(s->kc.ctx, q, t, s->jac);
@@ -359,12 +395,9 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
             a += s->jac[(size_t)i * (size_t)n + (size_t)j] * qd[j];
         s->resid[i] = a;
     }
-    MechrtStatus st = mechrt_qr_factor(&f, m, n, s->jac, n, project_tol(s), s->qrw, s->lqrw);
-    if (st != MECHRT_OK)
-        return st;
-    if (f.rank == 0)
-        return MECHRT_OK;   /* Phi_q = 0: nothing constrains the velocities */
-    mechrt_qr_solve(&f, s->resid, s->dqd);
+    MechrtStatus st = min_norm_solve(s, m, project_tol(s), s->resid, s->dqd, &zero);
+    if (st != MECHRT_OK || zero)
+        return st;   /* Phi_q = 0: nothing constrains the velocities */
     for (int j = 0; j < n; j++) {
         qd[j] -= s->dqd[j];
         if (!isfinite(qd[j]))
@@ -394,9 +427,9 @@ static MechrtStatus eval_phi(Sim *s, const double *q, double t, MechrtReport *re
     return MECHRT_OK;
 }
 
-/* Minimum-norm Newton onto Phi(q, t) = 0: dq = the least-norm solution of
-   the rank's rows of Phi_q dq = -Phi (QR as for the velocities), at least
-   one step, until |Phi| <= tol_phi and |dq| <= tol_dq. */
+/* Minimum-norm Newton onto Phi(q, t) = 0 (as mechrt_host_project, without
+   its SVD per step where QR does): dq = -pinv(Phi_q) Phi truncated at
+   pivot_tol, at least one step, until |Phi| <= tol_phi and |dq| <= tol_dq. */
 static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q, double t,
                                       MechrtReport *rep)
 {
@@ -415,14 +448,13 @@ static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q,
             return MECHRT_OK;
         if (rep->iterations >= o->max_iter)
             return MECHRT_EMAXITER;
-        MechrtQr f;
+        bool zero;
         s->kc.jac(s->kc.ctx, q, t, s->jac);
-        st = mechrt_qr_factor(&f, nh, n, s->jac, n, o->pivot_tol, s->qrw, s->lqrw);
+        st = min_norm_solve(s, nh, o->pivot_tol, s->resid, s->dqd, &zero);
         if (st != MECHRT_OK)
             return st;
-        if (f.rank == 0)
+        if (zero)
             return MECHRT_ESING;   /* Phi_q = 0: no direction to move in */
-        mechrt_qr_solve(&f, s->resid, s->dqd);
         double step = 0;
         for (int j = 0; j < n; j++) {
             if (!isfinite(s->dqd[j]))
@@ -529,6 +561,9 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->dyn.active = s->active;
     s->lqrw = m > 0 ? mechrt_qr_work_len((int)m, k->nq) : 0;
     s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
+    s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
+    if (m > 0 && !s->svd)
+        return false;
     /* W's error must not steer the step: its absolute scale is huge */
     double *scale = xcalloc((size_t)s->dim, sizeof *scale);
     for (int i = 0; i < s->dim; i++)
@@ -550,6 +585,7 @@ static void sim_close(Sim *s)
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
     free(s->y), free(s->active);
     free(s->qrw);
+    mechrt_svd_free(s->svd);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
 }
