@@ -33,8 +33,9 @@
  * keeps at a state on the manifold, and MechrtDynOptions.active leaves the
  * others out (as zero rows, never pivoted on) for the stages of the step.
  *
- * Cost: O(nr nq r) for the elimination, O(nq^2 (nq - r)) for Z^T M Z; the
- * mechanisms this serves have tens of coordinates. No square root is
+ * Cost: the elimination visits the pivot row's nonzeros and keeps each
+ * row's largest entry (a sparse Phi_q: about O(nr nq) per call, O(nr nq r)
+ * dense); Z^T M Z over M's nonzeros, O(nnz(M) (nq - r) + nq (nq - r)^2). No square root is
  * needed (no library call: the runtime's rule).
  *
  * Workspace (MECHRT_DYN_WORKSPACE_LEN): a nr*nq | mass nq*nq | z nq*nq |

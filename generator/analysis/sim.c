@@ -10,10 +10,11 @@
  *
  * Drift: the integrator keeps Phi = 0 and Phi_q qd = nu only to its error,
  * and the error grows (index reduction). So the state is projected back:
- * positions by minimum-norm Newton onto Phi(q, t) = 0 (mechrt_host_project:
- * SVD, redundant rows harmless), then velocities by the minimum-norm
- * correction onto Phi_q qd = nu (one pseudo-inverse solve; every row,
- * velocity-level ones too) (Hairer & Wanner, Solving ODEs II, VII.2).
+ * positions by minimum-norm Newton onto Phi(q, t) = 0, then velocities by
+ * the minimum-norm correction onto Phi_q qd = nu (every row, velocity-level
+ * ones too) (Hairer & Wanner, Solving ODEs II, VII.2): pseudo-inverse
+ * solves, by rank-revealing QR away from a rank drop and by the truncated
+ * SVD near one (min_norm_solve; redundant rows harmless).
  * One-step methods project after every accepted integrator step; msbdf,
  * whose history a change of the state would invalidate, projects at the
  * output times only and restarts there. Baumgarte's stabilisation
