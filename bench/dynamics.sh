@@ -2,7 +2,7 @@
 # bench/dynamics.sh MECHC - forward dynamics timed: Andrews' squeezer to t = 0.03, IFToMM A02 over 20 s, and the dynamics kernels per engine.
 #
 #   sh bench/dynamics.sh build/mechc                  (part of `make bench`)
-#   A02_N=40 A02_T1=2 REPEAT=3 sh bench/dynamics.sh build/mechc
+#   A02_N=40 A02_T1=1 REPEAT=3 sh bench/dynamics.sh build/mechc   (A02 over 1 s: quick)
 #
 # 1. Andrews (examples/andrews.mech, jit, rk8pd, --rtol/--atol 1e-8: the
 #    loosest tolerance that keeps 7 correct digits with a margin): the CPU

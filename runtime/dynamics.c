@@ -33,8 +33,9 @@
  * keeps at a state on the manifold, and MechrtDynOptions.active leaves the
  * others out (as zero rows, never pivoted on) for the stages of the step.
  *
- * Cost: O(nr nq r) for the elimination, O(nq^2 (nq - r)) for Z^T M Z; the
- * mechanisms this serves have tens of coordinates. No square root is
+ * Cost: the elimination visits the pivot row's nonzeros and keeps each
+ * row's largest entry (a sparse Phi_q: about O(nr nq) per call, O(nr nq r)
+ * dense); Z^T M Z over M's nonzeros, O(nnz(M) (nq - r) + nq (nq - r)^2). No square root is
  * needed (no library call: the runtime's rule).
  *
  * Workspace (MECHRT_DYN_WORKSPACE_LEN): a nr*nq | mass nq*nq | z nq*nq |
@@ -52,6 +53,7 @@ typedef struct DynWork {
     mechrt_real *kb, *gm;       /* K (r x d); K^T K + I (d x d) */
     mechrt_real *force, *cpiv, *hpiv, *v1, *v2, *v3;
     mechrt_real *g, *phi, *nu, *rpiv, *y, *ypiv;
+    long mnz;                   /* M's nonzeros packed in kb.., -1: use M dense */
 } DynWork;
 
 /* Entry (i, j) of a row-major matrix with leading dimension ld. */
@@ -144,6 +146,7 @@ static MechrtStatus dyn_setup(const MechrtKernels *k, mechrt_real *work, size_t 
     w->rpiv = w->nu + m;
     w->y = w->rpiv + m;
     w->ypiv = w->y + m;
+    w->mnz = -1;
     return MECHRT_OK;
 }
 
@@ -154,9 +157,24 @@ static void dyn_swap(mechrt_real *a, mechrt_real *b)
     *b = t;
 }
 
+/* max |a_ij| over j >= k of row i (-1 without columns): the pivot
+   search's row maxima, kept up to date instead of a full scan per step. */
+static mechrt_real dyn_row_max(const DynWork *w, int i, int k)
+{
+    mechrt_real best = -1;
+    int j;
+
+    for (j = k; j < w->n; j++)
+        if (MECHRT_FABS(AT(w->a, i, j, w->n)) > best)
+            best = MECHRT_FABS(AT(w->a, i, j, w->n));
+    return best;
+}
+
 /* Step k of the complete-pivoting elimination: the largest |a_ij|, i, j >= k,
-   into (*p, *c), its magnitude returned. */
-static mechrt_real dyn_pivot_search(const DynWork *w, int k, int *p, int *c)
+   into (*p, *c), its magnitude returned; the first in row-major order, as a
+   full scan would find it, from the row maxima rmax. */
+static mechrt_real dyn_pivot_search(const DynWork *w, const mechrt_real *rmax, int k, int *p,
+                                    int *c)
 {
     mechrt_real best = -1;
     int i, j;
@@ -164,54 +182,77 @@ static mechrt_real dyn_pivot_search(const DynWork *w, int k, int *p, int *c)
     *p = k;
     *c = k;
     for (i = k; i < w->m; i++)
-        for (j = k; j < w->n; j++) {
-            mechrt_real v = MECHRT_FABS(AT(w->a, i, j, w->n));
-            if (v > best) {
-                best = v;
-                *p = i;
-                *c = j;
-            }
+        if (rmax[i] > best) {
+            best = rmax[i];
+            *p = i;
+        }
+    for (j = k; j < w->n; j++)
+        if (MECHRT_FABS(AT(w->a, *p, j, w->n)) == best) {
+            *c = j;
+            break;
         }
     return best;
+}
+
+/* Rows k+1.. minus their multiple of pivot row k, over the pivot row's
+   nonzeros only (listed in nz: Jacobians are sparse); rows touched get
+   their maxima over the columns after k again. */
+static void dyn_eliminate(DynWork *w, int k, mechrt_real *rmax, mechrt_real *nz)
+{
+    int m = w->m, n = w->n, i, j, len = 0, t;
+    mechrt_real pivot = AT(w->a, k, k, n);
+
+    for (j = k + 1; j < n; j++)
+        if (AT(w->a, k, j, n) != 0)
+            nz[len++] = (mechrt_real)j;
+    for (i = k + 1; i < m; i++) {
+        mechrt_real aik = AT(w->a, i, k, n), l = aik / pivot;
+        AT(w->a, i, k, n) = l;
+        if (l != 0)
+            for (t = 0; t < len; t++) {
+                j = (int)nz[t];
+                AT(w->a, i, j, n) -= l * AT(w->a, k, j, n);
+            }
+        if (aik != 0)
+            rmax[i] = dyn_row_max(w, i, k + 1);
+    }
 }
 
 /* P Phi_q Qc = L U in place (LAPACK-style interchanges: at step k row k
    with rpiv[k], column k with cpiv[k]), stopped at the first pivot
    <= rank_tol * max|a_ij|. Returns the rank r; *ratio = smallest pivot /
-   max|a_ij| (1 without rows or with a zero matrix). */
+   max|a_ij| (1 without rows or with a zero matrix). Scratch: kb holds the
+   row maxima (m), h the pivot row's nonzero columns (n); both are free
+   until the null-space steps. */
 static int dyn_factor(DynWork *w, mechrt_real rank_tol, mechrt_real *ratio)
 {
     int m = w->m, n = w->n, kmax = m < n ? m : n, i, j, k, p, c;
-    mechrt_real amax = 0, thresh;
+    mechrt_real amax = 0, thresh, *rmax = w->kb;
 
-    for (i = 0; i < m; i++)
-        for (j = 0; j < n; j++)
-            if (MECHRT_FABS(AT(w->a, i, j, n)) > amax)
-                amax = MECHRT_FABS(AT(w->a, i, j, n));
+    for (i = 0; i < m; i++) {
+        rmax[i] = dyn_row_max(w, i, 0);
+        if (rmax[i] > amax)
+            amax = rmax[i];
+    }
     *ratio = 1;
     thresh = rank_tol * amax;
     for (k = 0; k < kmax; k++) {
-        mechrt_real best = dyn_pivot_search(w, k, &p, &c), pivot;
+        mechrt_real best = dyn_pivot_search(w, rmax, k, &p, &c);
         if (!(best > thresh) || best == 0)
             break;
         if (best / amax < *ratio)
             *ratio = best / amax;
         w->rpiv[k] = (mechrt_real)p;
         w->cpiv[k] = (mechrt_real)c;
-        if (p != k)
+        if (p != k) {
             for (j = 0; j < n; j++)
                 dyn_swap(&AT(w->a, k, j, n), &AT(w->a, p, j, n));
+            dyn_swap(&rmax[k], &rmax[p]);
+        }
         if (c != k)
             for (i = 0; i < m; i++)
                 dyn_swap(&AT(w->a, i, k, n), &AT(w->a, i, c, n));
-        pivot = AT(w->a, k, k, n);
-        for (i = k + 1; i < m; i++) {
-            mechrt_real l = AT(w->a, i, k, n) / pivot;
-            AT(w->a, i, k, n) = l;
-            if (l != 0)
-                for (j = k + 1; j < n; j++)
-                    AT(w->a, i, j, n) -= l * AT(w->a, k, j, n);
-        }
+        dyn_eliminate(w, k, rmax, w->h);
     }
     return k;
 }
@@ -282,11 +323,46 @@ static void dyn_null_basis(const DynWork *w, int r)
     }
 }
 
-/* y = M x (n). */
+/* M's nonzeros, row by row, as (i n + j, m_ij) pairs into kb and gm (2 m^2
+   reals, free from the end of dyn_factor until dyn_min_norm) when they fit:
+   a mass matrix is mostly zeros (diagonal for planar bodies about their
+   centres), and dyn_reduced multiplies by it n - r times. */
+static void dyn_mass_pack(DynWork *w)
+{
+    size_t n = (size_t)w->n, cap = 2u * (size_t)w->m * (size_t)w->m, cnt = 0, i;
+
+    w->mnz = -1;
+    for (i = 0; i < n * n; i++)
+        if (w->mass[i] != 0)
+            cnt++;
+    if (2u * cnt > cap || (size_t)(mechrt_real)(n * n) != n * n)
+        return;     /* no room, or an index a float cannot hold */
+    cnt = 0;
+    for (i = 0; i < n * n; i++)
+        if (w->mass[i] != 0) {
+            w->kb[2u * cnt] = (mechrt_real)i;
+            w->kb[2u * cnt + 1u] = w->mass[i];
+            cnt++;
+        }
+    w->mnz = (long)cnt;
+}
+
+/* y = M x (n): from the packed nonzeros when there are, summed in the same
+   order as the dense rows (the zeros add nothing). */
 static void dyn_mass_times(const DynWork *w, const mechrt_real *x, mechrt_real *y)
 {
     int i, j;
+    long t;
 
+    if (w->mnz >= 0) {
+        for (i = 0; i < w->n; i++)
+            y[i] = 0;
+        for (t = 0; t < w->mnz; t++) {
+            long ij = (long)w->kb[2 * t];
+            y[ij / w->n] += w->kb[2 * t + 1] * x[ij % w->n];
+        }
+        return;
+    }
     for (i = 0; i < w->n; i++) {
         mechrt_real s = 0;
         for (j = 0; j < w->n; j++)
@@ -513,6 +589,7 @@ MechrtStatus mechrt_forward_dynamics(const MechrtKernels *k, const MechrtDynOpti
     if (st != MECHRT_OK)
         return st;
     r = dyn_factor(&w, o.rank_tol, &ratio);
+    dyn_mass_pack(&w);      /* until dyn_lambda's dyn_min_norm */
     inconsistency = dyn_solve_l(&w, r, w.g);
     for (i = 0; i < w.n; i++)
         qdd[i] = i < r ? w.g[i] : MECHRT_R(0.0);

@@ -695,6 +695,9 @@ static void test_double_pendulum_energy(void **state)
     assert_true(c->phi_res < 1e-10);
     assert_true(res.steps > 100);
     assert_true(res.projections >= res.steps);
+    /* full rank far from any singular position: every projection solve
+       (each Newton iteration, each velocity correction) by QR, no SVD */
+    assert_int_equal(res.qr_solves, res.projections + res.projection_iterations);
     assert_true(res.calls.mass > 0 && res.calls.force == res.rhs_calls + c->n);
     free(c);
 }
@@ -768,6 +771,9 @@ static void test_redundant_simulation(void **state)
         assert_true(c->phi_res < 1e-8);
         if (method >= SIM_RK4IMP)
             assert_true(res.jacobian_calls > 0);
+        /* a redundant row always: the projections' truncated SVD, never QR */
+        assert_true(res.projections > 0);
+        assert_int_equal(res.qr_solves, 0);
         free(c);
     }
 }

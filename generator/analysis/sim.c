@@ -10,10 +10,11 @@
  *
  * Drift: the integrator keeps Phi = 0 and Phi_q qd = nu only to its error,
  * and the error grows (index reduction). So the state is projected back:
- * positions by minimum-norm Newton onto Phi(q, t) = 0 (mechrt_host_project:
- * SVD, redundant rows harmless), then velocities by the minimum-norm
- * correction onto Phi_q qd = nu (one pseudo-inverse solve; every row,
- * velocity-level ones too) (Hairer & Wanner, Solving ODEs II, VII.2).
+ * positions by minimum-norm Newton onto Phi(q, t) = 0, then velocities by
+ * the minimum-norm correction onto Phi_q qd = nu (every row, velocity-level
+ * ones too) (Hairer & Wanner, Solving ODEs II, VII.2): pseudo-inverse
+ * solves, by rank-revealing QR away from a rank drop and by the truncated
+ * SVD near one (min_norm_solve; redundant rows harmless).
  * One-step methods project after every accepted integrator step; msbdf,
  * whose history a change of the state would invalidate, projects at the
  * output times only and restarts there. Baumgarte's stabilisation
@@ -59,6 +60,9 @@
 
 /* Relative displacement of the central difference for Mdot qd. */
 #define SIM_MDOT_STEP 1e-5
+/* QR stands in for the projections' SVD where every pivot ratio exceeds
+   this many times their truncation tolerance (see min_norm_solve). */
+#define SIM_QR_MARGIN 100.0
 /* The step size is said to underflow below this share of |t1 - t0|. */
 #define SIM_HMIN_SHARE 1e-14
 
@@ -101,8 +105,9 @@ typedef struct Sim {
     int nq, nr, dim;             /* dim: 2 nq (+1 with energy) */
     double *work;                /* mechrt_forward_dynamics' workspace */
     size_t lwork;
-    MechrtHost *host;            /* position projection */
-    MechrtSvd *svd;              /* velocity projection, nr x nq */
+    double *qrw;                 /* the projections' QR workspace (nr x nq) */
+    size_t lqrw;
+    MechrtSvd *svd;              /* the same near a rank drop */
     double *jac, *nu, *resid, *dqd, *lambda, *mass, *mass2, *qs, *f0, *f1, *y;
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *drv;
@@ -238,16 +243,21 @@ static double half_mdot(Sim *s, const double *q, const double *qd)
     return 0.25 * sum / eps;    /* 1/2 * (quad+ - quad-) / (2 eps) */
 }
 
-/* qd^T M x with M at q (one mass call). */
-static double mass_form(Sim *s, const double *q, const double *qd, const double *x)
+/* qd^T M x for the n x n row-major M. */
+static double quad_form(int n, const double *m, const double *qd, const double *x)
 {
-    int n = s->nq;
-    s->kc.mass(s->kc.ctx, q, s->mass);
     double sum = 0;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
-            sum += qd[i] * s->mass[(size_t)i * (size_t)n + (size_t)j] * x[j];
+            sum += qd[i] * m[(size_t)i * (size_t)n + (size_t)j] * x[j];
     return sum;
+}
+
+/* qd^T M x with M at q (one mass call). */
+static double mass_form(Sim *s, const double *q, const double *qd, const double *x)
+{
+    s->kc.mass(s->kc.ctx, q, s->mass);
+    return quad_form(s->nq, s->mass, qd, x);
 }
 
 /* E = T - W at the state y, and the drift against E(t0). */
@@ -266,6 +276,14 @@ static void watch_energy(Sim *s, const double *y, bool first)
 
 /* ---- right-hand side -------------------------------------------------------- */
 
+/* M at the state of the last mechrt_forward_dynamics: its workspace holds
+   it after Phi_q (runtime/dynamics.c: "a nr*nq | mass nq*nq | ..."),
+   which saves the energy balance a mass call per right-hand side. */
+static const double *dyn_mass(const Sim *s)
+{
+    return s->work + (size_t)s->nr * (size_t)s->nq;
+}
+
 static int sim_rhs(double t, const double y[], double f[], void *params)
 {
     Sim *s = params;
@@ -282,7 +300,7 @@ static int sim_rhs(double t, const double y[], double f[], void *params)
         if (s->nr > 0 && rep.pivot_ratio < s->res->min_pivot_ratio)
             s->res->min_pivot_ratio = rep.pivot_ratio;
         if (s->o->energy)
-            f[2 * n] = mass_form(s, q, qd, f + n) + half_mdot(s, q, qd);
+            f[2 * n] = quad_form(n, dyn_mass(s), qd, f + n) + half_mdot(s, q, qd);
         return GSL_SUCCESS;
     }
     if (s->fail_status == MECHRT_OK) {
@@ -320,11 +338,54 @@ static int sim_jacobian(double t, const double y[], double *dfdy, double dfdt[],
 
 /* ---- projection ------------------------------------------------------------- */
 
+/* The rows' tolerance of both projections (row_tol): redundant rows, and
+   near a rank drop the row becoming dependent, are left alone; a small
+   pivot there would turn the integration's error into a large change of
+   position or speed (energy). */
+static double project_tol(const Sim *s)
+{
+    return fmax(s->o->dyn.rank_tol, s->o->row_tol);
+}
+
+/* x = the minimum-norm solution of A x = b, A the first m rows of s->jac,
+   with singular values below tol * sigma_max left alone (the projections'
+   semantics). Far from a rank drop nothing is truncated and the
+   rank-revealing QR (runtime/qr.c) gives the same x at a fraction of the
+   cost: taken when every row's pivot exceeds SIM_QR_MARGIN * tol times the
+   first (the pivots bound the singular values within modest factors);
+   otherwise the SVD. *zero: A = 0 (x untouched). */
+static MechrtStatus min_norm_solve(Sim *s, int m, double tol, const double *b, double *x,
+                                   bool *zero)
+{
+    int n = s->nq;
+    MechrtQr f;
+    MechrtSvdResult sv;
+    *zero = false;
+    MechrtStatus st = mechrt_qr_factor(&f, m, n, s->jac, n, fmin(0.5, SIM_QR_MARGIN * tol),
+                                       s->qrw, s->lqrw);
+    if (st != MECHRT_OK)
+        return st;
+    if (f.rank == m) {
+        s->res->qr_solves++;
+        mechrt_qr_solve(&f, b, x);
+        return MECHRT_OK;
+    }
+    if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
+        return MECHRT_ENOTFINITE;
+    if (!(sv.sigma_max > 0)) {
+        *zero = true;
+        return MECHRT_OK;
+    }
+    mechrt_svd_truncate(s->svd, tol * sv.sigma_max);
+    mechrt_svd_pinv_solve(s->svd, b, x);
+    return MECHRT_OK;
+}
+
 /* qd <- qd - pinv(Phi_q) (Phi_q qd - nu): the nearest velocities the rows allow. */
 static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, double t)
 {
     int n = s->nq, m = s->nr;
-    MechrtSvdResult sv;
+    bool zero;
     if (m == 0)
         return MECHRT_OK;
     s->kc.jac(s->kc.ctx, q, t, s->jac);
@@ -335,15 +396,9 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
             a += s->jac[(size_t)i * (size_t)n + (size_t)j] * qd[j];
         s->resid[i] = a;
     }
-    if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
-        return MECHRT_ENOTFINITE;
-    if (!(sv.sigma_max > 0))
-        return MECHRT_OK;   /* Phi_q = 0: nothing constrains the velocities */
-    /* as the rows of the step (row_tol): near a rank drop the direction
-       becoming dependent is left alone; a small singular value there would
-       turn the integration's error into a large change of speed (energy) */
-    mechrt_svd_truncate(s->svd, fmax(s->o->dyn.rank_tol, s->o->row_tol) * sv.sigma_max);
-    mechrt_svd_pinv_solve(s->svd, s->resid, s->dqd);
+    MechrtStatus st = min_norm_solve(s, m, project_tol(s), s->resid, s->dqd, &zero);
+    if (st != MECHRT_OK || zero)
+        return st;   /* Phi_q = 0: nothing constrains the velocities */
     for (int j = 0; j < n; j++) {
         qd[j] -= s->dqd[j];
         if (!isfinite(qd[j]))
@@ -352,16 +407,75 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
     return MECHRT_OK;
 }
 
+/* ||Phi(q, t)||_inf over the holonomic rows into rep (Phi in s->resid). */
+static MechrtStatus eval_phi(Sim *s, const double *q, double t, MechrtReport *rep)
+{
+    s->kc.phi(s->kc.ctx, q, t, s->resid);
+    rep->residual = 0;
+    rep->worst_row = 0;
+    for (int i = 0; i < s->inner->nh; i++) {
+        double a = fabs(s->resid[i]);
+        if (!isfinite(a)) {
+            rep->residual = a;
+            rep->worst_row = i;
+            return MECHRT_ENOTFINITE;
+        }
+        if (a > rep->residual) {
+            rep->residual = a;
+            rep->worst_row = i;
+        }
+    }
+    return MECHRT_OK;
+}
+
+/* Minimum-norm Newton onto Phi(q, t) = 0 (as mechrt_host_project, without
+   its SVD per step where QR does): dq = -pinv(Phi_q) Phi truncated at
+   pivot_tol, at least one step, until |Phi| <= tol_phi and |dq| <= tol_dq. */
+static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q, double t,
+                                      MechrtReport *rep)
+{
+    int n = s->nq, nh = s->inner->nh;
+    memset(rep, 0, sizeof *rep);
+    rep->step = -1;
+    rep->worst_row = -1;
+    rep->sing_index = -1;
+    if (nh == 0)
+        return MECHRT_OK;
+    for (;;) {
+        MechrtStatus st = eval_phi(s, q, t, rep);
+        if (st != MECHRT_OK)
+            return st;
+        if (rep->step >= 0 && rep->residual <= o->tol_phi && rep->step <= o->tol_dq)
+            return MECHRT_OK;
+        if (rep->iterations >= o->max_iter)
+            return MECHRT_EMAXITER;
+        bool zero;
+        s->kc.jac(s->kc.ctx, q, t, s->jac);
+        st = min_norm_solve(s, nh, o->pivot_tol, s->resid, s->dqd, &zero);
+        if (st != MECHRT_OK)
+            return st;
+        if (zero)
+            return MECHRT_ESING;   /* Phi_q = 0: no direction to move in */
+        double step = 0;
+        for (int j = 0; j < n; j++) {
+            if (!isfinite(s->dqd[j]))
+                return MECHRT_ENOTFINITE;
+            q[j] -= s->dqd[j];
+            step = fmax(step, fabs(s->dqd[j]));
+        }
+        rep->step = step;
+        rep->iterations++;
+    }
+}
+
 /* Positions onto Phi = 0, then velocities onto Phi_q qd = nu; fails with the message set. */
 static bool project_state(Sim *s, double *y, double t)
 {
     MechrtOptions po = s->o->mechrt;
     MechrtReport rep;
-    /* redundant rows, and near a rank drop the row becoming dependent, are
-       left alone as in the velocities (row_tol) */
-    po.pivot_tol = fmax(s->o->dyn.rank_tol, s->o->row_tol);
+    po.pivot_tol = project_tol(s);
     s->res->projections++;
-    MechrtStatus st = mechrt_host_project(s->host, &po, y, t, &rep);
+    MechrtStatus st = project_positions(s, &po, y, t, &rep);
     s->res->projection_iterations += rep.iterations;
     if (st != MECHRT_OK) {
         fail(s, st, t, "position projection");
@@ -446,9 +560,10 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->active = xcalloc(m + 1, sizeof *s->active);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
-    s->host = mechrt_host_new(&s->kc);
+    s->lqrw = m > 0 ? mechrt_qr_work_len((int)m, k->nq) : 0;
+    s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
     s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
-    if (!s->host || (m > 0 && !s->svd))
+    if (m > 0 && !s->svd)
         return false;
     /* W's error must not steer the step: its absolute scale is huge */
     double *scale = xcalloc((size_t)s->dim, sizeof *scale);
@@ -470,7 +585,7 @@ static void sim_close(Sim *s)
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
     free(s->y), free(s->active);
-    mechrt_host_free(s->host);
+    free(s->qrw);
     mechrt_svd_free(s->svd);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);

@@ -80,6 +80,7 @@ typedef struct SimResult {
     long rhs_calls;              /* forward-dynamics solves for the integrator */
     long jacobian_calls;         /* finite-difference Jacobians (implicit methods) */
     long projections;            /* position + velocity projections */
+    long qr_solves;              /* projection solves by QR (the others: SVD near a rank drop) */
     long projection_iterations;  /* Newton iterations in the position ones */
     SimKernelCalls calls;
     int max_redundant;           /* most rows found dependent at once */
