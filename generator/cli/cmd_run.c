@@ -395,18 +395,9 @@ static int report(const RunCli *c, const Model *m, const RunOutput *out, const R
         run_output_json(stdout, out, rs == RUN_FAILED ? res->message : NULL, res->t_fail);
     if (c->table && rs == RUN_OK && out->trace.rows == 1)
         print_table(m, out, res, c->digits);
-    if (rs == RUN_FAILED) {
-        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
-        if (res->states > 0)
-            fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file,
-                    res->states, res->states == 1 ? "state" : "states", res->t_fail,
-                    res->states == 1 ? "is" : "are");
+    if (run_output_report_failure(out, m, rs == RUN_FAILED ? res->message : NULL, res->states,
+                                  res->t_fail))
         status = EXIT_ANALYSIS;
-    }
-    if (out->full) {
-        fprintf(stderr, "mechc run: error: out of memory keeping the states for JSON\n");
-        status = EXIT_ANALYSIS;
-    }
     if (c->stats)
         print_stats(res, k, jnz, last->q, last->qd, last->t, c->forces);
     return status;

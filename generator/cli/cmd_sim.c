@@ -192,18 +192,9 @@ static int report(const SimCli *c, const Model *m, const RunOutput *out, const R
         status = EXIT_USAGE;        /* as run: a file that cannot be written */
     if (c->json)
         run_output_json(stdout, out, st == SIM_FAILED ? res->message : NULL, res->t_fail);
-    if (st == SIM_FAILED) {
-        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
-        if (res->states > 0)
-            fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file,
-                    res->states, res->states == 1 ? "state" : "states", res->t_fail,
-                    res->states == 1 ? "is" : "are");
+    if (run_output_report_failure(out, m, st == SIM_FAILED ? res->message : NULL, res->states,
+                                  res->t_fail))
         status = EXIT_ANALYSIS;
-    }
-    if (out->full) {
-        fprintf(stderr, "mechc sim: error: out of memory keeping the states for JSON\n");
-        status = EXIT_ANALYSIS;
-    }
     if (c->stats)
         print_stats(res, m->nr);
     return status;

@@ -299,3 +299,17 @@ bool run_output_pictures(const RunOutput *out, const RunPictures *p)
     free(t), free(q);
     return ok;
 }
+
+bool run_output_report_failure(const RunOutput *out, const Model *m, const char *message,
+                               int states, double t_fail)
+{
+    if (message) {
+        fprintf(stderr, "%s: error: %s\n", m->file, message);
+        if (states > 0)
+            fprintf(stderr, "%s: note: the %d %s before t = %.10g %s written\n", m->file, states,
+                    states == 1 ? "state" : "states", t_fail, states == 1 ? "is" : "are");
+    }
+    if (out->full)
+        fprintf(stderr, "mechc %s: error: out of memory keeping the states for JSON\n", out->cmd);
+    return message || out->full;
+}

@@ -75,6 +75,12 @@ void run_output_kinematic_state(void *out, double t, const double *q, const doub
    kept. error_message NULL: "ok": true. */
 void run_output_json(FILE *f, const RunOutput *out, const char *error_message, double error_t);
 
+/* After the analysis: its failure (message, and how many states before
+   t_fail were written) and a JSON store that ran out of memory, on stderr.
+   True when either happened (exit status 1). */
+bool run_output_report_failure(const RunOutput *out, const Model *m, const char *message,
+                               int states, double t_fail);
+
 /* The --trace points and --plot variables, resolved. */
 typedef struct RunPictures {
     SvgTrace traces[RUN_OUTPUT_MAX_TRACES];
