@@ -358,7 +358,27 @@ static const BadCase bad_cases[] = {
     {PRE "mass a m = 1\ngravity (0, -9.81)\ngravity (0, 1)\n", 7, 1, "a second gravity statement"},
     {PRE "gravity (0, -9.81)\n", 5, 1, "gravity without masses"},
     {PRE "force F: a (1, 0)\n", 5, 1, "a force without masses"},
-    {"spatial\nbody a\nspherical O: ground a\nmass a m = 1\n", 4, 1, "'mass' is planar only for now"},
+#define SPRE "spatial\nbody a z = -1\npoint p\nspherical O: ground a\n"
+    {SPRE "mass a m = -1\n", 5, 8, "the mass m of mass 'a' is negative"},
+    {SPRE "mass a m = 1 J = (-1, 1, 1)\n", 5, 19, "the moment of inertia Jxx of mass 'a' is negative"},
+    {SPRE "mass a m = 1 J = (1, 1, 1) Jxy = 2\n", 5, 14,
+     "the inertia tensor of 'a' is not positive definite: its principal moments are -1, 1, 3"},
+    {SPRE "mass a m = 1 J = (1, 1, 0)\n", 5, 14, "the inertia tensor of 'a' is not positive definite"},
+    {SPRE "mass a m = 1 J = (1, 1, 3)\n", 5, 14, "1 + 1 < 3 break the triangle inequality"},
+    {SPRE "mass a m = 1 Jxy = 0.1\n", 5, 14, "'Jxy' without J = (Jxx, Jyy, Jzz)"},
+    {SPRE "mass a m = 1 J = 2\n", 5, 18, "expected '(' after J = (Jxx, Jyy, Jzz)"},
+    {SPRE "mass p m = 1 J = (1, 1, 1)\n", 5, 14, "'p' is a point (a particle)"},
+    {SPRE "mass a m = 1 angle = 2\n", 5, 14, "unknown key 'angle' for mass 'a': expected m, J, Jxy, "
+     "Jxz, Jyz or com(sx, sy, sz)"},
+    {SPRE "mass e: at(1, 2) m = 1\n", 5, 16, "at(x, y, z) has three components, found two"},
+    {SPRE "mass a m = 1\ngravity (0, -9.81)\n", 6, 18, "gravity (gx, gy, gz) has three components"},
+    {SPRE "mass a m = 1\ntorque T: a = 1\n", 6, 15, "expected '(' after the torque (tx, ty, tz)"},
+    {SPRE "mass a m = 1\nrspring R: O k = 1\n", 6, 12, "a spatial rspring acts about a revolute's "
+     "or cylindrical's axis; 'O' is spherical"},
+    {SPRE "mass a m = 1\ntorque T: angle(O) = 1\n", 6, 17, "angle(O) takes a revolute or cylindrical"},
+    {SPRE "mass a m = 1\nspring S: a a k = 1\n", 6, 13, "spring 'S' joins a point to itself"},
+    {SPRE "mass a m = 1\nforce F: ground(1, 2, 3) (1, 0, 0)\n", 6, 10, "acts on ground only"},
+#undef SPRE
 };
 
 static void test_bad_input(void **state)

@@ -129,10 +129,182 @@ static void add_body(DynWork *w, const MassElement *e)
     accumulate(w, w->applied, phi, dot2(d, uy, mgx, ux, mgy));
 }
 
+/* ---- spatial: Euler-parameter bodies ---- */
+
+/* G(e) and E(e) of the Euler parameters e = (e0, e1, e2, e3) (Nikravesh,
+   Computer-Aided Analysis of Mechanical Systems, ch. 6 and 11): body-axes
+   and global angular velocity w' = 2 G ed, w = 2 E ed. Entry (i, k) is
+   sign * e[index]. */
+typedef struct EulerEntry {
+    signed char sign, index;
+} EulerEntry;
+
+static const EulerEntry euler_G[3][4] = {
+    {{-1, 1}, {1, 0}, {1, 3}, {-1, 2}},
+    {{-1, 2}, {-1, 3}, {1, 0}, {1, 1}},
+    {{-1, 3}, {1, 2}, {-1, 1}, {1, 0}},
+};
+static const EulerEntry euler_E[3][4] = {
+    {{-1, 1}, {1, 0}, {-1, 3}, {1, 2}},
+    {{-1, 2}, {1, 3}, {1, 0}, {-1, 1}},
+    {{-1, 3}, {-1, 2}, {1, 1}, {1, 0}},
+};
+
+/* The 3 x 4 matrix table(v) over four nodes v (the parameters or their rates). */
+static void euler_matrix(Dag *d, const EulerEntry table[3][4], const NodeId v[4], NodeId out[3][4])
+{
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 4; k++) {
+            NodeId x = v[table[i][k].index];
+            out[i][k] = table[i][k].sign < 0 ? dag_neg(d, x) : x;
+        }
+}
+
+/* J' (xx, yy, zz, xy, xz, yz) entry (i, j). */
+static double tensor_at(const double t[6], int i, int j)
+{
+    static const int at[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    return t[at[i][j]];
+}
+
+/* sum_j c[j] v[j] over three constants and nodes, zeros left out */
+static NodeId weighted3(Dag *d, const double c[3], NodeId const v[3])
+{
+    NodeId sum = DAG_ZERO;
+    for (int j = 0; j < 3; j++) {
+        if (c[j] == 0)
+            continue;
+        NodeId term = dag_mul(d, dag_const(d, c[j]), v[j]);
+        sum = dag_add(d, sum, term);
+    }
+    return sum;
+}
+
+/* A spatial body's rotation: T = 1/2 w'^T J' w', w' = 2 G ed, linear in
+   ed with G linear in e. Lagrange's equations with G(a) b = -G(b) a (so
+   Gd ed = 0 and d(G ed)/de = -Gd, Gd = G(ed)) give
+     M_ee += 4 G^T J' G,   Q_e += -4 Gd^T J' w' = 8 Gd^T J' Gd e
+   (Nikravesh eq. 11.27's velocity term). G e = 0, so M has e in its null
+   space; the row e.e - 1 makes the augmented matrix regular. */
+static void add_rotation(DynWork *w, const MassElement *e)
+{
+    Dag *d = w->dag;
+    NodeId p[4], pd[4], G[3][4], Gd[3][4];
+    for (int k = 0; k < 4; k++) {
+        p[k] = dag_var(d, e->euler + k);
+        pd[k] = dag_vard(d, e->euler + k);
+    }
+    euler_matrix(d, euler_G, p, G);
+    euler_matrix(d, euler_G, pd, Gd);
+    double J[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            J[i][j] = tensor_at(e->inertia, i, j);
+    for (int b = 0; b < 4 && !d->overflow; b++) {
+        NodeId col[3] = {G[0][b], G[1][b], G[2][b]}, jg[3];
+        for (int i = 0; i < 3; i++)
+            jg[i] = weighted3(d, J[i], col);     /* (J' G)(i, b) */
+        for (int a = 0; a <= b; a++) {
+            NodeId ga[3] = {G[0][a], G[1][a], G[2][a]};
+            NodeId sum = DAG_ZERO;
+            for (int i = 0; i < 3; i++) {
+                NodeId term = dag_mul(d, ga[i], jg[i]);
+                sum = dag_add(d, sum, term);
+            }
+            add_mass(w, e->euler + a, e->euler + b, dag_mul(d, dag_const(d, 4.0), sum));
+        }
+    }
+    NodeId omega[3], jw[3];
+    for (int i = 0; i < 3; i++) {
+        NodeId sum = DAG_ZERO;
+        for (int k = 0; k < 4; k++) {
+            NodeId term = dag_mul(d, G[i][k], pd[k]);
+            sum = dag_add(d, sum, term);
+        }
+        omega[i] = dag_mul(d, dag_const(d, 2.0), sum);
+    }
+    for (int i = 0; i < 3; i++)
+        jw[i] = weighted3(d, J[i], omega);
+    for (int a = 0; a < 4 && !d->overflow; a++) {
+        NodeId sum = DAG_ZERO;
+        for (int i = 0; i < 3; i++) {
+            NodeId term = dag_mul(d, Gd[i][a], jw[i]);
+            sum = dag_add(d, sum, term);
+        }
+        accumulate(w, w->velocity, e->euler + a, dag_mul(d, dag_const(d, -4.0), sum));
+    }
+}
+
+/* A spatial mass element: m at p = (px, py, pz) as add_element's
+   translation (T = 1/2 m |p_q qd|^2, any p(q)), then a body's rotation. */
+static void add_spatial_element(DynWork *w, const MassElement *e)
+{
+    Dag *d = w->dag;
+    NodeId parts[3] = {e->px, e->py, e->pz};
+    int n = support_of(w, parts, 3);
+    NodeId *dp = xmalloc((size_t)(3 * n + 1) * sizeof *dp);
+    for (int k = 0; k < n; k++)
+        for (int c = 0; c < 3; c++)
+            dp[3 * k + c] = diff_by_q(&w->df, parts[c], w->cols[k]);
+    NodeId m = dag_const(d, e->m);
+    for (int a = 0; a < n && !d->overflow; a++)
+        for (int b = a; b < n; b++) {
+            NodeId pp = dot2(d, dp[3 * a], dp[3 * b], dp[3 * a + 1], dp[3 * b + 1]);
+            NodeId zz = dag_mul(d, dp[3 * a + 2], dp[3 * b + 2]);
+            NodeId sum = dag_add(d, pp, zz);
+            add_mass(w, w->cols[a], w->cols[b], dag_mul(d, m, sum));
+        }
+    NodeId acc[3];
+    for (int c = 0; c < 3; c++) {
+        NodeId v = diff_total(&w->df, parts[c]);
+        acc[c] = diff_total(&w->df, v);
+    }
+    NodeId g[3];
+    for (int c = 0; c < 3; c++)
+        g[c] = dag_const(d, e->m * w->m->gravity[c]);
+    for (int k = 0; k < n && !d->overflow; k++) {
+        int j = w->cols[k];
+        const NodeId *u = dp + 3 * k;
+        NodeId pa = dot2(d, u[0], acc[0], u[1], acc[1]);
+        NodeId za = dag_mul(d, u[2], acc[2]);
+        NodeId sum = dag_add(d, pa, za);
+        w->velocity[j] = dag_sub(d, w->velocity[j], dag_mul(d, m, sum));
+        NodeId pg = dot2(d, u[0], g[0], u[1], g[1]);
+        NodeId zg = dag_mul(d, u[2], g[2]);
+        accumulate(w, w->applied, j, dag_add(d, pg, zg));
+    }
+    free(dp);
+    if (e->euler >= 0)
+        add_rotation(w, e);
+}
+
+/* A torque tau in global axes on a spatial body: its virtual work
+   tau . w, w = 2 E ed, so Q_e += 2 E^T tau. */
+static void add_body_torque(DynWork *w, const AppliedForce *f)
+{
+    Dag *d = w->dag;
+    NodeId p[4], E[3][4], tau[3] = {f->fx, f->fy, f->fz};
+    for (int k = 0; k < 4; k++)
+        p[k] = dag_var(d, f->coord + k);
+    euler_matrix(d, euler_E, p, E);
+    for (int a = 0; a < 4; a++) {
+        NodeId sum = DAG_ZERO;
+        for (int i = 0; i < 3; i++) {
+            NodeId term = dag_mul(d, E[i][a], tau[i]);
+            sum = dag_add(d, sum, term);
+        }
+        accumulate(w, w->applied, f->coord + a, dag_mul(d, dag_const(d, 2.0), sum));
+    }
+}
+
 /* One mass element's share of M, its velocity terms and its weight. */
 static void add_element(DynWork *w, const MassElement *e)
 {
     Dag *d = w->dag;
+    if (e->spatial) {
+        add_spatial_element(w, e);
+        return;
+    }
     if (e->body >= 0) {
         add_body(w, e);
         return;
@@ -207,6 +379,8 @@ static void add_force(DynWork *w, const AppliedForce *f)
     case FORCE_POINT:
         add_along(w, f->ax, f->fx);
         add_along(w, f->ay, f->fy);
+        if (w->m->spatial)
+            add_along(w, f->az, f->fz);
         return;
     case FORCE_TORQUE:
         add_along(w, f->ax, f->fx);
@@ -215,6 +389,10 @@ static void add_force(DynWork *w, const AppliedForce *f)
         NodeId ex = dag_sub(d, f->bx, f->ax);
         NodeId ey = dag_sub(d, f->by, f->ay);
         NodeId l2 = dot2(d, ex, ex, ey, ey);
+        if (w->m->spatial) {
+            NodeId ez = dag_sub(d, f->bz, f->az);
+            l2 = dag_add(d, l2, dag_mul(d, ez, ez));
+        }
         NodeId l = dag_call(d, OP_SQRT, l2, DAG_NONE);
         add_along(w, l, spring_force(w, f, l));
         return;
@@ -226,6 +404,9 @@ static void add_force(DynWork *w, const AppliedForce *f)
     }
     case FORCE_GENERAL:
         accumulate(w, w->applied, f->coord, f->fx);
+        return;
+    case FORCE_BODY_TORQUE:
+        add_body_torque(w, f);
         return;
     }
 }

@@ -14,6 +14,16 @@
  *                  Q -= (k (l - L0) + c ldot + F) l_q
  *   rspring:       a = theta_B - theta_A, Q -= (k (a - a0) + c adot + T) a_q
  *   gforce:        Q[coord] += value
+ *
+ * In a spatial file the elements' points have z (the third root is pz,
+ * no angle), and a spatial body's rotation, T = 1/2 w'^T J' w' with
+ * w' = W ed, W = 2 G(e), enters by Lagrange's equations written out for
+ * a velocity linear in ed, without the Euler-parameter identities the
+ * generated code's closed form uses (generator/diff/dynamics.c):
+ *   M_ee += W^T J' W,
+ *   Q_e  += -(d/dt W)^T J' w' - W^T J' (d/dt W) ed + (d(W ed)/de)^T J' w',
+ * so the two agree only if those identities hold: check compares them.
+ * A body torque tau (global axes): Q_e += 2 E^T tau.
  */
 #include "generic_impl.h"
 
@@ -23,8 +33,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* One program per mass element (px, py, theta) and per force (its
-   expressions, in AppliedForce order: ax ay bx by fx fy). */
+/* One program per mass element (px, py, theta; spatial px, py, pz) and
+   per force (its expressions: ax ay bx by fx fy, then az bz fz). */
 struct GenericDyn {
     const Model *m;
     Tape *mass_tapes, *force_tapes;
@@ -33,12 +43,90 @@ struct GenericDyn {
     double *dp;         /* 3 nq: one element's (px, py, theta)_q */
 };
 
-enum { FORCE_ROOTS = 6 };
+enum { FORCE_ROOTS = 9 };
 
+/* planar: the first six; spatial: az, bz, fz after them */
 static void force_roots(const AppliedForce *f, NodeId roots[FORCE_ROOTS])
 {
-    NodeId r[FORCE_ROOTS] = {f->ax, f->ay, f->bx, f->by, f->fx, f->fy};
+    NodeId r[FORCE_ROOTS] = {f->ax, f->ay, f->bx, f->by, f->fx, f->fy, f->az, f->bz, f->fz};
     memcpy(roots, r, sizeof r);
+}
+
+/* ---- spatial rotation ---- */
+
+/* The cross-product matrix of v: tilde(v) x = v x x. */
+static void tilde(const double v[3], double t[3][3])
+{
+    double m[3][3] = {{0, -v[2], v[1]}, {v[2], 0, -v[0]}, {-v[1], v[0], 0}};
+    memcpy(t, m, sizeof m);
+}
+
+/* G(e) = [-e_v, -tilde(e_v) + e0 I] (body axes) or E(e) = [-e_v, tilde(e_v) + e0 I]
+   (global axes), 3 x 4, e = (e0, e_v). */
+static void euler_matrix(const double e[4], bool global, double out[3][4])
+{
+    double t[3][3];
+    tilde(e + 1, t);
+    for (int i = 0; i < 3; i++) {
+        out[i][0] = -e[1 + i];
+        for (int j = 0; j < 3; j++)
+            out[i][1 + j] = (global ? t[i][j] : -t[i][j]) + (i == j ? e[0] : 0.0);
+    }
+}
+
+static double tensor_at(const double t[6], int i, int j)
+{
+    static const int at[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    return t[at[i][j]];
+}
+
+/* M_ee += W^T J' W, W = 2 G(e). */
+static void add_rotation_mass(const MassElement *e, const double *q, size_t nq, double *M)
+{
+    double W[3][4];
+    euler_matrix(q + e->euler, false, W);
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++) {
+            double sum = 0;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    sum += 4 * W[i][a] * tensor_at(e->inertia, i, j) * W[j][b];
+            M[(size_t)(e->euler + a) * nq + (size_t)(e->euler + b)] += sum;
+        }
+}
+
+/* Q_e += -Wd^T J' w' - W^T J' Wd ed + (d(W ed)/de)^T J' w', Wd = 2 G(ed):
+   Lagrange's equations of T = 1/2 (W ed)^T J' (W ed) with W linear in e. */
+static void add_rotation_velocity(const MassElement *e, const double *q, const double *qd, double *Q)
+{
+    const double *p = q + e->euler, *pd = qd + e->euler;
+    double G[3][4], Gd[3][4], w[3] = {0, 0, 0}, wd[3] = {0, 0, 0}, jw[3], jwd[3];
+    euler_matrix(p, false, G);
+    euler_matrix(pd, false, Gd);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 4; k++) {
+            w[i] += 2 * G[i][k] * pd[k];    /* w' */
+            wd[i] += 2 * Gd[i][k] * pd[k];  /* Wd ed */
+        }
+    for (int i = 0; i < 3; i++) {
+        jw[i] = jwd[i] = 0;
+        for (int j = 0; j < 3; j++) {
+            jw[i] += tensor_at(e->inertia, i, j) * w[j];
+            jwd[i] += tensor_at(e->inertia, i, j) * wd[j];
+        }
+    }
+    for (int a = 0; a < 4; a++) {
+        double unit[4] = {0, 0, 0, 0}, Ga[3][4], dw[3] = {0, 0, 0};
+        unit[a] = 1;
+        euler_matrix(unit, false, Ga);      /* d(W ed)/de_a = 2 G(unit_a) ed */
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 4; k++)
+                dw[i] += 2 * Ga[i][k] * pd[k];
+        double sum = 0;
+        for (int i = 0; i < 3; i++)
+            sum += -2 * Gd[i][a] * jw[i] - 2 * G[i][a] * jwd[i] + dw[i] * jw[i];
+        Q[e->euler + a] += sum;
+    }
 }
 
 GenericDyn *generic_dynamics_open(const Model *m)
@@ -52,7 +140,7 @@ GenericDyn *generic_dynamics_open(const Model *m)
     int regs = 1;
     for (int i = 0; i < m->nmasses; i++) {
         const MassElement *e = &m->masses[i];
-        NodeId roots[3] = {e->px, e->py, e->theta};
+        NodeId roots[3] = {e->px, e->py, e->spatial ? e->pz : e->theta};
         tape_compile_roots(&d->mass_tapes[i], &m->dag, roots, 3, &cs);
         regs = d->mass_tapes[i].n > regs ? d->mass_tapes[i].n : regs;
     }
@@ -114,12 +202,15 @@ void generic_mass(Generic *g, const double *q, double *M)
         const MassElement *e = &m->masses[i];
         const Tape *p = &d->mass_tapes[i];
         root_gradients(d, p, q, NULL, 0.0, 3, d->dp);
+        double mz = e->spatial ? e->m : e->J;   /* the third root: pz, or theta */
         for (int a = 0; a < p->nqcols; a++)
             for (int b = 0; b < p->nqcols; b++) {
                 const double *u = d->dp + 3 * a, *v = d->dp + 3 * b;
                 M[(size_t)p->qcols[a] * nq + (size_t)p->qcols[b]] +=
-                    e->m * (u[0] * v[0] + u[1] * v[1]) + e->J * u[2] * v[2];
+                    e->m * (u[0] * v[0] + u[1] * v[1]) + mz * u[2] * v[2];
             }
+        if (e->euler >= 0)
+            add_rotation_mass(e, q, nq, M);
     }
 }
 
@@ -136,11 +227,18 @@ static void add_inertia(GenericDyn *d, const double *q, const double *qd, bool w
         tape_jet(p, &s, 2, d->jreg);
         double ax = root_jet(d, p, 0).dd, ay = root_jet(d, p, 1).dd, ath = root_jet(d, p, 2).dd;
         double gx = with_gravity ? m->gravity[0] : 0.0, gy = with_gravity ? m->gravity[1] : 0.0;
+        double gz = with_gravity ? m->gravity[2] : 0.0;
         for (int k = 0; k < p->nqcols; k++) {
             const double *u = d->dp + 3 * k;
-            Q[p->qcols[k]] += -e->m * (u[0] * ax + u[1] * ay) - e->J * u[2] * ath
-                              + e->m * (u[0] * gx + u[1] * gy);
+            if (e->spatial)     /* the third root is pz */
+                Q[p->qcols[k]] += -e->m * (u[0] * ax + u[1] * ay + u[2] * ath)
+                                  + e->m * (u[0] * gx + u[1] * gy + u[2] * gz);
+            else
+                Q[p->qcols[k]] += -e->m * (u[0] * ax + u[1] * ay) - e->J * u[2] * ath
+                                  + e->m * (u[0] * gx + u[1] * gy);
         }
+        if (e->euler >= 0)
+            add_rotation_velocity(e, q, qd, Q);
     }
 }
 
@@ -164,10 +262,15 @@ static double spring_pull(GenericDyn *d, const AppliedForce *f, const Tape *p, c
     Seed s = {.q = q, .qd = qd, .t = t, .dq = qd, .col_q = -1, .col_qd = -1, .dt = 1.0};
     tape_jet(p, &s, 1, d->jreg);
     Jet ax = root_jet(d, p, 0), ay = root_jet(d, p, 1), bx = root_jet(d, p, 2), by = root_jet(d, p, 3);
+    Jet az = root_jet(d, p, 6), bz = root_jet(d, p, 7);     /* 0 in a planar file */
     double act = root_jet(d, p, 4).v, l, rate;
     if (f->kind == FORCE_RSPRING) {
         l = bx.v - ax.v;
         rate = bx.d - ax.d;
+    } else if (d->m->spatial) {
+        double ex = bx.v - ax.v, ey = by.v - ay.v, ez = bz.v - az.v;
+        l = sqrt(ex * ex + ey * ey + ez * ez);
+        rate = (ex * (bx.d - ax.d) + ey * (by.d - ay.d) + ez * (bz.d - az.d)) / l;
     } else {
         double ex = bx.v - ax.v, ey = by.v - ay.v;
         l = sqrt(ex * ex + ey * ey);
@@ -190,6 +293,19 @@ static void add_spring(GenericDyn *d, const AppliedForce *f, const Tape *p, cons
     double ex = d->vreg[p->out[2]] - d->vreg[p->out[0]], ey = d->vreg[p->out[3]] - d->vreg[p->out[1]];
     add_gradient(d, p, q, qd, t, 2, 0, pull * ex / l, Q);
     add_gradient(d, p, q, qd, t, 3, 1, pull * ey / l, Q);
+    if (d->m->spatial) {
+        double ez = d->vreg[p->out[7]] - d->vreg[p->out[6]];
+        add_gradient(d, p, q, qd, t, 7, 6, pull * ez / l, Q);
+    }
+}
+
+/* Q_e += 2 E(e)^T tau: a torque in global axes on a spatial body. */
+static void add_body_torque(const AppliedForce *f, const double *q, const double tau[3], double *Q)
+{
+    double E[3][4];
+    euler_matrix(q + f->coord, true, E);
+    for (int a = 0; a < 4; a++)
+        Q[f->coord + a] += 2 * (E[0][a] * tau[0] + E[1][a] * tau[1] + E[2][a] * tau[2]);
 }
 
 static void add_applied(GenericDyn *d, const double *q, const double *qd, double t, double *Q)
@@ -204,6 +320,8 @@ static void add_applied(GenericDyn *d, const double *q, const double *qd, double
         case FORCE_POINT:
             add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
             add_gradient(d, p, q, qd, t, 1, -1, fy, Q);
+            if (m->spatial)
+                add_gradient(d, p, q, qd, t, 6, -1, d->vreg[p->out[8]], Q);
             break;
         case FORCE_TORQUE:
             add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
@@ -214,6 +332,11 @@ static void add_applied(GenericDyn *d, const double *q, const double *qd, double
         case FORCE_GENERAL:
             Q[f->coord] += fx;
             break;
+        case FORCE_BODY_TORQUE: {
+            double tau[3] = {fx, fy, d->vreg[p->out[8]]};
+            add_body_torque(f, q, tau, Q);
+            break;
+        }
         }
     }
 }

@@ -699,18 +699,25 @@ static NodeId dyn_expr(Builder *b, const Ast *ast)
 }
 
 /* The global position of a dynamics attachment: a body point, a
-   particle, ground, or at(x, y) (ctx: what at's expressions may use). */
+   particle, ground, or at(x, y) (ctx: what at's expressions may use);
+   in a spatial file xy[2] is z (xy has room for three). */
 static void dyn_point(Builder *b, const AstAttach *at, ExprContext ctx, const char *keyword,
-                      NodeId xy[2])
+                      NodeId xy[3])
 {
     if (at->at) {
+        NodeId z = b->spatial ? lower(b, at->sz, ctx) : DAG_ZERO;
         NodeId y = lower(b, at->sy, ctx);    /* sequenced: see AST_BINARY */
         xy[0] = lower(b, at->sx, ctx);
         xy[1] = y;
+        xy[2] = z;
         return;
     }
     Attach a = resolve_attach(b, at, ATTACH_ANY, keyword);
-    joints_point(b->model, a, xy);
+    xy[2] = DAG_ZERO;
+    if (b->spatial)
+        joints_spatial_point(b->model, a, xy);
+    else
+        joints_point(b->model, a, xy);
     check_nodes(b);
 }
 
@@ -730,10 +737,98 @@ static MassElement *new_mass(Builder *b, const Stmt *s)
                       "mass statement", s->name, line_of(b, m->masses[i].pos));
     grow(&m->arena, (void **)&m->masses, &b->cap_masses, m->nmasses + 1, sizeof *m->masses);
     MassElement *e = &m->masses[m->nmasses++];
-    *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1};
+    *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1,
+                       .spatial = b->spatial, .pz = DAG_ZERO, .euler = -1};
     e->m = dyn_constant(b, s, DKEY_M, "the mass m", true);
-    e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true);
+    if (!b->spatial)    /* a spatial J is a tensor: spatial_inertia */
+        e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true);
     return e;
+}
+
+/* The eigenvalues of the symmetric 3 x 3 matrix t (xx, yy, zz, xy, xz,
+   yz), ascending, by the trigonometric closed form (Smith 1961). */
+static void symmetric_eigenvalues(const double t[6], double ev[3])
+{
+    double p1 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5];
+    double q = (t[0] + t[1] + t[2]) / 3;
+    double p2 = (t[0] - q) * (t[0] - q) + (t[1] - q) * (t[1] - q) + (t[2] - q) * (t[2] - q) + 2 * p1;
+    double p = sqrt(p2 / 6);
+    if (p == 0) {
+        ev[0] = ev[1] = ev[2] = q;
+        return;
+    }
+    double b[6];
+    for (int i = 0; i < 6; i++)
+        b[i] = (t[i] - (i < 3 ? q : 0)) / p;
+    double det = b[0] * (b[1] * b[2] - b[5] * b[5]) - b[3] * (b[3] * b[2] - b[5] * b[4])
+                 + b[4] * (b[3] * b[5] - b[1] * b[4]);
+    double r = fmax(-1.0, fmin(1.0, det / 2));
+    double phi = acos(r) / 3;
+    ev[2] = q + 2 * p * cos(phi);
+    ev[0] = q + 2 * p * cos(phi + 2 * 3.14159265358979323846 / 3);
+    ev[1] = 3 * q - ev[0] - ev[2];
+}
+
+/* A spatial body's J = (Jxx, Jyy, Jzz) and products Jxy, Jxz, Jyz: the
+   inertia tensor about the centre of mass in body axes (its entries, so
+   Jxy = -sum m x y). Absent: 0 (a particle carried by the body). Given,
+   it must be positive definite and its principal moments must satisfy
+   the triangle inequality, as every mass distribution's do. */
+static void spatial_inertia(Builder *b, const Stmt *s, MassElement *e)
+{
+    static const char *const diag_names[3] = {"Jxx", "Jyy", "Jzz"};
+    static const DynKey product[3] = {DKEY_JXY, DKEY_JXZ, DKEY_JYZ};
+    char what[64];
+    if (!s->key[DKEY_J]) {
+        for (int i = 0; i < 3; i++)
+            if (s->key[product[i]])
+                diag_fail(b->diag, s->key_pos[product[i]], "'%s' without J = (Jxx, Jyy, Jzz): "
+                          "give the tensor's diagonal too", dyn_key_names[product[i]]);
+        return;
+    }
+    for (int i = 0; i < 3; i++) {
+        snprintf(what, sizeof what, "the moment of inertia %s", diag_names[i]);
+        e->inertia[i] = constant_value(b, s->inertia[i], what);
+        if (e->inertia[i] < 0)
+            diag_fail(b->diag, s->inertia[i]->pos, "%s of mass '%s' is negative (%g)", what,
+                      s->name, e->inertia[i]);
+    }
+    for (int i = 0; i < 3; i++) {
+        snprintf(what, sizeof what, "the product of inertia %s", dyn_key_names[product[i]]);
+        e->inertia[3 + i] = dyn_constant(b, s, product[i], what, false);
+    }
+    double ev[3];
+    symmetric_eigenvalues(e->inertia, ev);
+    double scale = fmax(fabs(ev[0]), fabs(ev[2]));
+    if (!(ev[0] > 1e-12 * scale) || scale == 0)
+        diag_fail(b->diag, s->key_pos[DKEY_J], "the inertia tensor of '%s' is not positive "
+                  "definite: its principal moments are %g, %g, %g", s->name, ev[0], ev[1], ev[2]);
+    if (ev[0] + ev[1] < ev[2] * (1 - 1e-12))
+        diag_fail(b->diag, s->key_pos[DKEY_J], "the inertia tensor of '%s' is no body's: its "
+                  "principal moments %g + %g < %g break the triangle inequality", s->name,
+                  ev[0], ev[1], ev[2]);
+}
+
+/* mass BODY m = .. [J = (..) Jxy = ..] [com(sx, sy, sz)] in a spatial
+   file: the centre of mass r + A(e) s, the tensor about it; a point's
+   mass is at the point. */
+static void spatial_body_mass(Builder *b, const Stmt *s, const Entity *ent, MassElement *e)
+{
+    bool body = ent->kind == ENT_BODY;
+    Attach at = {.q = ent->q, .spatial = true, .has_p = body};
+    if (s->vec[0]) {
+        at.sx = constant_value(b, s->vec[0], "a centre-of-mass offset");
+        at.sy = constant_value(b, s->vec[1], "a centre-of-mass offset");
+        at.sz = constant_value(b, s->vec[2], "a centre-of-mass offset");
+    }
+    NodeId xyz[3];
+    joints_spatial_point(b->model, at, xyz);
+    e->px = xyz[0], e->py = xyz[1], e->pz = xyz[2];
+    check_nodes(b);
+    if (body) {
+        e->euler = ent->q + 3;
+        spatial_inertia(b, s, e);
+    }
 }
 
 /* mass BODY m = .. [J = ..] [com(sx, sy)]: the body's centre of mass
@@ -753,6 +848,10 @@ static void build_body_mass(Builder *b, const Stmt *s)
         diag_fail(b->diag, s->vec_pos, "'%s' is a point (a particle): its mass is at the point, "
                   "no com(...)", s->name);
     MassElement *e = new_mass(b, s);
+    if (b->spatial) {
+        spatial_body_mass(b, s, ent, e);
+        return;
+    }
     Attach at = {.q = ent->q, .has_phi = body};
     if (s->vec[0]) {
         at.sx = constant_value(b, s->vec[0], "a centre-of-mass offset");
@@ -778,9 +877,9 @@ static void build_element_mass(Builder *b, const Stmt *s)
         diag_fail(b->diag, s->key_pos[DKEY_J], "mass '%s' has J but no 'angle = ...': the "
                   "angle whose rate J multiplies", s->name);
     MassElement *e = new_mass(b, s);
-    NodeId xy[2];
+    NodeId xy[3];
     dyn_point(b, &s->attach[0], EXPR_MASS, "mass", xy);
-    e->px = xy[0], e->py = xy[1];
+    e->px = xy[0], e->py = xy[1], e->pz = xy[2];
     if (s->key[DKEY_ANGLE])
         e->theta = lower(b, s->key[DKEY_ANGLE], EXPR_MASS);
 }
@@ -793,7 +892,8 @@ static AppliedForce *new_force(Builder *b, const Stmt *s, ForceKind kind)
     AppliedForce *f = &m->forces[m->nforces++];
     *f = (AppliedForce){.kind = kind, .name = s->name, .pos = s->pos, .ax = DAG_ZERO,
                         .ay = DAG_ZERO, .bx = DAG_ZERO, .by = DAG_ZERO, .fx = DAG_ZERO,
-                        .fy = DAG_ZERO, .coord = -1};
+                        .fy = DAG_ZERO, .coord = -1, .az = DAG_ZERO, .bz = DAG_ZERO,
+                        .fz = DAG_ZERO};
     return f;
 }
 
@@ -829,19 +929,49 @@ static bool depends_on_q(Builder *b, const NodeId *e, int n)
 static void refuse_idle(Builder *b, const Stmt *s, const AppliedForce *f)
 {
     const char *kw = dyn_keywords[s->dyn];
-    NodeId a[2] = {f->ax, f->ay}, ab[4] = {f->ax, f->ay, f->bx, f->by};
-    if (s->dyn == DYN_FORCE && !depends_on_q(b, a, 2))
+    NodeId a[3] = {f->ax, f->ay, f->az}, ab[6] = {f->ax, f->ay, f->bx, f->by, f->az, f->bz};
+    if (s->dyn == DYN_FORCE && !depends_on_q(b, a, 3))
         diag_fail(b->diag, s->attach[0].pos, "%s '%s' is applied at a fixed point (it depends "
                   "on no coordinate): it does no work", kw, s->name);
     if (s->dyn == DYN_TORQUE && s->lhs && !depends_on_q(b, a, 1))
         diag_fail(b->diag, s->lhs->pos, "%s '%s' acts on an angle that depends on no "
                   "coordinate: it does no work", kw, s->name);
-    if (s->dyn == DYN_SPRING && f->ax == f->bx && f->ay == f->by)
+    if (s->dyn == DYN_SPRING && f->ax == f->bx && f->ay == f->by && f->az == f->bz)
         diag_fail(b->diag, s->attach[1].pos, "%s '%s' joins a point to itself: its length is "
                   "always 0", kw, s->name);
-    if (s->dyn == DYN_SPRING && !depends_on_q(b, ab, 4))
+    if (s->dyn == DYN_SPRING && !depends_on_q(b, ab, 6))
         diag_fail(b->diag, s->attach[0].pos, "%s '%s' joins two fixed points (they depend on no "
                   "coordinate): it does no work", kw, s->name);
+}
+
+/* torque NAME: angle(e) = tau: e, or in a spatial file a revolute's or
+   cylindrical's name R alone for angle(R) (a motor between its bodies). */
+static NodeId torque_angle(Builder *b, const Ast *lhs)
+{
+    int index;
+    if (b->spatial && lhs->kind == AST_NAME && strmap_get(&b->names, lhs->name, &index)
+        && b->entities[index].kind == ENT_JOINT) {
+        const Joint *j = &b->model->joints[b->entities[index].q];
+        if (j->kind != JOINT_S_REVOLUTE && j->kind != JOINT_S_CYLINDRICAL)
+            diag_fail(b->diag, lhs->pos, "torque: angle(%s) takes a revolute or cylindrical "
+                      "joint; '%s' is %s", lhs->name, lhs->name, joint_info[j->kind].keyword);
+        NodeId a = joints_spatial_angle(b->model, j);
+        check_nodes(b);
+        return a;
+    }
+    return lower(b, lhs, EXPR_HOLONOMIC);
+}
+
+/* torque NAME: BODY = (tx, ty, tz) in a spatial file: a torque in global
+   axes on a body, Q[e] += 2 E(e)^T tau (the virtual work tau . w, w = 2 E ed). */
+static void spatial_body_torque(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    Attach a = resolve_attach(b, &s->attach[0], ATTACH_FRAME, dyn_keywords[s->dyn]);
+    f->kind = FORCE_BODY_TORQUE;
+    f->coord = a.q + 3;
+    f->fz = dyn_expr(b, s->vec[2]);
+    f->fy = dyn_expr(b, s->vec[1]);
+    f->fx = dyn_expr(b, s->vec[0]);
 }
 
 /* force, torque, spring, rspring, gforce: one applied force. */
@@ -854,17 +984,23 @@ static void build_force(Builder *b, const Stmt *s)
     const char *kw = dyn_keywords[s->dyn];
     refuse_ground(b, s, s->dyn == DYN_FORCE || s->dyn == DYN_TORQUE ? 1 : 2);
     AppliedForce *f = new_force(b, s, kinds[s->dyn]);
-    NodeId xy[2];
+    NodeId xy[3];
     switch (s->dyn) {
     case DYN_FORCE:
         dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
-        f->ax = xy[0], f->ay = xy[1];
+        f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
         refuse_idle(b, s, f);
+        if (b->spatial)
+            f->fz = dyn_expr(b, s->vec[2]);
         f->fy = dyn_expr(b, s->vec[1]);
         f->fx = dyn_expr(b, s->vec[0]);
         return;
     case DYN_TORQUE:
-        f->ax = s->lhs ? lower(b, s->lhs, EXPR_HOLONOMIC) : dyn_angle(b, &s->attach[0], kw);
+        if (b->spatial && !s->lhs) {
+            spatial_body_torque(b, s, f);
+            return;
+        }
+        f->ax = s->lhs ? torque_angle(b, s->lhs) : dyn_angle(b, &s->attach[0], kw);
         refuse_idle(b, s, f);
         f->fx = dyn_expr(b, s->value);
         return;
@@ -874,11 +1010,22 @@ static void build_force(Builder *b, const Stmt *s)
         if (s->dyn == DYN_SPRING) {
             f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true);
             dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
-            f->ax = xy[0], f->ay = xy[1];
+            f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
             dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
-            f->bx = xy[0], f->by = xy[1];
+            f->bx = xy[0], f->by = xy[1], f->bz = xy[2];
             refuse_idle(b, s, f);
             f->fx = dyn_expr(b, s->key[DKEY_FORCE]);
+        } else if (b->spatial) {   /* about a joint's axis: B's angle is angle(R), A's 0 */
+            f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
+            Entity *e = lookup(b, s->attach[0].name, s->attach[0].pos);
+            const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+            if (!j || (j->kind != JOINT_S_REVOLUTE && j->kind != JOINT_S_CYLINDRICAL))
+                diag_fail(b->diag, s->attach[0].pos, "a spatial rspring acts about a revolute's "
+                          "or cylindrical's axis; '%s' is %s", e->name,
+                          j ? joint_info[j->kind].keyword : entity_word(e->kind));
+            f->bx = joints_spatial_angle(b->model, j);
+            check_nodes(b);
+            f->fx = dyn_expr(b, s->key[DKEY_TORQUE]);
         } else {
             f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
             f->ax = dyn_angle(b, &s->attach[0], kw);
@@ -919,6 +1066,8 @@ static void build_dynamics(Builder *b, const Stmt *s)
     b->gravity_line = line_of(b, s->pos);
     b->model->gravity[0] = constant_value(b, s->vec[0], "the gravity component gx");
     b->model->gravity[1] = constant_value(b, s->vec[1], "the gravity component gy");
+    if (b->spatial)
+        b->model->gravity[2] = constant_value(b, s->vec[2], "the gravity component gz");
 }
 
 static void build(Builder *b, const Program *prog, const char *default_name)

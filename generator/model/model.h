@@ -74,8 +74,10 @@ typedef struct ModelOutput {
 /* A mass element (DYN.md): mass m at the point p = (px, py), expressions of
    q (a body's centre of mass r + A(phi) s, a particle's position, or an
    element's at(x, y)), and moment of inertia J about p for the angle theta.
-   Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2. Spatial
-   bodies (later) will add pz and an inertia tensor over Euler parameters. */
+   Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2.
+   In a spatial file p = (px, py, pz), no theta, and a spatial body's own
+   mass adds 1/2 w'^T J' w' with w' = 2 G(e) ed its angular velocity in
+   body axes and J' the tensor `inertia` about the centre of mass. */
 typedef struct MassElement {
     const char *name;   /* the body, point or element */
     SrcPos pos;
@@ -85,6 +87,11 @@ typedef struct MassElement {
     int body;           /* a planar body's own mass: its x coordinate (then
                            p = r + A(phi) s, s = (sx, sy)); -1 otherwise */
     double sx, sy;
+    bool spatial;       /* a spatial file's: pz below, theta DAG_ZERO */
+    NodeId pz;
+    int euler;          /* a spatial body's own mass: the index of its e0
+                           (e0..e3 at euler .. euler + 3); -1 otherwise */
+    double inertia[6];  /* J' in body axes: xx, yy, zz, xy, xz, yz */
 } MassElement;
 
 typedef enum ForceKind {
@@ -93,10 +100,12 @@ typedef enum ForceKind {
     FORCE_SPRING,       /* l = |B - A|, f = k (l - L0) + c ldot + fx, Q += -f l_q */
     FORCE_RSPRING,      /* a = theta_B - theta_A, tau = k (a - a0) + c adot + fx, Q += -tau a_q */
     FORCE_GENERAL,      /* Q[coord] += fx */
+    FORCE_BODY_TORQUE,  /* spatial: Q[e0..e3] += 2 E(e)^T (fx, fy, fz), e at coord */
 } ForceKind;
 
 /* An applied force, every kind by virtual work. Expressions (fx, fy) may
-   use q, der(q) and t. */
+   use q, der(q) and t. In a spatial file points and forces have z
+   components too (az, bz, fz; DAG_ZERO in a planar file). */
 typedef struct AppliedForce {
     ForceKind kind;
     const char *name;
@@ -107,7 +116,8 @@ typedef struct AppliedForce {
     NodeId fx, fy;      /* POINT: components; otherwise fx the value (the
                            actuator's force or torque for a spring) */
     double k, c, free;  /* SPRING, RSPRING: stiffness, damping, free length or angle */
-    int coord;          /* GENERAL: the coordinate */
+    int coord;          /* GENERAL: the coordinate; BODY_TORQUE: e0's */
+    NodeId az, bz, fz;
 } AppliedForce;
 
 typedef struct Model {
@@ -134,7 +144,7 @@ typedef struct Model {
     MassElement *masses;
     int nforces;
     AppliedForce *forces;
-    double gravity[2];  /* (0, 0) without a gravity statement */
+    double gravity[3];  /* (0, 0, 0) without a gravity statement; gz spatial only */
 } Model;
 
 /* Reads, parses and resolves a .mech text. Returns NULL with diag filled

@@ -19,6 +19,7 @@ const char *const dyn_keywords[DYN_KIND_COUNT] = {
 const char *const dyn_key_names[DKEY_COUNT] = {
     [DKEY_M] = "m", [DKEY_J] = "J", [DKEY_K] = "k", [DKEY_C] = "c", [DKEY_LENGTH] = "length",
     [DKEY_ANGLE] = "angle", [DKEY_FORCE] = "force", [DKEY_TORQUE] = "torque",
+    [DKEY_JXY] = "Jxy", [DKEY_JXZ] = "Jxz", [DKEY_JYZ] = "Jyz",
 };
 
 bool joint_kind_in(JointKind kind, bool spatial)

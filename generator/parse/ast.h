@@ -109,7 +109,9 @@ typedef enum DynKind {
 
 /* The `key = value` options of the dynamics statements. */
 typedef enum DynKey {
-    DKEY_M, DKEY_J, DKEY_K, DKEY_C, DKEY_LENGTH, DKEY_ANGLE, DKEY_FORCE, DKEY_TORQUE, DKEY_COUNT
+    DKEY_M, DKEY_J, DKEY_K, DKEY_C, DKEY_LENGTH, DKEY_ANGLE, DKEY_FORCE, DKEY_TORQUE,
+    DKEY_JXY, DKEY_JXZ, DKEY_JYZ,   /* spatial: the inertia tensor's off-diagonal entries */
+    DKEY_COUNT
 } DynKey;
 
 extern const char *const dyn_keywords[DYN_KIND_COUNT];
@@ -159,7 +161,9 @@ typedef struct Stmt {
     bool declares;          /* DYNAMICS: name is declared (mass NAME: ...) */
     Ast *key[DKEY_COUNT];   /* DYNAMICS: key = value (NULL: absent) */
     SrcPos key_pos[DKEY_COUNT];
-    Ast *vec[2];            /* force (fx, fy), gravity (gx, gy), com(sx, sy) */
+    Ast *vec[3];            /* force (fx, fy), gravity (gx, gy), com(sx, sy);
+                               spatial: three components, and a body's torque */
+    Ast *inertia[3];        /* spatial mass: J = (Jxx, Jyy, Jzz) (NULL: absent) */
     SrcPos vec_pos;
 
     struct Stmt *next;

@@ -738,6 +738,11 @@ static const unsigned dyn_allowed[DYN_KIND_COUNT] = {
     [DYN_RSPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_ANGLE) | KEYBIT(DKEY_TORQUE),
 };
 
+/* A spatial body's own mass: J is the tensor's diagonal, the products
+   its off-diagonal entries; a spatial mass element has no angle, no J. */
+static const unsigned spatial_body_mass = KEYBIT(DKEY_M) | KEYBIT(DKEY_J) | KEYBIT(DKEY_JXY)
+                                          | KEYBIT(DKEY_JXZ) | KEYBIT(DKEY_JYZ);
+
 /* The keys in `allowed`, listed as "m, J or com" for messages. */
 static void list_keys(char *buf, size_t size, unsigned allowed, const char *extra)
 {
@@ -755,14 +760,25 @@ static void list_keys(char *buf, size_t size, unsigned allowed, const char *extr
                                 words[i]);
 }
 
-/* at(x, y): a point given by expressions of the coordinates, into a. */
+/* at(x, y), spatial at(x, y, z): a point given by expressions of the
+   coordinates, into a. */
 static void at_point(Parser *p, AstAttach *a)
 {
     a->at = true;
     a->name = NULL;
     a->pos = p->tok.pos;
     advance(p);
-    pair(p, "at(x, y)", &a->sx, &a->sy);
+    offset(p, p->spatial ? "at(x, y, z)" : "at(x, y)", a);
+}
+
+/* A vector of the file's dimension: (x, y), spatial (x, y, z); what
+   names it in messages (its spatial form when the file is spatial). */
+static void vector(Parser *p, const char *what, const char *spatial_what, Ast **out)
+{
+    if (p->spatial)
+        components(p, spatial_what, 3, out);
+    else
+        pair(p, what, &out[0], &out[1]);
 }
 
 /* dyn_attachment = 'at' pair | NAME [pair]   (frame_only: a body or ground alone) */
@@ -797,7 +813,7 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
     char what[DIAG_MESSAGE_MAX];
     snprintf(what, sizeof what, "the offset of '%s'", a->name);
     a->has_offset = true;
-    pair(p, what, &a->sx, &a->sy);
+    offset(p, what, a);
 }
 
 /* keys = {KEY '=' expr | 'com' pair | 'at' pair}, each at most once;
@@ -806,6 +822,8 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
 static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
 {
     unsigned allowed = dyn_allowed[s->dyn] & (com ? ~KEYBIT(DKEY_ANGLE) : ~0u);
+    if (p->spatial && s->dyn == DYN_MASS)
+        allowed = com ? spatial_body_mass : KEYBIT(DKEY_M);
     while (p->tok.kind == TOK_IDENT) {
         bool is_com = com && lex_is_word(&p->tok, "com"), is_at = at && lex_is_word(&p->tok, "at");
         if ((is_com && s->vec[0]) || (is_at && s->attach[0].at))
@@ -814,7 +832,7 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
         if (is_com) {
             s->vec_pos = p->tok.pos;
             advance(p);
-            pair(p, "com(sx, sy)", &s->vec[0], &s->vec[1]);
+            vector(p, "com(sx, sy)", "com(sx, sy, sz)", s->vec);
             continue;
         }
         if (is_at) {
@@ -825,7 +843,8 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
         while (k < DKEY_COUNT && !lex_is_word(&p->tok, dyn_key_names[k]))
             k++;
         char list[128];
-        list_keys(list, sizeof list, allowed, com ? "com(sx, sy)" : at ? "at(x, y)" : NULL);
+        list_keys(list, sizeof list, allowed, com ? (p->spatial ? "com(sx, sy, sz)" : "com(sx, sy)")
+                  : at ? (p->spatial ? "at(x, y, z)" : "at(x, y)") : NULL);
         if (k == DKEY_COUNT || !(allowed & KEYBIT(k)))
             diag_fail(p->diag, p->tok.pos, "unknown key '%.*s' for %s '%s': expected %s",
                       p->tok.len, p->tok.start, dyn_keywords[s->dyn], s->name, list);
@@ -837,6 +856,11 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
         if (p->tok.kind != TOK_EQ)
             expected(p, "'=' after '%s'", dyn_key_names[k]);
         advance(p);
+        if (p->spatial && k == DKEY_J) {    /* the tensor's diagonal; key[J] marks it given */
+            components(p, "J = (Jxx, Jyy, Jzz)", 3, s->inertia);
+            s->key[k] = s->inertia[0];
+            continue;
+        }
         s->key[k] = expr(p);
     }
 }
@@ -851,8 +875,9 @@ static void dyn_mass(Parser *p, Stmt *s)
         advance(p);
         dyn_keys(p, s, false, true);
         if (!s->attach[0].at)
-            expected(p, "'at(x, y)' for the mass element '%s' (or 'mass BODY m = ...' "
-                     "without ':' for a body's own mass)", s->name);
+            expected(p, "'%s' for the mass element '%s' (or 'mass BODY m = ...' "
+                     "without ':' for a body's own mass)", p->spatial ? "at(x, y, z)" : "at(x, y)",
+                     s->name);
     } else {
         dyn_keys(p, s, true, false);
     }
@@ -884,7 +909,26 @@ static void dyn_torque(Parser *p, Stmt *s)
     if (p->tok.kind != TOK_EQ)
         expected(p, "'=' and the torque of '%s'", s->name);
     advance(p);
+    if (p->spatial && !s->lhs) {    /* a spatial body's torque: global components */
+        s->vec_pos = p->tok.pos;
+        components(p, "the torque (tx, ty, tz)", 3, s->vec);
+        return;
+    }
     s->value = expr(p);
+}
+
+/* spatial rspring = 'rspring' NAME ':' JOINT keys   (about a revolute's or
+   cylindrical's axis: its angle(JOINT)) */
+static void dyn_spatial_rspring(Parser *p, Stmt *s)
+{
+    AstAttach *a = &s->attach[0];
+    if (p->tok.kind != TOK_IDENT || is_reserved(&p->tok))
+        expected(p, "a revolute or cylindrical joint after 'rspring %s:' (a spatial rspring "
+                 "acts about the joint's axis)", s->name);
+    a->name = token_text(p, &p->tok);
+    a->pos = p->tok.pos;
+    advance(p);
+    dyn_keys(p, s, false, false);
 }
 
 /* dynamics = mass | torque | gravity pair
@@ -896,13 +940,10 @@ static void dynamics(Parser *p, Stmt *s, DynKind kind)
     s->kind = STMT_DYNAMICS;
     s->dyn = kind;
     const char *kw = dyn_keywords[kind];
-    if (p->spatial)
-        diag_fail(p->diag, s->pos, "'%s' is planar only for now: masses and forces cannot be "
-                  "written in a spatial file yet", kw);
     advance(p);
     if (kind == DYN_GRAVITY) {
         s->vec_pos = p->tok.pos;
-        pair(p, "gravity (gx, gy)", &s->vec[0], &s->vec[1]);
+        vector(p, "gravity (gx, gy)", "gravity (gx, gy, gz)", s->vec);
         return;
     }
     if (kind == DYN_MASS) {
@@ -922,18 +963,23 @@ static void dynamics(Parser *p, Stmt *s, DynKind kind)
         if (p->tok.kind != TOK_LPAREN && a->has_offset && !a->at) {
             /* `force F: body (fx, fy)`: the pair was the force, not an offset */
             a->has_offset = false;
-            s->vec[0] = a->sx, s->vec[1] = a->sy, a->sx = a->sy = NULL;
+            s->vec[0] = a->sx, s->vec[1] = a->sy, s->vec[2] = a->sz;
+            a->sx = a->sy = a->sz = NULL;
             s->vec_pos = offset_pos;
             return;
         }
         s->vec_pos = p->tok.pos;
-        pair(p, "the force (fx, fy)", &s->vec[0], &s->vec[1]);
+        vector(p, "the force (fx, fy)", "the force (fx, fy, fz)", s->vec);
         return;
     }
     case DYN_TORQUE:
         dyn_torque(p, s);
         return;
     case DYN_SPRING: case DYN_RSPRING:
+        if (p->spatial && kind == DYN_RSPRING) {
+            dyn_spatial_rspring(p, s);
+            return;
+        }
         dyn_attachment(p, s, 0, 2, kind == DYN_RSPRING);
         dyn_attachment(p, s, 1, 2, kind == DYN_RSPRING);
         dyn_keys(p, s, false, false);
@@ -970,7 +1016,7 @@ static void list_keywords(char *buf, size_t size, bool spatial)
     for (int k = 0; k < JOINT_KIND_COUNT; k++)
         if (joint_kind_in((JointKind)k, spatial))
             words[count++] = joint_info[k].keyword;
-    for (int k = 0; k < DYN_KIND_COUNT && !spatial; k++)   /* planar only, for now */
+    for (int k = 0; k < DYN_KIND_COUNT; k++)
         words[count++] = dyn_keywords[k];
     for (int k = 0; k < count && n > 0 && (size_t)n < size; k++)
         n += snprintf(buf + n, size - (size_t)n, "%s %s", k == count - 1 ? " or" : ",", words[k]);
