@@ -11,7 +11,8 @@
  * origin costs M no operation; bad input fails at its line and column.
  */
 #include "testutil.h"
-#include "testcache.h"
+#define TESTDYN_SUITE "dynamics"
+#include "testdyn.h"
 #include "testload.h"
 
 #include "../generator/analysis/check.h"
@@ -23,32 +24,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-
-static TestCache cache;
-
-static int setup(void **state)
-{
-    (void)state;
-    return testcache_setup(&cache, "dynamics");
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    return testcache_teardown(&cache);
-}
-
-/* The engines a test runs: jit, generic, and aot with a compiler. */
-static int engine_count(void) { return cache.have_cc ? ENGINE_KIND_COUNT : 2; }
-
-static void open_engine(Engine *e, EngineKind kind, const Mech *mech)
-{
-    Diag diag;
-    if (!engine_open(e, kind, mech, &diag))
-        fail_msg("%s: %s", engine_names[kind], diag.message);
-    assert_non_null(e->k.mass);
-    assert_non_null(e->k.force);
-}
 
 /* A random state: q = base + U(-1, 1), qd = U(-2, 2), t = U(0, 1). */
 static void random_state(uint64_t *rng, int nq, const double *base, double *q, double *qd, double *t)
@@ -174,15 +149,44 @@ static const char every_force[] =
     "rspring R: a b k = 5 c = 0.2 angle = 0.1 torque = 1.5\n"
     "gforce H: s = -2*s - 0.1*der(s)^3\n";
 
+/* every spatial force kind (spatial bodies: Euler parameters) */
+static const char every_spatial_force[] =
+    "spatial\n"
+    "param k = 40\n"
+    "body a x = 0.2 y = 0.1 z = 0.05 orient = axis(0, 0, 1, 0.3)\n"
+    "body b x = 1.1 y = -0.2 z = 0.4 orient = xyz(0.1, -0.2, 0.3)\n"
+    "point p x = 0.5 y = 0.9 z = -0.3\n"
+    "coord s = 0.1\n"
+    "revolute O: ground(0, 0, 0) a(-0.2, 0, 0) axis(0, 0, 1)\n"
+    "revolute R: a(0.2, 0, 0) b(-0.3, 0.1, 0) axis(0, 1, 1)\n"
+    "distance D: b(0.3, 0.1, 0) p length = 0.8\n"
+    "constraint C: s = 0.1*sin(t)\n"
+    "mass a m = 1.2 J = (0.01, 0.03, 0.03) com(0.1, -0.05, 0.02)\n"
+    "mass b m = 0.7 J = (0.02, 0.02, 0.01) Jxy = 0.001 Jyz = -0.002\n"
+    "mass p m = 0.3\n"
+    "mass e: at(a.x + s, a.y*s, a.z - s^2) m = 0.4\n"
+    "gravity (0.5, -9.81, 1)\n"
+    "force F: b(0.2, -0.1, 0.3) (3*cos(t), der(b.x) - 2, b.e2)\n"
+    "force G: at(s, a.y, b.z) (1, 2*s, -1)\n"
+    "torque T: b = (-0.5*der(b.e1), 0.2, t)\n"
+    "torque M: angle(R) = 1.5 - 0.1*t\n"
+    "spring S1: a(0.1, 0.2, 0) b(-0.1, 0, 0.1) k = k c = 0.7 length = 0.4 force = 3*t\n"
+    "spring S2: ground(2, 1, 0) p k = 10 length = 0.1\n"
+    "rspring RS: R k = 5 c = 0.2 angle = 0.1 torque = 1.5\n"
+    "gforce H: s = -2*s - 0.1*der(s)^3\n";
+
 /* The engines agree on M and Q (to 1e-12), and the jit's eom equals its
    separate kernels, at random states. */
 static void test_engines_agree(void **state)
 {
     (void)state;
-    const char *names[] = {"every_force", "pendulum_dynamics.mech", "slider_crank_dynamics.mech"};
+    const char *names[] = {"every_force", "pendulum_dynamics.mech", "slider_crank_dynamics.mech",
+                           "every_spatial_force", "heavy_top.mech"};
     uint64_t rng = 3;
-    for (int f = 0; f < 3; f++) {
-        Mech *mech = f == 0 ? load_text(every_force, "every_force.mech") : load_example(names[f]);
+    for (int f = 0; f < 5; f++) {
+        Mech *mech = f == 0 ? load_text(every_force, "every_force.mech")
+                     : f == 3 ? load_text(every_spatial_force, "every_spatial_force.mech")
+                     : load_example(names[f]);
         const Model *m = mech->model;
         size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
         Engine e[ENGINE_KIND_COUNT];
