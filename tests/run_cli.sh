@@ -456,7 +456,7 @@ for f in "$ex"/*.mech; do
     name=$(basename "$f" .mech)
     case $name in
         pendulum_distance|pendulum_constraint|pendulum_dynamics) want=2 ;;
-        andrews|a01_pendulum|double_pendulum) want=2 ;;   # not driven: mechc sim
+        andrews|a01_pendulum|double_pendulum|heavy_top|spherical_pendulum) want=2 ;;   # not driven: mechc sim
         parallelogram_redundant|bricard) want=1 ;;
         *) want=0 ;;
     esac

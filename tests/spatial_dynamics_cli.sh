@@ -144,6 +144,15 @@ else
     skip "no cc: the written files are not compiled"
 fi
 
+# ---- pictures: sim draws a spatial mechanism as run does ----
+sim "$ex/heavy_top.mech" --t1 0.2 --steps 10 --qd "$top_qd" --svg "$tmp/top.svg" --view front \
+    --trace 'top(0, 0, 0.1)' --csv "$tmp/top.csv"
+check "heavy top: sim --svg --view front exits 0" status_is 0
+check "heavy top: the animation has the top's path" grep -q '<svg' "$tmp/top.svg"
+sim "$ex/pendulum_dynamics.mech" --svg "$tmp/p.svg" --view top --csv "$tmp/p.csv"
+check "sim --view on a planar file: exit 2" status_is 2
+check "sim --view on a planar file: says why" err_has "--view chooses how a spatial mechanism is seen"
+
 # ---- bad input ----
 printf 'spatial\nbody a z = -1\nspherical O: ground(0, 0, 0) a(0, 0, 1)\nmass a m = 1 J = (1, 1, 1) Jxz = 1.5\n' > "$tmp/bad.mech"
 run_mechc sim "$tmp/bad.mech"

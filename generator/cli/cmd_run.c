@@ -342,11 +342,6 @@ static bool finish(Args *a, void *opts)
    one is unknown. */
 static bool resolve_pictures(const Model *m, const RunCli *c, RunPictures *p)
 {
-    if (!m->spatial && c->view >= 0) {
-        fprintf(stderr, "%s: error: --view chooses how a spatial mechanism is seen, and this "
-                "one is planar (drawn as it is, x right, y up)\n", m->file);
-        return false;
-    }
     p->svg_path = c->svg_path;
     p->plot_path = c->plot_path;
     p->view = c->view;

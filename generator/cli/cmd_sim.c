@@ -26,7 +26,7 @@ typedef struct SimCli {
     MechLimits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
     CliList traces;
-    int engine, method, digits;
+    int engine, method, digits, view;
     bool json, stats;
     bool pictures, csv_stdout;      /* worked out from the above */
 } SimCli;
@@ -85,6 +85,9 @@ static const CliOption options[] = {
      .help = "write an animated SVG of the motion"},
     {"--trace", CLI_LIST_AT(SimCli, traces, MAX_TRACES), .what = "points", .metavar = "B(sx,sy)",
      .help = "draw the path of a body point in the animation, as run"},
+    {"--view", CLI_CHOICE_AT(SimCli, view, svg_view_names), .metavar = "V",
+     .help = "a spatial mechanism's animation seen from the front,\n"
+             "top, side or iso (default), as for run"},
     {"--plot", CLI_STRING_AT(SimCli, plot_path), .metavar = "FILE",
      .help = "write an SVG chart of variables against time"},
     {"--plot-vars", CLI_STRING_AT(SimCli, plot_list), .metavar = "LIST",
@@ -105,7 +108,7 @@ static bool resolve_pictures(const Model *m, const SimCli *c, RunPictures *p)
 {
     p->svg_path = c->svg_path;
     p->plot_path = c->plot_path;
-    p->view = -1;
+    p->view = c->view;
     return run_output_resolve_pictures("sim", m, &c->traces, c->plot_list, false, p);
 }
 
@@ -168,6 +171,10 @@ static bool finish(Args *a, void *opts)
     if ((c->traces.n > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
         fprintf(stderr, "mechc sim: error: %s goes with %s\n",
                 c->traces.n ? "--trace" : "--plot-vars", c->traces.n ? "--svg FILE" : "--plot FILE");
+        return false;
+    }
+    if (c->view >= 0 && !c->svg_path) {
+        fprintf(stderr, "mechc sim: error: --view goes with --svg FILE\n");
         return false;
     }
     c->pictures = c->svg_path || c->plot_path;
@@ -274,6 +281,6 @@ static const CliCommand command = {
 int cmd_sim(int argc, char **argv)
 {
     SimCli c = {.so = sim_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT, .method = -1};
+                .engine = ENGINE_JIT, .method = -1, .view = -1};
     return cli_main(&command, argc, argv, &c);
 }

@@ -197,6 +197,11 @@ bool run_output_resolve_pictures(const char *cmd, const Model *m, const CliList 
                                  const char *plot_list, bool forces, RunPictures *p)
 {
     char err[256];
+    if (!m->spatial && p->view >= 0) {
+        fprintf(stderr, "%s: error: --view chooses how a spatial mechanism is seen, and this "
+                "one is planar (drawn as it is, x right, y up)\n", m->file);
+        return false;
+    }
     p->ntraces = p->nvars = 0;
     for (int i = 0; i < traces->n; i++) {
         if (!svg_parse_trace(m, traces->items[i], &p->traces[p->ntraces++], err, sizeof err)) {

@@ -93,7 +93,8 @@ typedef struct RunPictures {
 
 /* Resolves the --trace texts and the --plot-vars list (NULL: every
    variable) against m; lambda(ROW) and effort(DRIVER) are known when
-   forces. false (reported on stderr) when one is unknown. */
+   forces. false (reported on stderr) when one is unknown, or when
+   p->view is set (>= 0) for a planar mechanism. */
 bool run_output_resolve_pictures(const char *cmd, const Model *m, const CliList *traces,
                                  const char *plot_list, bool forces, RunPictures *p);
 
