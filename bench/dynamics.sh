@@ -15,7 +15,8 @@
 #    of B0's position and velocity against the exact solution of the
 #    published definition (the one-angle equation of the parallelogram
 #    branch; the benchmark's data file was not available), and the energy.
-# 3. `mechc bench` on Andrews, the double pendulum and A02: ns per call of
+# 3. `mechc bench` on Andrews, the double pendulum, A02 and two spatial
+#    files (heavy_top, slider_crank_spatial_torque): ns per call of
 #    mass, force, m+q (both) and eom for generic, jit and aot, and the
 #    speed-ups generated / generic against the issue's targets (3x jit,
 #    5x aot).
@@ -91,7 +92,8 @@ awk -F, -v n="$a02_n" '
 
 echo
 echo "== dynamics kernels per call (mechc bench; target: generated / generic >= 3x jit, 5x aot)"
-for f in "$root/examples/andrews.mech" "$root/examples/double_pendulum.mech" "$tmp/a02.mech"; do
+for f in "$root/examples/andrews.mech" "$root/examples/double_pendulum.mech" "$tmp/a02.mech" \
+         "$root/examples/heavy_top.mech" "$root/examples/slider_crank_spatial_torque.mech"; do
     "$mechc" bench "$f" --repeat "$repeat" > "$tmp/bench.txt" 2> "$tmp/bench.err" \
         || { cat "$tmp/bench.err" >&2; exit 1; }
     sed -n '1p' "$tmp/bench.txt"
