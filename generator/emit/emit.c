@@ -185,6 +185,7 @@ typedef struct Emitter {
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
     bool hoisting;              /* in put_calls_first */
     const RollHooks *roll;      /* a loop body's leaves and stores (roll.c) */
+    bool rolled;                /* some function has loops (roll.c) */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -763,10 +764,11 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
     RollContext rc = {
         .kin = e->kin, .prefix = e->prefix, .function = emit_function_names[f],
         .real_float = opt->real_float, .sincos_name = e->sincos_name, .sin_name = e->sin_name,
-        .cos_name = e->cos_name,
+        .cos_name = e->cos_name, .sincos2_name = e->sincos2_name,
         .min_members = opt->roll == EMIT_ROLL_ALWAYS ? 2 : EMIT_ROLL_AUTO_MEMBERS,
         .write_body = put_roll_body, .emitter = e,
         .sincos_used = &e->sincos_used, .single_used = &e->single_used,
+        .sincos2_used = &e->sincos2_used,
     };
     SchedOutput *rest;
     int nrest;
@@ -776,6 +778,7 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
     free(*outs);
     *outs = rest;
     *n = nrest;
+    e->rolled = true;
     return ops;
 }
 
@@ -1047,7 +1050,11 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
-    if (!opt->direct_jac)
+    if (!opt->direct_jac && e->rolled)     /* a rolled file stays small: the loop everywhere */
+        sb_printf(&moves, "    for (int k = 0; k < %s_NNZ; ++k) {\n        %s_real v = packed[k];\n"
+                  "        packed[k] = 0;\n        jac[%s_jac_row[k] * %s_NQ + %s_jac_col[k]] = v;\n"
+                  "    }", upper, out->prefix, out->prefix, upper, out->prefix);
+    else if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
     put_all_nz(e, parts, bodies, &nzd, &nzf);

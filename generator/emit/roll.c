@@ -90,15 +90,25 @@ static int new_slot(Roll *r, Member *m, double v)
     return m->nslots++;
 }
 
-/* The row an output belongs to, or -1 (the placeholder of an empty Jacobian). */
-static int output_row(const Kinematics *kin, const SchedOutput *o)
+/* The row of each output, or -1 (the placeholder of an empty Jacobian).
+   The dense Jacobian's k-th store is entry k (collect_outputs in emit.c):
+   its index, row * NQ + col, passes INT_MAX in the largest mechanisms
+   and is not read back. */
+static int *output_rows(const Kinematics *kin, const SchedOutput *outs, int n)
 {
-    const char *a = o->array;
-    if (!strcmp(a, "vals") || !strcmp(a, "jac_vals"))
-        return o->index < kin->nnz ? kin->jac[o->index].row : -1;
-    if (!strcmp(a, "jac"))
-        return o->index / kin->model->nq;
-    return o->index;
+    int *rows = xmalloc((size_t)(n ? n : 1) * sizeof *rows);
+    int jac = 0;
+    for (int k = 0; k < n; k++) {
+        const char *a = outs[k].array;
+        int i = outs[k].index;
+        if (!strcmp(a, "jac"))
+            i = jac++;
+        if (!strcmp(a, "vals") || !strcmp(a, "jac_vals") || !strcmp(a, "jac"))
+            rows[k] = i >= 0 && i < kin->nnz ? kin->jac[i].row : -1;
+        else
+            rows[k] = i >= 0 && i < kin->model->nr ? i : -1;
+    }
+    return rows;
 }
 
 static int array_id(const char *name)
@@ -199,22 +209,19 @@ static uint64_t hash_code(const int32_t *w, int n)
 static void find_groups(Roll *r, int n)
 {
     const Model *model = r->c->kin->model;
+    int *rows = output_rows(r->c->kin, r->outs, n);
     r->members = xmalloc((size_t)(n ? n : 1) * sizeof *r->members);
     for (int k = 0; k < n;) {
-        int row = output_row(r->c->kin, &r->outs[k]);
-        int joint = row >= 0 ? model->rows[row].joint : -1;
+        int joint = rows[k] >= 0 ? model->rows[rows[k]].joint : -1;
         int end = k + 1;
-        while (joint >= 0 && end < n) {
-            int next = output_row(r->c->kin, &r->outs[end]);
-            if (next < 0 || model->rows[next].joint != joint)
-                break;
+        while (joint >= 0 && end < n && rows[end] >= 0 && model->rows[rows[end]].joint == joint)
             end++;
-        }
         Member *m = &r->members[r->nmembers++];
         *m = (Member){.first = k, .count = end - k, .group = -1, .ok = joint >= 0};
         read_member(r, m);
         k = end;
     }
+    free(rows);
     U64Map map;
     u64map_init(&map);
     r->groups = xmalloc((size_t)(r->nmembers ? r->nmembers : 1) * sizeof *r->groups);
@@ -263,15 +270,17 @@ static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *tab
                      const int *v, int count)
 {
     bool affine = true;
-    int step = count > 1 ? v[1] - v[0] : 0;
+    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
     for (int i = 1; i < count && affine; i++)
-        affine = v[i] - v[i - 1] == step;
+        affine = (long long)v[i] - v[i - 1] == step;
     if (affine && step == 0) {
         sb_printf(text, "%d", v[0]);
         return;
     }
     if (affine) {
-        sb_printf(text, "%d + %d * i", v[0], step);
+        if (v[0])
+            sb_printf(text, "%d + ", v[0]);
+        sb_printf(text, step == 1 ? "i" : "%lld * i", step);
         return;
     }
     sb_printf(parts, "static const int %s_%s[%d] = {\n", r->c->prefix, table, count);
@@ -295,6 +304,42 @@ static void put_real(StrBuf *sb, double v, bool real_float)
     sb_puts(sb, buf);
     if (real_float)
         sb_putc(sb, 'f');
+}
+
+/* The angles of coordinates v[0 .. count) whose sin and cos are both
+   used, two a call of the two-angle function (the same operations as the
+   pair function, so the same bits), into roll_s and roll_c from first. */
+static void put_pairs(const Roll *r, StrBuf *parts, StrBuf *loops, const char *table,
+                      const int *v, int count, int first)
+{
+    int half = count / 2;
+    int *even = xmalloc((size_t)half * sizeof *even), *odd = xmalloc((size_t)half * sizeof *odd);
+    for (int i = 0; i < half; i++) {
+        even[i] = v[2 * i];
+        odd[i] = v[2 * i + 1];
+    }
+    StrBuf a, b;
+    sb_init(&a);
+    sb_init(&b);
+    sb_puts(&a, "");
+    sb_puts(&b, "");
+    char name[96];
+    snprintf(name, sizeof name, "%s_e", table);
+    put_ints(r, parts, &a, name, even, half);
+    snprintf(name, sizeof name, "%s_o", table);
+    put_ints(r, parts, &b, name, odd, half);
+    sb_printf(loops, "    for (int i = 0; i < %d; i++)\n        %s(q[%s], q[%s], &roll_s[%d + 2 * i], "
+              "&roll_c[%d + 2 * i],\n            &roll_s[%d + 2 * i], &roll_c[%d + 2 * i]);\n", half,
+              r->c->sincos2_name, a.data, b.data, first, first, first + 1, first + 1);
+    if (count % 2)
+        sb_printf(loops, "    %s(q[%d], &roll_s[%d], &roll_c[%d]);\n", r->c->sincos_name,
+                  v[count - 1], first + count - 1, first + count - 1);
+    *r->c->sincos_used = true;      /* sincos2 calls it for its rare case */
+    *r->c->sincos2_used = true;
+    sb_free(&a);
+    sb_free(&b);
+    free(even);
+    free(odd);
 }
 
 /* The angles the rolled groups read: positions in the sin and cos arrays
@@ -359,6 +404,10 @@ static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
             continue;
         char table[64];
         snprintf(table, sizeof table, "%s_ra%d", r->c->function, kind);
+        if (kind == 0 && r->c->sincos2_name && n - first >= 2) {
+            put_pairs(r, parts, &loops, table, coords + first, n - first, first);
+            continue;
+        }
         StrBuf at;
         sb_init(&at);
         sb_puts(&at, "");

@@ -32,10 +32,11 @@ typedef struct RollContext {
        and cos as written), and the names for an angle of which only the
        sin or only the cos is used (NULL: the pair). */
     const char *sincos_name, *sin_name, *cos_name;
+    const char *sincos2_name;   /* two angles a call (emit.c), or NULL */
     int min_members;            /* fewest rows of one shape worth a loop */
     RollBodyWriter write_body;
     void *emitter;
-    bool *sincos_used, *single_used;    /* set when the loops call them */
+    bool *sincos_used, *single_used, *sincos2_used;     /* set when the loops call them */
 } RollContext;
 
 /* Rolls, among the n outputs of one function (row by row, as the emitter
