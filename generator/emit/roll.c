@@ -457,18 +457,9 @@ static void store_hook(void *ctx, StrBuf *sb, const SchedOutput *o)
     sb_printf(sb, "    %s[%s] = ", o->array, ((SlotTexts *)ctx)->text[o->index]);
 }
 
-/* Group g's tables (parts) and loop (body); returns its operations per call. */
-static long put_group(Roll *r, int g, int number, StrBuf *parts, StrBuf *body)
+/* The kinds of a shape's slots (W_CONST, W_Q, ...), into kind[nslots]. */
+static void slot_kinds(const Roll *r, const Member *rep, int32_t *kind)
 {
-    const Group *grp = &r->groups[g];
-    const Member *rep = &r->members[grp->rep];
-    int ns = rep->nslots, count = grp->count;
-    const char *P = r->c->prefix;
-    char **texts = xcalloc((size_t)(ns ? ns : 1), sizeof *texts);
-    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
-    int *ints = xmalloc((size_t)count * sizeof *ints);
-    /* the slots' kinds, from the shape */
-    int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     for (int w = rep->code_at; w < rep->code_at + rep->code_len;) {
         int32_t word = r->code[w];
         if (word == W_OUT)
@@ -477,16 +468,42 @@ static long put_group(Roll *r, int g, int number, StrBuf *parts, StrBuf *body)
             kind[r->code[w + 1]] = word;
         w += word == W_OUT ? 4 : word == W_TIME ? 1 : word < 0 ? 2 : 3;
     }
+}
+
+/* Member m's value of an index slot s of kind k: the coordinate, the
+   store's index, or the angle's position in roll_s and roll_c. */
+static int slot_int(const Roll *r, int m, int s, int32_t k)
+{
+    double v = r->vals[r->members[m].val_at + s];
+    if (k == W_SIN || k == W_COS)
+        return r->angle_pos[dag_node(r->dag, dag_node(r->dag, (NodeId)v)->a)->a];
+    return (int)v;
+}
+
+/* The loop over members[0 .. count) (of one shape): its tables (parts)
+   and loop (body); returns its operations per call. */
+static long put_loop(Roll *r, const int *members, int count, int number, StrBuf *parts,
+                     StrBuf *body)
+{
+    const Member *rep = &r->members[members[0]];
+    int ns = rep->nslots;
+    const char *P = r->c->prefix;
+    char **texts = xcalloc((size_t)(ns ? ns : 1), sizeof *texts);
+    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
+    int *ints = xmalloc((size_t)count * sizeof *ints);
+    /* the slots' kinds, from the shape */
+    int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
+    slot_kinds(r, rep, kind);
     for (int s = 0; s < ns; s++) {
         StrBuf t;
         sb_init(&t);
         sb_puts(&t, "");
-        const double *v0 = &r->vals[r->members[grp->members[0]].val_at + s];
+        const double *v0 = &r->vals[rep->val_at + s];
         char table[96];
         if (kind[s] == W_CONST) {
             bool same = true;
             for (int j = 1; j < count && same; j++) {
-                double v = r->vals[r->members[grp->members[j]].val_at + s];
+                double v = r->vals[r->members[members[j]].val_at + s];
                 same = memcmp(&v, v0, sizeof v) == 0;
             }
             uniform[s] = same;
@@ -495,22 +512,15 @@ static long put_group(Roll *r, int g, int number, StrBuf *parts, StrBuf *body)
                 sb_printf(parts, "static const %s_real %s[%d] = {\n", P, table, count);
                 for (int j = 0; j < count; j++) {
                     sb_puts(parts, j % 8 ? " " : "    ");
-                    put_real(parts, r->vals[r->members[grp->members[j]].val_at + s], r->c->real_float);
+                    put_real(parts, r->vals[r->members[members[j]].val_at + s], r->c->real_float);
                     sb_puts(parts, j % 8 == 7 || j == count - 1 ? ",\n" : ",");
                 }
                 sb_puts(parts, "};\n");
                 sb_printf(&t, "%s[i]", table);
             }
         } else {
-            for (int j = 0; j < count; j++) {
-                double v = r->vals[r->members[grp->members[j]].val_at + s];
-                if (kind[s] == W_SIN || kind[s] == W_COS) {
-                    const DagNode *trig = dag_node(r->dag, (NodeId)v);
-                    ints[j] = r->angle_pos[dag_node(r->dag, trig->a)->a];
-                } else {
-                    ints[j] = (int)v;
-                }
-            }
+            for (int j = 0; j < count; j++)
+                ints[j] = slot_int(r, members[j], s, kind[s]);
             const char *open = kind[s] == W_Q ? "q[" : kind[s] == W_QD ? "qd[" : kind[s] == W_SIN
                                ? "roll_s[" : kind[s] == W_COS ? "roll_c[" : "";
             sb_puts(&t, open);
@@ -576,6 +586,49 @@ static long put_group(Roll *r, int g, int number, StrBuf *parts, StrBuf *body)
     return (long)ops * count;
 }
 
+/* Group g as loops: each run of RUN_MIN or more members whose index
+   slots all grow by fixed steps gets a loop without tables; the other
+   members share one loop with tables, or go back to straight-line code
+   (group -1) when fewer than min_members. Returns the operations. */
+enum { RUN_MIN = 8 };
+static long put_group(Roll *r, int g, int *number, StrBuf *parts, StrBuf *body)
+{
+    const Group *grp = &r->groups[g];
+    const Member *rep = &r->members[grp->rep];
+    int ns = rep->nslots, count = grp->count, nleft = 0;
+    int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
+    slot_kinds(r, rep, kind);
+    int *left = xmalloc((size_t)count * sizeof *left);
+    long ops = 0;
+    for (int j = 0; j < count;) {
+        int k = j + 1;
+        for (; k < count; k++) {
+            bool steady = true;
+            for (int s = 0; s < ns && steady; s++)
+                if (kind[s] != W_CONST)
+                    steady = k == j + 1 ||
+                             (long long)slot_int(r, grp->members[k], s, kind[s]) - slot_int(r, grp->members[k - 1], s, kind[s])
+                             == (long long)slot_int(r, grp->members[j + 1], s, kind[s]) - slot_int(r, grp->members[j], s, kind[s]);
+            if (!steady)
+                break;
+        }
+        if (k - j >= RUN_MIN || (j == 0 && k == count)) {
+            ops += put_loop(r, grp->members + j, k - j, (*number)++, parts, body);
+            j = k;
+        } else {
+            left[nleft++] = grp->members[j++];
+        }
+    }
+    if (nleft >= r->c->min_members)
+        ops += put_loop(r, left, nleft, (*number)++, parts, body);
+    else
+        for (int j = 0; j < nleft; j++)
+            r->members[left[j]].group = -1;
+    free(left);
+    free(kind);
+    return ops;
+}
+
 int roll_function(const RollContext *c, const SchedOutput *outs, int n, StrBuf *parts,
                   StrBuf *body, SchedOutput **rest, int *nrest, long *ops)
 {
@@ -599,9 +652,14 @@ int roll_function(const RollContext *c, const SchedOutput *outs, int n, StrBuf *
         r.angle_pos = xmalloc((size_t)(nq ? nq : 1) * sizeof *r.angle_pos);
         memset(r.angle_pos, 0xff, (size_t)nq * sizeof *r.angle_pos);
         *ops += put_angles(&r, parts, body);
-        for (int g = 0, number = 0; g < r.ngroups; g++)
+        int number = 0;
+        for (int g = 0; g < r.ngroups; g++)
             if (rolled(&r, g))
-                *ops += put_group(&r, g, number++, parts, body);
+                *ops += put_group(&r, g, &number, parts, body);
+        nrolled = 0;
+        for (int i = 0; i < r.nmembers; i++)
+            if (r.members[i].group >= 0)
+                nrolled += r.members[i].count;
         *rest = xmalloc((size_t)(n - nrolled + 1) * sizeof **rest);
         for (int i = 0; i < r.nmembers; i++)
             if (r.members[i].group < 0)
