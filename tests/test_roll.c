@@ -212,6 +212,52 @@ static void test_gcc(void **state)
     pipeline_free(mech);
 }
 
+/* Written files built by tcc (what firmware debug builds and quick
+   builds see: libm's sin and cos, the pair only where the file's own
+   function is needed) on every example: the same bytes too. */
+static void test_unoptimised(void **state)
+{
+    (void)state;
+    if (system("tcc -v > /dev/null 2>&1") != 0) {
+        print_message("tcc not found: skipping\n");
+        skip();
+    }
+    const char *old = getenv("CC");
+    char *saved = old ? strdup(old) : NULL;
+    setenv("CC", "tcc", 1);
+    const char *dir = getenv("MECHC_EXAMPLES") ? getenv("MECHC_EXAMPLES") : "examples";
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    for (struct dirent *ent; (ent = readdir(d));) {
+        size_t len = strlen(ent->d_name);
+        if (len < 6 || strcmp(ent->d_name + len - 5, ".mech") != 0)
+            continue;
+        Mech *mech = load_example(ent->d_name);
+        check(ent->d_name, mech, false, false);
+        pipeline_free(mech);
+    }
+    closedir(d);
+    Mech *mech = load_script("chain.sh", 17);
+    assert_true(check("chain 17", mech, false, false));
+    pipeline_free(mech);
+    /* b0's sin is read by the loop, its cos only by the straight-line
+       rest: the two halves choose their trig calls apart */
+    mech = load_text("mechanism pairs\n"
+                     "body b0 x = 0 y = 0 phi = 0.1\nbody b1 x = 0 y = 0 phi = 0.2\n"
+                     "body b2 x = 0 y = 0 phi = 0.3\nbody b3 x = 0 y = 0 phi = 0.4\n"
+                     "constraint s0: b0.y = sin(b0.phi)\nconstraint s1: b1.y = sin(b1.phi)\n"
+                     "constraint s2: b2.y = sin(b2.phi)\nconstraint s3: b3.y = sin(b3.phi)\n"
+                     "constraint k: b0.x = cos(b0.phi) + 0.3*b0.y*b0.y\n", "pairs.mech");
+    assert_true(check("pairs", mech, false, false));
+    pipeline_free(mech);
+    if (saved) {
+        setenv("CC", saved, 1);
+        free(saved);
+    } else {
+        unsetenv("CC");
+    }
+}
+
 /* auto leaves small files straight-line (their text unchanged) and rolls
    a chain past EMIT_ROLL_AUTO_ROWS rows. */
 static void test_auto(void **state)
@@ -239,6 +285,7 @@ int main(void)
         cmocka_unit_test(test_every_example),
         cmocka_unit_test(test_chains),
         cmocka_unit_test(test_gcc),
+        cmocka_unit_test(test_unoptimised),
         cmocka_unit_test(test_auto),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
