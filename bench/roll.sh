@@ -12,7 +12,7 @@
 #   gen s          CPU time (user + system) of mechc gen
 #   gcc -O2 -c s   CPU time of gcc -std=c99 -O2 -c on it, and its peak memory
 # straight-line files above STRAIGHT_MAX_N (1000) are left out (gcc takes
-# minutes on them). The largest file gen writes is N = 7000: past about
+# minutes on them). The largest file gen writes is N = 7700: past about
 # N = 7700 the dense Jacobian's NR x NQ entries pass INT_MAX, which gen
 # refuses (--max-jac-entries); the N = 10 000 chain compiles in process
 # only, below. Then, for N in TIME_SIZES (100 1000), both files are built
@@ -27,7 +27,7 @@
 # POSIX sh and awk only.
 set -u
 mechc=${1:-build/mechc}
-sizes=${SIZES:-"100 1000 7000"}
+sizes=${SIZES:-"100 1000 7700"}
 time_sizes=${TIME_SIZES:-"100 1000"}
 straight_max=${STRAIGHT_MAX_N:-1000}
 repeat=${REPEAT:-11}

@@ -24,7 +24,8 @@ static const char usage[] =
     "                 [--sparse] [--roll auto|never|always] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
-    "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
+    "fused _all of the mechanism (loops for joints of one shape, --roll): needs\n"
+    "only <math.h>, no heap, no I/O.\n"
     "\n";
 
 static const char *const reals[] = {"double", "float", NULL};

@@ -290,6 +290,35 @@ static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *tab
     sb_printf(text, "%s_%s[i]", r->c->prefix, table);
 }
 
+/* Writes into text the element of array that row i reads or writes,
+   whose indices over the rows are v[0 .. count): array[v0] for one index,
+   through a pointer that moves with i (declared in decls, once per array
+   and step: libtcc then loads each element by one instruction) where they
+   grow by a fixed step, else through a table. */
+static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decls,
+                        const char *table, const char *array, bool output, const int *v,
+                        int count)
+{
+    bool affine = true;
+    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
+    for (int i = 1; i < count && affine; i++)
+        affine = (long long)v[i] - v[i - 1] == step;
+    if (!affine || step == 0) {
+        sb_printf(text, "%s[", array);
+        put_ints(r, parts, text, table, v, count);
+        sb_putc(text, ']');
+        return;
+    }
+    char name[64];
+    snprintf(name, sizeof name, "%s_%s%lld", array, step < 0 ? "m" : "", step < 0 ? -step : step);
+    char decl[160];
+    snprintf(decl, sizeof decl, " %s = ", name);
+    if (!strstr(decls->data, decl))
+        sb_printf(decls, "        %s%s_real *const%s%s + %lld * i;\n", output ? "" : "const ",
+                  r->c->prefix, decl, array, step);
+    sb_printf(text, "%s[%d]", name, v[0]);
+}
+
 /* A constant as C text that reads back as the same double (or float). */
 static void put_real(StrBuf *sb, double v, bool real_float)
 {
@@ -454,7 +483,7 @@ static void leaf_hook(void *ctx, StrBuf *sb, int slot)
 
 static void store_hook(void *ctx, StrBuf *sb, const SchedOutput *o)
 {
-    sb_printf(sb, "    %s[%s] = ", o->array, ((SlotTexts *)ctx)->text[o->index]);
+    sb_printf(sb, "    %s = ", ((SlotTexts *)ctx)->text[o->index]);
 }
 
 /* The kinds of a shape's slots (W_CONST, W_Q, ...), into kind[nslots]. */
@@ -494,6 +523,19 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
     /* the slots' kinds, from the shape */
     int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     slot_kinds(r, rep, kind);
+    const char **array = xcalloc((size_t)(ns ? ns : 1), sizeof *array);  /* what a slot indexes */
+    for (int w = rep->code_at; w < rep->code_at + rep->code_len;) {
+        int32_t word = r->code[w];
+        if (word == W_OUT)
+            array[r->code[w + 3]] = arrays[r->code[w + 1]];
+        else if (word < 0 && word != W_TIME)
+            array[r->code[w + 1]] = word == W_Q ? "q" : word == W_QD ? "qd"
+                                  : word == W_SIN ? "roll_s" : "roll_c";
+        w += word == W_OUT ? 4 : word == W_TIME ? 1 : word < 0 ? 2 : 3;
+    }
+    StrBuf decls;      /* the loop's row pointers */
+    sb_init(&decls);
+    sb_puts(&decls, "");
     for (int s = 0; s < ns; s++) {
         StrBuf t;
         sb_init(&t);
@@ -521,13 +563,8 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
         } else {
             for (int j = 0; j < count; j++)
                 ints[j] = slot_int(r, members[j], s, kind[s]);
-            const char *open = kind[s] == W_Q ? "q[" : kind[s] == W_QD ? "qd[" : kind[s] == W_SIN
-                               ? "roll_s[" : kind[s] == W_COS ? "roll_c[" : "";
-            sb_puts(&t, open);
             snprintf(table, sizeof table, "%s_r%d_x%d", r->c->function, number, s);
-            put_ints(r, parts, &t, table, ints, count);
-            if (*open)
-                sb_putc(&t, ']');
+            put_element(r, parts, &t, &decls, table, array[s], kind[s] == W_OUT, ints, count);
         }
         texts[s] = sb_take(&t);
     }
@@ -566,7 +603,9 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
     sb_puts(&stmts, "");
     int ops = r->c->write_body(r->c->emitter, &graph, outs, nouts, &hooks, &stmts);
     sb_printf(body, "    /* %d joints' rows of one shape: one loop */\n"
-              "    for (int i = 0; i < %d; i++) {\n", count, count);
+              "    for (int i = 0; i < %d; i++) {\n%s", count, count, decls.data);
+    sb_free(&decls);
+    free(array);
     for (const char *line = stmts.data; *line;) {     /* one level deeper */
         const char *end = strchr(line, '\n');
         size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
