@@ -12,10 +12,9 @@
 #   gen s          CPU time (user + system) of mechc gen
 #   gcc -O2 -c s   CPU time of gcc -std=c99 -O2 -c on it, and its peak memory
 # straight-line files above STRAIGHT_MAX_N (1000) are left out (gcc takes
-# minutes on them). The largest file gen writes is N = 7700: past about
-# N = 7700 the dense Jacobian's NR x NQ entries pass INT_MAX, which gen
-# refuses (--max-jac-entries); the N = 10 000 chain compiles in process
-# only, below. Then, for N in TIME_SIZES (100 1000), both files are built
+# minutes on them). gen writes chains up to N = 7722: past it the dense
+# Jacobian's NR x NQ entries pass INT_MAX, which gen refuses
+# (--max-jac-entries); the N = 10 000 chain compiles in process only, below. Then, for N in TIME_SIZES (100 1000), both files are built
 # with gcc -O2 -fPIC -shared (and tcc -shared when tcc is installed: code
 # as libtcc makes it, with libm's sin and cos) and bench/roll_time.c times
 # their kernels side by side, interleaved, after checking they compute the
