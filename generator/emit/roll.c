@@ -8,8 +8,11 @@
  * thousand coupler joints) differ only in their slots' values, so one
  * loop body, printed by the emitter from a small graph of the shape,
  * serves them all: a slot whose value is the same for every member is
- * written as that value, one that grows by a fixed step as base + step * i,
- * the rest read a static const table.
+ * written as that value, one that grows by a fixed step through a pointer
+ * that moves with the loop (q_6 = q + 6 * i, then q_6[3]), the rest read
+ * a static const table; a group is cut into runs of steady steps, so that
+ * an odd member (a chain's first joint) does not turn every index into a
+ * table.
  *
  * The body computes exactly the operations of each member's straight-line
  * code, so the results are the same bits; what it does not repeat is the
