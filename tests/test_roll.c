@@ -27,9 +27,11 @@ static double uniform(void)
 }
 
 /* Emits mech's double kernels with roll (written for gcc unless jit). */
-static void emit(const Mech *mech, int roll, bool jit, bool direct_jac, EmitResult *res)
+static void emit_real(const Mech *mech, int roll, bool jit, bool direct_jac, bool real_float,
+                      EmitResult *res)
 {
     EmitOptions opt = emit_default_options();
+    opt.real_float = real_float;
     opt.declare_math = jit;
     opt.direct_jac = direct_jac;
     opt.all_nz = true;
@@ -39,6 +41,11 @@ static void emit(const Mech *mech, int roll, bool jit, bool direct_jac, EmitResu
     Diag diag;
     if (!emit_mechanism(&mech->kin, &opt, res, &diag))
         fail_msg("%s: %s", mech->model->name, diag.message);
+}
+
+static void emit(const Mech *mech, int roll, bool jit, bool direct_jac, EmitResult *res)
+{
+    emit_real(mech, roll, jit, direct_jac, false, res);
 }
 
 /* Every kinematic kernel of a and b at a few random states: the same bytes. */
@@ -258,6 +265,76 @@ static void test_unoptimised(void **state)
     }
 }
 
+/* The float kernels of a and b (double-typed in Kernels, float in the
+   file) at a few states: the same bytes. */
+typedef void (*FloatPhi)(const float *, float, float *);
+typedef void (*FloatGamma)(const float *, const float *, float, float *);
+typedef void (*FloatAll)(const float *, const float *, float, float *, float *, float *, float *);
+
+static void compare_float(const char *name, const Mech *mech, const Kernels *a, const Kernels *b)
+{
+    const Model *m = mech->model;
+    int nq = m->nq, nr = m->nr, nnz = mech->kin.nnz > 0 ? mech->kin.nnz : 1;
+    size_t cap = 2 * ((size_t)nr * nq + (size_t)nnz) + 10 * (size_t)nr + 8;
+    float *q = malloc((size_t)nq * sizeof *q), *qd = malloc((size_t)nq * sizeof *qd);
+    float *out[2] = {malloc(cap * sizeof(float)), malloc(cap * sizeof(float))};
+    for (int trial = 0; trial < 3; trial++) {
+        for (int i = 0; i < nq; i++) {
+            q[i] = (float)(m->q0[i] + (trial ? 2 * uniform() - 1 : 0));
+            qd[i] = (float)(4 * uniform() - 2);
+        }
+        float t = 0.37f * (float)trial;
+        for (int k = 0; k < 2; k++) {
+            const Kernels *kr = k ? b : a;
+            float *o = out[k], *jac = o + nr + 1, *vals = jac + (size_t)nr * nq + 1, *nu = vals + nnz,
+                  *gamma = nu + nr, *jac2 = gamma + nr, *rest = jac2 + (size_t)nr * nq;
+            memset(o, 0x5a, cap * sizeof(float));
+            ((FloatPhi)(uintptr_t)kr->phi)(q, t, o);
+            ((FloatPhi)(uintptr_t)kr->jac)(q, t, jac);
+            ((FloatPhi)(uintptr_t)kr->jac_nz)(q, t, vals);
+            ((FloatPhi)(uintptr_t)kr->nu)(q, t, nu);
+            ((FloatGamma)(uintptr_t)kr->gamma)(q, qd, t, gamma);
+            ((FloatAll)(uintptr_t)kr->all)(q, qd, t, rest, jac2, rest + nr, rest + 2 * nr);
+            ((FloatAll)(uintptr_t)kr->all_nz)(q, qd, t, rest + 3 * nr, rest + 4 * nr,
+                                              rest + 4 * nr + nnz, rest + 5 * nr + nnz);
+        }
+        for (size_t i = 0; i < cap; i++)
+            if (memcmp(&out[0][i], &out[1][i], sizeof(float)) != 0)
+                fail_msg("%s (float): output word %zu differs: %.9g straight-line, %.9g rolled", name,
+                         i, (double)out[0][i], (double)out[1][i]);
+    }
+    free(q);
+    free(qd);
+    free(out[0]);
+    free(out[1]);
+}
+
+/* Float files (--real float: float tables and literals, sinf and cosf)
+   built by gcc -O2: the same bytes rolled and straight-line. */
+static void test_float(void **state)
+{
+    (void)state;
+    if (!aot_compiler_available())
+        skip();
+    Mech *mechs[] = {load_script("chain.sh", 15), load_example("all_statements.mech"),
+                     load_script("chain_spatial.sh", 5)};
+    for (size_t i = 0; i < sizeof mechs / sizeof *mechs; i++) {
+        EmitResult straight, rolled;
+        emit_real(mechs[i], EMIT_ROLL_NEVER, false, true, true, &straight);
+        emit_real(mechs[i], EMIT_ROLL_ALWAYS, false, true, true, &rolled);
+        assert_non_null(strstr(rolled.c_text, "one shape: one loop"));
+        Unit a, b;
+        const Kernels *ka = unit_open(&a, &straight, false, mechs[i]->model->name);
+        const Kernels *kb = unit_open(&b, &rolled, false, mechs[i]->model->name);
+        compare_float(mechs[i]->model->name, mechs[i], ka, kb);
+        unit_close(&a);
+        unit_close(&b);
+        emit_result_free(&straight);
+        emit_result_free(&rolled);
+        pipeline_free(mechs[i]);
+    }
+}
+
 /* auto leaves small files straight-line (their text unchanged) and rolls
    a chain past EMIT_ROLL_AUTO_ROWS rows. */
 static void test_auto(void **state)
@@ -286,6 +363,7 @@ int main(void)
         cmocka_unit_test(test_chains),
         cmocka_unit_test(test_gcc),
         cmocka_unit_test(test_unoptimised),
+        cmocka_unit_test(test_float),
         cmocka_unit_test(test_auto),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
