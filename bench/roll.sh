@@ -21,7 +21,9 @@
 # same bytes: ns per call, medians of REPEAT rounds, and rolled/straight.
 # Then the N = BIG_N chain (10 000; empty: left out) from the file to
 # machine code in process: `mechc run --steps 0 --stats` (jit, auto rolls
-# it), its stages and the whole command's CPU time and peak memory.
+# it), its stages and the whole command's CPU time and peak memory; and
+# the same source built by gcc (`--engine aot`, gcc -O2 -fPIC -shared
+# timed through a CC wrapper, in a fresh cache): its size and gcc's CPU.
 # Needs gcc and /usr/bin/time (without it the times say "-").
 # POSIX sh and awk only.
 set -u
@@ -111,4 +113,19 @@ if [ -n "$big_n" ]; then
     read -r bs bm < "$tmp/big"
     echo "whole command (load, derivatives, emission, libtcc, assembly): $bs s CPU," \
          "$(echo "$bm" | awk '{ printf "%.0f", $1 / 1024 }') MB peak"
+    # the same source under the system compiler: the aot engine's build,
+    # through a CC that times gcc and keeps the file's size (a fresh cache)
+    if [ -n "$timer" ]; then
+        {
+            echo '#!/bin/sh'
+            echo "for a; do case \$a in *.c) wc -c < \"\$a\" > '$tmp/aot.size' ;; esac; done"
+            echo "exec $timer -f '%U %S %M' -o '$tmp/aot.t' gcc \"\$@\""
+        } > "$tmp/cc.sh"
+        chmod +x "$tmp/cc.sh"
+        XDG_CACHE_HOME=$tmp/cache CC=$tmp/cc.sh "$mechc" run "$tmp/big.mech" --engine aot \
+            --steps 0 --csv /dev/null > /dev/null 2> "$tmp/aot.log" || { cat "$tmp/aot.log"; exit 1; }
+        tail -1 "$tmp/aot.t" | awk -v bytes="$(cat "$tmp/aot.size")" '{
+            printf "aot: gcc -O2 -fPIC -shared of its %.0f KB source: %.2f s CPU, %.0f MB peak\n",
+                   bytes / 1024, $1 + $2, $3 / 1024 }'
+    fi
 fi
