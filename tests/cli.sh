@@ -286,6 +286,23 @@ check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
 check "gen --prefix int (a C keyword) exits 2" status_is 2
 
+# ---- gen --roll: loops for joints of one shape (README "Loop-rolled code")
+sh "$ex/chain.sh" 90 "$tmp/chain90.mech"
+run gen "$tmp/chain90.mech" -o "$tmp/ch_auto.c"
+check "gen --roll auto (default) rolls a chain of 543 rows" grep -q "one shape: one loop" "$tmp/ch_auto.c"
+run gen "$tmp/chain90.mech" --roll never -o "$tmp/ch_never.c"
+check "gen --roll never writes no loop" sh -c '! grep -q "one shape: one loop" "$1"' _ "$tmp/ch_never.c"
+run gen "$ex/four_bar.mech" --roll always -o "$tmp/fb_always.c"
+check "gen --roll always exits 0 on the four-bar" status_is 0
+run gen "$ex/four_bar.mech" --roll sometimes
+check "gen --roll sometimes exits 2" status_is 2
+check "gen --roll sometimes names the choices" err_has "auto, never or always"
+run gen --help
+check "gen --help documents --roll" out_has "--roll WHEN"
+if have gcc; then
+    check "gcc compiles gen --roll auto output" gcc $cflags -c "$tmp/ch_auto.c" -o "$tmp/ch_auto.o"
+fi
+
 # ---- spatial mechanisms (issue 14): gen, eval, check and bench work on them
 for f in rssr all_spatial slider_crank_spatial rolling_disk; do
     run check "$ex/$f.mech" --samples 4

@@ -256,15 +256,21 @@ distance L: b(0.1, 0) m length = 1 + 0.1*t
 velocity v: der(m.x) + b.x*der(m.y) = sin(t)
 EOF
 
+# A chain written loop-rolled (gen --roll always): static const tables,
+# loops, arrays of sin and cos on the stack.
+sh "$root/examples/chain.sh" 12 "$tmp/chain_rolled.mech"
+
 # ---- generated kernels --------------------------------------------------------
-for mech in "$root"/examples/*.mech "$tmp/every_function.mech"; do
+for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolled.mech"; do
     name=$(basename "$mech" .mech)
     prefix=$(echo "$name" | tr -c 'A-Za-z0-9_\n' '_')
+    roll=never
+    [ "$name" = chain_rolled ] && roll=always
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
         try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
-            -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
+            --roll "$roll" -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
         try 12 "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
         if [ "$real" = float ]; then f=f; else f=; fi
         while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do

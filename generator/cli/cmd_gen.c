@@ -14,22 +14,25 @@ typedef struct GenCli {
     MechLimits limits;
     const char *out_path, *header_path;
     int real, trig, jac, dump;      /* indices into the choices below */
+    int roll;                       /* rolls[]: EmitRoll's order */
     bool stats;
 } GenCli;
 
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
-    "                 [--sparse] [--chunk N] [--stats]\n"
+    "                 [--sparse] [--roll auto|never|always] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
-    "fused _all of the mechanism: needs only <math.h>, no heap, no I/O.\n"
+    "fused _all of the mechanism (loops for joints of one shape, --roll): needs\n"
+    "only <math.h>, no heap, no I/O.\n"
     "\n";
 
 static const char *const reals[] = {"double", "float", NULL};
 static const char *const trigs[] = {"own", "libm", NULL};
 static const char *const jacs[] = {"spread", "direct", NULL};
 static const char *const dumps[] = {"rows", NULL};
+static const char *const rolls[] = {"auto", "never", "always", NULL};
 
 static const CliOption options[] = {
     {"-o", CLI_STRING_AT(GenCli, out_path), .alias = "--output", .metavar = "OUT.c",
@@ -56,6 +59,13 @@ static const CliOption options[] = {
      .help = "also write PREFIX_all_nz: Phi, the Jacobian's nonzeros, nu\n"
              "and gamma in one call (the sparse counterpart of _all,\n"
              "what run's sparse path calls)"},
+    {"--roll", CLI_CHOICE_AT(GenCli, roll, rolls), .metavar = "WHEN",
+     .help = "joints' rows of one shape (a chain's links) written once,\n"
+             "as a loop over tables of their constants and indices:\n"
+             "auto (default) for 500 rows or more, groups of 8 joints\n"
+             "or more; always (groups of 2 or more); never. The same\n"
+             "results to the bit; code size and compile time nearly\n"
+             "independent of the number of links"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"
@@ -117,6 +127,7 @@ static bool finish(Args *a, void *opts)
     c->emit.real_float = c->real == 1;
     c->emit.libm_trig = c->trig == 1;
     c->emit.direct_jac = c->jac == 1;
+    c->emit.roll = c->roll;     /* rolls[] is in EmitRoll's order */
     c->emit.max_ops = c->limits.max_code_ops;
     const char *why;
     char buf[256];
@@ -138,7 +149,8 @@ static bool finish(Args *a, void *opts)
 }
 
 /* --stats: sizes, operation counts, stage times, and an in-process compile. */
-static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, Diag *diag)
+static void print_stats(Mech *mech, int c_roll, const EmitResult *res, double emit_seconds,
+                        Diag *diag)
 {
     fprintf(stderr, "mechc gen: %s: %d coordinates, %d rows (%d holonomic, %d velocity level), "
             "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
@@ -153,7 +165,7 @@ static void print_stats(Mech *mech, const EmitResult *res, double emit_seconds, 
             (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
     EmitResult jit_src;
     double jit_emit = 0, jit_tcc = 0;
-    Jit *jit = pipeline_jit(mech, &jit_src, &jit_emit, &jit_tcc, diag);
+    Jit *jit = pipeline_jit_roll(mech, c_roll, &jit_src, &jit_emit, &jit_tcc, diag);
     if (jit)
         fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
                 "file to machine code %.3f s\n", jit_emit, jit_tcc,
@@ -195,7 +207,7 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     double emit_seconds = pipeline_now() - t0;
     bool ok = write_outputs(c, &res);
     if (c->stats)
-        print_stats(mech, &res, emit_seconds, diag);
+        print_stats(mech, c->emit.roll, &res, emit_seconds, diag);
     emit_result_free(&res);
     return ok ? EXIT_OK : EXIT_USAGE;
 }

@@ -12,6 +12,7 @@
 
 #include "../base/arena.h"
 #include "../sched/sched.h"
+#include "roll.h"
 #include "template.h"
 #include "templates.h"
 
@@ -183,6 +184,8 @@ typedef struct Emitter {
     int fused;                  /* negations written into their product, this function */
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
     bool hoisting;              /* in put_calls_first */
+    const RollHooks *roll;      /* a loop body's leaves and stores (roll.c) */
+    bool rolled;                /* some function has loops (roll.c) */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -222,7 +225,12 @@ static void put_expr(Emitter *e, StrBuf *sb, NodeId id, bool top)
     DagOp op = (DagOp)n->op;
     switch (op) {
     case OP_CONST: put_literal(sb, n->value, e->opt->real_float); return;
-    case OP_VAR:   sb_printf(sb, "q[%d]", n->a); return;
+    case OP_VAR:
+        if (e->roll)    /* a slot of a loop body */
+            e->roll->leaf(e->roll->ctx, sb, n->a);
+        else
+            sb_printf(sb, "q[%d]", n->a);
+        return;
     case OP_VARD:  sb_printf(sb, "qd[%d]", n->a); return;
     case OP_TIME:  sb_puts(sb, "t"); return;
     case OP_NEG:
@@ -462,10 +470,10 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     e->fused += sched_prepare_chunk(&e->sched, fn, chunk);
     e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
-    sb_puts(sb, "    ");
-    for (const Param *p = function_params[which]; p->name; p++)
-        sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
-    sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
+    for (const Param *p = function_params[which]; p->name && !e->roll; p++)
+        sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "    " : " ", p->name);
+    if (!e->roll)
+        sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
     if (calls_first(e, c))
         put_calls_first(e, sb, c);
     int at = 0;
@@ -474,7 +482,10 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
             if (e->sched.temp[c->nodes[at]] >= 0 && !e->written[c->nodes[at]])
                 put_temporary(e, sb, c, at, c->nodes[at]);
         const SchedOutput *o = &fn->outputs[c->first + i];
-        sb_printf(sb, "    %s[%d] = ", o->array, o->index);
+        if (e->roll)
+            e->roll->store(e->roll->ctx, sb, o);
+        else
+            sb_printf(sb, "    %s[%d] = ", o->array, o->index);
         put_expr(e, sb, o->value, false);
         sb_puts(sb, ";\n");
     }
@@ -717,6 +728,60 @@ static bool check_options(const Model *m, const EmitOptions *opt, EmitResult *ou
     return true;
 }
 
+/* A loop body of roll.c: the shape's graph scheduled as one chunk and
+   written by the same printer as straight-line code, its slots and store
+   indices through hooks. Returns its operations. */
+static int put_roll_body(void *emitter, const Dag *dag, SchedOutput *outs, int n,
+                         const RollHooks *hooks, StrBuf *sb)
+{
+    Emitter e = *(const Emitter *)emitter;
+    e.dag = dag;
+    e.roll = hooks;
+    e.written = xcalloc((size_t)dag->count + 1, sizeof *e.written);
+    sched_init(&e.sched, dag, 1 << 28);     /* one chunk: a loop body is small */
+    SchedFunction fn;
+    sched_function(&e.sched, outs, n, &fn);
+    e.fused = 0;
+    put_chunk(&e, sb, &fn, 0, EMIT_PHI, false);
+    int ops = fn.ops - e.fused;
+    sched_function_free(&fn);
+    sched_free(&e.sched);
+    free(e.written);
+    return ops;
+}
+
+/* Rolls what roll.c finds in function f's outputs (writing its tables and
+   loops into parts and body) when opt->roll asks for it; *outs and *n
+   become the outputs left for straight-line code. Returns the rolled
+   operations per call. */
+static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n, StrBuf *parts,
+                         StrBuf *body)
+{
+    const EmitOptions *opt = e->opt;
+    if (opt->roll == EMIT_ROLL_NEVER || f >= EMIT_MASS
+        || (opt->roll == EMIT_ROLL_AUTO && e->kin->model->nr < EMIT_ROLL_AUTO_ROWS))
+        return 0;
+    RollContext rc = {
+        .kin = e->kin, .prefix = e->prefix, .function = emit_function_names[f],
+        .real_float = opt->real_float, .sincos_name = e->sincos_name, .sin_name = e->sin_name,
+        .cos_name = e->cos_name, .sincos2_name = e->sincos2_name,
+        .min_members = opt->roll == EMIT_ROLL_ALWAYS ? 2 : EMIT_ROLL_AUTO_MEMBERS,
+        .write_body = put_roll_body, .emitter = e,
+        .sincos_used = &e->sincos_used, .single_used = &e->single_used,
+        .sincos2_used = &e->sincos2_used,
+    };
+    SchedOutput *rest;
+    int nrest;
+    long ops;
+    if (roll_function(&rc, *outs, *n, parts, body, &rest, &nrest, &ops) == 0)
+        return 0;
+    free(*outs);
+    *outs = rest;
+    *n = nrest;
+    e->rolled = true;
+    return ops;
+}
+
 /* Schedules and writes every function into parts and bodies (initialized
    here, freed by the caller); false when the code would pass max_ops. */
 static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
@@ -740,11 +805,12 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         SchedOutput *outs;
         int n;
         collect_outputs(e->kin, (EmitFunction)f, &outs, &n);
+        long rolled = roll_outputs(e, (EmitFunction)f, &outs, &n, &parts[f], &bodies[f]);
         SchedFunction fn;
         if (sched_function(&e->sched, outs, n, &fn)) {
             e->fused = 0;
             put_function(e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
-            out->ops[f] = fn.ops - e->fused;
+            out->ops[f] = (int)(fn.ops - e->fused + rolled);
             out->chunks[f] = fn.nchunks;
         } else {
             fits = false;
@@ -984,7 +1050,11 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
-    if (!opt->direct_jac)
+    if (!opt->direct_jac && e->rolled)     /* a rolled file stays small: the loop everywhere */
+        sb_printf(&moves, "    for (int k = 0; k < %s_NNZ; ++k) {\n        %s_real v = packed[k];\n"
+                  "        packed[k] = 0;\n        jac[%s_jac_row[k] * %s_NQ + %s_jac_col[k]] = v;\n"
+                  "    }", upper, out->prefix, out->prefix, upper, out->prefix);
+    else if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
     put_math(&math, e, parts, bodies);
     put_all_nz(e, parts, bodies, &nzd, &nzf);

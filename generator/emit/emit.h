@@ -30,7 +30,17 @@ typedef struct EmitOptions {
     bool all_nz;                /* also PREFIX_all_nz: Phi, the Jacobian's
                                    nonzeros, nu and gamma in one call (the
                                    sparse path of run; gen --sparse) */
+    int roll;                   /* EmitRoll: loops for joints' rows of one
+                                   shape (generator/emit/roll.c) */
 } EmitOptions;
+
+/* gen --roll: auto rolls the kinematic functions of a mechanism with at
+   least EMIT_ROLL_AUTO_ROWS rows, groups of EMIT_ROLL_AUTO_MEMBERS joints
+   or more; always rolls every group of two or more; never writes
+   straight-line code only. Rolled and straight-line kernels compute the
+   same bits. */
+typedef enum EmitRoll { EMIT_ROLL_AUTO, EMIT_ROLL_NEVER, EMIT_ROLL_ALWAYS } EmitRoll;
+enum { EMIT_ROLL_AUTO_ROWS = 500, EMIT_ROLL_AUTO_MEMBERS = 8 };
 
 /* The spec's function order, for op counts and reports; then all_nz, an
    extension (written only with EmitOptions.all_nz: its ops count 0 without),

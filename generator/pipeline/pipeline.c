@@ -92,7 +92,14 @@ void pipeline_free(Mech *mech)
 Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
                   double *tcc_seconds, Diag *diag)
 {
+    return pipeline_jit_roll(mech, EMIT_ROLL_AUTO, emitted, emit_seconds, tcc_seconds, diag);
+}
+
+Jit *pipeline_jit_roll(const Mech *mech, int roll, EmitResult *emitted, double *emit_seconds,
+                       double *tcc_seconds, Diag *diag)
+{
     EmitOptions opt = emit_default_options();
+    opt.roll = roll;
     opt.declare_math = true;
     opt.direct_jac = true;
     opt.all_nz = true;      /* run's sparse path */

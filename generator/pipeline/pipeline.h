@@ -33,6 +33,9 @@ void pipeline_free(Mech *mech);
 /* Emits double kernels for the JIT and compiles them with libtcc. */
 Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
                   double *tcc_seconds, Diag *diag);
+/* The same with EmitOptions.roll = roll (an EmitRoll): gen --stats --roll. */
+Jit *pipeline_jit_roll(const Mech *mech, int roll, EmitResult *emitted, double *emit_seconds,
+                       double *tcc_seconds, Diag *diag);
 
 double pipeline_now(void);
 
