@@ -257,20 +257,33 @@ velocity v: der(m.x) + b.x*der(m.y) = sin(t)
 EOF
 
 # A chain written loop-rolled (gen --roll always): static const tables,
-# loops, arrays of sin and cos on the stack.
+# loops, arrays of sin and cos on the stack; and one written sparse-only
+# (gen --sparse-only, rolled: no dense jac and all, all_nz instead).
 sh "$root/examples/chain.sh" 12 "$tmp/chain_rolled.mech"
+sh "$root/examples/chain.sh" 12 "$tmp/chain_sparse_only.mech"
 
 # ---- generated kernels --------------------------------------------------------
-for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolled.mech"; do
+for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolled.mech" \
+            "$tmp/chain_sparse_only.mech"; do
     name=$(basename "$mech" .mech)
     prefix=$(echo "$name" | tr -c 'A-Za-z0-9_\n' '_')
     roll=never
-    [ "$name" = chain_rolled ] && roll=always
+    only=
+    case $name in
+        chain_rolled) roll=always ;;
+        chain_sparse_only) roll=always only=--sparse-only ;;
+    esac
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
         try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
-            --roll "$roll" -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
+            --roll "$roll" $only -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
+        if [ -n "$only" ]; then
+            try 5 "$name ($real): no dense jac or all, ${prefix}_all_nz" sh -c \
+                "grep -q '^#define $(echo "$prefix" | tr a-z A-Z)_SPARSE_ONLY 1' '$d/$prefix.h' &&
+                 grep -q '${prefix}_all_nz(' '$d/$prefix.c' &&
+                 ! grep -E '${prefix}_(jac|all)\(' '$d/$prefix.c' '$d/$prefix.h'"
+        fi
         try 12 "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
         if [ "$real" = float ]; then f=f; else f=; fi
         while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do

@@ -23,6 +23,9 @@ typedef struct MechLimits {
                                Jacobian and checks only where it would, RunOptions) */
     int max_nodes;          /* expression-graph nodes incl. derivatives (default 2000000) */
     int max_code_ops;       /* operations in the generated C, all functions (default 4000000) */
+    const char *jac_advice; /* ends max_jac_entries' error: how the command can do
+                               without the dense Jacobian (gen: --sparse-only);
+                               NULL: nothing */
 } MechLimits;
 
 static inline MechLimits mech_default_limits(void)

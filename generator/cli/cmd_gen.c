@@ -16,12 +16,15 @@ typedef struct GenCli {
     int real, trig, jac, dump;      /* indices into the choices below */
     int roll;                       /* rolls[]: EmitRoll's order */
     bool stats;
+    int dense_limit;                /* --max-jac-entries, kept here with
+                                       --sparse-only (the model then skips it) */
 } GenCli;
 
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
-    "                 [--sparse] [--roll auto|never|always] [--chunk N] [--stats]\n"
+    "                 [--sparse | --sparse-only] [--roll auto|never|always]\n"
+    "                 [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism (loops for joints of one shape, --roll): needs\n"
@@ -59,6 +62,11 @@ static const CliOption options[] = {
      .help = "also write PREFIX_all_nz: Phi, the Jacobian's nonzeros, nu\n"
              "and gamma in one call (the sparse counterpart of _all,\n"
              "what run's sparse path calls)"},
+    {"--sparse-only", CLI_FLAG_AT(GenCli, emit.sparse_only),
+     .help = "PREFIX_all_nz, and no dense PREFIX_jac or PREFIX_all\n"
+             "(NR*NQ entries): for mechanisms past --max-jac-entries,\n"
+             "which binds only dense files; the header defines\n"
+             "PREFIX_SPARSE_ONLY 1"},
     {"--roll", CLI_CHOICE_AT(GenCli, roll, rolls), .metavar = "WHEN",
      .help = "joints' rows of one shape (a chain's links) written once,\n"
              "as a loop over tables of their constants and indices:\n"
@@ -129,6 +137,10 @@ static bool finish(Args *a, void *opts)
     c->emit.direct_jac = c->jac == 1;
     c->emit.roll = c->roll;     /* rolls[] is in EmitRoll's order */
     c->emit.max_ops = c->limits.max_code_ops;
+    if (c->emit.sparse_only) {      /* checked in gen_file, where it binds */
+        c->dense_limit = c->limits.max_jac_entries;
+        c->limits.max_jac_entries = 0;
+    }
     const char *why;
     char buf[256];
     if (c->emit.prefix && (why = emit_check_prefix(c->emit.prefix))) {
@@ -149,7 +161,7 @@ static bool finish(Args *a, void *opts)
 }
 
 /* --stats: sizes, operation counts, stage times, and an in-process compile. */
-static void print_stats(Mech *mech, int c_roll, const EmitResult *res, double emit_seconds,
+static void print_stats(Mech *mech, const GenCli *c, const EmitResult *res, double emit_seconds,
                         Diag *diag)
 {
     fprintf(stderr, "mechc gen: %s: %d coordinates, %d rows (%d holonomic, %d velocity level), "
@@ -158,14 +170,16 @@ static void print_stats(Mech *mech, int c_roll, const EmitResult *res, double em
     fprintf(stderr, "mechc gen: operations after sharing:");
     int nf = emit_function_count(&mech->kin);
     for (int f = 0; f < nf; f++)
-        if (f != EMIT_ALL_NZ || res->ops[f] > 0)
+        if (res->ops[f] > 0 || (f != EMIT_ALL_NZ && !(c->emit.sparse_only
+                                                      && (f == EMIT_JAC || f == EMIT_ALL))))
             fprintf(stderr, "%s %s %d", f ? "," : "", emit_function_names[f], res->ops[f]);
     fputc('\n', stderr);
     fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",
             (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
     EmitResult jit_src;
     double jit_emit = 0, jit_tcc = 0;
-    Jit *jit = pipeline_jit_roll(mech, c_roll, &jit_src, &jit_emit, &jit_tcc, diag);
+    Jit *jit = pipeline_jit_roll(mech, c->emit.roll, c->emit.sparse_only, &jit_src, &jit_emit,
+                                 &jit_tcc, diag);
     if (jit)
         fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
                 "file to machine code %.3f s\n", jit_emit, jit_tcc,
@@ -189,6 +203,23 @@ static bool write_outputs(const GenCli *c, const EmitResult *res)
     return ok;
 }
 
+/* --sparse-only on a file with masses: its mass and eom stay dense (M,
+   and eom's Jacobian), so the dense limit still binds; false (diag
+   filled) past it. */
+static bool dynamics_fit(const Mech *mech, int limit, Diag *diag)
+{
+    const Model *m = mech->model;
+    long long jac = (long long)m->nr * m->nq, mass = (long long)m->nq * m->nq;
+    long long most = jac > mass ? jac : mass;
+    if (!mech->kin.dyn.present || most <= limit)
+        return true;
+    diag_error_nopos(diag, "the file has masses: its PREFIX_mass and PREFIX_eom stay dense with "
+                     "--sparse-only, and the dense %s would have %lld entries, more than the "
+                     "limit of %d (--max-jac-entries)", jac >= mass ? "Jacobian" : "mass matrix",
+                     most, limit);
+    return false;
+}
+
 /* The generated C (or the rows) for the file. */
 static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
@@ -198,6 +229,10 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_OK;
     }
     c->emit.source_name = a->file;
+    if (c->emit.sparse_only && !dynamics_fit(mech, c->dense_limit, diag)) {
+        diag_print(diag, stderr);
+        return EXIT_USAGE;
+    }
     EmitResult res;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &c->emit, &res, diag)) {     /* about the file: "FILE: error: ..." */
@@ -207,7 +242,7 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     double emit_seconds = pipeline_now() - t0;
     bool ok = write_outputs(c, &res);
     if (c->stats)
-        print_stats(mech, c->emit.roll, &res, emit_seconds, diag);
+        print_stats(mech, c, &res, emit_seconds, diag);
     emit_result_free(&res);
     return ok ? EXIT_OK : EXIT_USAGE;
 }
@@ -221,5 +256,6 @@ static const CliCommand command = {
 int cmd_gen(int argc, char **argv)
 {
     GenCli c = {.emit = emit_default_options(), .limits = mech_default_limits(), .dump = -1};
+    c.limits.jac_advice = "write the file --sparse-only, without the dense Jacobian";
     return cli_main(&command, argc, argv, &c);
 }

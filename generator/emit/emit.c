@@ -782,6 +782,15 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
     return ops;
 }
 
+/* Whether the file gets function f: all_nz when asked for, the dense
+   jac and all unless sparse-only (the dynamics ones: emit_function_count). */
+static bool is_written(const EmitOptions *opt, EmitFunction f)
+{
+    if (f == EMIT_ALL_NZ)
+        return opt->all_nz;
+    return !(opt->sparse_only && (f == EMIT_JAC || f == EMIT_ALL));
+}
+
 /* Schedules and writes every function into parts and bodies (initialized
    here, freed by the caller); false when the code would pass max_ops. */
 static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
@@ -800,7 +809,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
             continue;
         if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
             continue;
-        if (f == EMIT_ALL_NZ && !opt->all_nz)
+        if (!is_written(opt, (EmitFunction)f))
             continue;
         SchedOutput *outs;
         int n;
@@ -818,7 +827,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sched_function_free(&fn);
     }
     sched_free(&e->sched);
-    if (!opt->direct_jac) {
+    if (!opt->direct_jac && !opt->sparse_only) {
         out->ops[EMIT_JAC] = out->ops[EMIT_JAC_NZ];
         out->chunks[EMIT_JAC] = out->chunks[EMIT_JAC_NZ];
     }
@@ -1012,6 +1021,37 @@ static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodi
     def->data[--def->len] = '\0';   /* mech.c.tmpl ends the line after it */
 }
 
+/* The dense jac and all (their declarations, JAC_DECL and ALL_DECL, the
+   definitions JAC and ALL), or, sparse-only, the interface's mark
+   (SPARSE_ONLY) and none of them. ALL is rendered without its last
+   newline (mech.c.tmpl ends the line after it). Returns a placeholder
+   without value, or NULL. */
+static const char *put_dense(const Emitter *e, TemplateVar *vars, int nvars, StrBuf *bufs[5])
+{
+    const char *bad;
+    if (e->opt->sparse_only) {
+        bad = template_render(bufs[4], template_sparse_only, vars, nvars);
+        template_set(vars, nvars, "SPARSE_ONLY", bufs[4]->data);
+        return bad;
+    }
+    bad = template_render(bufs[0], template_jac_decl, vars, nvars);
+    if (!bad)
+        bad = template_render(bufs[1], template_all_decl, vars, nvars);
+    if (!bad)
+        bad = template_render(bufs[2], e->opt->direct_jac ? template_jac_direct
+                                                          : template_jac_spread, vars, nvars);
+    if (!bad)
+        bad = template_render(bufs[3], template_all, vars, nvars);
+    if (bad)
+        return bad;
+    bufs[3]->data[--bufs[3]->len] = '\0';
+    template_set(vars, nvars, "JAC_DECL", bufs[0]->data);
+    template_set(vars, nvars, "ALL_DECL", bufs[1]->data);
+    template_set(vars, nvars, "JAC", bufs[2]->data);
+    template_set(vars, nvars, "ALL", bufs[3]->data);
+    return NULL;
+}
+
 /* The sizes and the include guard, as text for the templates. */
 typedef struct EmitSizes {
     char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
@@ -1037,20 +1077,24 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     const Model *m = e->kin->model;
     const char *upper = e->prefix_upper;
     StrBuf banner, ops, q0, coords, rows, jrow, jcol, math, iface, zero, jac, inc, moves, nzd, nzf;
-    StrBuf mrow, mcol, dyn_c, dyn_h;
+    StrBuf mrow, mcol, dyn_c, dyn_h, jac_decl, all_decl, all_def, mark;
     StrBuf *all_bufs[] = {&banner, &ops, &q0, &coords, &rows, &jrow, &jcol, &math, &iface,
-                          &zero, &jac, &inc, &moves, &nzd, &nzf, &mrow, &mcol, &dyn_c, &dyn_h};
+                          &zero, &jac, &inc, &moves, &nzd, &nzf, &mrow, &mcol, &dyn_c, &dyn_h,
+                          &jac_decl, &all_decl, &all_def, &mark};
+    StrBuf *dense_bufs[5] = {&jac_decl, &all_decl, &jac, &all_def, &mark};
     for (size_t i = 0; i < sizeof all_bufs / sizeof *all_bufs; i++) {
         sb_init(all_bufs[i]);
         sb_puts(all_bufs[i], "");
     }
     put_banner(&banner, opt->source_name ? opt->source_name : m->file);
     for (int f = 0; f < emit_function_count(e->kin); f++)
-        if (f != EMIT_ALL_NZ || opt->all_nz)
+        if (is_written(opt, (EmitFunction)f))
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
-    if (!opt->direct_jac && e->rolled)     /* a rolled file stays small: the loop everywhere */
+    if (opt->sparse_only)
+        ;   /* no dense jac to fill */
+    else if (!opt->direct_jac && e->rolled)    /* a rolled file stays small: the loop everywhere */
         sb_printf(&moves, "    for (int k = 0; k < %s_NNZ; ++k) {\n        %s_real v = packed[k];\n"
                   "        packed[k] = 0;\n        jac[%s_jac_row[k] * %s_NQ + %s_jac_col[k]] = v;\n"
                   "    }", upper, out->prefix, out->prefix, upper, out->prefix);
@@ -1080,18 +1124,17 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         {"MASS_NZ_PARTS", parts[EMIT_MASS_NZ].data}, {"MASS_NZ_BODY", bodies[EMIT_MASS_NZ].data},
         {"FORCE_PARTS", parts[EMIT_FORCE].data}, {"FORCE_BODY", bodies[EMIT_FORCE].data},
         {"EOM_PARTS", parts[EMIT_EOM].data}, {"EOM_BODY", bodies[EMIT_EOM].data},
+        {"JAC_DECL", ""}, {"ALL_DECL", ""}, {"ALL", ""}, {"SPARSE_ONLY", ""},
     };
     int nvars = (int)(sizeof vars / sizeof *vars);
-    /* DYNAMICS, DYN_INTERFACE, INTERFACE and JAC are rendered from the
-       others, then filled in */
+    /* DYNAMICS, DYN_INTERFACE, the dense functions and INTERFACE are
+       rendered from the others, then filled in */
     const char *bad = put_dynamics(e, vars, nvars, &dyn_c, &dyn_h);
+    if (!bad)
+        bad = put_dense(e, vars, nvars, dense_bufs);
     if (!bad)
         bad = template_render(&iface, template_interface, vars, nvars);
     template_set(vars, nvars, "INTERFACE", iface.data);
-    if (!bad)
-        bad = template_render(&jac, opt->direct_jac ? template_jac_direct : template_jac_spread,
-                              vars, nvars);
-    template_set(vars, nvars, "JAC", jac.data);
     StrBuf header, source;
     sb_init(&header);
     sb_init(&source);
@@ -1113,11 +1156,36 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     out->h_text = sb_take(&header);
 }
 
-bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag)
+/* False (diag filled) when a dense function the file would get has more
+   entries than its int indices reach: the Jacobian (jac, all, eom) and,
+   with masses, M (mass, eom). */
+static bool check_dense_size(const Kinematics *kin, const EmitOptions *opt, Diag *diag)
+{
+    const Model *m = kin->model;
+    long long jac = (long long)m->nr * m->nq, mass = (long long)m->nq * m->nq;
+    const char *what = NULL;
+    long long n = 0;
+    if (jac > EMIT_DENSE_MAX_ENTRIES && (!opt->sparse_only || kin->dyn.present))
+        what = "Jacobian", n = jac;
+    else if (kin->dyn.present && mass > EMIT_DENSE_MAX_ENTRIES)
+        what = "mass matrix", n = mass;
+    if (!what)
+        return true;
+    diag_error_nopos(diag, "the dense %s would have %lld entries, more than the %lld a generated "
+                     "file indexes with C ints%s", what, n, EMIT_DENSE_MAX_ENTRIES,
+                     kin->dyn.present ? " (a file with masses has dense M and _eom)"
+                                      : ": write it --sparse-only");
+    return false;
+}
+
+bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResult *out, Diag *diag)
 {
     const Model *m = kin->model;
     memset(out, 0, sizeof *out);
-    if (!check_options(m, opt, out, diag))
+    EmitOptions sparse = *options;      /* sparse-only files get all_nz */
+    sparse.all_nz |= sparse.sparse_only;
+    const EmitOptions *opt = &sparse;
+    if (!check_options(m, opt, out, diag) || !check_dense_size(kin, opt, diag))
         return false;
     char upper[128];
     size_t plen = strlen(out->prefix);

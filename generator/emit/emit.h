@@ -32,7 +32,17 @@ typedef struct EmitOptions {
                                    sparse path of run; gen --sparse) */
     int roll;                   /* EmitRoll: loops for joints' rows of one
                                    shape (generator/emit/roll.c) */
+    bool sparse_only;           /* no dense PREFIX_jac and PREFIX_all (NR*NQ
+                                   entries), PREFIX_all_nz instead; the
+                                   interface defines PREFIX_SPARSE_ONLY 1
+                                   (gen --sparse-only; engines above
+                                   EMIT_DENSE_MAX_ENTRIES) */
 } EmitOptions;
+
+/* The most entries of a dense matrix a generated file indexes: its
+   indices (row * NQ + col, and NR * NQ itself) are C ints. Above it only
+   sparse-only files are written (emit_mechanism refuses the rest). */
+#define EMIT_DENSE_MAX_ENTRIES 2147483647LL
 
 /* gen --roll: auto rolls the kinematic functions of a mechanism with at
    least EMIT_ROLL_AUTO_ROWS rows, groups of EMIT_ROLL_AUTO_MEMBERS joints
@@ -42,8 +52,9 @@ typedef struct EmitOptions {
 typedef enum EmitRoll { EMIT_ROLL_AUTO, EMIT_ROLL_NEVER, EMIT_ROLL_ALWAYS } EmitRoll;
 enum { EMIT_ROLL_AUTO_ROWS = 500, EMIT_ROLL_AUTO_MEMBERS = 8 };
 
-/* The spec's function order, for op counts and reports; then all_nz, an
-   extension (written only with EmitOptions.all_nz: its ops count 0 without),
+/* The spec's function order, for op counts and reports (jac and all count
+   0 in a sparse-only file); then all_nz, an extension (written only with
+   EmitOptions.all_nz or sparse_only: its ops count 0 without),
    and the dynamics functions, written only for a file with masses. */
 typedef enum EmitFunction {
     EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_ALL_NZ,
@@ -77,8 +88,9 @@ const char *emit_check_prefix(const char *prefix);
 const char *emit_check_header_name(const char *name);
 
 /* Writes the C source and header. Returns false (diag filled) for an
-   unusable prefix or header name, or code beyond max_ops; everything else
-   in the model is already valid. */
+   unusable prefix or header name, code beyond max_ops, or a dense
+   function beyond EMIT_DENSE_MAX_ENTRIES; everything else in the model is
+   already valid. */
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag);
 void emit_result_free(EmitResult *out);
 

@@ -95,8 +95,7 @@ static int new_slot(Roll *r, Member *m, double v)
 
 /* The row of each output, or -1 (the placeholder of an empty Jacobian).
    The dense Jacobian's k-th store is entry k (collect_outputs in emit.c):
-   its index, row * NQ + col, passes INT_MAX in the largest mechanisms
-   and is not read back. */
+   its index, row * NQ + col, is not read back. */
 static int *output_rows(const Kinematics *kin, const SchedOutput *outs, int n)
 {
     int *rows = xmalloc((size_t)(n ? n : 1) * sizeof *rows);

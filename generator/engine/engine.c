@@ -110,8 +110,9 @@ static void bind_code(Engine *e, const Kernels *code)
 {
     e->kernels = *code;
     e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = (void *)code,
-                           .phi = code_phi, .jac = code_jac, .nu = code_nu,
-                           .gamma = code_gamma, .all = code_all};
+                           .phi = code_phi, .jac = code->jac ? code_jac : NULL,
+                           .nu = code_nu, .gamma = code_gamma,
+                           .all = code->all ? code_all : NULL};   /* NULL: sparse-only */
     if (code->mass) {       /* the file has masses */
         e->k.mass = code_mass;
         e->k.force = code_force;
@@ -128,6 +129,7 @@ static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag
        mechanisms keep the compact form, for the compiler's sake. */
     eo.direct_jac = mech->kin.nnz <= 4000;
     eo.all_nz = true;       /* run's sparse path */
+    eo.sparse_only = pipeline_sparse_only(mech);
     eo.source_name = mech->model->file;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))

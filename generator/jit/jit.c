@@ -92,8 +92,10 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->mass_col = kernel(find, handle, prefix, "mass_col");
     bool dynamics = k->mass && k->mass_nz && k->force && k->eom && k->mass_row && k->mass_col;
     bool none = !k->mass && !k->mass_nz && !k->force && !k->eom && !k->mass_row && !k->mass_col;
-    return k->phi && k->jac && k->jac_nz && k->nu && k->gamma && k->all && k->jac_row
-           && k->jac_col && (dynamics || none);
+    /* a sparse-only unit has neither dense function, and all_nz instead */
+    bool dense = k->jac && k->all, sparse_only = !k->jac && !k->all && k->all_nz;
+    return k->phi && k->jac_nz && k->nu && k->gamma && k->jac_row && k->jac_col
+           && (dense || sparse_only) && (dynamics || none);
 }
 
 static void *tcc_find(void *s, const char *symbol) { return tcc_get_symbol(s, symbol); }

@@ -16,7 +16,8 @@ typedef void (*KernelEom)(const double *q, const double *qd, double t,
    them (libtcc, dlopen of a cc-built library): context-free, with jac_nz
    and its pattern. Engines evaluate through a MechrtKernels whose ctx is
    this struct (engine.c). all_nz (the fused kernel with the Jacobian's
-   nonzeros, EmitOptions.all_nz) is NULL in a unit written without it. */
+   nonzeros, EmitOptions.all_nz) is NULL in a unit written without it;
+   jac and all are NULL in a sparse-only one (EmitOptions.sparse_only). */
 typedef struct Kernels {
     KernelPhi phi, jac, jac_nz, nu;
     KernelGamma gamma;
@@ -34,7 +35,8 @@ typedef struct Kernels {
 typedef void *(*KernelFind)(void *handle, const char *symbol);
 
 /* Fills k with the generated functions PREFIX_phi, PREFIX_jac, ... of
-   handle; false when one is missing (PREFIX_all_nz may be). The dynamics
+   handle; false when one is missing (PREFIX_all_nz may be, or PREFIX_jac
+   and PREFIX_all together when PREFIX_all_nz is there). The dynamics
    functions are bound when the unit has them (all or none), NULL otherwise. */
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix);
 

@@ -149,8 +149,10 @@ static void check_jacobian_size(Builder *b, long long nr, long long nq, SrcPos p
 {
     if (b->limits->max_jac_entries > 0 && nr * nq > b->limits->max_jac_entries)
         diag_fail(b->diag, pos, "the dense Jacobian would have %lld row%s x %lld coordinate%s = "
-                  "%lld entries, more than the limit of %d", nr, nr == 1 ? "" : "s", nq,
-                  nq == 1 ? "" : "s", nr * nq, b->limits->max_jac_entries);
+                  "%lld entries, more than the limit of %d (--max-jac-entries)%s%s", nr,
+                  nr == 1 ? "" : "s", nq, nq == 1 ? "" : "s", nr * nq,
+                  b->limits->max_jac_entries, b->limits->jac_advice ? ": " : "",
+                  b->limits->jac_advice ? b->limits->jac_advice : "");
 }
 
 static int add_coord(Builder *b, const char *owner, const char *suffix, double q0, SrcPos pos)

@@ -89,17 +89,24 @@ void pipeline_free(Mech *mech)
     free(mech);
 }
 
+bool pipeline_sparse_only(const Mech *mech)
+{
+    return (long long)mech->model->nr * mech->model->nq > EMIT_DENSE_MAX_ENTRIES;
+}
+
 Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
                   double *tcc_seconds, Diag *diag)
 {
-    return pipeline_jit_roll(mech, EMIT_ROLL_AUTO, emitted, emit_seconds, tcc_seconds, diag);
+    return pipeline_jit_roll(mech, EMIT_ROLL_AUTO, false, emitted, emit_seconds, tcc_seconds,
+                             diag);
 }
 
-Jit *pipeline_jit_roll(const Mech *mech, int roll, EmitResult *emitted, double *emit_seconds,
-                       double *tcc_seconds, Diag *diag)
+Jit *pipeline_jit_roll(const Mech *mech, int roll, bool sparse_only, EmitResult *emitted,
+                       double *emit_seconds, double *tcc_seconds, Diag *diag)
 {
     EmitOptions opt = emit_default_options();
     opt.roll = roll;
+    opt.sparse_only = sparse_only || pipeline_sparse_only(mech);
     opt.declare_math = true;
     opt.direct_jac = true;
     opt.all_nz = true;      /* run's sparse path */

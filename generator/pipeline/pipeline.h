@@ -30,12 +30,19 @@ Mech *pipeline_load_bytes(const char *data, size_t len, const char *name, const 
                           Diag *diag);
 void pipeline_free(Mech *mech);
 
+/* Whether the engines' kernels of mech are sparse-only (no dense jac and
+   all): where its dense Jacobian has more entries than a generated file
+   indexes (EMIT_DENSE_MAX_ENTRIES), which only run's sparse path admits,
+   and it calls neither. */
+bool pipeline_sparse_only(const Mech *mech);
+
 /* Emits double kernels for the JIT and compiles them with libtcc. */
 Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
                   double *tcc_seconds, Diag *diag);
-/* The same with EmitOptions.roll = roll (an EmitRoll): gen --stats --roll. */
-Jit *pipeline_jit_roll(const Mech *mech, int roll, EmitResult *emitted, double *emit_seconds,
-                       double *tcc_seconds, Diag *diag);
+/* The same with EmitOptions.roll = roll (an EmitRoll) and sparse_only (or
+   pipeline_sparse_only): gen --stats --roll --sparse-only. */
+Jit *pipeline_jit_roll(const Mech *mech, int roll, bool sparse_only, EmitResult *emitted,
+                       double *emit_seconds, double *tcc_seconds, Diag *diag);
 
 double pipeline_now(void);
 
