@@ -213,8 +213,8 @@ static bool dynamics_fit(const Mech *mech, int limit, Diag *diag)
     long long most = jac > mass ? jac : mass;
     if (!mech->kin.dyn.present || most <= limit)
         return true;
-    diag_error_nopos(diag, "the file has masses: its PREFIX_mass and PREFIX_eom stay dense with "
-                     "--sparse-only, and the dense %s would have %lld entries, more than the "
+    diag_error_nopos(diag, "the file has masses, and its _mass and _eom stay dense with "
+                     "--sparse-only: the dense %s would have %lld entries, more than the "
                      "limit of %d (--max-jac-entries)", jac >= mass ? "Jacobian" : "mass matrix",
                      most, limit);
     return false;
