@@ -12,13 +12,18 @@
 #   gen s          CPU time (user + system) of mechc gen
 #   gcc -O2 -c s   CPU time of gcc -std=c99 -O2 -c on it, and its peak memory
 # straight-line files above STRAIGHT_MAX_N (1000) are left out (gcc takes
-# minutes on them). gen writes chains up to N = 7722: past it the dense
-# Jacobian's NR x NQ entries pass INT_MAX, which gen refuses
-# (--max-jac-entries); the N = 10 000 chain compiles in process only, below. Then, for N in TIME_SIZES (100 1000), both files are built
+# minutes on them). gen writes these dense files up to N = 7722: past it
+# the dense Jacobian's NR x NQ entries pass INT_MAX, which gen refuses
+# (--max-jac-entries); larger chains are written --sparse-only, below.
+# Then, for N in TIME_SIZES (100 1000), both files are built
 # with gcc -O2 -fPIC -shared (and tcc -shared when tcc is installed: code
 # as libtcc makes it, with libm's sin and cos) and bench/roll_time.c times
 # their kernels side by side, interleaved, after checking they compute the
 # same bytes: ns per call, medians of REPEAT rounds, and rolled/straight.
+# Then the files gen writes by default (roll auto) for N in WRITTEN_SIZES
+# (1000 10000): the ordinary one (dense P_jac and P_all; --sparse, past
+# --max-jac-entries left out) and the --sparse-only one, their size and
+# gcc -std=c99 -O2 -c's CPU time and peak memory.
 # Then the N = BIG_N chain (10 000; empty: left out) from the file to
 # machine code in process: `mechc run --steps 0 --stats` (jit, auto rolls
 # it), its stages and the whole command's CPU time and peak memory; and
@@ -33,6 +38,7 @@ time_sizes=${TIME_SIZES:-"100 1000"}
 straight_max=${STRAIGHT_MAX_N:-1000}
 repeat=${REPEAT:-11}
 big_n=${BIG_N-10000}
+written_sizes=${WRITTEN_SIZES-"1000 10000"}
 root=$(cd "$(dirname "$0")/.." && pwd)
 [ -x "$mechc" ] || { echo "usage: sh bench/roll.sh MECHC (run make first)" >&2; exit 2; }
 command -v gcc > /dev/null 2>&1 || { echo "bench/roll.sh: gcc is missing" >&2; exit 1; }
@@ -101,6 +107,31 @@ for n in $time_sizes; do
         awk 'NR == 1 { print; next } { print; for (i = 2; i <= NF; i++) v[NR, i] = $i; nf = NF }
              END { printf "%-28s", "rolled / straight"
                    for (i = 2; i <= nf; i++) printf " %10.2f", v[3, i] / v[2, i]; print "" }' "$tmp/t.out"
+    done
+done
+
+if [ -n "$written_sizes" ]; then
+    echo
+    echo "== written files, roll auto: gen --sparse (dense P_jac, P_all too) and gen --sparse-only =="
+    printf '%6s %7s %-12s %9s %7s %13s %10s\n' N NQ file KB "gen s" "gcc -O2 -c s" "gcc MB"
+fi
+for n in $written_sizes; do
+    [ -f "$tmp/c$n.mech" ] || sh "$root/examples/chain.sh" "$n" "$tmp/c$n.mech" || exit 1
+    for what in sparse sparse-only; do
+        f=$tmp/w${n}_$what
+        cpu "$f.gen" "$mechc" gen "$tmp/c$n.mech" "--$what" --prefix m -o "$f.c"
+        if [ ! -s "$f.c" ]; then
+            printf '%6s %7s %-12s %9s\n' "$n" $((6 * n + 3)) "$what" \
+                "(gen refuses it: $(grep -o 'more than the limit of [0-9]*' "$f.gen.log"))"
+            continue
+        fi
+        cpu "$f.gcc" gcc -std=c99 -O2 -c "$f.c" -o "$f.o"
+        kb=$(wc -c < "$f.c" | awk '{ printf "%.0f", $1 / 1024 }')
+        read -r gs _ < "$f.gen"
+        read -r gc gm < "$f.gcc"
+        printf '%6s %7s %-12s %9s %7s %13s %10s\n' "$n" $((6 * n + 3)) "$what" "$kb" "$gs" "$gc" \
+            "$(echo "$gm" | awk '{ printf "%.0f", $1 / 1024 }')"
+        rm -f "$f.c" "$f.o"
     done
 done
 
