@@ -170,8 +170,7 @@ static void print_stats(Mech *mech, const GenCli *c, const EmitResult *res, doub
     fprintf(stderr, "mechc gen: operations after sharing:");
     int nf = emit_function_count(&mech->kin);
     for (int f = 0; f < nf; f++)
-        if (res->ops[f] > 0 || (f != EMIT_ALL_NZ && !(c->emit.sparse_only
-                                                      && (f == EMIT_JAC || f == EMIT_ALL))))
+        if (emit_function_written(&c->emit, (EmitFunction)f))
             fprintf(stderr, "%s %s %d", f ? "," : "", emit_function_names[f], res->ops[f]);
     fputc('\n', stderr);
     fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",

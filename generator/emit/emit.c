@@ -782,12 +782,10 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
     return ops;
 }
 
-/* Whether the file gets function f: all_nz when asked for, the dense
-   jac and all unless sparse-only (the dynamics ones: emit_function_count). */
-static bool is_written(const EmitOptions *opt, EmitFunction f)
+bool emit_function_written(const EmitOptions *opt, EmitFunction f)
 {
     if (f == EMIT_ALL_NZ)
-        return opt->all_nz;
+        return opt->all_nz || opt->sparse_only;
     return !(opt->sparse_only && (f == EMIT_JAC || f == EMIT_ALL));
 }
 
@@ -809,7 +807,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
             continue;
         if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
             continue;
-        if (!is_written(opt, (EmitFunction)f))
+        if (!emit_function_written(opt, (EmitFunction)f))
             continue;
         SchedOutput *outs;
         int n;
@@ -1088,7 +1086,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     }
     put_banner(&banner, opt->source_name ? opt->source_name : m->file);
     for (int f = 0; f < emit_function_count(e->kin); f++)
-        if (is_written(opt, (EmitFunction)f))
+        if (emit_function_written(opt, (EmitFunction)f))
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &q0, &coords, &rows, &jrow, &jcol, &mrow, &mcol);
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);

@@ -69,6 +69,11 @@ extern const char *const emit_function_names[EMIT_FUNCTION_COUNT];
    ones when it has masses (EMIT_KINEMATIC_COUNT or EMIT_FUNCTION_COUNT). */
 int emit_function_count(const Kinematics *kin);
 
+/* Whether a file emitted with opt gets function f (kin with masses
+   permitting): all_nz with all_nz or sparse_only, jac and all unless
+   sparse_only. */
+bool emit_function_written(const EmitOptions *opt, EmitFunction f);
+
 typedef struct EmitResult {
     char *c_text;               /* malloc'ed */
     char *h_text;               /* malloc'ed; the header (always produced) */
