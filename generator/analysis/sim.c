@@ -153,7 +153,8 @@ typedef struct Sim {
     const MechrtHostMassNz *mnz;
     double *sx, *sw, *sphi, *sg, *sforce, *smass;  /* nq + nr; 2 (nq + nr); nr; nr; nq; mass nnz */
     bool all_active;             /* every row kept in this step */
-    bool vel_ready;              /* identity factors of the kept rows at the state */
+    bool vel_ready;              /* Phi_q's nonzeros and nu at the state, for the
+                                    velocity projection */
 } Sim;
 
 /* Counting wrappers: every kernel call of the simulation goes through these. */
@@ -666,16 +667,34 @@ static bool settle_positions(Sim *s, double *y, double t)
     return true;
 }
 
-/* qd <- qd - dqd, the minimum-norm correction onto the kept rows of
-   Phi_q qd = nu from the identity factors sparse_rows left at q. */
-static MechrtStatus sparse_project_velocities(Sim *s, double *qd)
+/* qd <- qd - dqd, the correction onto the kept rows of Phi_q qd = nu
+   nearest in kinetic energy (mass-orthogonal: least dqd^T M dqd) from
+   [M Phi_A^T; Phi_A 0] at q, Phi_q there from sparse_rows; the minimum-
+   norm one where M is singular on the rows' null space. Mass-orthogonal
+   (Bayo and Ledesma's projections) because it changes T only by
+   -1/2 dqd^T M dqd, second order in the correction: the correction is
+   largest where rows come back after a rank drop (the velocities that
+   moved freely along the fold directions while they were left out), and
+   the minimum-norm one there changed T at first order: on IFToMM A02,
+   3e-4 J at one flat position, then a phase error growing with time. */
+static MechrtStatus sparse_project_velocities(Sim *s, const double *q, double *qd)
 {
     int n = s->nq;
+    MechrtKktWeight w = MECHRT_KKT_MASS;
+    sparse_mass(s, q, mechrt_host_kkt_mass(s->kkt));
+    if (mechrt_host_kkt_factor(s->kkt, w, s->active, s->nr, s->o->dyn.pivot_tol)
+        != MECHRT_OK) {
+        w = MECHRT_KKT_IDENTITY;
+        MechrtStatus st = mechrt_host_kkt_factor(s->kkt, w, s->active, s->nr,
+                                                 SIM_KKT_PIVOT_TOL);
+        if (st != MECHRT_OK)
+            return st;
+    }
     sparse_jac_times(s, qd, s->resid);
     memset(s->sx, 0, (size_t)n * sizeof *s->sx);
     for (int i = 0; i < s->nr; i++)
         s->sx[n + i] = s->active[i] ? s->resid[i] - s->nu[i] : 0;
-    MechrtStatus st = mechrt_host_kkt_solve(s->kkt, MECHRT_KKT_IDENTITY, s->sx);
+    MechrtStatus st = mechrt_host_kkt_solve_refined(s->kkt, w, s->sx, s->sw);
     if (st != MECHRT_OK)
         return st;
     s->res->kkt_solves++;
@@ -687,10 +706,10 @@ static MechrtStatus sparse_project_velocities(Sim *s, double *qd)
 /* Velocities onto Phi_q qd = nu; fails with the message set. */
 static bool settle_velocities(Sim *s, double *y, double t)
 {
-    MechrtStatus st;
-    if (s->kkt && s->vel_ready) {
-        st = sparse_project_velocities(s, y + s->nq);
-    } else {
+    MechrtStatus st = MECHRT_EINVAL;
+    if (s->kkt && s->vel_ready)
+        st = sparse_project_velocities(s, y, y + s->nq);
+    if (st != MECHRT_OK) {
         if (s->kkt)
             s->res->dense_fallbacks++;
         st = project_velocities(s, y, y + s->nq, t);
@@ -723,8 +742,7 @@ static bool choose_rows(Sim *s, const double *y, double t, MechrtDynReport *out)
 }
 
 /* The sparse path's choice: every row where [I Phi_q^T; Phi_q 0] factors
-   with a modest pivot spread (no rank drop near), else choose_rows; then
-   the identity factors of the rows kept, for the velocity projection. */
+   with a modest pivot spread (no rank drop near), else choose_rows. */
 static bool sparse_rows(Sim *s, const double *y, double t)
 {
     int m = s->nr;
@@ -748,9 +766,7 @@ static bool sparse_rows(Sim *s, const double *y, double t)
         s->res->max_redundant = rep.redundant;
     if (rep.pivot_ratio < s->res->min_pivot_ratio)
         s->res->min_pivot_ratio = rep.pivot_ratio;
-    s->vel_ready = evaluated
-                   && mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_IDENTITY, s->active, m,
-                                             SIM_KKT_PIVOT_TOL) == MECHRT_OK;
+    s->vel_ready = evaluated;
     return true;
 }
 
