@@ -128,6 +128,13 @@ static void test_kkt_identity(void **state)
     for (int i = 0; i < 5; i++)
         assert_near(x3[i], want2[i], 0, 1e-14);
     assert_true(mechrt_host_kkt_spread(s, MECHRT_KKT_IDENTITY) >= 1);
+    /* the rank screen: every row, fresh pivots; a zero row is a rank drop */
+    double spread;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_OK);
+    assert_true(spread >= 1 && spread < 100);
+    mechrt_host_kkt_jac(s)[2] = mechrt_host_kkt_jac(s)[3] = 0;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_ESING);
+    assert_int_equal(mechrt_host_kkt_screen(s, 1, 1e-12, &spread), MECHRT_OK);
     mechrt_host_kkt_free(s);
 }
 

@@ -749,16 +749,19 @@ static bool choose_rows(Sim *s, const double *y, double t, MechrtDynReport *out)
 }
 
 /* The sparse path's choice: every row where [I Phi_q^T; Phi_q 0] factors
-   with a modest pivot spread (no rank drop near), else choose_rows. */
+   with a fresh pivot search and a modest pivot spread (no rank drop near:
+   mechrt_host_kkt_screen), else choose_rows. */
 static bool sparse_rows(Sim *s, const double *y, double t)
 {
     int m = s->nr;
     s->vel_ready = false;
     bool evaluated = sparse_eval(s, y, y + s->nq, t, false) == MECHRT_OK;
-    if (evaluated
-        && mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_IDENTITY, NULL, m, SIM_KKT_PIVOT_TOL)
-               == MECHRT_OK
-        && mechrt_host_kkt_spread(s->kkt, MECHRT_KKT_IDENTITY) <= SIM_KKT_SPREAD_MAX) {
+    double spread = INFINITY;
+    bool factored = evaluated
+                    && mechrt_host_kkt_screen(s->kkt, m, SIM_KKT_PIVOT_TOL, &spread) == MECHRT_OK;
+    if (factored)
+        s->res->max_screen_spread = fmax(s->res->max_screen_spread, spread);
+    if (spread <= SIM_KKT_SPREAD_MAX) {
         memset(s->active, 1, (size_t)m);
         s->all_active = s->vel_ready = true;
         s->res->rows_sparse++;

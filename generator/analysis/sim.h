@@ -109,6 +109,8 @@ typedef struct SimResult {
     bool sparse;
     long kkt_fresh, kkt_refactored, kkt_solves;
     long rows_sparse, rows_dense, dense_fallbacks;
+    double max_screen_spread;    /* largest pivot spread of [I Phi_q^T; Phi_q 0] with
+                                    every row, where it factored (sparse path) */
     long projection_iterations;  /* Newton iterations in the position ones */
     SimKernelCalls calls;
     int max_redundant;           /* most rows found dependent at once */

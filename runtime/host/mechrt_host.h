@@ -201,6 +201,8 @@ double mechrt_host_sparse_condest(MechrtHostSparse *s);
 void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col);
 /* Fresh factorisations (with pivot search) and refactorisations done. */
 void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored);
+/* Drops the factors: the next factorisation searches its pivots afresh. */
+void mechrt_host_sparse_refresh(MechrtHostSparse *s);
 
 /* ---- Sparse augmented matrix (sparse_kkt.c) -------------------------------
    [W Phi_A^T; Phi_A 0] for forward dynamics (W = M) and minimum-norm
@@ -234,6 +236,14 @@ double *mechrt_host_kkt_mass(MechrtHostKkt *s);
    mechrt_host_sparse_factor. */
 MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
                                     const unsigned char *active, int rows, double pivot_tol);
+/* The rank screen: [I Phi_q^T; Phi_q 0] with the first `rows` rows
+   factored with a fresh pivot search, into factors of its own. Partial
+   pivoting shows a rank drop near as a small pivot; a refactorisation's
+   old order need not (a drop of many ranks can spread over many moderate
+   pivots). *spread = max|u_kk| / min|u_kk|; the statuses of
+   mechrt_host_kkt_factor. */
+MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
+                                    double *spread);
 /* x (nq + nr) <- the solution for right side x, with the last factors of w. */
 MechrtStatus mechrt_host_kkt_solve(MechrtHostKkt *s, MechrtKktWeight w, double *x);
 /* The same with one step of iterative refinement (a residual over the
@@ -242,7 +252,8 @@ MechrtStatus mechrt_host_kkt_solve_refined(MechrtHostKkt *s, MechrtKktWeight w, 
                                            double *work);
 /* max|u_kk| / min|u_kk| of w's last factors (INFINITY without). */
 double mechrt_host_kkt_spread(const MechrtHostKkt *s, MechrtKktWeight w);
-/* Factorisations with pivot search and refactorisations, both weights. */
+/* Factorisations with pivot search and refactorisations, both weights and
+   the screen. */
 void mechrt_host_kkt_counts(const MechrtHostKkt *s, long *fresh, long *refactored);
 
 /* Workspace length, in doubles, of mechrt_host_sparse_step. */

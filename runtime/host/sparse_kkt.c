@@ -33,7 +33,7 @@ struct MechrtHostKkt {
     unsigned char *mdiag;           /* M's entry e is on the diagonal */
     int *row, *col;                 /* the pattern, entries in the order of fill() */
     double *jac, *mass;             /* the caller's values: jnz, mnz */
-    MechrtHostSparse *lu[2];        /* per MechrtKktWeight */
+    MechrtHostSparse *lu[3];        /* per MechrtKktWeight; [2] the rank screen's */
 };
 
 /* A pattern without a callback: values are written, not evaluated. */
@@ -97,7 +97,7 @@ MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
     }
     MechrtHostJacNz pat = {s->mnz + s->nxd + 2 * s->jnz + nr, s->row, s->col, NULL, kkt_no_eval,
                            NULL};
-    for (int w = 0; w < 2; w++) {
+    for (int w = 0; w < 3; w++) {
         s->lu[w] = mechrt_host_sparse_new(nq + nr, &pat);
         if (!s->lu[w]) {
             mechrt_host_kkt_free(s);
@@ -111,8 +111,8 @@ void mechrt_host_kkt_free(MechrtHostKkt *s)
 {
     if (!s)
         return;
-    mechrt_host_sparse_free(s->lu[0]);
-    mechrt_host_sparse_free(s->lu[1]);
+    for (int w = 0; w < 3; w++)
+        mechrt_host_sparse_free(s->lu[w]);
     free(s->xdiag), free(s->mdiag), free(s->row), free(s->col), free(s->jac), free(s->mass);
     free(s);
 }
@@ -159,6 +159,17 @@ MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
     return mechrt_host_sparse_factor(lu, pivot_tol);
 }
 
+MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
+                                    double *spread)
+{
+    MechrtHostSparse *lu = s->lu[2];
+    kkt_fill(s, MECHRT_KKT_IDENTITY, NULL, rows, mechrt_host_sparse_values(lu));
+    mechrt_host_sparse_refresh(lu);
+    MechrtStatus st = mechrt_host_sparse_factor(lu, pivot_tol);
+    *spread = mechrt_host_sparse_spread(lu);
+    return st;
+}
+
 MechrtStatus mechrt_host_kkt_solve(MechrtHostKkt *s, MechrtKktWeight w, double *x)
 {
     return mechrt_host_sparse_solve(s->lu[w == MECHRT_KKT_MASS ? 0 : 1], x);
@@ -195,9 +206,11 @@ double mechrt_host_kkt_spread(const MechrtHostKkt *s, MechrtKktWeight w)
 
 void mechrt_host_kkt_counts(const MechrtHostKkt *s, long *fresh, long *refactored)
 {
-    long f0, r0, f1, r1;
-    mechrt_host_sparse_counts(s->lu[0], &f0, &r0);
-    mechrt_host_sparse_counts(s->lu[1], &f1, &r1);
-    *fresh = f0 + f1;
-    *refactored = r0 + r1;
+    *fresh = *refactored = 0;
+    for (int w = 0; w < 3; w++) {
+        long f, r;
+        mechrt_host_sparse_counts(s->lu[w], &f, &r);
+        *fresh += f;
+        *refactored += r;
+    }
 }
