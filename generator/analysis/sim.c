@@ -158,6 +158,8 @@ typedef struct Sim {
     const MechrtHostMassNz *mnz;
     double *sx, *sw, *sphi, *sg, *sforce, *smass;  /* nq + nr; 2 (nq + nr); nr; nr; nq; mass nnz */
     bool all_active;             /* every row kept in this step */
+    double *mq, mq_t;            /* (q, t) of the factors of M's augmented matrix */
+    bool mq_valid;               /* ... with this step's rows */
     bool vel_ready;              /* Phi_q's nonzeros and nu at the state, for the
                                     velocity projection */
 } Sim;
@@ -314,6 +316,29 @@ static MechrtStatus sparse_eval(Sim *s, const double *q, const double *qd, doubl
                                                                         : MECHRT_ENOTFINITE;
 }
 
+/* [M Phi_A^T; Phi_A 0] factored at (q, t) with the step's rows, M's and
+   Phi_q's nonzeros at q in the buffers; skipped where the factors are
+   already at the same q and t with these rows (the matrix depends on
+   nothing else): the velocity projection's serve the step's first stage,
+   its retries after a rejection, and the output state's solve. */
+static MechrtStatus sparse_mass_factor(Sim *s, const double *q, double t)
+{
+    size_t bytes = (size_t)s->nq * sizeof *q;
+    if (s->mq_valid && t == s->mq_t && memcmp(q, s->mq, bytes) == 0) {
+        s->res->kkt_reused++;
+        return MECHRT_OK;
+    }
+    s->mq_valid = false;
+    MechrtStatus st = mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_MASS, s->active, s->nr,
+                                             s->o->dyn.pivot_tol);
+    if (st == MECHRT_OK) {
+        memcpy(s->mq, q, bytes);
+        s->mq_t = t;
+        s->mq_valid = true;
+    }
+    return st;
+}
+
 /* qdd (and lambda, nr, when not NULL) from [M Phi_A^T; Phi_A 0] with the
    rows of active (NULL: all), gamma stabilised as dyn_eval does. */
 static MechrtStatus sparse_accel(Sim *s, const double *q, const double *qd, double t,
@@ -330,7 +355,7 @@ static MechrtStatus sparse_accel(Sim *s, const double *q, const double *qd, doub
             s->sg[i] -= 2 * o->baumgarte_alpha * (s->resid[i] - s->nu[i])
                       + (i < s->inner->nh ? o->baumgarte_beta * o->baumgarte_beta * s->sphi[i] : 0);
     }
-    st = mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_MASS, active, m, o->pivot_tol);
+    st = sparse_mass_factor(s, q, t);     /* active is the step's rows, or all of them */
     if (st != MECHRT_OK)
         return st;
     memcpy(s->sx, s->sforce, (size_t)n * sizeof *s->sx);
@@ -684,13 +709,12 @@ static bool settle_positions(Sim *s, double *y, double t)
    moved freely along the fold directions while they were left out), and
    the minimum-norm one there changed T at first order: on IFToMM A02,
    3e-4 J at one flat position, then a phase error growing with time. */
-static MechrtStatus sparse_project_velocities(Sim *s, const double *q, double *qd)
+static MechrtStatus sparse_project_velocities(Sim *s, const double *q, double t, double *qd)
 {
     int n = s->nq;
     MechrtKktWeight w = MECHRT_KKT_MASS;
     sparse_mass(s, q, mechrt_host_kkt_mass(s->kkt));
-    if (mechrt_host_kkt_factor(s->kkt, w, s->active, s->nr, s->o->dyn.pivot_tol)
-        != MECHRT_OK) {
+    if (sparse_mass_factor(s, q, t) != MECHRT_OK) {
         w = MECHRT_KKT_IDENTITY;
         MechrtStatus st = mechrt_host_kkt_factor(s->kkt, w, s->active, s->nr,
                                                  SIM_KKT_PIVOT_TOL);
@@ -715,7 +739,7 @@ static bool settle_velocities(Sim *s, double *y, double t)
 {
     MechrtStatus st = MECHRT_EINVAL;
     if (s->kkt && s->vel_ready)
-        st = sparse_project_velocities(s, y, y + s->nq);
+        st = sparse_project_velocities(s, y, t, y + s->nq);
     if (st != MECHRT_OK) {
         if (s->kkt)
             s->res->dense_fallbacks++;
@@ -755,6 +779,7 @@ static bool sparse_rows(Sim *s, const double *y, double t)
 {
     int m = s->nr;
     s->vel_ready = false;
+    s->mq_valid = false;    /* the rows may change */
     bool evaluated = sparse_eval(s, y, y + s->nq, t, false) == MECHRT_OK;
     double spread = INFINITY;
     bool factored = evaluated
@@ -857,6 +882,7 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
             return false;
         s->res->sparse = true;
         s->sx = xcalloc(n + m, sizeof *s->sx);
+        s->mq = xcalloc(n, sizeof *s->mq);
         s->sw = xcalloc(2 * (n + m), sizeof *s->sw);
         s->sphi = xcalloc(m, sizeof *s->sphi);
         s->sg = xcalloc(m, sizeof *s->sg);
@@ -893,7 +919,7 @@ static void sim_close(Sim *s)
     if (s->kkt)
         mechrt_host_kkt_counts(s->kkt, &s->res->kkt_fresh, &s->res->kkt_refactored);
     mechrt_host_kkt_free(s->kkt);
-    free(s->sx), free(s->sw), free(s->sphi), free(s->sg), free(s->sforce), free(s->smass);
+    free(s->sx), free(s->mq), free(s->sw), free(s->sphi), free(s->sg), free(s->sforce), free(s->smass);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
 }

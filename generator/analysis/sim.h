@@ -108,6 +108,7 @@ typedef struct SimResult {
        projection solves that fell back to the dense methods */
     bool sparse;
     long kkt_fresh, kkt_refactored, kkt_solves;
+    long kkt_reused;             /* M's factors reused at the same state */
     long rows_sparse, rows_dense, dense_fallbacks;
     double max_screen_spread;    /* largest pivot spread of [I Phi_q^T; Phi_q 0] with
                                     every row, where it factored (sparse path) */

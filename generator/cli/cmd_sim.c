@@ -126,10 +126,11 @@ static void print_stats(const SimResult *r, int nr)
             r->projections, r->projection_iterations, r->qr_solves, r->svd_solves);
     if (r->sparse)
         fprintf(stderr, "mechc sim: stats: sparse augmented matrix (KLU): %ld factorisations "
-                "with pivoting, %ld refactorisations, %ld projection solves; rows chosen by "
-                "its pivots %ld times, by the dense elimination %ld times (near a rank "
-                "drop); %ld dense fallbacks\n", r->kkt_fresh, r->kkt_refactored, r->kkt_solves,
-                r->rows_sparse, r->rows_dense, r->dense_fallbacks);
+                "with pivoting, %ld refactorisations, %ld reused at the same state, %ld "
+                "projection solves; rows chosen by its pivots %ld times, by the dense "
+                "elimination %ld times (near a rank drop); %ld dense fallbacks\n",
+                r->kkt_fresh, r->kkt_refactored, r->kkt_reused, r->kkt_solves, r->rows_sparse,
+                r->rows_dense, r->dense_fallbacks);
     fprintf(stderr, "mechc sim: stats: kernel calls: mass %ld, force %ld, all %ld, jac %ld, "
             "gamma %ld, phi %ld, nu %ld", k->mass, k->force, k->all, k->jac, k->gamma,
             k->phi, k->nu);
