@@ -34,10 +34,12 @@
  * coordinates) take the sparse path instead: the generated kernels'
  * nonzeros (all_nz, jac_nz, mass_nz) into the augmented matrix [W Phi_A^T;
  * Phi_A 0] on KLU (runtime/host/sparse_kkt.c), W = M for the right side
- * (one refactorisation and a refined solve per call, the rows of the
- * step as identity rows) and W = I for the minimum-norm projections, no
- * nr x nq or nq x nq array touched per call. The rows: where [I Phi_q^T;
- * Phi_q 0] with every row factors with a pivot spread below
+ * (one refactorisation per call, a refined solve near a rank drop, the
+ * rows of the step as identity rows), W = I for the minimum-norm position
+ * Newton and W = M for the mass-orthogonal velocity projection
+ * (sparse_project_velocities says why), no nr x nq or nq x nq array
+ * touched per call. The rows: where [I Phi_q^T; Phi_q 0] with every row,
+ * factored with a fresh pivot search, has a pivot spread below
  * SIM_KKT_SPREAD_MAX, every row is kept (no rank drop near, the dense
  * elimination would keep them all); only otherwise does the dense
  * rank-revealing elimination decide, which on IFToMM A02 is a few steps
