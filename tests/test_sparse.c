@@ -77,6 +77,95 @@ static void test_klu_solve(void **state)
     mechrt_host_sparse_free(s);
 }
 
+/* ---- the augmented matrix [W Phi^T; Phi 0] (sparse_kkt.c) ---------------- */
+
+/* M = [2 .5 0; .5 1 0; 0 0 0] (coordinate 2 without mass: no diagonal
+   entry in M's pattern), Phi = [1 0 1; 0 1 1]. */
+static const int m_row[] = {0, 0, 1, 1}, m_col[] = {0, 1, 0, 1};
+static const double m_val[] = {2, 0.5, 0.5, 1};
+static const int j_row[] = {0, 0, 1, 1}, j_col[] = {0, 2, 1, 2};
+static const double j_val[] = {1, 1, 1, 1};
+
+static void kkt_no_jac(void *ctx, const double *q, double t, double *vals)
+{
+    (void)ctx, (void)q, (void)t, (void)vals;
+}
+
+static MechrtHostKkt *small_kkt(void)
+{
+    MechrtHostJacNz j = {4, j_row, j_col, NULL, kkt_no_jac, NULL};
+    MechrtHostMassNz m = {4, m_row, m_col, NULL, NULL};
+    MechrtHostKkt *s = mechrt_host_kkt_new(3, 2, &j, &m);
+    assert_non_null(s);
+    memcpy(mechrt_host_kkt_jac(s), j_val, sizeof j_val);
+    memcpy(mechrt_host_kkt_mass(s), m_val, sizeof m_val);
+    return s;
+}
+
+static void test_kkt_identity(void **state)
+{
+    (void)state;
+    MechrtHostKkt *s = small_kkt();
+    /* every row: x = Phi^T (Phi Phi^T)^-1 b, y = -(Phi Phi^T)^-1 b; b = (1, 2) */
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, NULL, 2, 1e-12), MECHRT_OK);
+    double x[5] = {0, 0, 0, 1, 2};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x), MECHRT_OK);
+    const double want[5] = {0, 1, 1, 0, -1};
+    for (int i = 0; i < 5; i++)
+        assert_near(x[i], want[i], 0, 1e-14);
+    /* row 1 left out: an identity row, its unknown = its right side */
+    const unsigned char active[2] = {1, 0};
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, active, 2, 1e-12), MECHRT_OK);
+    double x2[5] = {0, 0, 0, 1, 5};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x2), MECHRT_OK);
+    const double want2[5] = {0.5, 0, 0.5, -0.5, 5};
+    for (int i = 0; i < 5; i++)
+        assert_near(x2[i], want2[i], 0, 1e-14);
+    /* rows = 1 leaves row 1 out the same way */
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, NULL, 1, 1e-12), MECHRT_OK);
+    double x3[5] = {0, 0, 0, 1, 5};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x3), MECHRT_OK);
+    for (int i = 0; i < 5; i++)
+        assert_near(x3[i], want2[i], 0, 1e-14);
+    assert_true(mechrt_host_kkt_spread(s, MECHRT_KKT_IDENTITY) >= 1);
+    /* the rank screen: every row, fresh pivots; a zero row is a rank drop */
+    double spread;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_OK);
+    assert_true(spread >= 1 && spread < 100);
+    mechrt_host_kkt_jac(s)[2] = mechrt_host_kkt_jac(s)[3] = 0;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_ESING);
+    assert_int_equal(mechrt_host_kkt_screen(s, 1, 1e-12, &spread), MECHRT_OK);
+    mechrt_host_kkt_free(s);
+}
+
+static void test_kkt_mass(void **state)
+{
+    (void)state;
+    MechrtHostKkt *s = small_kkt();
+    /* M is singular but positive definite on null(Phi) = span (1, 1, -1):
+       the augmented matrix is regular; the solution checked by its residual */
+    const double a[5][5] = {{2, 0.5, 0, 1, 0}, {0.5, 1, 0, 0, 1}, {0, 0, 0, 1, 1},
+                            {1, 0, 1, 0, 0}, {0, 1, 1, 0, 0}};
+    const double b[5] = {1, 2, 3, 4, 5};
+    double x[5], work[10];
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_MASS, NULL, 2, 1e-12), MECHRT_OK);
+    memcpy(x, b, sizeof b);
+    assert_int_equal(mechrt_host_kkt_solve_refined(s, MECHRT_KKT_MASS, x, work), MECHRT_OK);
+    for (int i = 0; i < 5; i++) {
+        double r = -b[i];
+        for (int k = 0; k < 5; k++)
+            r += a[i][k] * x[k];
+        assert_near(r, 0, 0, 1e-13);
+    }
+    /* without Phi's rows M alone is singular (coordinate 2): refused */
+    const unsigned char none[2] = {0, 0};
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_MASS, none, 2, 1e-12), MECHRT_ESING);
+    long fresh, re;
+    mechrt_host_kkt_counts(s, &fresh, &re);
+    assert_true(fresh >= 2);
+    mechrt_host_kkt_free(s);
+}
+
 static void test_klu_singular_named(void **state)
 {
     (void)state;
@@ -488,6 +577,8 @@ int main(void)
         cmocka_unit_test(test_all_nz_kernel),
         cmocka_unit_test(test_all_nz_run),
         cmocka_unit_test(test_dense_limit),
+        cmocka_unit_test(test_kkt_identity),
+        cmocka_unit_test(test_kkt_mass),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -201,6 +201,60 @@ double mechrt_host_sparse_condest(MechrtHostSparse *s);
 void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col);
 /* Fresh factorisations (with pivot search) and refactorisations done. */
 void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored);
+/* Drops the factors: the next factorisation searches its pivots afresh. */
+void mechrt_host_sparse_refresh(MechrtHostSparse *s);
+
+/* ---- Sparse augmented matrix (sparse_kkt.c) -------------------------------
+   [W Phi_A^T; Phi_A 0] for forward dynamics (W = M) and minimum-norm
+   projections (W = I) of large mechanisms: M's and Phi_q's nonzeros, the
+   rows left out as identity rows (their unknown y_i = b_i), KLU. */
+
+/* M's nonzeros as generated code gives them (PREFIX_mass_nz with its
+   pattern PREFIX_mass_row, PREFIX_mass_col; both triangles). */
+typedef struct MechrtHostMassNz {
+    int nnz;
+    const int *row, *col;
+    void *ctx;
+    void (*mass_nz)(void *ctx, const double *q, double *vals);
+} MechrtHostMassNz;
+
+typedef enum MechrtKktWeight { MECHRT_KKT_MASS, MECHRT_KKT_IDENTITY } MechrtKktWeight;
+
+typedef struct MechrtHostKkt MechrtHostKkt;
+
+/* For nq coordinates and nr rows with the two patterns (kept by pointer
+   only while this call runs); NULL when out of memory or a pattern is bad. */
+MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
+                                   const MechrtHostMassNz *mnz);
+void mechrt_host_kkt_free(MechrtHostKkt *s);
+/* Where the caller writes Phi_q's nonzeros (jac_nz, all_nz) and M's
+   (mass_nz) for the next factorisation. */
+double *mechrt_host_kkt_jac(MechrtHostKkt *s);
+double *mechrt_host_kkt_mass(MechrtHostKkt *s);
+/* Factors the matrix of weight w keeping row r where r < rows and
+   active[r] (active NULL: every one of the first rows); the statuses of
+   mechrt_host_sparse_factor. */
+MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
+                                    const unsigned char *active, int rows, double pivot_tol);
+/* The rank screen: [I Phi_q^T; Phi_q 0] with the first `rows` rows
+   factored with a fresh pivot search, into factors of its own. Partial
+   pivoting shows a rank drop near as a small pivot; a refactorisation's
+   old order need not (a drop of many ranks can spread over many moderate
+   pivots). *spread = max|u_kk| / min|u_kk|; the statuses of
+   mechrt_host_kkt_factor. */
+MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
+                                    double *spread);
+/* x (nq + nr) <- the solution for right side x, with the last factors of w. */
+MechrtStatus mechrt_host_kkt_solve(MechrtHostKkt *s, MechrtKktWeight w, double *x);
+/* The same with one step of iterative refinement (a residual over the
+   nonzeros and a second solve); work: 2 (nq + nr) doubles. */
+MechrtStatus mechrt_host_kkt_solve_refined(MechrtHostKkt *s, MechrtKktWeight w, double *x,
+                                           double *work);
+/* max|u_kk| / min|u_kk| of w's last factors (INFINITY without). */
+double mechrt_host_kkt_spread(const MechrtHostKkt *s, MechrtKktWeight w);
+/* Factorisations with pivot search and refactorisations, both weights and
+   the screen. */
+void mechrt_host_kkt_counts(const MechrtHostKkt *s, long *fresh, long *refactored);
 
 /* Workspace length, in doubles, of mechrt_host_sparse_step. */
 #define MECHRT_HOST_SPARSE_WORK_LEN(nq) (4u * (size_t)(nq))
