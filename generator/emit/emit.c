@@ -16,6 +16,7 @@
 #include "templates.h"
 
 #include <ctype.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -183,6 +184,9 @@ typedef struct Emitter {
     int fused;                  /* negations written into their product, this function */
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
     bool hoisting;              /* in put_calls_first */
+    int *call_rank;             /* per node: its call's number among the chunk's
+                                   sin/cos that may go first (rank_calls) */
+    int hoist;                  /* how many of those go first */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -420,35 +424,81 @@ static void put_temporary(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, N
     put_export(e, sb, partner);
 }
 
-/* Where trigonometry is a call (libm, or the tool's sincos from the JIT),
-   the chunk's sin and cos come first: the callee returns them through
-   memory anyway, and arithmetic between calls would be spilled across
-   them. Inline sincos (the written file's default) stays next to its first
-   use, where it keeps few values live, unless the chunk has so few that
-   they all stay in registers (then the evaluations overlap). */
+/* A sin or cos that put_calls_first writes at the top of its chunk. */
+static bool goes_first(const void *ctx, NodeId id)
+{
+    const Emitter *e = ctx;
+    return e->call_rank[id] < e->hoist || e->call_rank[id] < 0;
+}
+
+/* Numbers the chunk's sin/cos calls that could go to its top (their
+   argument at hand), in order, a pair sharing its number; returns how
+   many. Where trig is a call, a pair whose two values share a factor
+   gets -1 instead: it always goes first (sched_pair_shares_factor). The
+   other nodes of the chunk get INT_MAX. */
+static int rank_calls(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
+{
+    int n = 0;
+    for (int at = 0; at < c->nnodes; at++) {
+        NodeId id = c->nodes[at];
+        DagOp op = dag_op(e->dag, id);
+        e->call_rank[id] = INT_MAX;
+        if ((op != OP_SIN && op != OP_COS) || e->sched.temp[id] < 0
+            || sched_is_import(&e->sched, id, e->chunk) || !at_hand(e, dag_node(e->dag, id)->a))
+            continue;
+        NodeId partner = sincos_partner(e, id);
+        if (partner != DAG_NONE && e->sched.pos[partner] < at)
+            e->call_rank[id] = e->call_rank[partner];
+        else if (e->trig_calls && sched_pair_shares_factor(&e->sched, fn, e->chunk, id))
+            e->call_rank[id] = -1;      /* always first */
+        else
+            e->call_rank[id] = n++;
+    }
+    return n;
+}
+
+/* How many of the chunk's first sin/cos calls go to its top (put_calls_first).
+   Where trigonometry is a call (libm, or the tool's sincos from the JIT),
+   the number that carries the fewest values across calls (spill.c), none
+   on a tie: hoisted, a sin or cos lives across the later calls (it
+   returns through memory anyway, but gcc copies it out of the shared
+   result slots); left next to its first use, what rows computed before it
+   and reuse after it is spilled instead. Inline sincos (the written
+   file's default) stays next to its first use, where it keeps few values
+   live, unless the chunk has so few that they all stay in registers (then
+   the evaluations overlap). */
 enum { EMIT_TRIG_IN_REGISTERS = 8 };
 
-static bool calls_first(const Emitter *e, const SchedChunk *c)
+static int calls_first(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
 {
-    if (e->trig_calls)
-        return true;
+    int ncalls = rank_calls(e, fn, c);
+    if (e->trig_calls) {
+        int best = 0, least = INT_MAX;
+        for (e->hoist = 0; e->hoist <= ncalls; e->hoist++) {
+            int across = sched_values_across_calls(&e->sched, fn, e->chunk, goes_first, e);
+            if (across < least) {
+                least = across;
+                best = e->hoist;
+            }
+        }
+        return best;
+    }
     int values = 0;
     for (int at = 0; at < c->nnodes; at++) {
         DagOp op = dag_op(e->dag, c->nodes[at]);
         if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
             values++;
     }
-    return values <= EMIT_TRIG_IN_REGISTERS;
+    return values <= EMIT_TRIG_IN_REGISTERS ? INT_MAX : 0;
 }
 
+/* Writes the chunk's first e->hoist sin/cos calls (rank_calls). */
 static void put_calls_first(Emitter *e, StrBuf *sb, const SchedChunk *c)
 {
     e->hoisting = true;
     for (int at = 0; at < c->nnodes; at++) {
         NodeId id = c->nodes[at];
-        DagOp op = dag_op(e->dag, id);
-        if ((op == OP_SIN || op == OP_COS) && e->sched.temp[id] >= 0 && !e->written[id]
-            && !sched_is_import(&e->sched, id, e->chunk) && at_hand(e, dag_node(e->dag, id)->a))
+        if (goes_first(e, id) && !e->written[id])
             put_temporary(e, sb, c, at, id);
     }
     e->hoisting = false;
@@ -466,8 +516,8 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     for (const Param *p = function_params[which]; p->name; p++)
         sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
     sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
-    if (calls_first(e, c))
-        put_calls_first(e, sb, c);
+    e->hoist = calls_first(e, fn, c);
+    put_calls_first(e, sb, c);
     int at = 0;
     for (int i = 0; i < c->count; i++) {
         for (; at < c->ends[i]; at++)
@@ -1081,9 +1131,11 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     }
     e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
+    e.call_rank = xcalloc((size_t)m->dag.count + 1, sizeof *e.call_rank);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     bool fits = put_functions(&e, parts, bodies, out);
     free(e.written);
+    free(e.call_rank);
     if (fits)
         render_files(&e, parts, bodies, out);
     else
