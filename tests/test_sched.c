@@ -219,12 +219,13 @@ static void test_trig_once_per_function(void **state)
     pipeline_free(mech);
 }
 
-/* The written file of mech with prefix ch and libm's sin and cos. */
-static void emit_libm(const Mech *mech, EmitResult *res)
+/* The written file of mech with prefix ch, with libm's sin and cos or
+   (libm false) the file's own. */
+static void emit_ch(const Mech *mech, bool libm, EmitResult *res)
 {
     EmitOptions opt = emit_default_options();
     opt.prefix = "ch";
-    opt.libm_trig = true;
+    opt.libm_trig = libm;
     Diag diag;
     diag_init(&diag, "emit", NULL, 0);
     assert_true(emit_mechanism(&mech->kin, &opt, res, &diag));
@@ -240,7 +241,7 @@ static void test_signed_constants_share(void **state)
     (void)state;
     Mech *mech = load_chain(1);
     EmitResult res;
-    emit_libm(mech, &res);
+    emit_ch(mech, true, &res);
     char *text = function_text(res.c_text, "ch", "jac_nz");
     int times[64] = {0}, products = 0;
     for (const char *p = text; (p = strstr(p, "0.5")) != NULL; p++) {
@@ -354,34 +355,42 @@ static char *first_part(const char *c, const char *name)
     return strndup(p, (size_t)(end - p));
 }
 
-/* The angles whose cos text calls before its first store to array. */
-static int calls_before_store(const char *text, const char *array)
+/* The calls of call ("cos(q[") text makes before its first store to
+   array. */
+static int calls_before_store(const char *text, const char *call, const char *array)
 {
     const char *store = strstr(text, array);
     int n = 0;
-    for (const char *p = text; (p = strstr(p, "cos(q[")) != NULL && p < store; p++)
+    for (const char *p = text; (p = strstr(p, call)) != NULL && p < store; p++)
         n++;
     return n;
 }
 
-/* Where sin and cos are libm calls (chain of 10 loops, 21 angles): phi's
-   calls stay next to their first uses (in place, fewer values live across
-   calls: one angle before the first store), and γ's, whose cos and sin
-   share the factor qd², come first (copied out of sincos's result slots
-   rather than loaded from them as one vector). */
+/* Where sin and cos are real calls, libm's (chain of 10 loops, 21
+   angles) or one noinline copy of the written file's pair (the default
+   file of a chain of 20 loops, over 64 calls): phi's calls stay next to
+   their first uses (in place, fewer values live across calls: one angle
+   before the first store), and γ's, whose cos and sin share the factor
+   qd², come first (copied out of the result slots rather than loaded
+   from them as one vector). */
 static void test_calls_placed(void **state)
 {
     (void)state;
-    Mech *mech = load_chain(10);
-    EmitResult res;
-    emit_libm(mech, &res);
-    char *phi = first_part(res.c_text, "phi"), *gamma = first_part(res.c_text, "gamma");
-    assert_int_equal(calls_before_store(phi, "phi["), 1);
-    assert_true(calls_before_store(gamma, "gamma[") >= 10);
-    free(phi);
-    free(gamma);
-    emit_result_free(&res);
-    pipeline_free(mech);
+    for (int libm = 1; libm >= 0; libm--) {
+        Mech *mech = load_chain(libm ? 10 : 20);
+        EmitResult res;
+        emit_ch(mech, libm, &res);
+        const char *call = libm ? "cos(q[" : "ch_sincos";
+        if (!libm)
+            assert_non_null(strstr(res.c_text, "#define CH_TRIG static __attribute__((noinline))"));
+        char *phi = first_part(res.c_text, "phi"), *gamma = first_part(res.c_text, "gamma");
+        assert_int_equal(calls_before_store(phi, call, "phi["), 1);
+        assert_true(calls_before_store(gamma, call, "gamma[") >= (libm ? 10 : 5));
+        free(phi);
+        free(gamma);
+        emit_result_free(&res);
+        pipeline_free(mech);
+    }
 }
 
 int main(void)

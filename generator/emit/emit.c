@@ -183,6 +183,7 @@ typedef struct Emitter {
     int chunk;                  /* the chunk being written */
     int fused;                  /* negations written into their product, this function */
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
+    bool pair_out_of_line;      /* the file calls one noinline copy of its pair */
     bool hoisting;              /* in put_calls_first */
     int *call_rank;             /* per node: its call's number among the chunk's
                                    sin/cos that may go first (rank_calls) */
@@ -822,6 +823,19 @@ static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *n
     return n;
 }
 
+/* Calls of the written file's own sin/cos functions. Inlined at every
+   call (gcc splits the pair function at its rare-case test and calls the
+   rest out of line, through memory, unless forced), the pair takes gcc
+   -O2 several times as long as libm calls would: files with more calls
+   than EMIT_INLINE_TRIG_MAX call one copy. */
+enum { EMIT_INLINE_TRIG_MAX = 64 };
+static long pair_calls(const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
+{
+    return count_calls(parts, bodies, e->sincos_name) + count_calls(parts, bodies, e->sincos2_name) +
+           count_calls(parts, bodies, e->sin_name) + count_calls(parts, bodies, e->cos_name) +
+           count_calls(parts, bodies, e->sincos2_some_name);
+}
+
 /* The calls that leave some values unused (sin_name, cos_name,
    sincos2_some_name) as macros, the firmware rules allowing no other
    static function: where optimising (opt) the pair itself, so the bits
@@ -856,9 +870,8 @@ static _Noreturn void placeholder_bug(const char *name)
 
 /* What the kernels call for math: libm declared (JIT) or included, and
    the sincos functions the emitter used, for written files chosen by the
-   compiler (templates/trig.tmpl). parts and bodies: the written functions. */
-enum { EMIT_INLINE_TRIG_MAX = 64 };
-static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
+   compiler (templates/trig.tmpl), the pair inlined unless pair_out_of_line. */
+static void put_math(StrBuf *math, const Emitter *e)
 {
     const char *upper = e->prefix_upper;
     if (e->opt->declare_math) {
@@ -885,15 +898,7 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
     if (!e->sincos_used && !e->single_used)
         return;
-    /* Inlined at every call (gcc splits the pair function at its rare-case
-       test and calls the rest out of line, through memory, unless forced),
-       the pair takes gcc -O2 several times as long as libm calls would:
-       large files call one copy. */
-    bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
-                       count_calls(parts, bodies, e->sincos2_name) +
-                       count_calls(parts, bodies, e->sin_name) +
-                       count_calls(parts, bodies, e->cos_name) +
-                       count_calls(parts, bodies, e->sincos2_some_name) <= EMIT_INLINE_TRIG_MAX;
+    bool inline_pair = !e->pair_out_of_line;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
     TemplateVar sv[] = {
@@ -1036,7 +1041,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     put_zero_fill(&zero, e->kin, opt, out->prefix, upper);
     if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
-    put_math(&math, e, parts, bodies);
+    put_math(&math, e);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
 
     EmitSizes z;
@@ -1093,6 +1098,14 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     out->h_text = sb_take(&header);
 }
 
+static void free_functions(StrBuf *parts, StrBuf *bodies)
+{
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        sb_free(&parts[f]);
+        sb_free(&bodies[f]);
+    }
+}
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag)
 {
     const Model *m = kin->model;
@@ -1134,6 +1147,14 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     e.call_rank = xcalloc((size_t)m->dag.count + 1, sizeof *e.call_rank);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     bool fits = put_functions(&e, parts, bodies, out);
+    if (fits && !e.trig_calls && e.sin_name && pair_calls(&e, parts, bodies) > EMIT_INLINE_TRIG_MAX) {
+        /* Written again: the pair will be one out-of-line copy, so every
+           call is a real call, placed as libm's are (calls_first). */
+        e.pair_out_of_line = e.trig_calls = true;
+        e.sincos_used = e.sincos2_used = e.single_used = false;
+        free_functions(parts, bodies);
+        fits = put_functions(&e, parts, bodies, out);
+    }
     free(e.written);
     free(e.call_rank);
     if (fits)
@@ -1141,10 +1162,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     else
         diag_error_nopos(diag, "the generated code would have more than %ld operations, "
                          "the limit (see --max-code-ops)", opt->max_ops);
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
-        sb_free(&parts[f]);
-        sb_free(&bodies[f]);
-    }
+    free_functions(parts, bodies);
     return fits;
 }
 
