@@ -768,6 +768,54 @@ static bool check_options(const Model *m, const EmitOptions *opt, EmitResult *ou
     return true;
 }
 
+/* True when function f has code of its own in the file (the dense
+   Jacobian is spread from jac_nz, jac_spread.tmpl, unless direct). */
+static bool is_written(const Emitter *e, EmitFunction f)
+{
+    return (int)f < emit_function_count(e->kin) && (f != EMIT_JAC || e->opt->direct_jac)
+           && (f != EMIT_ALL_NZ || e->opt->all_nz);
+}
+
+/* Fewest calls of the file's own sin/cos functions the written functions
+   can make: each evaluates every angle it uses, two at most a call. Above
+   EMIT_INLINE_TRIG_MAX the file is written once, its calls placed as
+   real calls from the start. */
+static long pair_calls_at_least(const Emitter *e)
+{
+    const Dag *dag = e->dag;
+    size_t n = (size_t)dag->count + 1;
+    uint32_t *mark = xcalloc(n, sizeof *mark), *angle = xcalloc(n, sizeof *angle);
+    NodeId *stack = xmalloc(n * sizeof *stack), *roots = NULL;
+    long calls = 0;
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        if (!is_written(e, (EmitFunction)f))
+            continue;
+        SchedOutput *outs;
+        int nout;
+        collect_outputs(e->kin, (EmitFunction)f, &outs, &nout);
+        roots = xrealloc(roots, (size_t)nout + 1, sizeof *roots);
+        for (int i = 0; i < nout; i++)
+            roots[i] = outs[i].value;
+        dag_mark_reachable(dag, roots, nout, mark, (uint32_t)f + 1, stack);
+        long angles = 0;
+        for (NodeId id = 0; id < dag->count; id++) {
+            DagOp op = dag_op(dag, id);
+            if (mark[id] == (uint32_t)f + 1 && (op == OP_SIN || op == OP_COS)
+                && angle[dag_node(dag, id)->a] != (uint32_t)f + 1) {
+                angle[dag_node(dag, id)->a] = (uint32_t)f + 1;
+                angles++;
+            }
+        }
+        calls += (angles + 1) / 2;
+        free(outs);
+    }
+    free(mark);
+    free(angle);
+    free(stack);
+    free(roots);
+    return calls;
+}
+
 /* Schedules and writes every function into parts and bodies (initialized
    here, freed by the caller); false when the code would pass max_ops. */
 static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
@@ -782,11 +830,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
-        if (f >= emit_function_count(e->kin))
-            continue;
-        if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
-            continue;
-        if (f == EMIT_ALL_NZ && !opt->all_nz)
+        if (!is_written(e, (EmitFunction)f) || !fits)
             continue;
         SchedOutput *outs;
         int n;
@@ -1146,6 +1190,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *o
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
     e.call_rank = xcalloc((size_t)m->dag.count + 1, sizeof *e.call_rank);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
+    if (!e.trig_calls && e.sin_name && pair_calls_at_least(&e) > EMIT_INLINE_TRIG_MAX)
+        e.pair_out_of_line = e.trig_calls = true;
     bool fits = put_functions(&e, parts, bodies, out);
     if (fits && !e.trig_calls && e.sin_name && pair_calls(&e, parts, bodies) > EMIT_INLINE_TRIG_MAX) {
         /* Written again: the pair will be one out-of-line copy, so every
