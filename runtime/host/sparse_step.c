@@ -132,3 +132,30 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
     k->gamma(k->ctx, q, qd, tn, qdd);   /* gamma needs the velocities just found */
     return mechrt_host_sparse_solve(s, qdd);
 }
+
+MechrtStatus mechrt_host_sparse_velocity(MechrtHostSparse *s, const MechrtKernels *k,
+                                         const MechrtOptions *opts, const double *q, double t,
+                                         double *qd, double *qdd, double *work,
+                                         MechrtReport *report)
+{
+    MechrtOptions o = opts ? *opts : mechrt_default_options();
+    MechrtReport dummy;
+    MechrtReport *r = report ? report : &dummy;
+    mechrt_report_clear(r);
+    if (!s || !k || !k->nu || !k->gamma || !q || !qd || !work)
+        return MECHRT_EINVAL;
+    int n = k->nq;
+    double *zero = work, *phi = work + n, *gamma = work + 2 * n;
+    memset(zero, 0, (size_t)n * sizeof *zero);
+    /* the fused kernel's gamma (at qd = 0) is not used: gamma needs the
+       velocities solved for */
+    if (!mechrt_host_sparse_eval_all(s, q, zero, t, phi, qd, gamma)) {
+        mechrt_host_sparse_eval(s, q, t);
+        k->nu(k->ctx, q, t, qd);
+    }
+    MechrtStatus st = sp_factor_cond(s, &o, r);
+    if (st != MECHRT_OK || (st = mechrt_host_sparse_solve(s, qd)) != MECHRT_OK || !qdd)
+        return st;
+    k->gamma(k->ctx, q, qd, t, qdd);
+    return mechrt_host_sparse_solve(s, qdd);
+}
