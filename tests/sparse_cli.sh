@@ -132,10 +132,19 @@ run "$tmp/chain50.mech" --steps 4 --max-jac-entries 1000 --engine generic
 check "... --engine generic (dense only): exit 2" status_is 2
 check "... --engine generic: says sparse cannot serve" err_has "the sparse path cannot serve"
 
+# ---- the size limits refuse larger mechanisms with the line, exit 2 ---------
+sh "$ex/chain.sh" 1000 "$tmp/chain1000.mech"
+run "$tmp/chain1000.mech" --steps 1 --max-coords 5000 --csv /dev/null
+check "chain 1000 past --max-coords 5000: exit 2" status_is 2
+check "... the coordinate that passes it, with line and column" \
+    err_matches "chain1000.mech:4196:6: error: too many coordinates (the limit is 5000)"
+run "$tmp/chain1000.mech" --steps 1 --max-rows 5000 --csv /dev/null
+check "chain 1000 past --max-rows 5000: exit 2" status_is 2
+check "... the row that passes it" err_matches "chain1000.mech:4199:1: error: too many rows"
+
 # ---- no nr x nq matrix on the sparse path: 1000 loops in 250 MB of address
 # space, where the dense Jacobian alone takes 288 MB (skipped where the
 # build cannot start under that limit: sanitizers reserve terabytes) -------
-sh "$ex/chain.sh" 1000 "$tmp/chain1000.mech"
 if (ulimit -v 250000 && "$mechc" run "$ex/four_bar.mech" --steps 1 > /dev/null 2>&1); then
     (ulimit -v 250000 && "$mechc" run "$tmp/chain1000.mech" --steps 2 --linear sparse \
         --csv "$tmp/c1000.csv") > "$tmp/out" 2> "$tmp/err"
@@ -223,5 +232,17 @@ check "redundant sparse: at t = 0" err_matches "error: t = 0: "
 check "redundant sparse: singular" err_has "singular Jacobian"
 check "redundant sparse: names the pivot's row and coordinate" \
     err_matches "sparse LU found no pivot for [a-z0-9]*\.[a-z]* in row [A-Z0-9]*\.[a-z]*"
+# velocity-level rows that repeat each other: KLU's failing pivot named too
+cat > "$tmp/ksing.mech" << 'EOF'
+mechanism ksing
+body cart x = 1  y = 0  phi = pi/2
+knife  blade: cart axis(1, 0)
+driver side:  der(cart.y)*cos(cart.phi) - der(cart.x)*sin(cart.phi) = 0
+driver turn:  der(cart.phi) = 1
+EOF
+run "$tmp/ksing.mech" --linear sparse --csv /dev/null
+check "velocity rows singular, sparse: exit 1" status_is 1
+check "velocity rows singular, sparse: the time, the pivot's coordinate and row" \
+    err_matches "error: t = 0: velocity and acceleration analysis failed: singular Jacobian.*sparse LU found no pivot for cart.y in row side"
 
 suite_end
