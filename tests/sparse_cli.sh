@@ -220,6 +220,36 @@ cut -d, -f1-904 "$tmp/tr300.csv" > "$tmp/tr300q.csv"
 check "train 300: the last trailer at t = 2 as the N-trailer equations'" \
     near_last "$tmp/tr300q.csv" "$(trailer_ref 300 2)"
 
+# ---- a scissor lift of N stages (examples/scissor.sh) -------------------------
+# deck_closed N CSV: every state's platform against the closed form in the
+# driver, deck.y = N sin(theta), theta = 0.6 + 0.4 sin(2 pi t), with its
+# rate and acceleration, and deck.x = 0 (positions 1e-9, rates 1e-7,
+# accelerations 1e-5, absolute)
+deck_closed() {
+    awk -F, -v n="$1" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+        { t = $1; pi = atan2(0, -1); th = 0.6 + 0.4 * sin(2 * pi * t)
+          thd = 0.8 * pi * cos(2 * pi * t); thdd = -1.6 * pi * pi * sin(2 * pi * t)
+          e[1] = $(c["deck.y"]) - n * sin(th); e[2] = $(c["deck.x"])
+          e[3] = $(c["d(deck.y)"]) - n * cos(th) * thd
+          e[4] = $(c["dd(deck.y)"]) - n * (cos(th) * thdd - sin(th) * thd * thd)
+          tol[1] = tol[2] = 1e-9; tol[3] = 1e-7; tol[4] = 1e-5
+          for (k = 1; k <= 4; k++) if (!((e[k] < 0 ? -e[k] : e[k]) <= tol[k])) bad = 1
+          rows++ }
+        END { exit bad || rows != 101 }' "$2"
+}
+sh "$ex/scissor.sh" 5 "$tmp/sc5.mech"
+run "$tmp/sc5.mech" --csv "$tmp/sc5.csv"
+check "scissor 5: exit 0" status_is 0
+check "scissor 5: the platform at every state as N sin(theta)" deck_closed 5 "$tmp/sc5.csv"
+sh "$ex/scissor.sh" 20 "$tmp/sc20.mech"
+run "$tmp/sc20.mech" --linear dense --steps 20 --csv "$tmp/sc20.d.csv"
+run "$tmp/sc20.mech" --linear sparse --steps 20 --csv "$tmp/sc20.s.csv"
+check "scissor 20: dense and sparse agree to 1e-10" same_csv "$tmp/sc20.d.csv" "$tmp/sc20.s.csv"
+sh "$ex/scissor.sh" 200 "$tmp/sc200.mech"
+run "$tmp/sc200.mech" --stats --csv "$tmp/sc200.csv"
+check "scissor 200 (1203 coordinates): exit 0, sparse" err_has "sparse LU (KLU)"
+check "scissor 200: the platform at every state as N sin(theta)" deck_closed 200 "$tmp/sc200.csv"
+
 # ---- singular, sparse ---------------------------------------------------------
 # the toggle passes on the sparse path too (the dense rank-revealing
 # fallback, tests/test_branch.c); a redundant row at t0 names KLU's pivot
