@@ -250,6 +250,23 @@ run "$tmp/sc200.mech" --stats --csv "$tmp/sc200.csv"
 check "scissor 200 (1203 coordinates): exit 0, sparse" err_has "sparse LU (KLU)"
 check "scissor 200: the platform at every state as N sin(theta)" deck_closed 200 "$tmp/sc200.csv"
 
+# ---- check on the sparse path ------------------------------------------------
+# chain N = 1200 (7203 coordinates, past the default dense-Jacobian limit):
+# auto checks the Jacobian's nonzeros; --linear dense is refused at the limit
+sh "$ex/chain.sh" 1200 "$tmp/c1200.mech"
+run_mechc check "$tmp/c1200.mech" --no-aot --samples 3
+check "check chain 1200: exit 0" status_is 0
+check "check chain 1200: sparse" out_has "sparse: the Jacobian's 24005 nonzeros"
+check "check chain 1200: assembled (KLU)" out_has "around the configuration assembled at t = 0"
+check "check chain 1200: the verdict" out_has "ok: every comparison is within its tolerance"
+run_mechc check "$tmp/c1200.mech" --no-aot --linear dense
+check "check chain 1200 --linear dense: exit 2" status_is 2
+check "check chain 1200 --linear dense: the limit named" \
+    err_has "the dense Jacobian would have 51883209 entries, more than the limit of 50000000"
+sh "$ex/train.sh" 60 "$tmp/train60.mech"
+run_mechc check "$tmp/train60.mech" --no-aot --samples 3 --linear sparse
+check "check train 60 --linear sparse (velocity rows by groups of qd): exit 0" status_is 0
+
 # ---- singular, sparse ---------------------------------------------------------
 # the toggle passes on the sparse path too (the dense rank-revealing
 # fallback, tests/test_branch.c); a redundant row at t0 names KLU's pivot
