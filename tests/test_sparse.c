@@ -166,6 +166,38 @@ static void test_kkt_mass(void **state)
     mechrt_host_kkt_free(s);
 }
 
+/* The projection's minimum-norm step by SuiteSparseQR: Phi_q = [1 0 1; 0 1
+   1] and Phi = (-1, -2) give dq = pinv(Phi_q) (1, 2) = (0, 1, 1); a third
+   row, the sum of the two with a consistent Phi, is dropped as redundant
+   and leaves dq as it was (the dense path's truncated SVD does the same). */
+static const int mn_row[] = {0, 0, 1, 1, 2, 2, 2};
+static const int mn_col[] = {0, 2, 1, 2, 0, 1, 2};
+
+static void fill_mn(void *ctx, const double *q, double t, double *vals)
+{
+    (void)ctx, (void)q, (void)t;
+    static const double v[7] = {1, 1, 1, 1, 1, 1, 2};
+    memcpy(vals, v, sizeof v);
+}
+
+static void test_minnorm_step(void **state)
+{
+    (void)state;
+    MechrtHostJacNz j = {7, mn_row, mn_col, NULL, fill_mn, NULL};
+    double q[3] = {0, 0, 0}, dq[3];
+    for (int nh = 2; nh <= 3; nh++) {
+        MechrtHostMinNorm *m = mechrt_host_minnorm_new(nh, 3, &j);
+        assert_non_null(m);
+        double phi[3] = {-1, -2, -3};
+        assert_int_equal(mechrt_host_minnorm_step(m, q, 0, phi, 1e-12, dq), MECHRT_OK);
+        assert_near(dq[0], 0, 0, 1e-14);
+        assert_near(dq[1], 1, 1e-14, 0);
+        assert_near(dq[2], 1, 1e-14, 0);
+        mechrt_host_minnorm_free(m);
+    }
+    assert_null(mechrt_host_minnorm_new(4, 3, &j));     /* more rows than coordinates */
+}
+
 static void test_klu_singular_named(void **state)
 {
     (void)state;
@@ -412,19 +444,26 @@ static void test_toggle_sparse(void **state)
 static void test_refusals(void **state)
 {
     (void)state;
-    Mech *mech = load_file("examples/knife_cart.mech");
-    Collected c;
-    run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
-    assert_non_null(strstr(c.res.message, "velocity-level rows"));
-    mechrt_trace_free(&c.trace);
-    run_linear(mech, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
-    assert_false(c.res.sparse);
-    mechrt_trace_free(&c.trace);
-    pipeline_free(mech);
+    /* velocity-level rows run sparse (KLU, SuiteSparseQR), as dense */
+    static const char *const vel[] = {"examples/knife_cart.mech", "examples/rolling_wheel.mech",
+                                      "examples/skate_velocity.mech"};
+    Collected c, d;
+    for (size_t f = 0; f < sizeof vel / sizeof *vel; f++) {
+        Mech *vm = load_file(vel[f]);
+        run_linear(vm, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
+        assert_int_equal(c.status, RUN_OK);
+        assert_true(c.res.sparse);
+        assert_true(c.res.refactorisations + c.res.fresh_factorisations > 0);
+        run_linear(vm, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &d);
+        assert_int_equal(d.status, RUN_OK);
+        assert_false(d.res.sparse);     /* small: dense */
+        expect_same(&d, &c, vel[f]);
+        mechrt_trace_free(&c.trace);
+        mechrt_trace_free(&d.trace);
+        pipeline_free(vm);
+    }
 
-    mech = load_file("examples/slider_crank.mech");
+    Mech *mech = load_file("examples/slider_crank.mech");
     run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_GENERIC, &c);
     assert_int_equal(c.status, RUN_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "generic engine"));
@@ -568,6 +607,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_klu_solve),
         cmocka_unit_test(test_klu_singular_named),
+        cmocka_unit_test(test_minnorm_step),
         cmocka_unit_test(test_klu_repivots),
         cmocka_unit_test(test_klu_bad_pattern),
         cmocka_unit_test(test_examples_agree),

@@ -35,7 +35,9 @@
  * stepping, its checks and substeps are shared. The sparse path never forms
  * an nr x nq matrix: its diagnostics name the failing pivot's row and
  * coordinate instead of an SVD's, and the nearly singular test at t0 is
- * KLU's condition estimate. Velocity-level rows stay dense for now.
+ * KLU's condition estimate. With velocity-level rows the sparse path's
+ * host (mechrt_host_new_sparse) solves the velocities by KLU and projects
+ * by SuiteSparseQR's minimum-norm steps.
  *
  * Failures stop the run and say when, why and where: the time as
  * `t = VALUE`, the runtime's cause, the row with the largest residual or
@@ -129,7 +131,9 @@ typedef struct Run {
     double *q, *qd, *qdd;    /* one block of 3 nq: qd == q + nq, qdd == q + 2 nq */
     double *work;
     size_t lwork;
-    MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense */
+    MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense (with
+                                velocity-level rows: the sparse host's) */
+    bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
     MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
@@ -1057,8 +1061,7 @@ static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
         goto out;
     }
     note_move(r, q0);
-    st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, o->t0, r->qd, r->qdd, r->work,
-                                      r->lwork, rep);
+    st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd, r->qdd, rep);
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
         goto out;
@@ -1075,7 +1078,8 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     const RunOptions *o = r->o;
     MechrtReport rep;
     RunStatus status = RUN_OK;
-    MechrtHost *host = mechrt_host_new(r->k);
+    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
+    r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
         r->res->status = RUN_FAILED;
@@ -1107,8 +1111,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
             status = RUN_FAILED;
             goto out;
         }
-        st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
-                                          r->lwork, &rep);
+        st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, tn, r->qd, r->qdd, &rep);
         bool forces_ok = st != MECHRT_OK || inverse_at(r, tn);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
@@ -1124,6 +1127,10 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     }
 out:
     r->res->host = *mechrt_host_stats(host);
+    if (r->sp)
+        mechrt_host_sparse_counts(r->sp, &r->res->fresh_factorisations,
+                                  &r->res->refactorisations);
+    r->sp = NULL;
     mechrt_host_free(host);
     return status;
 }
@@ -1146,15 +1153,9 @@ static RunStatus bad_input(RunResult *res, const char *fmt, ...)
 static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
                           size_t size)
 {
-    bool can = o->jac_nz && m->nv == 0;
+    bool can = o->jac_nz != NULL;
     *sparse = o->linear == RUN_LINEAR_SPARSE
               || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
-    if (*sparse && m->nv > 0) {
-        snprintf(why, size, "--linear sparse does not support velocity-level rows yet (%d "
-                 "here: rolling, knife edges, velocity drivers); their integration is dense: "
-                 "use --linear dense or auto", m->nv);
-        return false;
-    }
     if (*sparse && !o->jac_nz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -1251,7 +1252,8 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     r.q = xcalloc(3 * nq, sizeof *r.q);
     r.qd = r.q + nq;
     r.qdd = r.q + 2 * nq;
-    if (sparse && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+    r.sparse = sparse;
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
         free(r.q);
         return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
                          "entries) is not a valid %d x %d pattern, or out of memory",

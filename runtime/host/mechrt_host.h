@@ -53,11 +53,28 @@ typedef struct MechrtHostStats {
 /* ---- The host object (host.c) ------------------------------------------ */
 
 typedef struct MechrtHost MechrtHost;
+/* Defined below (the sparse Jacobian). */
+typedef struct MechrtHostJacNz MechrtHostJacNz;
+typedef struct MechrtHostSparse MechrtHostSparse;
 
 /* Workspaces for the mechanism of k (which must outlive the host).
    NULL when out of memory or k is malformed. */
 MechrtHost *mechrt_host_new(const MechrtKernels *k);
 void mechrt_host_free(MechrtHost *h);
+/* The same on the sparse Jacobian of pattern jnz (whose arrays must outlive
+   the host): velocity solves by KLU, the projection's minimum-norm steps
+   by SuiteSparseQR; nothing of size nr x nq or nq x nq is allocated.
+   Needs nh + nv == nq. */
+MechrtHost *mechrt_host_new_sparse(const MechrtKernels *k, const MechrtHostJacNz *jnz);
+/* Velocity and acceleration at (q, t) (mechrt_velocity_acceleration, dense
+   or on the sparse host's KLU). */
+MechrtStatus mechrt_host_velocity_acceleration(MechrtHost *h, const MechrtOptions *o,
+                                               const double *q, double t, double *qd,
+                                               double *qdd, MechrtReport *report);
+/* The sparse host's factorisation (NULL for a dense host): the failing
+   pivot of its last ESING, its counts. */
+MechrtHostSparse *mechrt_host_sparse_of(MechrtHost *h);
+
 const MechrtHostStats *mechrt_host_stats(const MechrtHost *h);
 
 /* Gauss-Newton on the nh holonomic rows, any nh <= nq (nh == 0: nothing
@@ -156,7 +173,7 @@ double mechrt_host_singular_direction(int m, int n, const double *a, double *row
    PREFIX_jac_nz with its fixed pattern PREFIX_jac_row, PREFIX_jac_col):
    entry e sits at (row[e], col[e]); jac_nz writes the nnz values in that
    order. The arrays must outlive every user. */
-typedef struct MechrtHostJacNz {
+struct MechrtHostJacNz {
     int nnz;
     const int *row, *col;
     void *ctx;              /* passed unchanged to jac_nz and all_nz */
@@ -165,9 +182,7 @@ typedef struct MechrtHostJacNz {
        (PREFIX_all_nz); may be NULL */
     void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
                    double *vals, double *nu, double *gamma);
-} MechrtHostJacNz;
-
-typedef struct MechrtHostSparse MechrtHostSparse;
+};
 
 /* The n x n matrix of pattern jnz (copied; its arrays are kept by
    pointer), analysed once. NULL when out of memory, or an index is out of
@@ -268,6 +283,30 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
                                      const MechrtOptions *opts, double *q, double *qd,
                                      double *qdd, double t, double h, double *work, size_t lwork,
                                      MechrtReport *report);
+
+/* mechrt_velocity_acceleration (runtime/analysis.c) on the sparse
+   Jacobian s: one evaluation at (q, t), one factorisation with the same
+   pivot test and condition screen, qd from nu and, when qdd is not NULL,
+   qdd from gamma at the new qd (qdd NULL: mechrt_velocity). work: 3 nq
+   doubles. */
+MechrtStatus mechrt_host_sparse_velocity(MechrtHostSparse *s, const MechrtKernels *k,
+                                         const MechrtOptions *opts, const double *q, double t,
+                                         double *qd, double *qdd, double *work,
+                                         MechrtReport *report);
+
+/* The minimum-norm Gauss-Newton step of the projection over the nh
+   holonomic rows of pattern jnz (sparse_qr.c: SuiteSparseQR of Phi_q^T;
+   its velocity-level rows, row >= nh, are left out). NULL when out of
+   memory or an index is out of range. */
+typedef struct MechrtHostMinNorm MechrtHostMinNorm;
+MechrtHostMinNorm *mechrt_host_minnorm_new(int nh, int nq, const MechrtHostJacNz *jnz);
+void mechrt_host_minnorm_free(MechrtHostMinNorm *m);
+/* dq = -pinv(Phi_q) phi at (q, t), the rows whose remaining norm is at most
+   pivot_tol times the largest row norm dropped (redundant rows).
+   MECHRT_ESING when Phi_q = 0, MECHRT_ENOTFINITE for NaN or Inf,
+   MECHRT_EINVAL when out of memory. */
+MechrtStatus mechrt_host_minnorm_step(MechrtHostMinNorm *m, const double *q, double t,
+                                      const double *phi, double pivot_tol, double *dq);
 
 /* ---- Output (output.c; numbers: format_real.c) ---------------------------- */
 
