@@ -66,7 +66,7 @@ static MechrtStatus ls_factor(Ls *s)
 static MechrtStatus ls_newton(Ls *s)
 {
     MechrtReport *r = s->r;
-    mechrt_real *x = s->dq;
+    mechrt_real *x = s->dq, *q = s->q;
     int n = s->k->nq, i;
     MechrtStatus st = ls_eval(s);
 
@@ -89,7 +89,7 @@ static MechrtStatus ls_newton(Ls *s)
         if (chk != 0)   /* overflow in a nearly singular solve */
             return MECHRT_ENOTFINITE;
         for (i = 0; i < n; i++)
-            s->q[i] -= x[i];
+            q[i] -= x[i];
         r->step = step;
         r->iterations++;
         if ((st = ls_eval(s)) != MECHRT_OK)
@@ -122,6 +122,18 @@ static MechrtStatus ls_factor_cond(Ls *s, bool want_cond)
         return st;
     if (o->cond_screen > 0 && mechrt_lup_spread(s->f) <= o->cond_screen * o->cond_warn)
         return MECHRT_OK;
+    if (s->f->gen_now) {
+        /* the estimate reads the pattern LU's factors: that LU on the same
+           values (the unrolled one leaves them), screened by its pivots */
+        const MechrtLuGen *g = s->f->gen;
+        s->f->gen = NULL;
+        st = ls_factor(s);
+        s->f->gen = g;
+        if (st != MECHRT_OK)
+            return st;
+        if (o->cond_screen > 0 && mechrt_lup_spread(s->f) <= o->cond_screen * o->cond_warn)
+            return MECHRT_OK;
+    }
     if (s->jnz) {   /* the factorisation consumed the values: evaluate them again */
         s->jnz->jac_nz(s->jnz->ctx, s->q, s->t, s->jac);
         anorm = mechrt_lup_norm1(s->f, s->jac);
@@ -186,9 +198,14 @@ MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, Mec
         return MECHRT_EINVAL;
     if ((st = ls_setup(&s, work, lwork)) != MECHRT_OK)
         return st;
-    if (h != 0)
-        for (i = 0; i < k->nq; i++)
-            q[i] += h * qd[i] + MECHRT_R(0.5) * h * h * qdd[i];
+    if (h != 0) {
+        /* 0.5 h h qdd[i] is ((0.5 h) h) qdd[i]: the factor hoisted, the
+           same numbers */
+        mechrt_real hh = MECHRT_R(0.5) * h * h;
+        int n = k->nq;
+        for (i = 0; i < n; i++)
+            q[i] += h * qd[i] + hh * qdd[i];
+    }
     s.q = q;
     s.t = t + h;
     if ((st = ls_newton(&s)) != MECHRT_OK)

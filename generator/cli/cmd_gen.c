@@ -56,6 +56,11 @@ static const CliOption options[] = {
      .help = "also write PREFIX_all_nz: Phi, the Jacobian's nonzeros, nu\n"
              "and gamma in one call (the sparse counterpart of _all,\n"
              "what run's sparse path calls)"},
+    {"--lu", CLI_FLAG_AT(GenCli, emit.lu),
+     .help = "also write PREFIX_lu_factor and PREFIX_lu_solve: the\n"
+             "Jacobian's LU unrolled for its pattern, constants folded,\n"
+             "with run-time pivot checks (square mechanisms without\n"
+             "velocity rows, up to 100 coordinates; what run calls)"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"

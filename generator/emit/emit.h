@@ -4,6 +4,7 @@
 
 #include "../base/diag.h"
 #include "../base/limits.h"
+#include "../base/strbuf.h"
 #include "../diff/kinematics.h"
 
 #include <stdbool.h>
@@ -30,6 +31,9 @@ typedef struct EmitOptions {
     bool all_nz;                /* also PREFIX_all_nz: Phi, the Jacobian's
                                    nonzeros, nu and gamma in one call (the
                                    sparse path of run; gen --sparse) */
+    bool lu;                    /* also PREFIX_lu_factor and PREFIX_lu_solve
+                                   (emit_lu.c; gen --lu): the Jacobian's LU
+                                   unrolled for its pattern */
 } EmitOptions;
 
 /* The spec's function order, for op counts and reports; then all_nz, an
@@ -69,6 +73,16 @@ const char *emit_check_header_name(const char *name);
 /* Writes the C source and header. Returns false (diag filled) for an
    unusable prefix or header name, or code beyond max_ops; everything else
    in the model is already valid. */
+/* The shortest decimal of v that reads back exactly (as a float with
+   real_float), negative ones parenthesized: how constants are written. */
+void emit_put_literal(StrBuf *sb, double v, bool real_float);
+
+/* PREFIX_lu_factor and PREFIX_lu_solve (emit_lu.c) appended to decl and
+   def when opt->lu is set and the mechanism is square, without velocity
+   rows and small enough; nothing otherwise. */
+void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
+             const char *upper, StrBuf *decl, StrBuf *def);
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag);
 void emit_result_free(EmitResult *out);
 

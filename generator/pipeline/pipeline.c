@@ -96,6 +96,7 @@ Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
     opt.declare_math = true;
     opt.direct_jac = true;
     opt.all_nz = true;      /* run's sparse path */
+    opt.lu = true;           /* run's dense path: the unrolled LU */
     opt.prefix = "mechc_jit";
     opt.source_name = mech->model->file;
     opt.max_ops = mech->limits.max_code_ops;

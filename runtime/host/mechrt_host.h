@@ -165,6 +165,10 @@ typedef struct MechrtHostJacNz {
        (PREFIX_all_nz); may be NULL */
     void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
                    double *vals, double *nu, double *gamma);
+    /* The pattern's unrolled LU (PREFIX_lu_factor, PREFIX_lu_solve, as
+       MechrtLuGen's: factors in at most nq*nq reals); both may be NULL */
+    int (*lu_factor)(void *ctx, const double *a, double *lu, double pivot_tol, double *spread);
+    void (*lu_solve)(void *ctx, const double *lu, const double *b, double *x);
 } MechrtHostJacNz;
 
 typedef struct MechrtHostSparse MechrtHostSparse;
