@@ -44,12 +44,6 @@
 
 #include "mechrt.h"
 
-/* The unrolled LU's factors serve while their pivots' spread stays below
-   this; above it (near a singular position, where every rounding
-   difference is amplified) the pattern LU factors, with partial
-   pivoting's own order. */
-#define LUP_GEN_SPREAD MECHRT_R(1e4)
-
 /* Row-major index of entry (r, j) in the n*n map. */
 #define LUP_AT(f, r, j) ((size_t)(r) * (size_t)(f)->n + (size_t)(j))
 
@@ -505,7 +499,7 @@ MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_in
        the pattern LU factors the same matrix; its factors go to dense,
        which only the pattern LU's fallback and estimate use */
     if (f->gen && f->gen->factor(f->gen->ctx, f->lu, f->dense, pivot_tol, &f->gen_spread) == 0
-        && f->gen_spread <= LUP_GEN_SPREAD) {
+        && f->gen_spread <= MECHRT_R(MECHRT_LUP_GEN_SPREAD)) {
         f->gen_now = true;
         f->gen_factors++;
         return MECHRT_OK;

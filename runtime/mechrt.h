@@ -115,8 +115,14 @@ typedef enum MechrtStatus {
     static const MechrtJacNz p##_jac_nz_kernel = {                               \
         P##_NNZ, p##_jac_row, p##_jac_col, NULL, p##_mechrt_jac_nz}
 
-/* MECHRT_DEFINE_LU(fb, FB) wraps the unrolled LU of `mechc gen --lu
-   --prefix fb` (fb_lu_factor, fb_lu_solve, FB_LU_NSLOTS) and defines
+/* The unrolled LU's factors serve while their pivots' spread
+   max|u_kk| / min|u_kk| stays at or below this; above it (near a
+   singular position, where every rounding difference is amplified) the
+   pattern LU factors, with partial pivoting's own order. */
+#define MECHRT_LUP_GEN_SPREAD 1e4
+
+/* MECHRT_DEFINE_LU(fb, FB) wraps the unrolled LU and step of `mechc gen
+   --lu --prefix fb` (fb_lu_factor, fb_lu_solve, fb_step, FB_LU_NSLOTS) and defines
    `static const MechrtLuGen fb_lu` for mechrt_lup_use. */
 #define MECHRT_DEFINE_LU(p, P)                                                   \
     static int p##_mechrt_lu_factor(void *ctx, const mechrt_real *a,             \
@@ -126,8 +132,14 @@ typedef enum MechrtStatus {
     static void p##_mechrt_lu_solve(void *ctx, const mechrt_real *lu,            \
                                     const mechrt_real *b, mechrt_real *x)        \
     { (void)ctx; p##_lu_solve(lu, b, x); }                                       \
+    static int p##_mechrt_step(void *ctx, mechrt_real *q, mechrt_real *qd,       \
+                               mechrt_real *qdd, mechrt_real t, mechrt_real h,   \
+                               const mechrt_real *tol, int max_iter,             \
+                               mechrt_real *out, int *iout)                      \
+    { (void)ctx; return p##_step(q, qd, qdd, t, h, tol, max_iter, out, iout); }  \
     static const MechrtLuGen p##_lu = {                                          \
-        P##_LU_NSLOTS, NULL, p##_mechrt_lu_factor, p##_mechrt_lu_solve}
+        P##_LU_NSLOTS, NULL, p##_mechrt_lu_factor, p##_mechrt_lu_solve,          \
+        p##_mechrt_step}
 
 #endif /* MECHRT_H_COMMON */
 
@@ -578,6 +590,14 @@ typedef struct MechrtLuGen {
     int (*factor)(void *ctx, const mechrt_real *a, mechrt_real *lu, mechrt_real pivot_tol,
                   mechrt_real *spread);
     void (*solve)(void *ctx, const mechrt_real *lu, const mechrt_real *b, mechrt_real *x);
+    /* The whole step over the same file's kernels (P_step), or NULL:
+       mechrt_step_lup's numbers without its calls through pointers; 0, or
+       nonzero with q, qd, qdd untouched (the runtime then steps). tol:
+       tol_phi, tol_dq, pivot_tol, the largest pivot spread; out: residual,
+       last step; iout: iterations, worst row. */
+    int (*step)(void *ctx, mechrt_real *q, mechrt_real *qd, mechrt_real *qdd, mechrt_real t,
+                mechrt_real h, const mechrt_real *tol, int max_iter, mechrt_real *out,
+                int *iout);
 } MechrtLuGen;
 
 typedef struct MechrtLup {

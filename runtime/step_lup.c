@@ -176,13 +176,45 @@ static MechrtStatus ls_setup(Ls *s, mechrt_real *work, size_t lwork)
     return MECHRT_OK;
 }
 
+/* The step by the kernels' own P_step (the same operations as below,
+   its calls direct): true when it took it, the report then filled as
+   this file would fill it; false, the state untouched, otherwise. Its
+   largest pivot spread: the unrolled LU's limit, and where a condition
+   estimate is wanted the screen's, so that a step it takes needs none. */
+static bool ls_gen_step(Ls *s, mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
+                        mechrt_real t, mechrt_real h, bool want_cond)
+{
+    const MechrtOptions *o = s->o;
+    mechrt_real tol[4], out[2];
+    int iout[2];
+
+    tol[0] = o->tol_phi;
+    tol[1] = o->tol_dq;
+    tol[2] = o->pivot_tol;
+    tol[3] = MECHRT_R(MECHRT_LUP_GEN_SPREAD);
+    if (want_cond && o->cond_warn > 0) {
+        mechrt_real screen = o->cond_screen > 0 ? o->cond_screen * o->cond_warn : 0;
+        tol[3] = screen < tol[3] ? screen : tol[3];
+    }
+    if (s->f->gen->step(s->f->gen->ctx, q, qd, qdd, t, h, tol, o->max_iter, out, iout) != 0)
+        return false;
+    s->r->iterations = iout[0];
+    s->r->residual = out[0];
+    s->r->step = out[1];
+    s->r->worst_row = iout[1];
+    s->r->factorisations = iout[0] + 1;
+    s->f->gen_factors += iout[0] + 1;
+    s->f->gen_now = s->f->dense_now = false;
+    return true;
+}
+
 MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, MechrtLup *f,
                              const MechrtOptions *opts,
                              mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
                              mechrt_real t, mechrt_real h,
                              mechrt_real *work, size_t lwork, MechrtReport *report)
 {
-    MechrtOptions o = opts ? *opts : mechrt_default_options();
+    MechrtOptions dflt;
     MechrtReport dummy;
     Ls s;
     MechrtStatus st;
@@ -191,16 +223,25 @@ MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, Mec
     s.k = k;
     s.jnz = jnz;
     s.f = f;
-    s.o = &o;
+    if (!opts) {
+        dflt = mechrt_default_options();
+        opts = &dflt;
+    }
+    s.o = opts;
     s.r = report ? report : &dummy;
     mechrt_report_clear(s.r);
     if (!q || !qd || !qdd || !isfinite(h))
         return MECHRT_EINVAL;
+    /* the kernels' own step calls its own kernels: k and the workspace
+       are checked (and carved) when the runtime steps */
+    if (f && f->gen && f->gen->step && k && f->n == k->nq && work
+        && ls_gen_step(&s, q, qd, qdd, t, h, report != NULL))
+        return MECHRT_OK;
     if ((st = ls_setup(&s, work, lwork)) != MECHRT_OK)
         return st;
     if (h != 0) {
         /* 0.5 h h qdd[i] is ((0.5 h) h) qdd[i]: the factor hoisted, the
-           same numbers */
+           same numbers (P_step's) */
         mechrt_real hh = MECHRT_R(0.5) * h * h;
         int n = k->nq;
         for (i = 0; i < n; i++)

@@ -102,14 +102,20 @@ static void gen_solve(void *ctx, const double *lu, const double *b, double *x)
     ((const Kernels *)ctx)->lu_solve(lu, b, x);
 }
 
+static int gen_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                    const double *tol, int max_iter, double *out, int *iout)
+{
+    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+}
+
 static void gen_jac_nz(void *ctx, const double *q, double t, double *vals)
 {
     ((const Kernels *)ctx)->jac_nz(q, t, vals);
 }
 
-/* A pattern LU for e's Jacobian, with e's unrolled LU when gen (its
-   arrays freed by lup_free). */
-static MechrtLup *lup_new(const Engine *e, const Mech *mech, bool gen, MechrtLuGen *g)
+/* A pattern LU for e's Jacobian (one block: free it), with e's unrolled
+   LU when gen > 0, and its step when gen > 1. */
+static MechrtLup *lup_new(const Engine *e, const Mech *mech, int gen, MechrtLuGen *g)
 {
     int n = mech->model->nq;
     size_t lw = mechrt_lup_work_size(n), liw = mechrt_lup_iwork_size(n);
@@ -117,8 +123,9 @@ static MechrtLup *lup_new(const Engine *e, const Mech *mech, bool gen, MechrtLuG
     double *w = (double *)(f + 1);
     assert_int_equal(mechrt_lup_init(f, n, mech->kin.nnz, e->kernels.jac_row, e->kernels.jac_col,
                                      w, lw, (int *)(w + lw), liw), MECHRT_OK);
-    *g = (MechrtLuGen){n * n, (void *)&e->kernels, gen_factor, gen_solve};
-    if (gen)
+    *g = (MechrtLuGen){n * n, (void *)&e->kernels, gen_factor, gen_solve,
+                       gen > 1 ? gen_step : NULL};
+    if (gen > 0)
         assert_int_equal(mechrt_lup_use(f, g), MECHRT_OK);
     return f;
 }
@@ -137,8 +144,8 @@ static void test_declines(void **s)
     assert_int_equal(n, 9);
     assert_true(mech->kin.nnz <= 64);
     MechrtLuGen g;
-    MechrtLup *f = lup_new(&e, mech, true, &g);
-    MechrtLuGen none = {n * n, NULL, NULL, NULL};
+    MechrtLup *f = lup_new(&e, mech, 1, &g);
+    MechrtLuGen none = {n * n, NULL, NULL, NULL, NULL};
     assert_int_equal(mechrt_lup_use(f, &none), MECHRT_EINVAL);   /* no functions */
     unsigned seed = 777;
     for (int trial = 0; trial < 2000 && declined < 5; trial++) {
@@ -174,6 +181,23 @@ static void test_declines(void **s)
         }
     }
     assert_int_equal(e.kernels.lu_factor(vals, lu, 1e-12, &spread), -1);
+
+    /* P_step declines without touching the state: a NaN velocity, and too
+       few iterations allowed */
+    double st[27], before[27], tol[4] = {1e-8, 1e-8, 1e-12, 1e4}, out[2];
+    int iout[2];
+    memcpy(st, mech->model->q0, 9 * sizeof *st);
+    for (int i = 9; i < 27; i++)
+        st[i] = 0;
+    assert_int_equal(e.kernels.lu_step(st, st + 9, st + 18, 0, 0, tol, 25, out, iout), 0);
+    st[9] = NAN;
+    memcpy(before, st, sizeof st);
+    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 25, out, iout) != 0);
+    assert_memory_equal(st, before, sizeof st);
+    st[9] = 0;
+    memcpy(before, st, sizeof st);
+    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 0, out, iout) != 0);
+    assert_memory_equal(st, before, sizeof st);
     free(f);
     engine_close(&e);
     pipeline_free(mech);
@@ -181,7 +205,8 @@ static void test_declines(void **s)
 
 /* mechrt_step_lup with the unrolled LU steps as without it: the same
    Newton iterations and states to 1e-12, every factorisation the
-   unrolled LU's. */
+   unrolled LU's; with the kernels' P_step too, the same numbers as with
+   the unrolled LU alone, bit for bit, and the same reports. */
 static void test_step(void **s)
 {
     (void)s;
@@ -191,31 +216,41 @@ static void test_step(void **s)
         Mech *mech = open_example(files[c], &e);
         const Model *m = mech->model;
         int n = m->nq, steps = 400;
-        MechrtLuGen g[2];
-        MechrtLup *f[2] = {lup_new(&e, mech, false, &g[0]), lup_new(&e, mech, true, &g[1])};
+        MechrtLuGen g[3];
+        MechrtLup *f[3];
         MechrtJacNz jnz = {mech->kin.nnz, e.kernels.jac_row, e.kernels.jac_col,
                            (void *)&e.kernels, gen_jac_nz};
         size_t lwork = mechrt_workspace_size(n, n);
-        double *work = xcalloc(lwork, sizeof *work), *st[2];
-        for (int v = 0; v < 2; v++) {
+        double *work = xcalloc(lwork, sizeof *work), *st[3];
+        for (int v = 0; v < 3; v++) {
+            f[v] = lup_new(&e, mech, v, &g[v]);
             st[v] = xcalloc(3 * (size_t)n, sizeof *st[v]);
             memcpy(st[v], m->q0, (size_t)n * sizeof *st[v]);
         }
         for (int k = 0; k <= steps; k++) {
             double t = k == 0 ? 0 : (k - 1) / (double)steps, h = k == 0 ? 0 : 1.0 / steps;
-            MechrtReport r[2];
-            for (int v = 0; v < 2; v++)
+            MechrtReport r[3];
+            for (int v = 0; v < 3; v++)
                 assert_int_equal(mechrt_step_lup(&e.k, &jnz, f[v], NULL, st[v], st[v] + n,
                                                  st[v] + 2 * n, t, h, work, lwork, &r[v]),
                                  MECHRT_OK);
             assert_int_equal(r[0].iterations, r[1].iterations);
-            for (int i = 0; i < 3 * n; i++)
+            assert_int_equal(r[1].iterations, r[2].iterations);
+            assert_int_equal(r[1].worst_row, r[2].worst_row);
+            assert_int_equal(r[1].factorisations, r[2].factorisations);
+            assert_true(r[1].residual == r[2].residual && r[1].step == r[2].step);
+            for (int i = 0; i < 3 * n; i++) {
                 assert_near(st[1][i], st[0][i], 1e-12, 1e-12);
+                assert_true(st[2][i] == st[1][i]);
+            }
         }
         assert_true(f[1]->gen_factors >= 2 * steps);
         assert_int_equal(f[1]->analyses + f[1]->replays, 0);
+        assert_int_equal(f[2]->gen_factors, f[1]->gen_factors);
         assert_int_equal(f[0]->gen_factors, 0);
-        free(work), free(st[0]), free(st[1]), free(f[0]), free(f[1]);
+        free(work);
+        for (int v = 0; v < 3; v++)
+            free(st[v]), free(f[v]);
         engine_close(&e);
         pipeline_free(mech);
     }

@@ -1193,7 +1193,7 @@ static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *
     }
     if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
         *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
-                             o->jac_nz->lu_solve};
+                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
         mechrt_lup_use(f, gen);
     }
     return f;
@@ -1381,6 +1381,12 @@ static void code_lu_solve(void *ctx, const double *lu, const double *b, double *
     ((const Kernels *)ctx)->lu_solve(lu, b, x);
 }
 
+static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                        const double *tol, int max_iter, double *out, int *iout)
+{
+    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+}
+
 bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
 {
     const Kernels *code = e->k.ctx;
@@ -1390,6 +1396,7 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
     *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
                              code_jac_nz, code->all_nz ? code_all_nz : NULL,
                              code->lu_factor ? code_lu_factor : NULL,
-                             code->lu_factor ? code_lu_solve : NULL};
+                             code->lu_factor ? code_lu_solve : NULL,
+                             code->lu_factor ? code_lu_step : NULL};
     return true;
 }

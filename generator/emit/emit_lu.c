@@ -26,10 +26,16 @@
  *   #define P_LU_NSLOTS  k        reals of the factors
  *   int  P_lu_factor(const P_real *a, P_real *lu, P_real pivot_tol, P_real *spread);
  *   void P_lu_solve(const P_real *lu, const P_real *b, P_real *x);
+ *   int  P_step(P_real *q, P_real *qd, P_real *qdd, P_real t, P_real h,
+ *               const P_real *tol, int max_iter, P_real *out, int *iout);
  * a: the P_NNZ values of P_jac_nz (read only); lu: P_LU_NSLOTS reals;
  * returns 0, or 1 + the elimination step whose check failed (-1: an
  * entry is NaN or infinite); *spread = max|u_kk| / min|u_kk| (the
- * condition estimate's screen). x may be b.
+ * condition estimate's screen). x may be b. P_step is the runtime's
+ * kinematic step (runtime/step_lup.c) over these kernels and this LU, the
+ * same operations in the same order, with the calls direct, the loops
+ * unrolled and the factorisations and solves written in place: nonzero,
+ * the state untouched, wherever the runtime must step instead.
  */
 #include "emit.h"
 
@@ -73,7 +79,11 @@ typedef struct LuGen {
     int nslots;
     int *prow, *pcol;       /* pivot k at (prow[k], pcol[k]) */
     bool *row_done, *col_done;
+    bool inline_factors;    /* P_step: the solves read the factor's temporaries */
 } LuGen;
+
+static void lu_factor_text(LuGen *g, StrBuf *def, const StrBuf *loads, const StrBuf *steps,
+                           double cmax, double cmin);
 
 #define AT(g, r, c) ((size_t)(r) * (size_t)(g)->n + (size_t)(c))
 
@@ -268,7 +278,12 @@ static void lu_checks(LuGen *g, int k, LuVal p, const int *cand, int nc, double 
     }
     for (int i = 0; i < nc; i++) {
         LuVal c = g->a[AT(g, cand[i], pc)];
-        if (c.known && p.known)
+        bool again = false;   /* one graph node in two rows: checked once */
+        for (int j = 0; j < i; j++) {
+            LuVal d = g->a[AT(g, cand[j], pc)];
+            again |= !c.known && !d.known && c.var == d.var;
+        }
+        if ((c.known && p.known) || again)
             continue;   /* chosen here, and constant */
         sb_puts(b, any ? "\n        || !(" : "    if (!(");
         any = true;
@@ -326,6 +341,8 @@ static void lu_put_factor(LuGen *g, StrBuf *sb, LuVal v)
 {
     if (v.known)
         emit_put_literal(sb, fabs(v.c), g->opt->real_float);
+    else if (g->inline_factors)
+        sb_printf(sb, "t%d", v.var);
     else
         sb_printf(sb, "lu[%d]", lu_slot(g, v));
 }
@@ -336,11 +353,12 @@ static bool lu_is_negative(LuVal v)
 }
 
 /* y_i -= f * y: the forward and backward substitutions' update. */
-static void lu_put_update(LuGen *g, StrBuf *sb, const char *target, LuVal f, const char *y)
+static void lu_put_update(LuGen *g, StrBuf *sb, const char *ind, const char *target, LuVal f,
+                          const char *y)
 {
     if (f.known && f.c == 0)
         return;
-    sb_printf(sb, "    %s %s= ", target, lu_is_negative(f) ? "+" : "-");
+    sb_printf(sb, "%s%s %s= ", ind, target, lu_is_negative(f) ? "+" : "-");
     if (!(f.known && fabs(f.c) == 1)) {
         lu_put_factor(g, sb, f);
         sb_puts(sb, " * ");
@@ -348,47 +366,126 @@ static void lu_put_update(LuGen *g, StrBuf *sb, const char *target, LuVal f, con
     sb_printf(sb, "%s;\n", y);
 }
 
-/* P_lu_solve's body: b in locals, L forward in the pivot order, U backward. */
-static void lu_solve_body(LuGen *g, StrBuf *sb)
+/* x = A^-1 b from the factors in lu: b read from the array in, L forward
+   in the pivot order, U backward, into locals x0 .. x(n-1) (ind: the
+   statements' indentation). */
+static void lu_solve_text(LuGen *g, StrBuf *sb, const char *in, const char *ind)
 {
     int n = g->n;
     char y[32], yr[32];
+    bool *later = xcalloc((size_t)n, sizeof *later);
     for (int r = 0; r < n; r++)
-        sb_printf(sb, "    %s_real y%d = b[%d];\n", g->prefix, r, r);
+        sb_printf(sb, "%s%s_real y%d = %s[%d];\n", ind, g->prefix, r, in, r);
+    for (int k = 0; k < n; k++)
+        later[g->prow[k]] = true;
     for (int k = 0; k < n; k++) {
+        /* the rows eliminated after k hold L's entries in column pcol[k] */
+        later[g->prow[k]] = false;
         snprintf(yr, sizeof yr, "y%d", g->prow[k]);
-        for (int i = 0; i < n; i++) {
-            /* the rows eliminated after k hold L's entries in column pcol[k] */
-            bool later = false;
-            for (int m = k + 1; m < n; m++)
-                later |= g->prow[m] == i;
-            if (later && g->present[AT(g, i, g->pcol[k])]) {
+        for (int i = 0; i < n; i++)
+            if (later[i] && g->present[AT(g, i, g->pcol[k])]) {
                 snprintf(y, sizeof y, "y%d", i);
-                lu_put_update(g, sb, y, g->a[AT(g, i, g->pcol[k])], yr);
+                lu_put_update(g, sb, ind, y, g->a[AT(g, i, g->pcol[k])], yr);
             }
-        }
     }
+    free(later);
     for (int k = n - 1; k >= 0; k--) {
         int pr = g->prow[k], pc = g->pcol[k];
         snprintf(y, sizeof y, "x%d", pc);
-        sb_printf(sb, "    %s_real x%d = y%d;\n", g->prefix, pc, pr);
+        sb_printf(sb, "%s%s_real x%d = y%d;\n", ind, g->prefix, pc, pr);
         for (int m = k + 1; m < n; m++) {
             char xc[32];
             snprintf(xc, sizeof xc, "x%d", g->pcol[m]);
             if (g->present[AT(g, pr, g->pcol[m])])
-                lu_put_update(g, sb, y, g->a[AT(g, pr, g->pcol[m])], xc);
+                lu_put_update(g, sb, ind, y, g->a[AT(g, pr, g->pcol[m])], xc);
         }
         LuVal p = g->a[AT(g, pr, pc)];
         if (!(p.known && fabs(p.c) == 1)) {
-            sb_printf(sb, "    x%d /= ", pc);
+            sb_printf(sb, "%sx%d /= ", ind, pc);
             lu_put_factor(g, sb, p);
             sb_puts(sb, ";\n");
         }
         if (lu_is_negative(p))
-            sb_printf(sb, "    x%d = -x%d;\n", pc, pc);
+            sb_printf(sb, "%sx%d = -x%d;\n", ind, pc, pc);
     }
-    for (int c = 0; c < n; c++)
+}
+
+/* P_lu_solve's body. */
+static void lu_solve_body(LuGen *g, StrBuf *sb)
+{
+    lu_solve_text(g, sb, "b", "    ");
+    for (int c = 0; c < g->n; c++)
         sb_printf(sb, "    x[%d] = x%d;\n", c, c);
+}
+
+/* P_step (see the header's comment and runtime/step_lup.c, whose
+   operations it repeats in the same order): the loops unrolled, the
+   three solves written in place, so that their solutions stay in
+   registers. */
+static void lu_step_def(LuGen *g, StrBuf *def, const StrBuf *loads, const StrBuf *steps,
+                        double cmax, double cmin)
+{
+    /* Finiteness by sums: fin adds the values checked and fin - fin is 0
+       only when every one was finite (a sum that overflows declines a
+       step the runtime then takes: safe, and never seen at sane scales). */
+    const char *p = g->prefix, *u = g->upper;
+    int n = g->n;
+    sb_printf(def, "\nint %s_step(%s_real *q, %s_real *qd, %s_real *qdd, %s_real t, %s_real h,\n"
+              "             const %s_real *tol, int max_iter, %s_real *out, int *iout)\n{\n",
+              p, p, p, p, p, p, p, p);
+    sb_printf(def, "    %s_real qq[%s_NQ], phi[%s_NQ], rhs[%s_NQ], v[%s_NQ], a[%s_NNZ];\n"
+              "    %s_real res = 0, stp = -1, fin, m;\n    const %s_real pivot_tol = tol[2];\n"
+              "    int it = 0, worst;\n\n", p, u, u, u, u, u, p, p);
+    sb_printf(def, "    if (h != 0) {\n        const %s_real hh = (%s_real)0.5 * h * h;\n", p, p);
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        qq[%d] = q[%d] + (h * qd[%d] + hh * qdd[%d]);\n", i, i, i, i);
+    sb_puts(def, "    } else {\n");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        qq[%d] = q[%d];\n", i, i);
+    sb_puts(def, "    }\n    t += h;\n    for (;;) {\n");
+    sb_printf(def, "        %s_phi(qq, t, phi);\n        %s_jac_nz(qq, t, a);\n", p, p);
+    /* the residual decides from the second evaluation on (before the
+       first step the test fails anyway, and a value of Phi that is not
+       finite makes the step's): max |Phi_i|, the row found afterwards */
+    sb_puts(def, "        if (stp >= 0) {\n            res = 0;\n            fin = 0;\n");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "            m = %s_LU_ABS(phi[%d]);\n            fin += phi[%d];\n"
+                  "            res = m > res ? m : res;\n", u, i, i);
+    sb_puts(def, "            if (fin - fin != 0)\n                return 1;\n"
+            "            if (res <= tol[0] && stp <= tol[1])\n                break;\n        }\n"
+            "        if (it >= max_iter)\n            return 2;\n        {\n");
+    lu_factor_text(g, def, loads, steps, cmax, cmin);
+    sb_puts(def, "            if (!(hi / lo <= tol[3]))\n                return 2;\n"
+            "            fin = 0;\n");
+    lu_solve_text(g, def, "phi", "            ");
+    sb_puts(def, "            stp = 0;\n");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "            m = %s_LU_ABS(x%d);\n            fin += x%d;\n"
+                  "            stp = m > stp ? m : stp;\n", u, i, i);
+    sb_puts(def, "            if (fin - fin != 0)\n                return 3;\n");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "            qq[%d] -= x%d;\n", i, i);
+    sb_puts(def, "        }\n        it++;\n    }\n    {\n");
+    lu_factor_text(g, def, loads, steps, cmax, cmin);
+    sb_printf(def, "    if (!(hi / lo <= tol[3]))\n        return 2;\n    fin = 0;\n"
+              "    %s_nu(qq, t, rhs);\n    {\n", p);
+    lu_solve_text(g, def, "rhs", "        ");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        v[%d] = x%d;\n        fin += x%d;\n", i, i, i);
+    sb_printf(def, "    }\n    %s_gamma(qq, v, t, rhs);\n    {\n", p);
+    lu_solve_text(g, def, "rhs", "        ");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        fin += x%d;\n", i);
+    sb_puts(def, "        if (fin - fin != 0)\n            return 3;\n");
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        q[%d] = qq[%d];\n        qd[%d] = v[%d];\n", i, i, i, i);
+    for (int i = 0; i < n; i++)
+        sb_printf(def, "        qdd[%d] = x%d;\n", i, i);
+    /* the first row with the largest |Phi_i|, as the runtime reports it */
+    sb_puts(def, "    }\n    }\n    for (worst = 0; worst < ");
+    sb_printf(def, "%s_NQ - 1 && !(%s_LU_ABS(phi[worst]) == res); worst++)\n        ;\n", u, u);
+    sb_puts(def, "    out[0] = res;\n    out[1] = stp;\n    iout[0] = it;\n"
+            "    iout[1] = worst;\n    return 0;\n}\n");
 }
 
 /* The factor's loads: each distinct variable value of the Jacobian once
@@ -419,8 +516,8 @@ static double lu_loads(LuGen *g, const Kinematics *kin, NodeValues *nv)
             int t = g->ntemp++;
             g->a[at] = (LuVal){false, 0, t, false};
             sb_printf(g->body, "    const %s_real t%d = a[%d];\n", g->prefix, t, e);
-            sb_printf(g->body, "    chk += t%d - t%d;\n    amax = %s_LU_ABS(t%d) > amax ? "
-                      "%s_LU_ABS(t%d) : amax;\n", t, t, g->upper, t, g->upper, t);
+            sb_printf(g->body, "    chk += t%d;\n    amax = %s_LU_ABS(t%d) > amax ? "
+                      "%s_LU_ABS(t%d) : amax;\n", t, g->upper, t, g->upper, t);
             g->ops += 4;
         }
     }
@@ -463,15 +560,31 @@ static void lu_factor_def(LuGen *g, StrBuf *def, const StrBuf *loads, const StrB
                           double cmax, double cmin)
 {
     const char *p = g->prefix;
-    bool f = g->opt->real_float, pivots = !isinf(cmin);
     sb_printf(def, "int %s_lu_factor(const %s_real *a, %s_real *lu, %s_real pivot_tol, "
               "%s_real *spread)\n{\n", p, p, p, p, p);
+    lu_factor_text(g, def, loads, steps, cmax, cmin);
+    for (int t = 0; t < g->ntemp; t++)
+        if (g->slot[t] >= 0)
+            sb_printf(def, "    lu[%d] = t%d;\n", g->slot[t], t);
+    sb_puts(def, "    (void)lu;\n    *spread = hi / lo;\n    return 0;\n}\n");
+}
+
+/* The factor's statements (P_lu_factor's body, and P_step's in place):
+   declarations, loads, the scale, the steps; nonzero returns where a
+   check fails, lo and hi the pivots' extremes at the end. */
+static void lu_factor_text(LuGen *g, StrBuf *def, const StrBuf *loads, const StrBuf *steps,
+                           double cmax, double cmin)
+{
+    const char *p = g->prefix;
+    bool f = g->opt->real_float, pivots = !isinf(cmin);
     sb_printf(def, "    %s_real chk = 0, amax = ", p);
     emit_put_literal(def, cmax, f);
     sb_puts(def, ", thresh, ap, lo, hi = ");
     emit_put_literal(def, pivots ? cmin : 0, f);
     sb_printf(def, ";\n    (void)a; (void)ap;\n%s", loads->data);
-    sb_puts(def, "    if (chk != 0)\n        return -1;\n    thresh = pivot_tol * amax;\n");
+    /* chk sums the values: chk - chk is 0 only when all are finite (an
+       overflowing sum declines a factorisation the runtime then does) */
+    sb_puts(def, "    if (chk - chk != 0)\n        return -1;\n    thresh = pivot_tol * amax;\n");
     /* without constant pivots lo starts at amax: the spread is then an
        upper bound (a pivot above every entry is rare), the screen safe */
     sb_puts(def, "    lo = ");
@@ -486,10 +599,6 @@ static void lu_factor_def(LuGen *g, StrBuf *def, const StrBuf *loads, const StrB
         sb_puts(def, " > thresh))\n        return 1;\n");
     }
     sb_puts(def, steps->data);
-    for (int t = 0; t < g->ntemp; t++)
-        if (g->slot[t] >= 0)
-            sb_printf(def, "    lu[%d] = t%d;\n", g->slot[t], t);
-    sb_puts(def, "    (void)lu;\n    *spread = hi / lo;\n    return 0;\n}\n");
 }
 
 static void lu_free(LuGen *g)
@@ -542,12 +651,25 @@ void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
                   "%s_real *spread);\n", prefix, prefix, prefix, prefix, prefix);
         sb_printf(decl, "void %s_lu_solve(const %s_real *lu, const %s_real *b, %s_real *x);\n",
                   prefix, prefix, prefix, prefix);
-        sb_printf(def, "\n\n/* ---- begin lu ---- */\n/* |x| without libm */\n"
-                  "#define %s_LU_ABS(x) ((x) < 0 ? -(x) : (x))\n\n", upper);
+        sb_printf(decl, "/* One kinematic step over these kernels and this LU (the runtime's\n"
+                  "   mechrt_step_lup with every call direct): 0, or nonzero with the state\n"
+                  "   untouched when the runtime must take the step itself. tol: tol_phi,\n"
+                  "   tol_dq, pivot_tol, the largest pivot spread; out: ||Phi||_inf, the\n"
+                  "   last ||dq||_inf; iout: iterations, worst row. */\n"
+                  "int %s_step(%s_real *q, %s_real *qd, %s_real *qdd, %s_real t, %s_real h,\n"
+                  "            const %s_real *tol, int max_iter, %s_real *out, int *iout);\n",
+                  prefix, prefix, prefix, prefix, prefix, prefix, prefix, prefix);
+        sb_printf(def, "\n\n/* ---- begin lu ---- */\n/* |x|: one instruction where "
+                  "optimising, no libm call elsewhere */\n#if %s_OPTIMIZED\n"
+                  "#define %s_LU_ABS(x) %s(x)\n#else\n"
+                  "#define %s_LU_ABS(x) ((x) < 0 ? -(x) : (x))\n#endif\n\n",
+                  upper, upper, opt->real_float ? "fabsf" : "fabs", upper);
         lu_factor_def(&g, def, &loads, &steps, cmax, cmin);
         sb_printf(def, "\nvoid %s_lu_solve(const %s_real *lu, const %s_real *b, %s_real *x)\n"
-                  "{\n    (void)lu;\n%s}\n/* ---- end lu ---- */", prefix, prefix, prefix,
-                  prefix, solve.data);
+                  "{\n    (void)lu;\n%s}\n", prefix, prefix, prefix, prefix, solve.data);
+        g.inline_factors = true;
+        lu_step_def(&g, def, &loads, &steps, cmax, cmin);
+        sb_puts(def, "/* ---- end lu ---- */");
     }
     for (int i = 0; i < 3; i++)
         sb_free(bufs[i]);

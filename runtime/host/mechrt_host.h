@@ -169,6 +169,8 @@ typedef struct MechrtHostJacNz {
        MechrtLuGen's: factors in at most nq*nq reals); both may be NULL */
     int (*lu_factor)(void *ctx, const double *a, double *lu, double pivot_tol, double *spread);
     void (*lu_solve)(void *ctx, const double *lu, const double *b, double *x);
+    int (*lu_step)(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                   const double *tol, int max_iter, double *out, int *iout);
 } MechrtHostJacNz;
 
 typedef struct MechrtHostSparse MechrtHostSparse;
