@@ -1397,6 +1397,6 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
                              code_jac_nz, code->all_nz ? code_all_nz : NULL,
                              code->lu_factor ? code_lu_factor : NULL,
                              code->lu_factor ? code_lu_solve : NULL,
-                             code->lu_factor ? code_lu_step : NULL};
+                             code->lu_step ? code_lu_step : NULL};
     return true;
 }

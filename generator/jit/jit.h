@@ -36,7 +36,8 @@ typedef struct Kernels {
        unit written without it or for a mechanism it does not serve. */
     KernelLuFactor lu_factor;
     KernelLuSolve lu_solve;
-    KernelLuStep lu_step;   /* PREFIX_step: the kinematic step over them */
+    KernelLuStep lu_step;   /* PREFIX_step: the kinematic step over them
+                               (above 24 coordinates one that declines) */
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
