@@ -269,7 +269,7 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
-        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
+        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" --lu \
             --roll "$roll" -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
         try 12 "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
         if [ "$real" = float ]; then f=f; else f=; fi

@@ -13,6 +13,9 @@
 # jac_nz, nu and gamma; the dense-Jacobian limit (--max-jac-entries) binds
 # only runs that form one, and a chain of 1000 loops runs sparse in less
 # address space than its dense Jacobian.
+# gen --lu writes the unrolled LU and P_step (and only then, and only for
+# stepped mechanisms), and the written step alone follows the
+# slider-crank's closed form.
 #
 #   sh tests/sparse_cli.sh build/mechc
 set -u
@@ -291,5 +294,44 @@ run "$tmp/ksing.mech" --linear sparse --csv /dev/null
 check "velocity rows singular, sparse: exit 1" status_is 1
 check "velocity rows singular, sparse: the time, the pivot's coordinate and row" \
     err_matches "error: t = 0: velocity and acceleration analysis failed: singular Jacobian.*sparse LU found no pivot for cart.y in row side"
+
+# ---- gen --lu: the unrolled LU and step -----------------------------------------
+# written only with --lu and for stepped mechanisms; the written P_step alone
+# (no runtime) turns the slider-crank along its closed form
+check "gen: no lu without --lu" sh -c "! grep -q lu_factor '$tmp/fb.c'"
+run_mechc gen "$ex/knife_cart.mech" --lu -o "$tmp/kc.c"
+check "gen --lu, velocity rows: exit 0, no lu" sh -c "[ $rc = 0 ] && ! grep -q lu_factor '$tmp/kc.c'"
+run_mechc gen "$ex/slider_crank.mech" --prefix sc --lu -o "$tmp/sclu.c" --header "$tmp/sclu.h"
+check "gen --lu: exit 0" status_is 0
+check "gen --lu: factor, solve and step declared" sh -c "grep -q '^int sc_lu_factor(' '$tmp/sclu.h' \
+    && grep -q '^void sc_lu_solve(' '$tmp/sclu.h' && grep -q '^int sc_step(' '$tmp/sclu.h' \
+    && grep -q '^#define SC_LU_NSLOTS [0-9]' '$tmp/sclu.h'"
+if have cc; then
+    cat > "$tmp/sclu_main.c" << 'EOF'
+#include "sclu.h"
+#include <math.h>
+#include <stdio.h>
+int main(void)
+{
+    sc_real s[3 * SC_NQ], tol[4] = {1e-10, 1e-10, 1e-12, 1e4}, out[2], worst = 0;
+    int i, iout[2], k;
+    for (i = 0; i < 3 * SC_NQ; i++)
+        s[i] = i < SC_NQ ? sc_q0[i] : 0;
+    for (k = 0; k <= 100; k++) {
+        double t = k == 0 ? 0 : (k - 1) / 100.0, h = k == 0 ? 0 : 0.01, th;
+        if (sc_step(s, s + SC_NQ, s + 2 * SC_NQ, t, h, tol, 25, out, iout) != 0)
+            return 2;
+        th = 2 * 3.141592653589793 * (t + h);   /* slider.x is q[6] */
+        th = 0.1 * cos(th) + sqrt(0.09 - 0.01 * sin(th) * sin(th)) - s[6];
+        worst = fabs(th) > worst ? fabs(th) : worst;
+    }
+    printf("%.3g\n", worst);
+    return worst < 1e-9 ? 0 : 1;
+}
+EOF
+    check "gen --lu: the written step alone follows the closed form to 1e-9" \
+        sh -c "cc -std=c99 -O2 -I'$tmp' -o '$tmp/sclu_main' '$tmp/sclu_main.c' '$tmp/sclu.c' -lm \
+               && '$tmp/sclu_main'"
+fi
 
 suite_end

@@ -136,6 +136,7 @@ typedef struct Run {
     bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
     MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
+    MechrtLuGen lup_gen;     /* the kernels' unrolled LU, when they have one */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
@@ -1176,7 +1177,8 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
    there is one, the mechanism is stepped (no velocity rows) and its
    worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
-static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz)
+static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
+                              MechrtLuGen *gen)
 {
     if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
         return NULL;
@@ -1189,6 +1191,11 @@ static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *
         != MECHRT_OK) {
         free(f);
         return NULL;
+    }
+    if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
+        *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
+                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
+        mechrt_lup_use(f, gen);
     }
     return f;
 }
@@ -1261,7 +1268,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     }
     res->sparse = sparse;
     if (!sparse)
-        r.lup = run_lup_new(m, o, &r.lup_jnz);
+        r.lup = run_lup_new(m, o, &r.lup_jnz, &r.lup_gen);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -1282,6 +1289,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     if (r.lup) {
         res->fresh_factorisations = r.lup->analyses;
         res->refactorisations = r.lup->replays;
+        res->generated_factorisations = r.lup->gen_factors;
         free(r.lup);
     }
     if (status == RUN_OK && r.episode)
@@ -1364,6 +1372,23 @@ static void code_all_nz(void *ctx, const double *q, const double *qd, double t, 
     ((const Kernels *)ctx)->all_nz(q, qd, t, phi, vals, nu, gamma);
 }
 
+static int code_lu_factor(void *ctx, const double *a, double *lu, double pivot_tol,
+                          double *spread)
+{
+    return ((const Kernels *)ctx)->lu_factor(a, lu, pivot_tol, spread);
+}
+
+static void code_lu_solve(void *ctx, const double *lu, const double *b, double *x)
+{
+    ((const Kernels *)ctx)->lu_solve(lu, b, x);
+}
+
+static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                        const double *tol, int max_iter, double *out, int *iout)
+{
+    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+}
+
 bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
 {
     const Kernels *code = e->k.ctx;
@@ -1371,6 +1396,9 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
         || !code->jac_row || !code->jac_col)
         return false;
     *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
-                             code_jac_nz, code->all_nz ? code_all_nz : NULL};
+                             code_jac_nz, code->all_nz ? code_all_nz : NULL,
+                             code->lu_factor ? code_lu_factor : NULL,
+                             code->lu_factor ? code_lu_solve : NULL,
+                             code->lu_step ? code_lu_step : NULL};
     return true;
 }

@@ -162,6 +162,11 @@ static void put_literal(StrBuf *sb, double v, bool real_float)
         sb_putc(sb, ')');
 }
 
+void emit_put_literal(StrBuf *sb, double v, bool real_float)
+{
+    put_literal(sb, v, real_float);
+}
+
 typedef struct Emitter {
     const Kinematics *kin;
     const Dag *dag;
@@ -1161,6 +1166,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         put_jac_moves(&moves, e->kin);
     put_math(&math, e);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
+    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf);
 
     EmitSizes z;
     put_sizes(e, &z);

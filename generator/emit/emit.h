@@ -4,6 +4,7 @@
 
 #include "../base/diag.h"
 #include "../base/limits.h"
+#include "../base/strbuf.h"
 #include "../diff/kinematics.h"
 
 #include <stdbool.h>
@@ -32,6 +33,9 @@ typedef struct EmitOptions {
                                    sparse path of run; gen --sparse) */
     int roll;                   /* EmitRoll: loops for joints' rows of one
                                    shape (generator/emit/roll.c) */
+    bool lu;                    /* also PREFIX_lu_factor and PREFIX_lu_solve
+                                   (emit_lu.c; gen --lu): the Jacobian's LU
+                                   unrolled for its pattern */
 } EmitOptions;
 
 /* gen --roll: auto rolls the kinematic functions of a mechanism with at
@@ -79,6 +83,16 @@ const char *emit_check_header_name(const char *name);
 /* Writes the C source and header. Returns false (diag filled) for an
    unusable prefix or header name, or code beyond max_ops; everything else
    in the model is already valid. */
+/* The shortest decimal of v that reads back exactly (as a float with
+   real_float), negative ones parenthesized: how constants are written. */
+void emit_put_literal(StrBuf *sb, double v, bool real_float);
+
+/* PREFIX_lu_factor and PREFIX_lu_solve (emit_lu.c) appended to decl and
+   def when opt->lu is set and the mechanism is square, without velocity
+   rows and small enough; nothing otherwise. */
+void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
+             const char *upper, StrBuf *decl, StrBuf *def);
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *opt, EmitResult *out, Diag *diag);
 void emit_result_free(EmitResult *out);
 

@@ -103,6 +103,7 @@ Jit *pipeline_jit_roll(const Mech *mech, int roll, EmitResult *emitted, double *
     opt.declare_math = true;
     opt.direct_jac = true;
     opt.all_nz = true;      /* run's sparse path */
+    opt.lu = true;           /* run's dense path: the unrolled LU */
     opt.prefix = "mechc_jit";
     /* Chunks exist for optimizing compilers, whose passes grow faster than
        the function; libtcc's time is linear, and a part boundary costs it a

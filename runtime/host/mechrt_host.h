@@ -182,6 +182,12 @@ struct MechrtHostJacNz {
        (PREFIX_all_nz); may be NULL */
     void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
                    double *vals, double *nu, double *gamma);
+    /* The pattern's unrolled LU (PREFIX_lu_factor, PREFIX_lu_solve, as
+       MechrtLuGen's: factors in at most nq*nq reals); both may be NULL */
+    int (*lu_factor)(void *ctx, const double *a, double *lu, double pivot_tol, double *spread);
+    void (*lu_solve)(void *ctx, const double *lu, const double *b, double *x);
+    int (*lu_step)(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                   const double *tol, int max_iter, double *out, int *iout);
 };
 
 /* The n x n matrix of pattern jnz (copied; its arrays are kept by
