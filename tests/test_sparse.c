@@ -93,7 +93,7 @@ static void kkt_no_jac(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostKkt *small_kkt(void)
 {
-    MechrtHostJacNz j = {4, j_row, j_col, NULL, kkt_no_jac, NULL};
+    MechrtHostJacNz j = {.nnz = 4, .row = j_row, .col = j_col, .ctx = NULL, .jac_nz = kkt_no_jac};
     MechrtHostMassNz m = {4, m_row, m_col, NULL, NULL};
     MechrtHostKkt *s = mechrt_host_kkt_new(3, 2, &j, &m);
     assert_non_null(s);
@@ -183,7 +183,7 @@ static void fill_mn(void *ctx, const double *q, double t, double *vals)
 static void test_minnorm_step(void **state)
 {
     (void)state;
-    MechrtHostJacNz j = {7, mn_row, mn_col, NULL, fill_mn, NULL};
+    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
     double q[3] = {0, 0, 0}, dq[3];
     for (int nh = 2; nh <= 3; nh++) {
         MechrtHostMinNorm *m = mechrt_host_minnorm_new(nh, 3, &j);
@@ -246,7 +246,7 @@ static void test_klu_repivots(void **state)
 {
     (void)state;
     double v[4] = {1, 1, 1e-3, 2};
-    MechrtHostJacNz j = {4, full_row, full_col, v, fill_full, NULL};
+    MechrtHostJacNz j = {.nnz = 4, .row = full_row, .col = full_col, .ctx = v, .jac_nz = fill_full};
     MechrtHostSparse *s = mechrt_host_sparse_new(2, &j);
     assert_non_null(s);
     mechrt_host_sparse_eval(s, NULL, 0);
@@ -272,7 +272,7 @@ static void test_klu_bad_pattern(void **state)
     (void)state;
     double v[6] = {1, 1, 1, 1, 1, 1};
     static const int dup_col[] = {0, 0, 0, 1, 1, 2};    /* (0, 0) twice */
-    MechrtHostJacNz j = {6, p_row, dup_col, v, fill_vals, NULL};
+    MechrtHostJacNz j = {.nnz = 6, .row = p_row, .col = dup_col, .ctx = v, .jac_nz = fill_vals};
     assert_null(mechrt_host_sparse_new(3, &j));
     static const int far_col[] = {0, 3, 0, 1, 1, 2};    /* column 3 of 3 */
     j.col = far_col;

@@ -95,8 +95,8 @@ MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
         mechrt_host_kkt_free(s);
         return NULL;
     }
-    MechrtHostJacNz pat = {s->mnz + s->nxd + 2 * s->jnz + nr, s->row, s->col, NULL, kkt_no_eval,
-                           NULL};
+    MechrtHostJacNz pat = {.nnz = s->mnz + s->nxd + 2 * s->jnz + nr, .row = s->row,
+                           .col = s->col, .jac_nz = kkt_no_eval};
     for (int w = 0; w < 3; w++) {
         s->lu[w] = mechrt_host_sparse_new(nq + nr, &pat);
         if (!s->lu[w]) {
