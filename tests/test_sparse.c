@@ -39,7 +39,7 @@ static void fill_vals(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostJacNz small_pattern(double *v)
 {
-    return (MechrtHostJacNz){6, p_row, p_col, v, fill_vals, NULL};
+    return (MechrtHostJacNz){.nnz = 6, .row = p_row, .col = p_col, .ctx = v, .jac_nz = fill_vals};
 }
 
 static void test_klu_solve(void **state)
