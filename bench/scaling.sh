@@ -1,16 +1,19 @@
 #!/bin/sh
 # bench/scaling.sh MECHC - how `mechc run` grows with the mechanism: chains
 # of N four-bar loops (examples/chain.sh N, 6N + 3 coordinates), run with
-# the dense LU and with the sparse one (KLU), then the issue-15 target run
-# and the N = 10 000 chain.
+# the dense LU and with the sparse one (KLU) for N = 10, 100, 1000 and
+# 10 000, then the issue-15 target run.
 #
 #   sh bench/scaling.sh build/mechc                    (part of `make bench`)
-#   SIZES="10 100 1000 3000" STEPS=100 BIG_N= sh bench/scaling.sh build/mechc
+#   SIZES="10 100 1000 3000" STEPS=100 sh bench/scaling.sh build/mechc
 #
 # Per size and linear algebra, one `mechc run --steps STEPS --csv /dev/null
 # --stats` (the dense LU's O(n^3) steps are few at N >= DENSE_FEW_N: their
 # per-step figures are still per step; above DENSE_MAX_N, 1000, the dense
 # matrix alone would take gigabytes and the dense runs are left out):
+#   gen s          generation: derivatives and emission of the C (--stats'
+#                  stage times, wall)
+#   compile s      libtcc's compilation of it (--stats, wall)
 #   step ms        wall time of one step, inside run (--stats; output excluded)
 #   step CPU ms    the process's CPU time of one step (--stats)
 #   wall s, CPU s  the whole command: parse, generate, JIT-compile, assemble,
@@ -21,20 +24,20 @@
 # command CPU and peak memory, split into set-up (the same command with
 # --steps 0: parse, derivatives, emission, libtcc, assembly), the steps
 # (--stats) and the rest, the printing of 3 x 6003 x 1001 numbers; the same
-# with --digits 6. Then N = BIG_N (10 000: 60 003 coordinates, sparse; empty
-# BIG_N: left out), `run --steps BIG_STEPS`: set-up CPU and its stages
-# (--stats, wall), CPU per step, peak memory.
+# with --digits 6. Then, when BIG_N is set (empty by default: the table has
+# N = 10 000), N = BIG_N, `run --steps BIG_STEPS`: set-up CPU and its
+# stages (--stats, wall), CPU per step, peak memory.
 # Without /usr/bin/time the whole-command columns say "-".
 # POSIX sh and awk only.
 set -u
 mechc=${1:-build/mechc}
-sizes=${SIZES:-"10 100 1000"}
+sizes=${SIZES:-"10 100 1000 10000"}
 steps=${STEPS:-100}
 dense_few_n=${DENSE_FEW_N:-1000}
 dense_few_steps=${DENSE_FEW_STEPS:-2}
 dense_max_n=${DENSE_MAX_N:-1000}
 target_n=${TARGET_N:-1000}
-big_n=${BIG_N-10000}
+big_n=${BIG_N:-}
 big_steps=${BIG_STEPS:-100}
 if [ ! -x "$mechc" ]; then
     echo "usage: sh bench/scaling.sh MECHC   ('$mechc' is not an executable; run make first)" >&2
@@ -71,8 +74,8 @@ stat() {
 }
 
 echo "mechc run on chains of N four-bar loops (examples/chain.sh N), dense LU against KLU"
-printf '%6s %6s %-6s %5s %10s %12s %8s %8s %10s\n' \
-    N nq linear steps "step ms" "step CPU ms" "wall s" "CPU s" "max RSS MB"
+printf '%6s %6s %-6s %5s %7s %9s %10s %12s %8s %8s %10s\n' \
+    N nq linear steps "gen s" "compile s" "step ms" "step CPU ms" "wall s" "CPU s" "max RSS MB"
 for n in $sizes; do
     sh "$here/../examples/chain.sh" "$n" "$tmp/chain.mech" || exit 2
     nq=$((6 * n + 3))
@@ -94,10 +97,15 @@ for n in $sizes; do
         eval "cpu_$lin=$c"
         read -r wall user sys rss < "$tmp/r.time"
         awk -v n="$n" -v nq="$nq" -v l="$lin" -v s="$s" -v a="$a" -v c="$c" -v w="$wall" \
-            -v u="$user" -v y="$sys" -v r="$rss" 'BEGIN {
+            -v u="$user" -v y="$sys" -v r="$rss" \
+            -v st="$(sed -n 's/.*stats: set-up: //p' "$tmp/r.err")" 'BEGIN {
             cpu = (u == "-") ? "-" : sprintf("%.2f", u + y)
             mb = (r == "-") ? "-" : sprintf("%.1f", r / 1024)
-            printf "%6d %6d %-6s %5d %10.3f %12.3f %8s %8s %10s\n", n, nq, l, s, a / 1e6, c / 1e6, w, cpu, mb }'
+            # "load A s, derivatives B s, emission C s, compilation D s"
+            nf = split(st, f, /[ ,]+/)
+            for (i = 1; i < nf; i++) v[f[i]] = f[i + 1]
+            printf "%6d %6d %-6s %5d %7.3f %9.3f %10.3f %12.3f %8s %8s %10s\n", n, nq, l, s,
+                   v["derivatives"] + v["emission"], v["compilation"], a / 1e6, c / 1e6, w, cpu, mb }'
     done
     awk -v n="$n" -v d="${cpu_dense:-}" -v s="${cpu_sparse:-}" 'BEGIN {
         if (d != "" && s != "" && s > 0) printf "%6d  dense / sparse step CPU time: %.1f\n", n, d / s }'

@@ -12,17 +12,8 @@
 # N = 1000 gives 6003 coordinates and 6003 rows.
 # POSIX sh and awk only.
 
-usage() {
-    echo "usage: sh examples/chain.sh N [OUTFILE]   (N a positive integer)" >&2
-    exit 2
-}
-
-[ $# -ge 1 ] && [ $# -le 2 ] || usage
-case $1 in
-    ''|*[!0-9]*) usage ;;
-esac
-n=$1
-[ "$n" -ge 1 ] 2>/dev/null || usage
+. "$(dirname "$0")/size_arg.sh"
+size_arg "$@"
 
 gen() {
     awk -v n="$n" 'BEGIN {
@@ -70,8 +61,4 @@ gen() {
     }'
 }
 
-if [ $# -eq 2 ]; then
-    gen > "$2" || exit 1
-else
-    gen
-fi
+size_out

@@ -15,17 +15,8 @@
 #   rows N .norm + 5N revolute + (N - 1) distance + 1 driver = 7N = NQ.
 # N = 100 gives 700 coordinates and 700 rows. POSIX sh and awk only.
 
-usage() {
-    echo "usage: sh examples/chain_spatial.sh N [OUTFILE]   (N a positive integer)" >&2
-    exit 2
-}
-
-[ $# -ge 1 ] && [ $# -le 2 ] || usage
-case $1 in
-    ''|*[!0-9]*) usage ;;
-esac
-n=$1
-[ "$n" -ge 1 ] 2>/dev/null || usage
+. "$(dirname "$0")/size_arg.sh"
+size_arg "$@"
 
 gen() {
     awk -v n="$n" 'BEGIN {
@@ -61,8 +52,4 @@ gen() {
     }'
 }
 
-if [ $# -eq 2 ]; then
-    gen > "$2" || exit 1
-else
-    gen
-fi
+size_out

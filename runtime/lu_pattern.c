@@ -129,12 +129,26 @@ MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const
     f->dense_now = false;
     f->analyses = 0;
     f->replays = 0;
+    f->gen = NULL;
+    f->gen_now = false;
+    f->gen_spread = 0;
+    f->gen_factors = 0;
     lup_reset_map(f);
     for (e = 0; e < nnz; e++)
         if (f->map[LUP_AT(f, row[e], col[e])] != e) {   /* repeated */
             f->n = 0;
             return MECHRT_EINVAL;
         }
+    return MECHRT_OK;
+}
+
+MechrtStatus mechrt_lup_use(MechrtLup *f, const MechrtLuGen *gen)
+{
+    if (!f || f->n < 1 || (gen && (!gen->factor || !gen->solve || gen->nslots < 1
+                                   || (size_t)gen->nslots > (size_t)f->n * (size_t)f->n)))
+        return MECHRT_EINVAL;
+    f->gen = gen;
+    f->gen_now = false;
     return MECHRT_OK;
 }
 
@@ -442,17 +456,17 @@ static MechrtStatus lup_fallback(MechrtLup *f, int k, mechrt_real pivot_tol, mec
     return st;
 }
 
-MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_index)
+/* The pattern LU's factorisation (mechrt_lup_factor without gen); kept
+   out of line, so that gen's path does not pay for its frame. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static MechrtStatus lup_factor_pivoting(MechrtLup *f, mechrt_real pivot_tol, int *sing_index)
 {
     mechrt_real amax, thresh;
     MechrtStatus st;
     int k, sing;
 
-    if (sing_index)
-        *sing_index = -1;
-    if (!f || f->n < 1)
-        return MECHRT_EINVAL;
-    f->dense_now = false;
     if (!f->ordered)
         return lup_fallback(f, 0, pivot_tol, 0, sing_index);
     st = lup_scan(f, &amax);
@@ -471,6 +485,26 @@ MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_in
         return lup_fallback(f, k, pivot_tol, thresh, sing_index);
     f->replays++;
     return MECHRT_OK;
+}
+
+MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_index)
+{
+    if (sing_index)
+        *sing_index = -1;
+    if (!f || f->n < 1)
+        return MECHRT_EINVAL;
+    f->dense_now = false;
+    f->gen_now = false;
+    /* the unrolled LU reads the values and leaves them: where it declines,
+       the pattern LU factors the same matrix; its factors go to dense,
+       which only the pattern LU's fallback and estimate use */
+    if (f->gen && f->gen->factor(f->gen->ctx, f->lu, f->dense, pivot_tol, &f->gen_spread) == 0
+        && f->gen_spread <= MECHRT_R(MECHRT_LUP_GEN_SPREAD)) {
+        f->gen_now = true;
+        f->gen_factors++;
+        return MECHRT_OK;
+    }
+    return lup_factor_pivoting(f, pivot_tol, sing_index);
 }
 
 MechrtStatus mechrt_lup_factor_dense(MechrtLup *f, const mechrt_real *a, int lda,
@@ -501,6 +535,10 @@ void mechrt_lup_solve(const MechrtLup *f, const mechrt_real *b, mechrt_real *x)
     const int *p, *end;
     int n = f->n, i;
 
+    if (f->gen_now) {
+        f->gen->solve(f->gen->ctx, f->dense, b, x);
+        return;
+    }
     if (f->dense_now) {
         if (x != b)
             for (i = 0; i < n; i++)
@@ -527,6 +565,8 @@ mechrt_real mechrt_lup_spread(const MechrtLup *f)
     size_t n = (size_t)f->n, k;
     mechrt_real lo, hi;
 
+    if (f->gen_now)
+        return f->gen_spread;
     if (f->dense_now) {
         lo = hi = MECHRT_LUP_ABS(f->dense[0]);
         for (k = 1; k < n; k++) {

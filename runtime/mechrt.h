@@ -115,6 +115,32 @@ typedef enum MechrtStatus {
     static const MechrtJacNz p##_jac_nz_kernel = {                               \
         P##_NNZ, p##_jac_row, p##_jac_col, NULL, p##_mechrt_jac_nz}
 
+/* The unrolled LU's factors serve while their pivots' spread
+   max|u_kk| / min|u_kk| stays at or below this; above it (near a
+   singular position, where every rounding difference is amplified) the
+   pattern LU factors, with partial pivoting's own order. */
+#define MECHRT_LUP_GEN_SPREAD 1e4
+
+/* MECHRT_DEFINE_LU(fb, FB) wraps the unrolled LU and step of `mechc gen
+   --lu --prefix fb` (fb_lu_factor, fb_lu_solve, fb_step, FB_LU_NSLOTS) and defines
+   `static const MechrtLuGen fb_lu` for mechrt_lup_use. */
+#define MECHRT_DEFINE_LU(p, P)                                                   \
+    static int p##_mechrt_lu_factor(void *ctx, const mechrt_real *a,             \
+                                    mechrt_real *lu, mechrt_real pivot_tol,      \
+                                    mechrt_real *spread)                         \
+    { (void)ctx; return p##_lu_factor(a, lu, pivot_tol, spread); }               \
+    static void p##_mechrt_lu_solve(void *ctx, const mechrt_real *lu,            \
+                                    const mechrt_real *b, mechrt_real *x)        \
+    { (void)ctx; p##_lu_solve(lu, b, x); }                                       \
+    static int p##_mechrt_step(void *ctx, mechrt_real *q, mechrt_real *qd,       \
+                               mechrt_real *qdd, mechrt_real t, mechrt_real h,   \
+                               const mechrt_real *tol, int max_iter,             \
+                               mechrt_real *out, int *iout)                      \
+    { (void)ctx; return p##_step(q, qd, qdd, t, h, tol, max_iter, out, iout); }  \
+    static const MechrtLuGen p##_lu = {                                          \
+        P##_LU_NSLOTS, NULL, p##_mechrt_lu_factor, p##_mechrt_lu_solve,          \
+        p##_mechrt_step}
+
 #endif /* MECHRT_H_COMMON */
 
 /* ---- Part that depends on the real type ------------------------------- */
@@ -166,6 +192,8 @@ typedef enum MechrtStatus {
 #define mechrt_lup_norm1             mechrtf_lup_norm1
 #define mechrt_lup_cond1             mechrtf_lup_cond1
 #define mechrt_step_lup              mechrtf_step_lup
+#define MechrtLuGen                  MechrtfLuGen
+#define mechrt_lup_use               mechrtf_lup_use
 #define MechrtQr                     MechrtfQr
 #define mechrt_qr_work_len           mechrtf_qr_work_len
 #define mechrt_qr_factor             mechrtf_qr_factor
@@ -549,6 +577,29 @@ MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions
    pivoting would choose the same pivots; otherwise that factorisation is
    the dense one again, and its order is recorded. The state is the
    caller's; its fields are for reading (counts, tests). */
+/* The unrolled LU that `mechc gen --lu` writes for the Jacobian's pattern
+   (P_lu_factor, P_lu_solve; MECHRT_DEFINE_LU): a pivot order fixed when
+   the file was written, checked at run time. factor reads the pattern's
+   nnz values a and writes nslots reals of factors to lu; nonzero when a
+   check failed (a pivot too small against its column or the
+   singularity threshold, or an entry not finite), then nothing is
+   promised. */
+typedef struct MechrtLuGen {
+    int nslots;
+    void *ctx;              /* passed unchanged to factor and solve */
+    int (*factor)(void *ctx, const mechrt_real *a, mechrt_real *lu, mechrt_real pivot_tol,
+                  mechrt_real *spread);
+    void (*solve)(void *ctx, const mechrt_real *lu, const mechrt_real *b, mechrt_real *x);
+    /* The whole step over the same file's kernels (P_step), or NULL:
+       mechrt_step_lup's numbers without its calls through pointers; 0, or
+       nonzero with q, qd, qdd untouched (the runtime then steps). tol:
+       tol_phi, tol_dq, pivot_tol, the largest pivot spread; out: residual,
+       last step; iout: iterations, worst row. */
+    int (*step)(void *ctx, mechrt_real *q, mechrt_real *qd, mechrt_real *qdd, mechrt_real t,
+                mechrt_real h, const mechrt_real *tol, int max_iter, mechrt_real *out,
+                int *iout);
+} MechrtLuGen;
+
 typedef struct MechrtLup {
     int n, nnz;
     const int *row, *col;   /* the pattern, kept by pointer */
@@ -570,6 +621,10 @@ typedef struct MechrtLup {
     bool dense_now;         /* the current factors are lu.c's, in dense */
     long analyses;          /* orders recorded (factorisations lu.c finished) */
     long replays;           /* factorisations done wholly by replaying */
+    const MechrtLuGen *gen; /* the unrolled LU tried first (mechrt_lup_use), or NULL */
+    bool gen_now;           /* the current factors are gen's, in dense */
+    mechrt_real gen_spread; /* their pivots' spread */
+    long gen_factors;       /* factorisations gen did (its checks passed) */
 } MechrtLup;
 
 /* The kernels' sparse Jacobian (spec section 4: P_NNZ, P_jac_row,
@@ -592,6 +647,13 @@ size_t mechrt_lup_iwork_size(int n);
    n*n + 6n. */
 MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const int *col,
                              mechrt_real *work, size_t lwork, int *iwork, size_t liwork);
+
+/* Makes mechrt_lup_factor try gen first (NULL: no longer): where its
+   checks pass its factors serve the solves, elsewhere the pattern LU
+   factors as before. Results then agree with partial pivoting's to
+   rounding, not bit for bit. MECHRT_EINVAL when gen's functions are
+   missing or its nslots exceed n*n. */
+MechrtStatus mechrt_lup_use(MechrtLup *f, const MechrtLuGen *gen);
 
 /* Where the pattern's values go (nnz reals, entry e at e) before
    mechrt_lup_factor, which consumes them. */

@@ -66,7 +66,7 @@ static MechrtStatus ls_factor(Ls *s)
 static MechrtStatus ls_newton(Ls *s)
 {
     MechrtReport *r = s->r;
-    mechrt_real *x = s->dq;
+    mechrt_real *x = s->dq, *q = s->q;
     int n = s->k->nq, i;
     MechrtStatus st = ls_eval(s);
 
@@ -89,7 +89,7 @@ static MechrtStatus ls_newton(Ls *s)
         if (chk != 0)   /* overflow in a nearly singular solve */
             return MECHRT_ENOTFINITE;
         for (i = 0; i < n; i++)
-            s->q[i] -= x[i];
+            q[i] -= x[i];
         r->step = step;
         r->iterations++;
         if ((st = ls_eval(s)) != MECHRT_OK)
@@ -122,6 +122,18 @@ static MechrtStatus ls_factor_cond(Ls *s, bool want_cond)
         return st;
     if (o->cond_screen > 0 && mechrt_lup_spread(s->f) <= o->cond_screen * o->cond_warn)
         return MECHRT_OK;
+    if (s->f->gen_now) {
+        /* the estimate reads the pattern LU's factors: that LU on the same
+           values (the unrolled one leaves them), screened by its pivots */
+        const MechrtLuGen *g = s->f->gen;
+        s->f->gen = NULL;
+        st = ls_factor(s);
+        s->f->gen = g;
+        if (st != MECHRT_OK)
+            return st;
+        if (o->cond_screen > 0 && mechrt_lup_spread(s->f) <= o->cond_screen * o->cond_warn)
+            return MECHRT_OK;
+    }
     if (s->jnz) {   /* the factorisation consumed the values: evaluate them again */
         s->jnz->jac_nz(s->jnz->ctx, s->q, s->t, s->jac);
         anorm = mechrt_lup_norm1(s->f, s->jac);
@@ -164,13 +176,45 @@ static MechrtStatus ls_setup(Ls *s, mechrt_real *work, size_t lwork)
     return MECHRT_OK;
 }
 
+/* The step by the kernels' own P_step (the same operations as below,
+   its calls direct): true when it took it, the report then filled as
+   this file would fill it; false, the state untouched, otherwise. Its
+   largest pivot spread: the unrolled LU's limit, and where a condition
+   estimate is wanted the screen's, so that a step it takes needs none. */
+static bool ls_gen_step(Ls *s, mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
+                        mechrt_real t, mechrt_real h, bool want_cond)
+{
+    const MechrtOptions *o = s->o;
+    mechrt_real tol[4], out[2];
+    int iout[2];
+
+    tol[0] = o->tol_phi;
+    tol[1] = o->tol_dq;
+    tol[2] = o->pivot_tol;
+    tol[3] = MECHRT_R(MECHRT_LUP_GEN_SPREAD);
+    if (want_cond && o->cond_warn > 0) {
+        mechrt_real screen = o->cond_screen > 0 ? o->cond_screen * o->cond_warn : 0;
+        tol[3] = screen < tol[3] ? screen : tol[3];
+    }
+    if (s->f->gen->step(s->f->gen->ctx, q, qd, qdd, t, h, tol, o->max_iter, out, iout) != 0)
+        return false;
+    s->r->iterations = iout[0];
+    s->r->residual = out[0];
+    s->r->step = out[1];
+    s->r->worst_row = iout[1];
+    s->r->factorisations = iout[0] + 1;
+    s->f->gen_factors += iout[0] + 1;
+    s->f->gen_now = s->f->dense_now = false;
+    return true;
+}
+
 MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, MechrtLup *f,
                              const MechrtOptions *opts,
                              mechrt_real *q, mechrt_real *qd, mechrt_real *qdd,
                              mechrt_real t, mechrt_real h,
                              mechrt_real *work, size_t lwork, MechrtReport *report)
 {
-    MechrtOptions o = opts ? *opts : mechrt_default_options();
+    MechrtOptions dflt;
     MechrtReport dummy;
     Ls s;
     MechrtStatus st;
@@ -179,16 +223,30 @@ MechrtStatus mechrt_step_lup(const MechrtKernels *k, const MechrtJacNz *jnz, Mec
     s.k = k;
     s.jnz = jnz;
     s.f = f;
-    s.o = &o;
+    if (!opts) {
+        dflt = mechrt_default_options();
+        opts = &dflt;
+    }
+    s.o = opts;
     s.r = report ? report : &dummy;
     mechrt_report_clear(s.r);
     if (!q || !qd || !qdd || !isfinite(h))
         return MECHRT_EINVAL;
+    /* the kernels' own step calls its own kernels: k and the workspace
+       are checked (and carved) when the runtime steps */
+    if (f && f->gen && f->gen->step && k && f->n == k->nq && work
+        && ls_gen_step(&s, q, qd, qdd, t, h, report != NULL))
+        return MECHRT_OK;
     if ((st = ls_setup(&s, work, lwork)) != MECHRT_OK)
         return st;
-    if (h != 0)
-        for (i = 0; i < k->nq; i++)
-            q[i] += h * qd[i] + MECHRT_R(0.5) * h * h * qdd[i];
+    if (h != 0) {
+        /* 0.5 h h qdd[i] is ((0.5 h) h) qdd[i]: the factor hoisted, the
+           same numbers (P_step's) */
+        mechrt_real hh = MECHRT_R(0.5) * h * h;
+        int n = k->nq;
+        for (i = 0; i < n; i++)
+            q[i] += h * qd[i] + hh * qdd[i];
+    }
     s.q = q;
     s.t = t + h;
     if ((st = ls_newton(&s)) != MECHRT_OK)

@@ -276,7 +276,7 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
-        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" \
+        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" --lu \
             --roll "$roll" $only -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
         if [ -n "$only" ]; then
             try 5 "$name ($real): no dense jac or all, ${prefix}_all_nz" sh -c \

@@ -329,4 +329,15 @@ check "chain 1000: 1 DOF without the driver" out_has "DOF by the rank: 0 with dr
 run info "$tmp/c1000.mech" --linear dense
 check "chain 1000 --linear dense: refused, exit 2" status_is 2
 check "chain 1000 --linear dense: says why" err_has "beyond --max-dense"
+# chain N = 1200 (7203 x 7203 = 51.9 million entries, past the default
+# dense-Jacobian limit of 50 million): the sparse rank forms no dense
+# matrix, so auto loads it; --linear dense is refused at the limit
+sh "$ex/chain.sh" 1200 "$tmp/c1200.mech"
+run info "$tmp/c1200.mech"
+check "chain 1200 (past the dense limit): exit 0" status_is 0
+check "chain 1200: full rank by sparse QR" out_has "holonomic rows: rank 7203 of 7203"
+run info "$tmp/c1200.mech" --linear dense
+check "chain 1200 --linear dense: exit 2" status_is 2
+check "chain 1200 --linear dense: the dense limit named, with the line" \
+    err_matches "c1200.mech:[0-9]*:[0-9]*: error: the dense Jacobian would have .* more than the limit of 50000000"
 suite_end

@@ -92,6 +92,14 @@ static void test_examples_pass(void **state)
         CheckOptions opt = check_default_options();
         opt.samples = 6;
         CheckReport rep;
+        /* the sparse comparisons first (fewer samples), then the dense */
+        opt.linear = RUN_LINEAR_SPARSE;
+        opt.samples = 3;
+        assert_true(check_mechanism(mech, &opt, &rep, &diag));
+        if (!rep.ok || !rep.sparse)
+            fail_msg("%s: --linear sparse: %s", path, rep.ok ? "not sparse" : "fails");
+        opt.linear = RUN_LINEAR_DENSE;
+        opt.samples = 6;
         assert_true(check_mechanism(mech, &opt, &rep, &diag));
         for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
             const CheckItem *it = &rep.items[w];
@@ -150,13 +158,14 @@ static void test_aot_left_out(void **state)
     pipeline_free(mech);
 }
 
-/* Runs check on an example with one fault; returns the report. */
-static void run_fault(const char *file, CheckFaultKind kind, const char *row, const char *col,
-                      double factor, CheckReport *rep)
+/* Runs check (dense or sparse) on an example with one fault; returns the report. */
+static void run_fault_linear(const char *file, CheckFaultKind kind, const char *row,
+                             const char *col, double factor, RunLinear linear, CheckReport *rep)
 {
     Diag diag;
     Mech *mech = load_example(file, &diag);
     CheckOptions opt = check_default_options();
+    opt.linear = linear;
     opt.samples = 4;
     opt.use_aot = false;
     opt.fault = (CheckFault){.kind = kind, .row = row_index(mech->model, row),
@@ -164,7 +173,14 @@ static void run_fault(const char *file, CheckFaultKind kind, const char *row, co
     assert_true(check_mechanism(mech, &opt, rep, &diag));
     /* the item's row index is checked against the fault's by the caller */
     assert_false(rep->ok);
+    assert_int_equal(rep->sparse, linear == RUN_LINEAR_SPARSE);
     pipeline_free(mech);
+}
+
+static void run_fault(const char *file, CheckFaultKind kind, const char *row, const char *col,
+                      double factor, CheckReport *rep)
+{
+    run_fault_linear(file, kind, row, col, factor, RUN_LINEAR_AUTO, rep);
 }
 
 static void expect(const CheckReport *rep, CheckWhat what, int row, const char *hint_part)
@@ -223,6 +239,72 @@ static void test_jacobian_missing_term(void **state)
     CheckReport rep;
     run_fault("four_bar.mech", CHECK_FAULT_JAC_SCALE, "O2.y", "crank.phi", 0.0, &rep);
     expect(&rep, CHECK_JAC_FD, row_of("four_bar.mech", "O2.y"), "missing");
+}
+
+/* The sparse comparisons (the Jacobian's nonzeros against differences by
+   column groups) catch the same Jacobian mistakes at the same row and
+   column, with the same hints. */
+static void test_sparse_jacobian_faults(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *file, *row, *col;
+        double factor;
+        const char *hint;
+    } f[] = {
+        {"slider_crank.mech", "A.x", "crank.phi", -1.0, "sign"},
+        {"four_bar.mech", "B.y", "rocker.phi", 2.0, "factor 2 too many"},
+        {"four_bar.mech", "O2.y", "crank.phi", 0.0, "missing"},
+        {"knife_cart.mech", "blade", "cart.y", -1.0, "sign"},
+        {"rolling_wheel.mech", "roll", "wheel.phi", 2.0, "factor 2 too many"},
+    };
+    for (size_t i = 0; i < sizeof f / sizeof *f; i++) {
+        CheckReport rep;
+        run_fault_linear(f[i].file, CHECK_FAULT_JAC_SCALE, f[i].row, f[i].col, f[i].factor,
+                         RUN_LINEAR_SPARSE, &rep);
+        expect(&rep, CHECK_JAC_FD, row_of(f[i].file, f[i].row), f[i].hint);
+        Diag diag;
+        Mech *mech = load_example(f[i].file, &diag);
+        assert_int_equal(rep.items[CHECK_JAC_FD].col, coord_index(mech->model, f[i].col));
+        pipeline_free(mech);
+        assert_true(rep.items[CHECK_NU_FD].error <= rep.items[CHECK_NU_FD].tol);
+    }
+}
+
+static Mech *load_text(const char *text, Diag *diag);
+
+/* A chain of 50 loops (303 coordinates) checked both ways: the same
+   verdict, the Jacobian's worst error of the same size, the dense and the
+   sparse assembly at the same state. */
+static void test_sparse_chain_agrees(void **state)
+{
+    (void)state;
+    char text[64 * 1024];
+    FILE *p = popen("sh examples/chain.sh 50", "r");
+    assert_non_null(p);
+    size_t n = fread(text, 1, sizeof text - 1, p);
+    text[n] = '\0';
+    assert_int_equal(pclose(p), 0);
+    CheckReport rep[2];
+    for (int k = 0; k < 2; k++) {
+        Diag diag;
+        Mech *mech = load_text(text, &diag);
+        assert_non_null(mech);
+        CheckOptions opt = check_default_options();
+        opt.samples = 4;
+        opt.linear = k ? RUN_LINEAR_SPARSE : RUN_LINEAR_DENSE;
+        assert_true(check_mechanism(mech, &opt, &rep[k], &diag));
+        pipeline_free(mech);
+        assert_true(rep[k].ok);
+        assert_true(rep[k].assembled);
+        assert_int_equal(rep[k].sparse, k == 1);
+    }
+    double ed = rep[0].items[CHECK_JAC_FD].error, es = rep[1].items[CHECK_JAC_FD].error;
+    assert_true(es > 0 && es < 1e-8 && ed > 0 && ed < 1e-8);
+    for (int w = CHECK_NU_FD; w <= CHECK_GAMMA_FD; w++)    /* the same samples: same values */
+        assert_near(rep[1].items[w].value, rep[0].items[w].value, 1e-9, 1e-12);
+    assert_true(rep[1].items[CHECK_PAIR_FIRST].checked);           /* phi jit/generic */
+    assert_false(rep[1].items[CHECK_PAIR_FIRST + 1].checked);      /* jac jit/generic: dense */
 }
 
 static void test_velocity_row_jacobian(void **state)
@@ -479,6 +561,8 @@ int main(void)
         cmocka_unit_test(test_jacobian_factor_two),
         cmocka_unit_test(test_jacobian_missing_term),
         cmocka_unit_test(test_velocity_row_jacobian),
+        cmocka_unit_test(test_sparse_jacobian_faults),
+        cmocka_unit_test(test_sparse_chain_agrees),
         cmocka_unit_test(test_gamma_velocity_terms_dropped),
         cmocka_unit_test(test_gamma_phi_tt_dropped),
         cmocka_unit_test(test_gamma_zero),

@@ -58,6 +58,11 @@ static const BadInput bad_inputs[] = {
     {"spatial\nbody b\nconstraint C: b.phi = 0\n", 3, 17, "body 'b' has no coordinate 'phi' (it has x, y, z, e0, e1, e2 and e3)"},
     {"spatial\npoint p\nconstraint C: p.e0 = 0\n", 3, 17, "point 'p' has no coordinate 'e0' (it has x, y and z)"},
     {"spatial\nbody b\nrolling R: b radius = 1\n", 3, 24, "'axis(ux, uy, uz)' after the attachments of rolling 'R'"},
+    /* axes that must not be parallel: as written, and once turned by the
+       initial orientation (b turned by pi/2 about x takes its y to z) */
+    {"spatial\nbody b\nuniversal U: ground b axis(0, 0, 1) axis(0, 0, 2)\n", 3, 37, "the two axes of universal 'U' are parallel in the initial orientations"},
+    {"spatial\nbody b orient = axis(1, 0, 0, pi/2)\nperpendicular P: ground b axis(0, 0, 1) axis(0, 1, 0)\n", 3, 41, "the two axes of perpendicular 'P' are parallel"},
+    {"spatial\nbody d z = 1\nrolling R: d radius = 1 axis(0, 0, 1)\n", 3, 25, "the disk of rolling 'R' lies flat"},
 };
 
 static void test_bad_inputs(void **state)
@@ -78,20 +83,34 @@ static void test_bad_inputs(void **state)
     }
 }
 
+/* text loads and has nr rows. */
+static void assert_loads(const char *text, int nr)
+{
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load_text(text, "ok.mech", &limits, &diag);
+    if (!mech)
+        fail_msg("rejected: %s", diag.message);
+    assert_int_equal(mech->model->nr, nr);
+    pipeline_free(mech);
+}
+
 /* What stays valid: t in options, and joints between different frames. */
 static void test_time_in_options_is_fine(void **state)
 {
     (void)state;
-    MechLimits limits = mech_default_limits();
-    Diag diag;
-    Mech *mech = pipeline_load_text("body b\ndistance d: ground b length = 1 + t\n"
-                                    "prismatic p: ground b axis(1,0) angle = 0.1*t\n"
-                                    "body w\nrolling r: w radius = 0.3 + 0.1*t\n",
-                                    "ok.mech", &limits, &diag);
-    if (!mech)
-        fail_msg("rejected: %s", diag.message);
-    assert_int_equal(mech->model->nr, 4);
-    pipeline_free(mech);
+    assert_loads("body b\ndistance d: ground b length = 1 + t\n"
+                 "prismatic p: ground b axis(1,0) angle = 0.1*t\n"
+                 "body w\nrolling r: w radius = 0.3 + 0.1*t\n", 4);
+}
+
+/* The same local axes are not parallel once B starts turned: accepted
+   (b.norm and U's four rows). */
+static void test_turned_universal_accepted(void **state)
+{
+    (void)state;
+    assert_loads("spatial\nbody b orient = axis(1, 0, 0, pi/2)\n"
+                 "universal U: ground b axis(0, 0, 1) axis(0, 0, 1)\n", 5);
 }
 
 /* The body table: bodies and points in declaration order with their first
@@ -272,6 +291,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_time_in_options_is_fine),
+        cmocka_unit_test(test_turned_universal_accepted),
         cmocka_unit_test(test_body_table),
         cmocka_unit_test(test_orientations),
         cmocka_unit_test(test_spatial_bodies),

@@ -219,6 +219,18 @@ static void test_trig_once_per_function(void **state)
     pipeline_free(mech);
 }
 
+/* The written file of mech with prefix ch, with libm's sin and cos or
+   (libm false) the file's own. */
+static void emit_ch(const Mech *mech, bool libm, EmitResult *res)
+{
+    EmitOptions opt = emit_default_options();
+    opt.prefix = "ch";
+    opt.libm_trig = libm;
+    Diag diag;
+    diag_init(&diag, "emit", NULL, 0);
+    assert_true(emit_mechanism(&mech->kin, &opt, res, &diag));
+}
+
 /* -c*u and c*u are one product: in the chain of one loop, the Jacobian
    needs +-0.5 sin and +-0.5 cos of the three angles; each temporary is
    multiplied by 0.5 once, and the other sign is a negation of the shared
@@ -228,13 +240,8 @@ static void test_signed_constants_share(void **state)
 {
     (void)state;
     Mech *mech = load_chain(1);
-    EmitOptions opt = emit_default_options();
-    opt.prefix = "ch";
-    opt.libm_trig = true;
     EmitResult res;
-    Diag diag;
-    diag_init(&diag, "emit", NULL, 0);
-    assert_true(emit_mechanism(&mech->kin, &opt, &res, &diag));
+    emit_ch(mech, true, &res);
     char *text = function_text(res.c_text, "ch", "jac_nz");
     int times[64] = {0}, products = 0;
     for (const char *p = text; (p = strstr(p, "0.5")) != NULL; p++) {
@@ -257,12 +264,148 @@ static void test_signed_constants_share(void **state)
     pipeline_free(mech);
 }
 
+/* A handmade function's outputs scheduled as one chunk and prepared. */
+static void schedule_one(Scheduler *s, const Dag *dag, const NodeId *values, int n,
+                         SchedFunction *fn)
+{
+    SchedOutput *outs = malloc((size_t)n * sizeof *outs);
+    for (int i = 0; i < n; i++)
+        outs[i] = (SchedOutput){"out", i, values[i]};
+    sched_init(s, dag, 1 << 20);
+    assert_true(sched_function(s, outs, n, fn));
+    assert_int_equal(fn->nchunks, 1);
+    sched_prepare_chunk(s, fn, 0);
+}
+
+static bool every_call_first(const void *ctx, NodeId id)
+{
+    (void)ctx;
+    (void)id;
+    return true;
+}
+
+/* Values across calls, counted by hand. First: a = q2 q3 stored with q4
+   and, after sin(q0), with q5: left in place the sin call lies inside a's
+   life (1); at the top, nothing is computed before the call but the call
+   itself (0). Second: sin(q0) and cos(q1), each stored at once: in place
+   neither lives across the other (0); at the top, sin(q0) lives across
+   cos(q1)'s call (1). */
+static void test_values_across_calls(void **state)
+{
+    (void)state;
+    for (int which = 0; which < 2; which++) {
+        Dag dag;
+        dag_init(&dag, 1000);
+        NodeId q[6];
+        for (int i = 0; i < 6; i++)
+            q[i] = dag_var(&dag, i);
+        NodeId a = dag_mul(&dag, q[2], q[3]);
+        NodeId first[3] = {dag_add(&dag, a, q[4]), dag_call(&dag, OP_SIN, q[0], DAG_NONE),
+                           dag_sub(&dag, a, q[5])};
+        NodeId second[2] = {dag_call(&dag, OP_SIN, q[0], DAG_NONE),
+                            dag_call(&dag, OP_COS, q[1], DAG_NONE)};
+        Scheduler s;
+        SchedFunction fn;
+        schedule_one(&s, &dag, which == 0 ? first : second, which == 0 ? 3 : 2, &fn);
+        int in_place = sched_values_across_calls(&s, &fn, 0, NULL, NULL);
+        int at_top = sched_values_across_calls(&s, &fn, 0, every_call_first, NULL);
+        assert_int_equal(in_place, which == 0 ? 1 : 0);
+        assert_int_equal(at_top, which == 0 ? 0 : 1);
+        sched_function_free(&fn);
+        sched_free(&s);
+        dag_free(&dag);
+    }
+}
+
+/* γ's (cos, sin) times one computed factor qd0² is a shared factor; phi's
+   0.5 cos, 0.5 sin (a constant) and a lone sin are not. */
+static void test_pair_shares_factor(void **state)
+{
+    (void)state;
+    for (int which = 0; which < 3; which++) {
+        Dag dag;
+        dag_init(&dag, 1000);
+        NodeId q0 = dag_var(&dag, 0), qd0 = dag_vard(&dag, 0);
+        NodeId sn = dag_call(&dag, OP_SIN, q0, DAG_NONE), cs = dag_call(&dag, OP_COS, q0, DAG_NONE);
+        NodeId factor = which == 1 ? dag_const(&dag, 0.5) : dag_mul(&dag, qd0, qd0);
+        NodeId values[2] = {dag_mul(&dag, cs, factor),
+                            which == 2 ? dag_add(&dag, sn, factor) : dag_mul(&dag, sn, factor)};
+        Scheduler s;
+        SchedFunction fn;
+        schedule_one(&s, &dag, values, 2, &fn);
+        assert_true(s.temp[sn] >= 0 && s.temp[cs] >= 0);
+        assert_int_equal(sched_pair_shares_factor(&s, &fn, 0, sn), which == 0);
+        assert_int_equal(sched_pair_shares_factor(&s, &fn, 0, cs), which == 0);
+        sched_function_free(&fn);
+        sched_free(&s);
+        dag_free(&dag);
+    }
+}
+
+/* The first part of name's function in c (a malloc'd copy). */
+static char *first_part(const char *c, const char *name)
+{
+    char head[64];
+    snprintf(head, sizeof head, "void ch_%s_part0(", name);
+    const char *p = strstr(c, head);
+    while (p && strstr(p, ")\n{\n") > strchr(p, ';'))     /* its declaration */
+        p = strstr(p + 1, head);
+    assert_non_null(p);
+    const char *end = strstr(p, "\n}\n");
+    return strndup(p, (size_t)(end - p));
+}
+
+/* The calls of call ("cos(q[") text makes before its first store to
+   array. */
+static int calls_before_store(const char *text, const char *call, const char *array)
+{
+    const char *store = strstr(text, array);
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, call)) != NULL && p < store; p++)
+        n++;
+    return n;
+}
+
+/* Where sin and cos are real calls, libm's (chain of 10 loops, 21
+   angles) or one noinline copy of the written file's pair (the default
+   file over 64 calls: a chain of 20 loops, known to need that many before
+   it is written, and of 14, found to once written and written again):
+   phi's calls stay next to
+   their first uses (in place, fewer values live across calls: one angle
+   before the first store), and γ's, whose cos and sin share the factor
+   qd², come first (copied out of the result slots rather than loaded
+   from them as one vector). */
+static void test_calls_placed(void **state)
+{
+    (void)state;
+    static const int loops[3] = {10, 20, 14};
+    for (int k = 0; k < 3; k++) {
+        bool libm = k == 0;
+        Mech *mech = load_chain(loops[k]);
+        EmitResult res;
+        emit_ch(mech, libm, &res);
+        const char *call = libm ? "cos(q[" : "ch_sincos";
+        if (!libm)
+            assert_non_null(strstr(res.c_text, "#define CH_TRIG static __attribute__((noinline))"));
+        char *phi = first_part(res.c_text, "phi"), *gamma = first_part(res.c_text, "gamma");
+        assert_int_equal(calls_before_store(phi, call, "phi["), 1);
+        assert_true(calls_before_store(gamma, call, "gamma[") >= (libm ? 10 : 5));
+        free(phi);
+        free(gamma);
+        emit_result_free(&res);
+        pipeline_free(mech);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_each_node_once),
         cmocka_unit_test(test_trig_once_per_function),
         cmocka_unit_test(test_signed_constants_share),
+        cmocka_unit_test(test_values_across_calls),
+        cmocka_unit_test(test_pair_shares_factor),
+        cmocka_unit_test(test_calls_placed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -39,7 +39,7 @@ static void fill_vals(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostJacNz small_pattern(double *v)
 {
-    return (MechrtHostJacNz){6, p_row, p_col, v, fill_vals, NULL};
+    return (MechrtHostJacNz){.nnz = 6, .row = p_row, .col = p_col, .ctx = v, .jac_nz = fill_vals};
 }
 
 static void test_klu_solve(void **state)
@@ -75,6 +75,127 @@ static void test_klu_solve(void **state)
     double c = mechrt_host_sparse_condest(s);
     assert_true(c >= 1 && c < 100);
     mechrt_host_sparse_free(s);
+}
+
+/* ---- the augmented matrix [W Phi^T; Phi 0] (sparse_kkt.c) ---------------- */
+
+/* M = [2 .5 0; .5 1 0; 0 0 0] (coordinate 2 without mass: no diagonal
+   entry in M's pattern), Phi = [1 0 1; 0 1 1]. */
+static const int m_row[] = {0, 0, 1, 1}, m_col[] = {0, 1, 0, 1};
+static const double m_val[] = {2, 0.5, 0.5, 1};
+static const int j_row[] = {0, 0, 1, 1}, j_col[] = {0, 2, 1, 2};
+static const double j_val[] = {1, 1, 1, 1};
+
+static void kkt_no_jac(void *ctx, const double *q, double t, double *vals)
+{
+    (void)ctx, (void)q, (void)t, (void)vals;
+}
+
+static MechrtHostKkt *small_kkt(void)
+{
+    MechrtHostJacNz j = {.nnz = 4, .row = j_row, .col = j_col, .ctx = NULL, .jac_nz = kkt_no_jac};
+    MechrtHostMassNz m = {4, m_row, m_col, NULL, NULL};
+    MechrtHostKkt *s = mechrt_host_kkt_new(3, 2, &j, &m);
+    assert_non_null(s);
+    memcpy(mechrt_host_kkt_jac(s), j_val, sizeof j_val);
+    memcpy(mechrt_host_kkt_mass(s), m_val, sizeof m_val);
+    return s;
+}
+
+static void test_kkt_identity(void **state)
+{
+    (void)state;
+    MechrtHostKkt *s = small_kkt();
+    /* every row: x = Phi^T (Phi Phi^T)^-1 b, y = -(Phi Phi^T)^-1 b; b = (1, 2) */
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, NULL, 2, 1e-12), MECHRT_OK);
+    double x[5] = {0, 0, 0, 1, 2};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x), MECHRT_OK);
+    const double want[5] = {0, 1, 1, 0, -1};
+    for (int i = 0; i < 5; i++)
+        assert_near(x[i], want[i], 0, 1e-14);
+    /* row 1 left out: an identity row, its unknown = its right side */
+    const unsigned char active[2] = {1, 0};
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, active, 2, 1e-12), MECHRT_OK);
+    double x2[5] = {0, 0, 0, 1, 5};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x2), MECHRT_OK);
+    const double want2[5] = {0.5, 0, 0.5, -0.5, 5};
+    for (int i = 0; i < 5; i++)
+        assert_near(x2[i], want2[i], 0, 1e-14);
+    /* rows = 1 leaves row 1 out the same way */
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_IDENTITY, NULL, 1, 1e-12), MECHRT_OK);
+    double x3[5] = {0, 0, 0, 1, 5};
+    assert_int_equal(mechrt_host_kkt_solve(s, MECHRT_KKT_IDENTITY, x3), MECHRT_OK);
+    for (int i = 0; i < 5; i++)
+        assert_near(x3[i], want2[i], 0, 1e-14);
+    assert_true(mechrt_host_kkt_spread(s, MECHRT_KKT_IDENTITY) >= 1);
+    /* the rank screen: every row, fresh pivots; a zero row is a rank drop */
+    double spread;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_OK);
+    assert_true(spread >= 1 && spread < 100);
+    mechrt_host_kkt_jac(s)[2] = mechrt_host_kkt_jac(s)[3] = 0;
+    assert_int_equal(mechrt_host_kkt_screen(s, 2, 1e-12, &spread), MECHRT_ESING);
+    assert_int_equal(mechrt_host_kkt_screen(s, 1, 1e-12, &spread), MECHRT_OK);
+    mechrt_host_kkt_free(s);
+}
+
+static void test_kkt_mass(void **state)
+{
+    (void)state;
+    MechrtHostKkt *s = small_kkt();
+    /* M is singular but positive definite on null(Phi) = span (1, 1, -1):
+       the augmented matrix is regular; the solution checked by its residual */
+    const double a[5][5] = {{2, 0.5, 0, 1, 0}, {0.5, 1, 0, 0, 1}, {0, 0, 0, 1, 1},
+                            {1, 0, 1, 0, 0}, {0, 1, 1, 0, 0}};
+    const double b[5] = {1, 2, 3, 4, 5};
+    double x[5], work[10];
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_MASS, NULL, 2, 1e-12), MECHRT_OK);
+    memcpy(x, b, sizeof b);
+    assert_int_equal(mechrt_host_kkt_solve_refined(s, MECHRT_KKT_MASS, x, work), MECHRT_OK);
+    for (int i = 0; i < 5; i++) {
+        double r = -b[i];
+        for (int k = 0; k < 5; k++)
+            r += a[i][k] * x[k];
+        assert_near(r, 0, 0, 1e-13);
+    }
+    /* without Phi's rows M alone is singular (coordinate 2): refused */
+    const unsigned char none[2] = {0, 0};
+    assert_int_equal(mechrt_host_kkt_factor(s, MECHRT_KKT_MASS, none, 2, 1e-12), MECHRT_ESING);
+    long fresh, re;
+    mechrt_host_kkt_counts(s, &fresh, &re);
+    assert_true(fresh >= 2);
+    mechrt_host_kkt_free(s);
+}
+
+/* The projection's minimum-norm step by SuiteSparseQR: Phi_q = [1 0 1; 0 1
+   1] and Phi = (-1, -2) give dq = pinv(Phi_q) (1, 2) = (0, 1, 1); a third
+   row, the sum of the two with a consistent Phi, is dropped as redundant
+   and leaves dq as it was (the dense path's truncated SVD does the same). */
+static const int mn_row[] = {0, 0, 1, 1, 2, 2, 2};
+static const int mn_col[] = {0, 2, 1, 2, 0, 1, 2};
+
+static void fill_mn(void *ctx, const double *q, double t, double *vals)
+{
+    (void)ctx, (void)q, (void)t;
+    static const double v[7] = {1, 1, 1, 1, 1, 1, 2};
+    memcpy(vals, v, sizeof v);
+}
+
+static void test_minnorm_step(void **state)
+{
+    (void)state;
+    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
+    double q[3] = {0, 0, 0}, dq[3];
+    for (int nh = 2; nh <= 3; nh++) {
+        MechrtHostMinNorm *m = mechrt_host_minnorm_new(nh, 3, &j);
+        assert_non_null(m);
+        double phi[3] = {-1, -2, -3};
+        assert_int_equal(mechrt_host_minnorm_step(m, q, 0, phi, 1e-12, dq), MECHRT_OK);
+        assert_near(dq[0], 0, 0, 1e-14);
+        assert_near(dq[1], 1, 1e-14, 0);
+        assert_near(dq[2], 1, 1e-14, 0);
+        mechrt_host_minnorm_free(m);
+    }
+    assert_null(mechrt_host_minnorm_new(4, 3, &j));     /* more rows than coordinates */
 }
 
 static void test_klu_singular_named(void **state)
@@ -125,7 +246,7 @@ static void test_klu_repivots(void **state)
 {
     (void)state;
     double v[4] = {1, 1, 1e-3, 2};
-    MechrtHostJacNz j = {4, full_row, full_col, v, fill_full, NULL};
+    MechrtHostJacNz j = {.nnz = 4, .row = full_row, .col = full_col, .ctx = v, .jac_nz = fill_full};
     MechrtHostSparse *s = mechrt_host_sparse_new(2, &j);
     assert_non_null(s);
     mechrt_host_sparse_eval(s, NULL, 0);
@@ -151,7 +272,7 @@ static void test_klu_bad_pattern(void **state)
     (void)state;
     double v[6] = {1, 1, 1, 1, 1, 1};
     static const int dup_col[] = {0, 0, 0, 1, 1, 2};    /* (0, 0) twice */
-    MechrtHostJacNz j = {6, p_row, dup_col, v, fill_vals, NULL};
+    MechrtHostJacNz j = {.nnz = 6, .row = p_row, .col = dup_col, .ctx = v, .jac_nz = fill_vals};
     assert_null(mechrt_host_sparse_new(3, &j));
     static const int far_col[] = {0, 3, 0, 1, 1, 2};    /* column 3 of 3 */
     j.col = far_col;
@@ -323,19 +444,26 @@ static void test_toggle_sparse(void **state)
 static void test_refusals(void **state)
 {
     (void)state;
-    Mech *mech = load_file("examples/knife_cart.mech");
-    Collected c;
-    run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
-    assert_non_null(strstr(c.res.message, "velocity-level rows"));
-    mechrt_trace_free(&c.trace);
-    run_linear(mech, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
-    assert_false(c.res.sparse);
-    mechrt_trace_free(&c.trace);
-    pipeline_free(mech);
+    /* velocity-level rows run sparse (KLU, SuiteSparseQR), as dense */
+    static const char *const vel[] = {"examples/knife_cart.mech", "examples/rolling_wheel.mech",
+                                      "examples/skate_velocity.mech"};
+    Collected c, d;
+    for (size_t f = 0; f < sizeof vel / sizeof *vel; f++) {
+        Mech *vm = load_file(vel[f]);
+        run_linear(vm, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
+        assert_int_equal(c.status, RUN_OK);
+        assert_true(c.res.sparse);
+        assert_true(c.res.refactorisations + c.res.fresh_factorisations > 0);
+        run_linear(vm, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &d);
+        assert_int_equal(d.status, RUN_OK);
+        assert_false(d.res.sparse);     /* small: dense */
+        expect_same(&d, &c, vel[f]);
+        mechrt_trace_free(&c.trace);
+        mechrt_trace_free(&d.trace);
+        pipeline_free(vm);
+    }
 
-    mech = load_file("examples/slider_crank.mech");
+    Mech *mech = load_file("examples/slider_crank.mech");
     run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_GENERIC, &c);
     assert_int_equal(c.status, RUN_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "generic engine"));
@@ -479,6 +607,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_klu_solve),
         cmocka_unit_test(test_klu_singular_named),
+        cmocka_unit_test(test_minnorm_step),
         cmocka_unit_test(test_klu_repivots),
         cmocka_unit_test(test_klu_bad_pattern),
         cmocka_unit_test(test_examples_agree),
@@ -488,6 +617,8 @@ int main(void)
         cmocka_unit_test(test_all_nz_kernel),
         cmocka_unit_test(test_all_nz_run),
         cmocka_unit_test(test_dense_limit),
+        cmocka_unit_test(test_kkt_identity),
+        cmocka_unit_test(test_kkt_mass),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

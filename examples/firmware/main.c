@@ -3,11 +3,15 @@
  * Turns the slider-crank of examples/slider_crank.mech through one crank
  * revolution in STEPS equal time steps (assembly at t = 0, then predictor,
  * Newton corrector, velocity and acceleration per step, all in
- * mechrt_step_lup, whose LU works on the Jacobian's nonzeros) and prints, every PRINT_EVERY steps, the step number, t and
+ * mechrt_step_lup, whose LU is the kernels' own: sc_lu_factor and
+ * sc_lu_solve of `mechc gen --lu`, unrolled for the Jacobian's pattern,
+ * with the runtime's pattern LU where their pivot checks decline; built
+ * with -DPATTERN_LU_ONLY, the pattern LU alone) and prints, every
+ * PRINT_EVERY steps, the step number, t and
  * the slider's position, velocity and acceleration along the guide.
  *
  * What makes it firmware-like: the kernels (sc.c, sc.h) come from
- * `mechc gen examples/slider_crank.mech --prefix sc [--real float]` at build
+ * `mechc gen examples/slider_crank.mech --prefix sc --lu [--real float]` at build
  * time, the runtime core (the .c files of runtime/) is compiled
  * next to them, and every array lives in static storage sized at compile
  * time: no heap, no recursion, no library call in the numerical code. The
@@ -31,6 +35,8 @@ typedef char sc_real_matches_mechrt_real[sizeof(sc_real) == sizeof(mechrt_real) 
    and `static const MechrtJacNz sc_jac_nz_kernel` over sc_jac_nz. */
 MECHRT_DEFINE_KERNELS(sc, SC);
 MECHRT_DEFINE_JAC_NZ(sc, SC);
+/* `static const MechrtLuGen sc_lu` over sc_lu_factor and sc_lu_solve. */
+MECHRT_DEFINE_LU(sc, SC);
 
 enum {
     STEPS = 200,      /* time steps over one revolution, t = 0 .. PERIOD */
@@ -99,6 +105,12 @@ int main(void)
     st = mechrt_lup_init(&lup, SC_NQ, SC_NNZ, sc_jac_row, sc_jac_col, lup_work,
                          sizeof lup_work / sizeof lup_work[0], lup_iwork,
                          sizeof lup_iwork / sizeof lup_iwork[0]);
+#ifndef PATTERN_LU_ONLY
+    if (st == MECHRT_OK)
+        st = mechrt_lup_use(&lup, &sc_lu);
+#else
+    (void)sc_lu;
+#endif
     if (st != MECHRT_OK) {
         printf("error: %s\n", mechrt_strerror(st));
         return 1;

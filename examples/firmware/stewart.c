@@ -19,8 +19,12 @@
  * the two parts of every step after the first (40 instructions a tick
  * under QEMU -icount shift=0, as in main.c) and the program prints the
  * means: instructions per forward-kinematics solve, and per velocity and
- * acceleration analysis. Kernels: `mechc gen examples/stewart.mech --prefix
- * st [--real float]`, the same real type as the runtime.
+ * acceleration analysis. Built with -DSTEP_TRACE (the Makefile's `cycles`
+ * target), it calls an empty marker function at the start of each part of
+ * every step after the first; cycles.sh finds their addresses in QEMU's
+ * trace of executed instructions and estimates the cycles of each part.
+ * Kernels: `mechc gen examples/stewart.mech --prefix st [--real float]`,
+ * the same real type as the runtime.
  */
 #include <math.h>
 #include <stdio.h>
@@ -58,6 +62,21 @@ enum {
 #define SYST_CVR (*(volatile unsigned long *)0xE000E018UL)
 #define SYST_MAX 0xFFFFFFUL
 #define TICKS_SINCE(c0) (((c0) - SYST_CVR) & SYST_MAX)
+#endif
+
+#ifdef STEP_TRACE
+/* Markers: cycles.awk opens a window at the entry of each (by name). */
+void mark_fk_plain(void);
+void mark_fk_pred(void);
+void mark_va(void);
+void mark_off(void);
+__attribute__((noinline)) void mark_fk_plain(void) { __asm__ volatile(""); }
+__attribute__((noinline)) void mark_fk_pred(void) { __asm__ volatile(""); }
+__attribute__((noinline)) void mark_va(void) { __asm__ volatile(""); }
+__attribute__((noinline)) void mark_off(void) { __asm__ volatile(""); }
+#define MARK(step, f) do { if ((step) > 0) f(); } while (0)
+#else
+#define MARK(step, f) ((void)0)
 #endif
 
 static mechrt_real work[MECHRT_WORKSPACE_LEN(ST_NQ, ST_NR)];
@@ -157,7 +176,9 @@ int main(void)
 #ifdef STEP_COUNT
         unsigned long c0 = SYST_CVR;
 #endif
+        MARK(i, mark_fk_plain);
         st = solve(plain, tn, &it_plain);
+        MARK(i, mark_fk_pred);
 #ifdef STEP_COUNT
         unsigned long c1 = SYST_CVR;
 #endif
@@ -170,6 +191,7 @@ int main(void)
             for (k = 0; k < ST_NQ; k++)
                 q[k] = plain[k];
         }
+        MARK(i, mark_va);
 #ifdef STEP_COUNT
         unsigned long c2 = SYST_CVR;
 #endif
@@ -180,6 +202,7 @@ int main(void)
         }
         st = mechrt_velocity_acceleration(&st_kernels, NULL, q, tn, qd, qdd, work,
                                           sizeof work / sizeof work[0], NULL);
+        MARK(i, mark_off);
 #ifdef STEP_COUNT
         if (i > 0) {
             plain_ticks += (c0 - c1) & SYST_MAX;

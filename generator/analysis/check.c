@@ -39,6 +39,20 @@
  * When no run of steps agrees, the differences cannot tell: the comparison
  * is counted as unsettled, neither passed nor failed, and reported.
  *
+ * Large mechanisms (CheckOptions.linear, auto: above RUN_DENSE_MAX_NQ
+ * coordinates) are checked on the Jacobian's nonzeros: the engines' jac_nz
+ * (the generic interpreter's Jacobian is dense, so its jac is not
+ * compared there), the assembly by KLU's Newton step, and the Jacobian's
+ * finite differences taken for groups of columns that share no row
+ * (Curtis, Powell and Reid, J. Inst. Maths Applics 13, 1974): one
+ * difference of Phi (or Psi) with every column of a group moved at once
+ * gives, in each row, the entry of the one column of the group the
+ * pattern has there, and zero where it has none, so an entry missing from
+ * the pattern shows as a nonzero difference where 0 was expected. The
+ * groups (greedy colouring) number a handful for a chain: the work per
+ * sample grows as nq, not nq^2. The differences are central with one
+ * Richardson step (error O(h^4)), on the same ladder of steps as gamma's.
+ *
  * Where the worst error passes its tolerance, the two numbers are examined
  * for the classic textbook slips: a ratio of -1 or 2, a missing term, and for
  * gamma a decomposition of the finite difference into its -(Phi_q qd)_q qd,
@@ -53,6 +67,7 @@
 #include "../base/rng.h"
 #include "../engine/aot.h"
 #include "../eval/generic.h"
+#include "../../runtime/host/mechrt_host.h"
 
 #include <gsl/gsl_deriv.h>
 #include <gsl/gsl_eigen.h>
@@ -129,6 +144,15 @@ typedef struct Checker {
     double *mw, *mw2, *qv, *qv_fd;              /* M elsewhere; Q's velocity terms */
     gsl_eigen_symm_workspace *eigen;
     double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
+    /* the sparse comparisons (CheckOptions.linear) */
+    bool sparse;
+    MechrtHostJacNz jnz[ENGINE_KIND_COUNT];     /* jit's and aot's jac_nz */
+    bool has_nz[ENGINE_KIND_COUNT];
+    int nnz;
+    int ngroups;
+    int *group_start, *group_cols;              /* the column groups, CSR */
+    int *col_start, *col_ent;                   /* each column's entries */
+    int *ent;                                   /* nr: the group's entry in each row, or -1 */
     Arena buffers;                              /* owns every array above */
 } Checker;
 
@@ -139,7 +163,10 @@ static void under_test(Checker *c)
     const Engine *e = &c->eng[ENGINE_JIT];
     double **o = c->out[ENGINE_JIT];
     engine_phi(e, c->q, c->t, o[QTY_PHI]);
-    engine_jac(e, c->q, c->t, o[QTY_JAC]);
+    if (c->sparse)
+        c->jnz[ENGINE_JIT].jac_nz(c->jnz[ENGINE_JIT].ctx, c->q, c->t, o[QTY_JAC]);
+    else
+        engine_jac(e, c->q, c->t, o[QTY_JAC]);
     engine_nu(e, c->q, c->t, o[QTY_NU]);
     engine_gamma(e, c->q, c->qd, c->t, o[QTY_GAMMA]);
     if (c->dyn) {
@@ -157,7 +184,10 @@ static void under_test(Checker *c)
     case CHECK_FAULT_MASS_SCALE:
         break;
     case CHECK_FAULT_JAC_SCALE:
-        if (f->col >= 0 && f->col < c->nq)
+        for (int k = 0; c->sparse && k < c->nnz; k++)
+            if (c->jnz[ENGINE_JIT].row[k] == f->row && c->jnz[ENGINE_JIT].col[k] == f->col)
+                o[QTY_JAC][k] *= f->factor;
+        if (!c->sparse && f->col >= 0 && f->col < c->nq)
             o[QTY_JAC][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
         break;
     case CHECK_FAULT_NU_SCALE:
@@ -221,6 +251,8 @@ typedef enum FdKind {
     FD_PHI_PATH,    /* Phi(q + qd x [path_q], t + x [path_t]) */
     FD_PSI_QD,      /* Psi(q, qd with qd_col = x, t) */
     FD_PSI_PATH,    /* Psi(q + qd x [path_q], qd, t + x [path_t]) */
+    FD_PHI_GROUP,   /* Phi(q + x on the group's columns, t) */
+    FD_PSI_GROUP,   /* Psi(q, qd + x on the group's columns, t) */
 } FdKind;
 
 typedef struct VecFn {
@@ -229,6 +261,8 @@ typedef struct VecFn {
     int col;
     bool path_q, path_t;
     int comp;               /* the component gsl asks about */
+    const int *gcols;       /* FD_*_GROUP: the group's columns */
+    int gn;
     double x[FD_CACHE];
     double *val[FD_CACHE];
     int count, next;
@@ -258,6 +292,18 @@ static void vecfn_eval(VecFn *f, double x, double *out)
         for (int i = 0; i < nq; i++)
             c->qw[i] = c->q[i] + (f->path_q ? c->qd[i] * x : 0.0);
         generic_psi(c->eng[ENGINE_GENERIC].generic, c->qw, c->qd, c->t + (f->path_t ? x : 0.0), out);
+        return;
+    case FD_PHI_GROUP:
+        memcpy(c->qw, c->q, (size_t)nq * sizeof *c->qw);
+        for (int k = 0; k < f->gn; k++)
+            c->qw[f->gcols[k]] += x;
+        engine_phi(&c->eng[ENGINE_JIT], c->qw, c->t, out);
+        return;
+    case FD_PSI_GROUP:
+        memcpy(c->qdw, c->qd, (size_t)nq * sizeof *c->qdw);
+        for (int k = 0; k < f->gn; k++)
+            c->qdw[f->gcols[k]] += x;
+        generic_psi(c->eng[ENGINE_GENERIC].generic, c->q, c->qdw, c->t, out);
         return;
     }
 }
@@ -312,6 +358,22 @@ static void fd_second(VecFn *f, int n, double h, double *out)
     }
 }
 
+/* df/dx at 0 for every component into out: central differences
+   D(h) = (f(h) - f(-h))/2h at h and h/2, then Richardson (4 D(h/2) -
+   D(h))/3, error O(h^4) (the sparse Jacobian's column groups). */
+static void fd_first_vec(VecFn *f, int n, double h, double *out)
+{
+    Checker *c = f->c;
+    const double xs[4] = {-h, -0.5 * h, 0.5 * h, h};
+    for (int k = 0; k < 4; k++)
+        vecfn_eval(f, xs[k], c->d2[k]);
+    for (int i = 0; i < n; i++) {
+        double dh = (c->d2[3][i] - c->d2[0][i]) / (2.0 * h);
+        double dh2 = (c->d2[2][i] - c->d2[1][i]) / h;
+        out[i] = (4.0 * dh2 - dh) / 3.0;
+    }
+}
+
 static double second_step(const Checker *c);
 
 /* One finite difference a value is compared with, as a function of the
@@ -324,6 +386,7 @@ typedef struct FdProbe {
     int comp;
     double sign;
     bool second;
+    bool vector;        /* fd_first_vec's, kept per ladder step like the second's */
     double x0, scale;
     int n;
     Checker *c;
@@ -337,11 +400,14 @@ static double ladder_step(double h, int i)
 static double probe_at(FdProbe *p, int i, double h)
 {
     double step = ladder_step(h, i);
-    if (!p->second)
+    if (!p->second && !p->vector)
         return p->sign * fd_first(p->f, p->comp, p->x0, step);
     Checker *c = p->c;
     if (!c->ladder_have[i]) {
-        fd_second(p->f, p->n, step, c->ladder[i]);
+        if (p->vector)
+            fd_first_vec(p->f, p->n, step, c->ladder[i]);
+        else
+            fd_second(p->f, p->n, step, c->ladder[i]);
         c->ladder_have[i] = true;
     }
     return p->sign * c->ladder[i][p->comp];
@@ -412,13 +478,61 @@ static void compare_first(Checker *c, int what, int row, int col, double value, 
     compare_fd(c, what, row, col, value, sign * fd_first(f, comp, x0, h), &p, h);
 }
 
+/* The rows of one column group against one vector difference (rows first
+   .. first + n - 1, component i of the difference for row first + i):
+   each row's entry of the group, or 0 where the pattern has none. */
+static void compare_group(Checker *c, VecFn *f, int first, int n)
+{
+    double h = c->opt->fd_step;
+    memset(c->ladder_have, 0, sizeof c->ladder_have);
+    fd_first_vec(f, n, h, c->ladder[FD_COARSE]);
+    c->ladder_have[FD_COARSE] = true;
+    FdProbe p = {.f = f, .sign = 1.0, .vector = true, .scale = 1.0, .n = n, .c = c};
+    const double *vals = c->out[ENGINE_JIT][QTY_JAC];
+    for (int i = 0; i < n; i++) {
+        int e = c->ent[first + i];
+        p.comp = i;
+        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT].col[e] : -1,
+                   e >= 0 ? vals[e] : 0.0, c->ladder[FD_COARSE][i], &p, h);
+    }
+}
+
+/* The Jacobian's nonzeros against differences of Phi (position rows) and
+   Psi (velocity rows) along each column group. */
+static void check_fd_groups(Checker *c, double *scratch)
+{
+    const int *row = c->jnz[ENGINE_JIT].row;
+    VecFn f;
+    for (int g = 0; g < c->ngroups; g++) {
+        const int *cols = c->group_cols + c->group_start[g];
+        int gn = c->group_start[g + 1] - c->group_start[g];
+        for (int k = 0; k < gn; k++)
+            for (int a = c->col_start[cols[k]]; a < c->col_start[cols[k] + 1]; a++)
+                c->ent[row[c->col_ent[a]]] = c->col_ent[a];
+        for (int v = 0; v < 2; v++) {
+            int first = v ? c->nh : 0, n = v ? c->nv : c->nh;
+            if (n == 0)
+                continue;
+            vecfn_init(&f, c, v ? FD_PSI_GROUP : FD_PHI_GROUP, -1, false, false, scratch);
+            f.gcols = cols;
+            f.gn = gn;
+            compare_group(c, &f, first, n);
+        }
+        for (int k = 0; k < gn; k++)
+            for (int a = c->col_start[cols[k]]; a < c->col_start[cols[k] + 1]; a++)
+                c->ent[row[c->col_ent[a]]] = -1;
+    }
+}
+
 static void check_fd(Checker *c, double *scratch, double *vec)
 {
     double **u = c->out[ENGINE_JIT];
     int nq = c->nq, nh = c->nh, nv = c->nv;
     VecFn f;
     /* jac */
-    for (int j = 0; j < nq; j++) {
+    if (c->sparse)
+        check_fd_groups(c, scratch);
+    for (int j = 0; j < nq && !c->sparse; j++) {
         if (nh > 0) {
             vecfn_init(&f, c, FD_PHI_Q, j, false, false, scratch);
             for (int i = 0; i < nh; i++)
@@ -469,7 +583,10 @@ static void eval_engine(Checker *c, EngineKind k)
 {
     double **o = c->out[k];
     engine_phi(&c->eng[k], c->q, c->t, o[QTY_PHI]);
-    engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
+    if (!c->sparse)
+        engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
+    else if (c->has_nz[k])
+        c->jnz[k].jac_nz(c->jnz[k].ctx, c->q, c->t, o[QTY_JAC]);
     engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
     engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
     if (c->dyn) {
@@ -485,9 +602,13 @@ static void compare_pair(Checker *c, int pair)
     int nq = c->nq;
     for (int qty = 0; qty < QTY_COUNT; qty++) {
         int what = CHECK_PAIR_FIRST + pair * QTY_COUNT + qty;
-        int n = qty == QTY_PHI ? c->nh : qty == QTY_JAC ? c->nr * nq : c->nr;
+        bool nz = c->sparse && qty == QTY_JAC;
+        if (nz && !(c->has_nz[a] && c->has_nz[b]))
+            continue;   /* the generic interpreter's Jacobian is dense */
+        int n = qty == QTY_PHI ? c->nh : nz ? c->nnz : qty == QTY_JAC ? c->nr * nq : c->nr;
         for (int i = 0; i < n; i++) {
-            int row = qty == QTY_JAC ? i / nq : i, col = qty == QTY_JAC ? i % nq : -1;
+            int row = nz ? c->jnz[ENGINE_JIT].row[i] : qty == QTY_JAC ? i / nq : i;
+            int col = nz ? c->jnz[ENGINE_JIT].col[i] : qty == QTY_JAC ? i % nq : -1;
             record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i], 0.0);
         }
         if (n == 0)
@@ -735,11 +856,34 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
    holonomic rows are square (minimum-norm Newton with restarts from rough
    ones), else the initial values. */
 
+/* The sparse path's assembly: the construction, then Newton with KLU (a
+   step of length 0 of run's sparse path); no rough-guess fallback (it is
+   dense). */
+static bool assemble_klu(Checker *c, const MechrtKernels *k, double *q)
+{
+    size_t nq = (size_t)c->nq;
+    MechrtHostSparse *s = mechrt_host_sparse_new(c->nq, &c->jnz[ENGINE_JIT]);
+    double *work = xcalloc(MECHRT_HOST_SPARSE_WORK_LEN(nq) + 2 * nq, sizeof *work);
+    double *qd = work + MECHRT_HOST_SPARSE_WORK_LEN(nq), *qdd = qd + nq;
+    construct_with_kernels(c->m, k, 0.0, q);
+    bool ok = s && mechrt_host_sparse_step(s, k, NULL, q, qd, qdd, 0.0, 0.0, work,
+                                           MECHRT_HOST_SPARSE_WORK_LEN(nq), NULL) == MECHRT_OK;
+    mechrt_host_sparse_free(s);
+    free(work);
+    if (!ok)
+        memcpy(q, c->m->q0, nq * sizeof *q);
+    return ok;
+}
+
 static bool assemble(Checker *c, double *q)
 {
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
     if (c->nh != c->nq)
         return false;
+    if (c->sparse) {
+        MechrtKernels k = c->eng[ENGINE_JIT].k;
+        return assemble_klu(c, &k, q);
+    }
     /* Newton on the engine under test's phi and jac, not its fused all */
     MechrtKernels k = c->eng[ENGINE_JIT].k;
     k.all = NULL;
@@ -825,7 +969,7 @@ static void take_buffers(Checker *c)
     arena_init(&c->buffers);
     for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
         c->out[k][QTY_PHI] = take(c, nvec);
-        c->out[k][QTY_JAC] = take(c, nr * nq);
+        c->out[k][QTY_JAC] = take(c, c->sparse ? (size_t)c->nnz + 1 : nr * nq);
         c->out[k][QTY_NU] = take(c, nr);
         c->out[k][QTY_GAMMA] = take(c, nr);
     }
@@ -856,6 +1000,91 @@ static void take_buffers(Checker *c)
         c->qv_fd = take(c, nq);
         c->eigen = gsl_eigen_symm_alloc(nq);
     }
+}
+
+/* Counting sort of the entries by key (n keys): start (n + 1) and the
+   entries in key order. */
+static void entries_by(Checker *c, const int *key, int n, int **start, int **ent)
+{
+    *start = arena_alloc_array(&c->buffers, (size_t)n + 1, sizeof **start);
+    *ent = arena_alloc_array(&c->buffers, (size_t)c->nnz + 1, sizeof **ent);
+    int *next = xcalloc((size_t)n + 1, sizeof *next);
+    for (int e = 0; e < c->nnz; e++)
+        (*start)[key[e] + 1]++;
+    for (int i = 0; i < n; i++)
+        next[i] = (*start)[i + 1] += (*start)[i];
+    for (int i = 0; i < n; i++)
+        next[i] = (*start)[i];
+    for (int e = 0; e < c->nnz; e++)
+        (*ent)[next[key[e]]++] = e;
+    free(next);
+}
+
+/* The column groups: greedy colouring in column order, a column taking the
+   first group none of whose columns shares a row with it. */
+static void group_columns(Checker *c)
+{
+    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT];
+    int *row_start, *row_ent;
+    entries_by(c, j->row, c->nr, &row_start, &row_ent);
+    entries_by(c, j->col, c->nq, &c->col_start, &c->col_ent);
+    int *color = xmalloc(((size_t)c->nq + 1) * sizeof *color);
+    int *mark = xmalloc(((size_t)c->nq + 1) * sizeof *mark);
+    for (int k = 0; k < c->nq; k++)
+        color[k] = mark[k] = -1;
+    c->ngroups = 0;
+    for (int col = 0; col < c->nq; col++) {
+        for (int a = c->col_start[col]; a < c->col_start[col + 1]; a++) {
+            int r = j->row[c->col_ent[a]];
+            for (int b = row_start[r]; b < row_start[r + 1]; b++) {
+                int other = j->col[row_ent[b]];
+                if (color[other] >= 0)
+                    mark[color[other]] = col;
+            }
+        }
+        int g = 0;
+        while (g < c->ngroups && mark[g] == col)
+            g++;
+        color[col] = g;
+        c->ngroups += g == c->ngroups;
+    }
+    c->group_start = arena_alloc_array(&c->buffers, (size_t)c->ngroups + 1, sizeof *c->group_start);
+    c->group_cols = arena_alloc_array(&c->buffers, (size_t)c->nq + 1, sizeof *c->group_cols);
+    for (int col = 0; col < c->nq; col++)
+        c->group_start[color[col] + 1]++;
+    for (int g = 0; g < c->ngroups; g++) {
+        c->group_start[g + 1] += c->group_start[g];
+        mark[g] = c->group_start[g];
+    }
+    for (int col = 0; col < c->nq; col++)
+        c->group_cols[mark[color[col]]++] = col;
+    c->ent = arena_alloc_array(&c->buffers, (size_t)c->nr + 1, sizeof *c->ent);
+    for (int r = 0; r < c->nr; r++)
+        c->ent[r] = -1;
+    free(color), free(mark);
+}
+
+/* Sparse or dense (CheckOptions.linear) and, sparse, the engines' jac_nz:
+   jit's always, aot's when it has the same pattern. */
+static void choose_linear(Checker *c)
+{
+    RunLinear lin = c->opt->linear;
+    c->sparse = (lin == RUN_LINEAR_SPARSE || (lin == RUN_LINEAR_AUTO && c->nq > RUN_DENSE_MAX_NQ))
+                && run_jac_nz_of(&c->eng[ENGINE_JIT], &c->jnz[ENGINE_JIT]);
+    if (!c->sparse)
+        return;
+    c->has_nz[ENGINE_JIT] = true;
+    c->nnz = c->jnz[ENGINE_JIT].nnz;
+    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT], *a = &c->jnz[ENGINE_AOT];
+    c->has_nz[ENGINE_AOT] = c->open[ENGINE_AOT] && run_jac_nz_of(&c->eng[ENGINE_AOT], &c->jnz[ENGINE_AOT])
+                            && a->nnz == j->nnz
+                            && memcmp(a->row, j->row, (size_t)j->nnz * sizeof *j->row) == 0
+                            && memcmp(a->col, j->col, (size_t)j->nnz * sizeof *j->col) == 0;
+    c->rep->sparse = true;
+    size_t len = strlen(c->rep->note);
+    snprintf(c->rep->note + len, sizeof c->rep->note - len, "%ssparse: the Jacobian's %d nonzeros "
+             "(finite differences by %s), the generic engine's jac not compared (dense)",
+             len ? "; " : "", c->nnz, "column groups");
 }
 
 /* Sample s: the assembled state itself at s = 0, then random states
@@ -942,7 +1171,10 @@ bool check_mechanism(const Mech *mech, const CheckOptions *opt, CheckReport *rep
     init_items(rep, opt);
     bool ok = open_engines(&c, mech, diag);
     if (ok) {
+        choose_linear(&c);
         take_buffers(&c);
+        if (c.sparse)
+            group_columns(&c);
         sample_loop(&c);
         diagnose(&c);
         if (c.eigen)

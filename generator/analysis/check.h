@@ -3,6 +3,7 @@
 #define MECHC_CHECK_H
 
 #include "../engine/engine.h"
+#include "run.h"
 
 /* A deliberate mistake planted in the engine under test (the JIT kernels),
    so tests can prove that check catches what it is meant to catch. */
@@ -40,6 +41,11 @@ typedef struct CheckOptions {
     double fd_step2;        /* step of the second difference for gamma, times
                                max(1, |q|)^(1/6) (default 2e-3) */
     bool use_aot;           /* compare the aot engine too when a compiler exists (default true) */
+    /* dense (nr x nq Jacobians), or sparse: the Jacobian's nonzeros
+       (jac_nz), assembly by KLU, the Jacobian's finite differences by
+       groups of columns that share no row; auto: sparse above
+       RUN_DENSE_MAX_NQ coordinates (default auto) */
+    RunLinear linear;
     CheckFault fault;       /* tests only (default none) */
 } CheckOptions;
 
@@ -87,6 +93,7 @@ typedef struct CheckReport {
     bool assembled;         /* the base state came from Newton (else initial values) */
     bool engine_used[ENGINE_KIND_COUNT];
     char note[300];         /* e.g. why aot was not compared */
+    bool sparse;            /* the sparse comparisons were made (CheckOptions.linear) */
     CheckItem items[CHECK_WHAT_COUNT];
 } CheckReport;
 

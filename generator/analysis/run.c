@@ -35,7 +35,9 @@
  * stepping, its checks and substeps are shared. The sparse path never forms
  * an nr x nq matrix: its diagnostics name the failing pivot's row and
  * coordinate instead of an SVD's, and the nearly singular test at t0 is
- * KLU's condition estimate. Velocity-level rows stay dense for now.
+ * KLU's condition estimate. With velocity-level rows the sparse path's
+ * host (mechrt_host_new_sparse) solves the velocities by KLU and projects
+ * by SuiteSparseQR's minimum-norm steps.
  *
  * Failures stop the run and say when, why and where: the time as
  * `t = VALUE`, the runtime's cause, the row with the largest residual or
@@ -129,9 +131,12 @@ typedef struct Run {
     double *q, *qd, *qdd;    /* one block of 3 nq: qd == q + nq, qdd == q + 2 nq */
     double *work;
     size_t lwork;
-    MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense */
+    MechrtHostSparse *sp;    /* the sparse path's factorisation; NULL: dense (with
+                                velocity-level rows: the sparse host's) */
+    bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
     MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
+    MechrtLuGen lup_gen;     /* the kernels' unrolled LU, when they have one */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
@@ -1057,8 +1062,7 @@ static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
         goto out;
     }
     note_move(r, q0);
-    st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, o->t0, r->qd, r->qdd, r->work,
-                                      r->lwork, rep);
+    st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd, r->qdd, rep);
     if (st != MECHRT_OK) {
         fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
         goto out;
@@ -1075,7 +1079,8 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     const RunOptions *o = r->o;
     MechrtReport rep;
     RunStatus status = RUN_OK;
-    MechrtHost *host = mechrt_host_new(r->k);
+    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
+    r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
         r->res->status = RUN_FAILED;
@@ -1107,8 +1112,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
             status = RUN_FAILED;
             goto out;
         }
-        st = mechrt_velocity_acceleration(r->k, &o->mechrt, r->q, tn, r->qd, r->qdd, r->work,
-                                          r->lwork, &rep);
+        st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, tn, r->qd, r->qdd, &rep);
         bool forces_ok = st != MECHRT_OK || inverse_at(r, tn);
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
@@ -1124,6 +1128,10 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     }
 out:
     r->res->host = *mechrt_host_stats(host);
+    if (r->sp)
+        mechrt_host_sparse_counts(r->sp, &r->res->fresh_factorisations,
+                                  &r->res->refactorisations);
+    r->sp = NULL;
     mechrt_host_free(host);
     return status;
 }
@@ -1146,15 +1154,9 @@ static RunStatus bad_input(RunResult *res, const char *fmt, ...)
 static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
                           size_t size)
 {
-    bool can = o->jac_nz && m->nv == 0;
+    bool can = o->jac_nz != NULL;
     *sparse = o->linear == RUN_LINEAR_SPARSE
               || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
-    if (*sparse && m->nv > 0) {
-        snprintf(why, size, "--linear sparse does not support velocity-level rows yet (%d "
-                 "here: rolling, knife edges, velocity drivers); their integration is dense: "
-                 "use --linear dense or auto", m->nv);
-        return false;
-    }
     if (*sparse && !o->jac_nz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -1175,7 +1177,8 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
    there is one, the mechanism is stepped (no velocity rows) and its
    worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
-static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz)
+static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
+                              MechrtLuGen *gen)
 {
     if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
         return NULL;
@@ -1188,6 +1191,11 @@ static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *
         != MECHRT_OK) {
         free(f);
         return NULL;
+    }
+    if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
+        *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
+                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
+        mechrt_lup_use(f, gen);
     }
     return f;
 }
@@ -1251,7 +1259,8 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     r.q = xcalloc(3 * nq, sizeof *r.q);
     r.qd = r.q + nq;
     r.qdd = r.q + 2 * nq;
-    if (sparse && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+    r.sparse = sparse;
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
         free(r.q);
         return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
                          "entries) is not a valid %d x %d pattern, or out of memory",
@@ -1259,7 +1268,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     }
     res->sparse = sparse;
     if (!sparse)
-        r.lup = run_lup_new(m, o, &r.lup_jnz);
+        r.lup = run_lup_new(m, o, &r.lup_jnz, &r.lup_gen);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -1280,6 +1289,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     if (r.lup) {
         res->fresh_factorisations = r.lup->analyses;
         res->refactorisations = r.lup->replays;
+        res->generated_factorisations = r.lup->gen_factors;
         free(r.lup);
     }
     if (status == RUN_OK && r.episode)
@@ -1362,6 +1372,23 @@ static void code_all_nz(void *ctx, const double *q, const double *qd, double t, 
     ((const Kernels *)ctx)->all_nz(q, qd, t, phi, vals, nu, gamma);
 }
 
+static int code_lu_factor(void *ctx, const double *a, double *lu, double pivot_tol,
+                          double *spread)
+{
+    return ((const Kernels *)ctx)->lu_factor(a, lu, pivot_tol, spread);
+}
+
+static void code_lu_solve(void *ctx, const double *lu, const double *b, double *x)
+{
+    ((const Kernels *)ctx)->lu_solve(lu, b, x);
+}
+
+static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                        const double *tol, int max_iter, double *out, int *iout)
+{
+    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+}
+
 bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
 {
     const Kernels *code = e->k.ctx;
@@ -1369,6 +1396,9 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
         || !code->jac_row || !code->jac_col)
         return false;
     *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
-                             code_jac_nz, code->all_nz ? code_all_nz : NULL};
+                             code_jac_nz, code->all_nz ? code_all_nz : NULL,
+                             code->lu_factor ? code_lu_factor : NULL,
+                             code->lu_factor ? code_lu_solve : NULL,
+                             code->lu_step ? code_lu_step : NULL};
     return true;
 }

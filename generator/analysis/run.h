@@ -106,6 +106,8 @@ typedef struct RunResult {
     long fresh_factorisations;   /* sparse: KLU factorisations with pivoting
                                     (dense: the pattern LU's finished by lu.c)... */
     long refactorisations;       /* ... and with the pivot order kept (replayed) */
+    long generated_factorisations;   /* dense: by the kernels' unrolled LU
+                                        (PREFIX_lu_factor), not counted above */
     MechrtHostStats host;        /* integrator counters when integrated */
     /* through singular positions (holonomic runs): steps redone by the
        rank-revealing corrector (mechrt_rank_correct) because the LU found

@@ -30,6 +30,24 @@
  * inconsistent by the error over its small pivot. The projection restores
  * the rows left out.
  *
+ * Large mechanisms (SimOptions.linear; auto above SIM_DENSE_MAX_NQ
+ * coordinates) take the sparse path instead: the generated kernels'
+ * nonzeros (all_nz, jac_nz, mass_nz) into the augmented matrix [W Phi_A^T;
+ * Phi_A 0] on KLU (runtime/host/sparse_kkt.c), W = M for the right side
+ * (one refactorisation per call, a refined solve near a rank drop, the
+ * rows of the step as identity rows), W = I for the minimum-norm position
+ * Newton and W = M for the mass-orthogonal velocity projection
+ * (sparse_project_velocities says why), no nr x nq or nq x nq array
+ * touched per call. The rows: where [I Phi_q^T; Phi_q 0] with every row,
+ * factored with a fresh pivot search, has a pivot spread below
+ * SIM_KKT_SPREAD_MAX, every row is kept (no rank drop near, the dense
+ * elimination would keep them all); only otherwise does the dense
+ * rank-revealing elimination decide, which on IFToMM A02 is a few steps
+ * around each flat position. Positions are projected with the rows of the
+ * step before, velocities with the rows just chosen. Where a sparse
+ * factorisation fails, that call falls back to the dense method, which
+ * decides or names the cause.
+ *
  * Energy: E = T - W with T = 1/2 qd^T M qd and W' = qd^T M qdd +
  * 1/2 qd^T Mdot qd = qd.(Q - Phi_q^T lambda) + 1/2 qd^T Mdot qd, the power of
  * the applied forces (Q without its velocity terms, which the Mdot term
@@ -65,8 +83,24 @@
 #define SIM_QR_MARGIN 100.0
 /* The step size is said to underflow below this share of |t1 - t0|. */
 #define SIM_HMIN_SHARE 1e-14
+/* Sparse path: the pivot test of its factorisations (relative to the
+   largest entry, as the dense LU's), and the pivot spread of [I Phi_q^T;
+   Phi_q 0] with every row above which the rows are chosen by the dense
+   rank-revealing elimination. Its small eigenvalues are -sigma_i^2 of
+   Phi_q, so 1e6 is a singular value ratio near 1e-3, ten times above
+   row_tol's 1e-4 (pivots in the elimination track the singular values
+   within modest factors): far from a rank drop every row is kept without
+   the dense elimination, near one it decides. */
+#define SIM_KKT_PIVOT_TOL 1e-12
+#define SIM_KKT_SPREAD_MAX 1e6
+/* The right side's solve is refined once (mechrt_host_kkt_solve_refined)
+   where [M Phi_A^T; Phi_A 0]'s pivot spread exceeds this: near a rank
+   drop, where the multipliers dwarf the accelerations. Elsewhere (A02:
+   spreads of 40 to 2000) one solve is as accurate. */
+#define SIM_KKT_REFINE_SPREAD 1e4
 
 const char *const sim_method_names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf", NULL};
+const char *const sim_linear_names[] = {"auto", "dense", "sparse", NULL};
 
 SimOptions sim_default_options(void)
 {
@@ -87,6 +121,9 @@ SimOptions sim_default_options(void)
     o.assembly_max_iter = 100;
     o.max_steps = 10000000;
     o.notes = NULL;
+    o.linear = SIM_LINEAR_AUTO;
+    o.jac_nz = NULL;
+    o.mass_nz = NULL;
     return o;
 }
 
@@ -117,6 +154,16 @@ typedef struct Sim {
     double e0;                   /* E at t0 */
     MechrtDynOptions dyn;        /* the caller's, with the rows of this step */
     unsigned char *active;       /* nr: the rows kept during this step */
+    /* the sparse path (kkt NULL: dense) */
+    MechrtHostKkt *kkt;
+    const MechrtHostJacNz *jnz;
+    const MechrtHostMassNz *mnz;
+    double *sx, *sw, *sphi, *sg, *sforce, *smass;  /* nq + nr; 2 (nq + nr); nr; nr; nq; mass nnz */
+    bool all_active;             /* every row kept in this step */
+    double *mq, mq_t;            /* (q, t) of the factors of M's augmented matrix */
+    bool mq_valid;               /* ... with this step's rows */
+    bool vel_ready;              /* Phi_q's nonzeros and nu at the state, for the
+                                    velocity projection */
 } Sim;
 
 /* Counting wrappers: every kernel call of the simulation goes through these. */
@@ -216,9 +263,121 @@ static void explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep
     }
 }
 
+/* ---- the sparse path: the augmented matrix on KLU --------------------------- */
+
+/* y = Phi_q x over the Jacobian's nonzeros (nr rows). */
+static void sparse_jac_times(const Sim *s, const double *x, double *y)
+{
+    const double *v = mechrt_host_kkt_jac(s->kkt);
+    memset(y, 0, (size_t)s->nr * sizeof *y);
+    for (int e = 0; e < s->jnz->nnz; e++)
+        y[s->jnz->row[e]] += v[e] * x[s->jnz->col[e]];
+}
+
+/* qd^T M x over M's nonzeros vals. */
+static double sparse_mass_form(const Sim *s, const double *vals, const double *qd,
+                               const double *x)
+{
+    double sum = 0;
+    for (int e = 0; e < s->mnz->nnz; e++)
+        sum += qd[s->mnz->row[e]] * vals[e] * x[s->mnz->col[e]];
+    return sum;
+}
+
+/* M's nonzeros at q into vals (counted). */
+static void sparse_mass(Sim *s, const double *q, double *vals)
+{
+    s->res->calls.mass_nz++;
+    s->mnz->mass_nz(s->mnz->ctx, q, vals);
+}
+
+static bool all_finite(int n, const double *v)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return false;
+    return true;
+}
+
+/* Phi, Phi_q's nonzeros, nu and gamma at the state (one all_nz call), and
+   with dynamics M's nonzeros and Q. */
+static MechrtStatus sparse_eval(Sim *s, const double *q, const double *qd, double t,
+                                bool dynamics)
+{
+    double *jac = mechrt_host_kkt_jac(s->kkt);
+    s->res->calls.all_nz++;
+    s->jnz->all_nz(s->jnz->ctx, q, qd, t, s->sphi, jac, s->nu, s->sg);
+    if (!all_finite(s->jnz->nnz, jac) || !all_finite(s->nr, s->nu) || !all_finite(s->nr, s->sg))
+        return MECHRT_ENOTFINITE;
+    if (!dynamics)
+        return MECHRT_OK;
+    double *mass = mechrt_host_kkt_mass(s->kkt);
+    sparse_mass(s, q, mass);
+    s->kc.force(s->kc.ctx, q, qd, t, s->sforce);
+    return all_finite(s->mnz->nnz, mass) && all_finite(s->nq, s->sforce) ? MECHRT_OK
+                                                                        : MECHRT_ENOTFINITE;
+}
+
+/* [M Phi_A^T; Phi_A 0] factored at (q, t) with the step's rows, M's and
+   Phi_q's nonzeros at q in the buffers; skipped where the factors are
+   already at the same q and t with these rows (the matrix depends on
+   nothing else): the velocity projection's serve the step's first stage,
+   its retries after a rejection, and the output state's solve. */
+static MechrtStatus sparse_mass_factor(Sim *s, const double *q, double t)
+{
+    size_t bytes = (size_t)s->nq * sizeof *q;
+    if (s->mq_valid && t == s->mq_t && memcmp(q, s->mq, bytes) == 0) {
+        s->res->kkt_reused++;
+        return MECHRT_OK;
+    }
+    s->mq_valid = false;
+    MechrtStatus st = mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_MASS, s->active, s->nr,
+                                             s->o->dyn.pivot_tol);
+    if (st == MECHRT_OK) {
+        memcpy(s->mq, q, bytes);
+        s->mq_t = t;
+        s->mq_valid = true;
+    }
+    return st;
+}
+
+/* qdd (and lambda, nr, when not NULL) from [M Phi_A^T; Phi_A 0] with the
+   rows of active (NULL: all), gamma stabilised as dyn_eval does. */
+static MechrtStatus sparse_accel(Sim *s, const double *q, const double *qd, double t,
+                                 const unsigned char *active, double *qdd, double *lambda)
+{
+    int n = s->nq, m = s->nr;
+    const MechrtDynOptions *o = &s->o->dyn;
+    MechrtStatus st = sparse_eval(s, q, qd, t, true);
+    if (st != MECHRT_OK)
+        return st;
+    if (o->baumgarte_alpha != 0 || o->baumgarte_beta != 0) {
+        sparse_jac_times(s, qd, s->resid);
+        for (int i = 0; i < m; i++)
+            s->sg[i] -= 2 * o->baumgarte_alpha * (s->resid[i] - s->nu[i])
+                      + (i < s->inner->nh ? o->baumgarte_beta * o->baumgarte_beta * s->sphi[i] : 0);
+    }
+    st = sparse_mass_factor(s, q, t);     /* active is the step's rows, or all of them */
+    if (st != MECHRT_OK)
+        return st;
+    memcpy(s->sx, s->sforce, (size_t)n * sizeof *s->sx);
+    for (int i = 0; i < m; i++)
+        s->sx[n + i] = !active || active[i] ? s->sg[i] : 0;
+    st = mechrt_host_kkt_spread(s->kkt, MECHRT_KKT_MASS) > SIM_KKT_REFINE_SPREAD
+             ? mechrt_host_kkt_solve_refined(s->kkt, MECHRT_KKT_MASS, s->sx, s->sw)
+             : mechrt_host_kkt_solve(s->kkt, MECHRT_KKT_MASS, s->sx);
+    if (st != MECHRT_OK)
+        return st;
+    memcpy(qdd, s->sx, (size_t)n * sizeof *qdd);
+    if (lambda)
+        memcpy(lambda, s->sx + n, (size_t)m * sizeof *lambda);
+    return MECHRT_OK;
+}
+
 /* ---- energy --------------------------------------------------------------- */
 
-/* 1/2 qd^T Mdot qd by a central difference of M along qd (mass2, qs scratch). */
+/* 1/2 qd^T Mdot qd by a central difference of M along qd (qs scratch; M
+   into mass2, or its nonzeros into smass on the sparse path). */
 static double half_mdot(Sim *s, const double *q, const double *qd)
 {
     int n = s->nq;
@@ -233,11 +392,16 @@ static double half_mdot(Sim *s, const double *q, const double *qd)
     for (int sign = -1; sign <= 1; sign += 2) {
         for (int i = 0; i < n; i++)
             s->qs[i] = q[i] + sign * eps * qd[i];
-        s->kc.mass(s->kc.ctx, s->qs, s->mass2);
         double quad = 0;
-        for (int i = 0; i < n; i++)
-            for (int j = 0; j < n; j++)
-                quad += qd[i] * s->mass2[(size_t)i * (size_t)n + (size_t)j] * qd[j];
+        if (s->kkt) {
+            sparse_mass(s, s->qs, s->smass);
+            quad = sparse_mass_form(s, s->smass, qd, qd);
+        } else {
+            s->kc.mass(s->kc.ctx, s->qs, s->mass2);
+            for (int i = 0; i < n; i++)
+                for (int j = 0; j < n; j++)
+                    quad += qd[i] * s->mass2[(size_t)i * (size_t)n + (size_t)j] * qd[j];
+        }
         sum += sign * quad;
     }
     return 0.25 * sum / eps;    /* 1/2 * (quad+ - quad-) / (2 eps) */
@@ -266,7 +430,13 @@ static void watch_energy(Sim *s, const double *y, bool first)
     if (!s->o->energy)
         return;
     const double *q = y, *qd = y + s->nq;
-    double tk = 0.5 * mass_form(s, q, qd, qd), w = y[2 * s->nq];
+    double tk, w = y[2 * s->nq];
+    if (s->kkt) {
+        sparse_mass(s, q, s->smass);
+        tk = 0.5 * sparse_mass_form(s, s->smass, qd, qd);
+    } else {
+        tk = 0.5 * mass_form(s, q, qd, qd);
+    }
     double e = tk - w;
     if (first)
         s->e0 = e;
@@ -291,6 +461,18 @@ static int sim_rhs(double t, const double y[], double f[], void *params)
     const double *q = y, *qd = y + n;
     MechrtDynReport rep;
     s->res->rhs_calls++;
+    if (s->kkt) {
+        /* the rows left out are known: no rank decision here */
+        if (sparse_accel(s, q, qd, t, s->all_active ? NULL : s->active, f + n, NULL)
+            == MECHRT_OK) {
+            memcpy(f, qd, (size_t)n * sizeof *f);
+            if (s->o->energy)
+                f[2 * n] = sparse_mass_form(s, mechrt_host_kkt_mass(s->kkt), qd, f + n)
+                           + half_mdot(s, q, qd);
+            return GSL_SUCCESS;
+        }
+        s->res->dense_fallbacks++;     /* the dense method decides, or names the cause */
+    }
     MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->dyn, q, qd, t, f + n, NULL,
                                               s->work, s->lwork, &rep);
     if (st == MECHRT_OK) {
@@ -370,6 +552,7 @@ static MechrtStatus min_norm_solve(Sim *s, int m, double tol, const double *b, d
         mechrt_qr_solve(&f, b, x);
         return MECHRT_OK;
     }
+    s->res->svd_solves++;
     if (!mechrt_svd(s->svd, s->jac, m, n, n, -1, &sv))
         return MECHRT_ENOTFINITE;
     if (!(sv.sigma_max > 0)) {
@@ -428,6 +611,35 @@ static MechrtStatus eval_phi(Sim *s, const double *q, double t, MechrtReport *re
     return MECHRT_OK;
 }
 
+/* The minimum-norm correction dq (s->dqd) of the holonomic rows' residual
+   s->resid at q: on the sparse path from [I Phi_A^T; Phi_A 0] with the
+   rows of this step (min |dq| with Phi_A dq = Phi_A), where it factors;
+   else, and on the dense path, min_norm_solve. *zero: Phi_q = 0. */
+static MechrtStatus position_correction(Sim *s, const MechrtOptions *o, const double *q,
+                                        double t, bool *zero)
+{
+    int n = s->nq, nh = s->inner->nh;
+    *zero = false;
+    if (s->kkt) {
+        s->res->calls.jac_nz++;
+        s->jnz->jac_nz(s->jnz->ctx, q, t, mechrt_host_kkt_jac(s->kkt));
+        if (mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_IDENTITY, s->active, nh,
+                                   SIM_KKT_PIVOT_TOL) == MECHRT_OK) {
+            memset(s->sx, 0, (size_t)n * sizeof *s->sx);
+            for (int i = 0; i < s->nr; i++)
+                s->sx[n + i] = i < nh && s->active[i] ? s->resid[i] : 0;
+            if (mechrt_host_kkt_solve(s->kkt, MECHRT_KKT_IDENTITY, s->sx) == MECHRT_OK) {
+                memcpy(s->dqd, s->sx, (size_t)n * sizeof *s->dqd);
+                s->res->kkt_solves++;
+                return MECHRT_OK;
+            }
+        }
+        s->res->dense_fallbacks++;
+    }
+    s->kc.jac(s->kc.ctx, q, t, s->jac);
+    return min_norm_solve(s, nh, o->pivot_tol, s->resid, s->dqd, zero);
+}
+
 /* Minimum-norm Newton onto Phi(q, t) = 0 (as mechrt_host_project, without
    its SVD per step where QR does): dq = -pinv(Phi_q) Phi truncated at
    pivot_tol, at least one step, until |Phi| <= tol_phi and |dq| <= tol_dq. */
@@ -450,8 +662,7 @@ static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q,
         if (rep->iterations >= o->max_iter)
             return MECHRT_EMAXITER;
         bool zero;
-        s->kc.jac(s->kc.ctx, q, t, s->jac);
-        st = min_norm_solve(s, nh, o->pivot_tol, s->resid, s->dqd, &zero);
+        st = position_correction(s, o, q, t, &zero);
         if (st != MECHRT_OK)
             return st;
         if (zero)
@@ -468,8 +679,8 @@ static MechrtStatus project_positions(Sim *s, const MechrtOptions *o, double *q,
     }
 }
 
-/* Positions onto Phi = 0, then velocities onto Phi_q qd = nu; fails with the message set. */
-static bool project_state(Sim *s, double *y, double t)
+/* Positions onto Phi = 0; fails with the message set. */
+static bool settle_positions(Sim *s, double *y, double t)
 {
     MechrtOptions po = s->o->mechrt;
     MechrtReport rep;
@@ -487,7 +698,55 @@ static bool project_state(Sim *s, double *y, double t)
             msgf(s, "%s", mechrt_strerror(st));
         return false;
     }
-    st = project_velocities(s, y, y + s->nq, t);
+    return true;
+}
+
+/* qd <- qd - dqd, the correction onto the kept rows of Phi_q qd = nu
+   nearest in kinetic energy (mass-orthogonal: least dqd^T M dqd) from
+   [M Phi_A^T; Phi_A 0] at q, Phi_q there from sparse_rows; the minimum-
+   norm one where M is singular on the rows' null space. Mass-orthogonal
+   (Bayo and Ledesma's projections) because it changes T only by
+   -1/2 dqd^T M dqd, second order in the correction: the correction is
+   largest where rows come back after a rank drop (the velocities that
+   moved freely along the fold directions while they were left out), and
+   the minimum-norm one there changed T at first order: on IFToMM A02,
+   3e-4 J at one flat position, then a phase error growing with time. */
+static MechrtStatus sparse_project_velocities(Sim *s, const double *q, double t, double *qd)
+{
+    int n = s->nq;
+    MechrtKktWeight w = MECHRT_KKT_MASS;
+    sparse_mass(s, q, mechrt_host_kkt_mass(s->kkt));
+    if (sparse_mass_factor(s, q, t) != MECHRT_OK) {
+        w = MECHRT_KKT_IDENTITY;
+        MechrtStatus st = mechrt_host_kkt_factor(s->kkt, w, s->active, s->nr,
+                                                 SIM_KKT_PIVOT_TOL);
+        if (st != MECHRT_OK)
+            return st;
+    }
+    sparse_jac_times(s, qd, s->resid);
+    memset(s->sx, 0, (size_t)n * sizeof *s->sx);
+    for (int i = 0; i < s->nr; i++)
+        s->sx[n + i] = s->active[i] ? s->resid[i] - s->nu[i] : 0;
+    MechrtStatus st = mechrt_host_kkt_solve_refined(s->kkt, w, s->sx, s->sw);
+    if (st != MECHRT_OK)
+        return st;
+    s->res->kkt_solves++;
+    for (int j = 0; j < n; j++)
+        qd[j] -= s->sx[j];
+    return all_finite(n, qd) ? MECHRT_OK : MECHRT_ENOTFINITE;
+}
+
+/* Velocities onto Phi_q qd = nu; fails with the message set. */
+static bool settle_velocities(Sim *s, double *y, double t)
+{
+    MechrtStatus st = MECHRT_EINVAL;
+    if (s->kkt && s->vel_ready)
+        st = sparse_project_velocities(s, y, t, y + s->nq);
+    if (st != MECHRT_OK) {
+        if (s->kkt)
+            s->res->dense_fallbacks++;
+        st = project_velocities(s, y, y + s->nq, t);
+    }
     if (st != MECHRT_OK) {
         fail(s, st, t, "velocity projection");
         msgf(s, "%s", mechrt_strerror(st));
@@ -498,7 +757,7 @@ static bool project_state(Sim *s, double *y, double t)
 
 /* The rows the next step keeps, decided at y (on the manifold after a
    projection): redundant ones out, for every stage of the step. */
-static bool choose_rows(Sim *s, const double *y, double t)
+static bool choose_rows(Sim *s, const double *y, double t, MechrtDynReport *out)
 {
     MechrtDynReport rep;
     MechrtDynOptions ro = s->o->dyn;
@@ -510,13 +769,54 @@ static bool choose_rows(Sim *s, const double *y, double t)
         msgf(s, "%s", mechrt_strerror(st));
         return false;
     }
+    if (out)
+        *out = rep;
     return true;
 }
 
-/* After a step (or at the start): projection when on, then the rows. */
+/* The sparse path's choice: every row where [I Phi_q^T; Phi_q 0] factors
+   with a fresh pivot search and a modest pivot spread (no rank drop near:
+   mechrt_host_kkt_screen), else choose_rows. */
+static bool sparse_rows(Sim *s, const double *y, double t)
+{
+    int m = s->nr;
+    s->vel_ready = false;
+    s->mq_valid = false;    /* the rows may change */
+    bool evaluated = sparse_eval(s, y, y + s->nq, t, false) == MECHRT_OK;
+    double spread = INFINITY;
+    bool factored = evaluated
+                    && mechrt_host_kkt_screen(s->kkt, m, SIM_KKT_PIVOT_TOL, &spread) == MECHRT_OK;
+    if (factored)
+        s->res->max_screen_spread = fmax(s->res->max_screen_spread, spread);
+    if (spread <= SIM_KKT_SPREAD_MAX) {
+        memset(s->active, 1, (size_t)m);
+        s->all_active = s->vel_ready = true;
+        s->res->rows_sparse++;
+        return true;
+    }
+    MechrtDynReport rep;
+    s->res->rows_dense++;
+    if (!choose_rows(s, y, t, &rep))
+        return false;
+    s->all_active = rep.redundant == 0;
+    if (rep.redundant > s->res->max_redundant)
+        s->res->max_redundant = rep.redundant;
+    if (rep.pivot_ratio < s->res->min_pivot_ratio)
+        s->res->min_pivot_ratio = rep.pivot_ratio;
+    s->vel_ready = evaluated;
+    return true;
+}
+
+/* After a step (or at the start): projection when on, then the rows; the
+   sparse path chooses the rows before the velocity projection, which
+   uses them. */
 static bool settle(Sim *s, double *y, double t, bool project)
 {
-    return (!project || project_state(s, y, t)) && choose_rows(s, y, t);
+    if (!s->kkt)
+        return (!project || (settle_positions(s, y, t) && settle_velocities(s, y, t)))
+               && choose_rows(s, y, t, NULL);
+    return (!project || settle_positions(s, y, t)) && sparse_rows(s, y, t)
+           && (!project || settle_velocities(s, y, t));
 }
 
 /* ---- set-up ------------------------------------------------------------------ */
@@ -530,6 +830,21 @@ static const gsl_odeiv2_step_type *step_type(SimMethod m)
     case SIM_MSBDF: return gsl_odeiv2_step_msbdf;
     }
     return gsl_odeiv2_step_rk8pd;
+}
+
+/* The sparse path's kernels are there (and rows to constrain). */
+static bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o)
+{
+    return k->nh + k->nv > 0 && o->jac_nz && o->jac_nz->all_nz && o->jac_nz->jac_nz
+           && o->mass_nz && o->mass_nz->mass_nz;
+}
+
+/* The sparse path is taken: asked for, or auto on a large mechanism. */
+static bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o)
+{
+    return sim_sparse_can(k, o)
+           && (o->linear == SIM_LINEAR_SPARSE
+               || (o->linear == SIM_LINEAR_AUTO && k->nq > SIM_DENSE_MAX_NQ));
 }
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */
@@ -558,8 +873,24 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->f1 = xcalloc((size_t)s->dim, sizeof *s->f1);
     s->y = xcalloc((size_t)s->dim, sizeof *s->y);
     s->active = xcalloc(m + 1, sizeof *s->active);
+    memset(s->active, 1, m + 1);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
+    if (sim_sparse_wanted(k, o)) {
+        s->jnz = o->jac_nz;
+        s->mnz = o->mass_nz;
+        s->kkt = mechrt_host_kkt_new(k->nq, (int)m, o->jac_nz, o->mass_nz);
+        if (!s->kkt)
+            return false;
+        s->res->sparse = true;
+        s->sx = xcalloc(n + m, sizeof *s->sx);
+        s->mq = xcalloc(n, sizeof *s->mq);
+        s->sw = xcalloc(2 * (n + m), sizeof *s->sw);
+        s->sphi = xcalloc(m, sizeof *s->sphi);
+        s->sg = xcalloc(m, sizeof *s->sg);
+        s->sforce = xcalloc(n, sizeof *s->sforce);
+        s->smass = xcalloc((size_t)o->mass_nz->nnz + 1, sizeof *s->smass);
+    }
     s->lqrw = m > 0 ? mechrt_qr_work_len((int)m, k->nq) : 0;
     s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
     s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
@@ -587,6 +918,10 @@ static void sim_close(Sim *s)
     free(s->y), free(s->active);
     free(s->qrw);
     mechrt_svd_free(s->svd);
+    if (s->kkt)
+        mechrt_host_kkt_counts(s->kkt, &s->res->kkt_fresh, &s->res->kkt_refactored);
+    mechrt_host_kkt_free(s->kkt);
+    free(s->sx), free(s->mq), free(s->sw), free(s->sphi), free(s->sg), free(s->sforce), free(s->smass);
     if (s->drv)
         gsl_odeiv2_driver_free(s->drv);
 }
@@ -605,6 +940,14 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
 {
     int n = s->nq;
     MechrtDynReport rep;
+    /* every row kept: the multipliers are unique and the sparse solve gives
+       them; near a rank drop the dense method's minimum-norm ones */
+    if (s->kkt && s->all_active
+        && sparse_accel(s, y, y + n, t, NULL, s->f0, s->lambda) == MECHRT_OK) {
+        state(ctx, t, y, y + n, s->f0, s->lambda);
+        s->res->states++;
+        return true;
+    }
     MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->o->dyn, y, y + n, t, s->f0,
                                               s->lambda, s->work, s->lwork, &rep);
     if (st != MECHRT_OK) {
@@ -710,6 +1053,9 @@ static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimRes
     if (k->nh > k->nq)
         return bad_input(res, "%d holonomic rows for %d coordinates: the position "
                          "projection needs at most one row per coordinate", k->nh, k->nq);
+    if (o->linear == SIM_LINEAR_SPARSE && !sim_sparse_can(k, o))
+        return bad_input(res, "--linear sparse needs the generated kernels' nonzeros (--engine "
+                         "jit or aot) and at least one constraint row");
     return SIM_OK;
 }
 

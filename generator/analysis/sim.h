@@ -16,6 +16,7 @@
 #include <stdio.h>
 
 #include "../../runtime/mechrt.h"
+#include "../../runtime/host/mechrt_host.h"
 #include "../model/model.h"
 
 /* The integrators: explicit embedded Runge-Kutta pairs, and two implicit
@@ -25,6 +26,18 @@ typedef enum SimMethod { SIM_RK8PD, SIM_RKF45, SIM_RK4IMP, SIM_MSBDF } SimMethod
 
 /* "rk8pd", "rkf45", "rk4imp", "msbdf", NULL: the --method names, in order. */
 extern const char *const sim_method_names[];
+
+/* The linear algebra of the right side and the projections: the dense
+   null-space method and QR/SVD, or the sparse augmented matrix on KLU
+   (runtime/host/sparse_kkt.c; needs the generated kernels' patterns);
+   auto: sparse above SIM_DENSE_MAX_NQ coordinates when it can. */
+typedef enum SimLinear { SIM_LINEAR_AUTO, SIM_LINEAR_DENSE, SIM_LINEAR_SPARSE } SimLinear;
+
+/* "auto", "dense", "sparse", NULL: the --linear names, in order. */
+extern const char *const sim_linear_names[];
+
+/* auto's size limit of the dense path: run's (RUN_DENSE_MAX_NQ). */
+#define SIM_DENSE_MAX_NQ 100
 
 /* What a simulation does; fill with sim_default_options(). */
 typedef struct SimOptions {
@@ -53,6 +66,11 @@ typedef struct SimOptions {
     int assembly_max_iter;  /* minimum-norm Newton at t0 when projection fails; 100 */
     long max_steps;         /* integrator steps allowed in all; 10 000 000 */
     FILE *notes;            /* notes ("FILE: note: ..."); NULL: none */
+    SimLinear linear;       /* SIM_LINEAR_AUTO */
+    /* the generated kernels' nonzeros (jit, aot), NULL without: the
+       sparse path needs both and jac_nz->all_nz */
+    const MechrtHostJacNz *jac_nz;
+    const MechrtHostMassNz *mass_nz;
 } SimOptions;
 
 SimOptions sim_default_options(void);
@@ -65,6 +83,7 @@ enum { SIM_MESSAGE_MAX = 1024 };
 /* Kernel calls by kind, through the counting wrapper. */
 typedef struct SimKernelCalls {
     long phi, jac, nu, gamma, all, mass, force;
+    long jac_nz, all_nz, mass_nz;    /* the sparse path's */
 } SimKernelCalls;
 
 typedef struct SimResult {
@@ -80,7 +99,19 @@ typedef struct SimResult {
     long rhs_calls;              /* forward-dynamics solves for the integrator */
     long jacobian_calls;         /* finite-difference Jacobians (implicit methods) */
     long projections;            /* position + velocity projections */
-    long qr_solves;              /* projection solves by QR (the others: SVD near a rank drop) */
+    long qr_solves;              /* dense projection solves by QR */
+    long svd_solves;             /* dense projection solves by the SVD (near a rank drop) */
+    /* the sparse path: whether it ran; KLU factorisations of the augmented
+       matrix with pivot search and without; projection solves on it; row
+       choices by the augmented matrix's pivots alone and by the dense
+       rank-revealing elimination (near a rank drop); right sides and
+       projection solves that fell back to the dense methods */
+    bool sparse;
+    long kkt_fresh, kkt_refactored, kkt_solves;
+    long kkt_reused;             /* M's factors reused at the same state */
+    long rows_sparse, rows_dense, dense_fallbacks;
+    double max_screen_spread;    /* largest pivot spread of [I Phi_q^T; Phi_q 0] with
+                                    every row, where it factored (sparse path) */
     long projection_iterations;  /* Newton iterations in the position ones */
     SimKernelCalls calls;
     int max_redundant;           /* most rows found dependent at once */

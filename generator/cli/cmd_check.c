@@ -12,13 +12,15 @@ typedef struct CheckCli {
     CheckOptions opt;
     MechLimits limits;
     int seed;               /* opt.seed, read as an int */
+    int linear;             /* --linear, a RunLinear */
     bool json;
+    long long max_dense;    /* limits.max_jac_entries, checked by check_file */
 } CheckCli;
 
 static const char usage[] =
     "usage: mechc check FILE.mech [--samples N] [--seed S] [--tol T] [--tol-engines T]\n"
     "                   [--fd-step H] [--fd-step2 H] [--spread-q S] [--spread-qd S]\n"
-    "                   [--no-aot] [--json]\n"
+    "                   [--no-aot] [--linear dense|sparse|auto] [--json]\n"
     "\n"
     "Compares the generated Jacobian, nu and gamma with finite differences of Phi\n"
     "(and of Psi for velocity-level rows), and the engines (jit, generic, aot when a\n"
@@ -51,6 +53,10 @@ static const CliOption options[] = {
     {"--spread-qd", CLI_REAL_AT(CheckCli, opt.spread_qd), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "S", .help = "sampled qd = uniform(-S, S) (default 1)"},
     {"--no-aot", CLI_CLEAR_AT(CheckCli, opt.use_aot), .help = "do not build and compare the aot engine"},
+    {"--linear", CLI_CHOICE_AT(CheckCli, linear, run_linear_names), .metavar = "L",
+     .help = "dense Jacobians, or sparse: the Jacobian's nonzeros,\n"
+             "assembly by KLU, finite differences by column groups;\n"
+             "auto (default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates)"},
     {"--json", CLI_FLAG_AT(CheckCli, json),
      .help = "print JSON: ok, samples, worst[{what, error, row, ...}]"},
 };
@@ -239,6 +245,18 @@ static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     CheckCli *c = opts;
     CheckReport rep;
     c->opt.seed = (unsigned long)c->seed;
+    c->opt.linear = (RunLinear)c->linear;
+    const Model *m = mech->model;
+    bool sparse = c->linear == RUN_LINEAR_SPARSE
+                  || (c->linear == RUN_LINEAR_AUTO && m->nq > RUN_DENSE_MAX_NQ);
+    long long dense = (long long)m->nr * m->nq, mass = m->nmasses > 0 ? (long long)m->nq * m->nq : 0;
+    if ((!sparse && dense > c->max_dense) || mass > c->max_dense) {
+        fprintf(stderr, "mechc check: error: %s: the dense %s would have %lld entries, more than "
+                "the limit of %lld (--max-jac-entries)%s\n", a->file,
+                mass > c->max_dense ? "mass matrix" : "Jacobian", mass > c->max_dense ? mass : dense,
+                c->max_dense, mass > c->max_dense ? "" : ": use --linear sparse");
+        return EXIT_USAGE;
+    }
     if (!check_mechanism(mech, &c->opt, &rep, diag)) {
         cli_error(a, diag);
         return EXIT_USAGE;
@@ -251,10 +269,20 @@ static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     return rep.ok ? EXIT_OK : EXIT_ANALYSIS;
 }
 
+/* The dense-Jacobian limit is checked here, after loading, where the
+   comparisons would form dense matrices: the sparse ones form none. */
+static bool finish(Args *a, void *opts)
+{
+    CheckCli *c = opts;
+    c->max_dense = c->limits.max_jac_entries;
+    c->limits.max_jac_entries = 0;
+    return args_need_file(a);
+}
+
 static const CliCommand command = {
     .name = "check", .usage = usage, CLI_OPTIONS(options), .column = 20, .epilogue = epilogue,
     .limits_offset = offsetof(CheckCli, limits),
-    .run = check_file,
+    .finish = finish, .run = check_file,
 };
 
 int cmd_check(int argc, char **argv)

@@ -23,7 +23,7 @@ typedef struct GenCli {
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
-    "                 [--sparse | --sparse-only] [--roll auto|never|always]\n"
+    "                 [--sparse | --sparse-only] [--roll auto|never|always] [--lu]\n"
     "                 [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
@@ -74,6 +74,11 @@ static const CliOption options[] = {
              "or more; always (groups of 2 or more); never. The same\n"
              "results to the bit; code size and compile time nearly\n"
              "independent of the number of links"},
+    {"--lu", CLI_FLAG_AT(GenCli, emit.lu),
+     .help = "also write PREFIX_lu_factor and PREFIX_lu_solve: the\n"
+             "Jacobian's LU unrolled for its pattern, constants folded,\n"
+             "with run-time pivot checks (square mechanisms without\n"
+             "velocity rows, up to 100 coordinates; what run calls)"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"

@@ -575,10 +575,21 @@ static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     return status;
 }
 
+/* The rank is dense only up to --max-dense (choose_linear), so the model's
+   dense-Jacobian limit binds only --linear dense: auto and sparse load
+   chains of 60 003 coordinates (their sparse QR forms no dense matrix). */
+static bool finish(Args *a, void *opts)
+{
+    InfoCli *c = opts;
+    if (c->linear != RUN_LINEAR_DENSE)
+        c->limits.max_jac_entries = 0;
+    return args_need_file(a);
+}
+
 static const CliCommand command = {
     .name = "info", .usage = usage, CLI_OPTIONS(options), .column = 17, .epilogue = epilogue,
     .limits_offset = offsetof(InfoCli, limits),
-    .run = info_file,
+    .finish = finish, .run = info_file,
 };
 
 int cmd_info(int argc, char **argv)

@@ -246,6 +246,10 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
         fprintf(stderr, "mechc run: stats: pattern LU: %ld of %ld factorisations finished by "
                 "the dense LU (a new pivot order), the others replayed\n",
                 res->fresh_factorisations, res->fresh_factorisations + res->refactorisations);
+    if (res->generated_factorisations > 0)
+        fprintf(stderr, "mechc run: stats: unrolled LU (the kernels' lu_factor): %ld "
+                "factorisations; its pivot checks sent the others to the pattern LU\n",
+                res->generated_factorisations);
     double ns_all = run_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
     fprintf(stderr, "mechc run: stats: one %s call (Phi, Phi_q, nu, gamma) takes "
             "%.1f ns: a step costs %.2f of them\n",

@@ -10,6 +10,7 @@
  */
 #include "cli.h"
 
+#include "../analysis/run.h"
 #include "../analysis/sim.h"
 #include "../base/arena.h"
 #include "run_output.h"
@@ -26,7 +27,7 @@ typedef struct SimCli {
     MechLimits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
     CliList traces;
-    int engine, method, digits, view;
+    int engine, method, digits, view, linear;
     bool json, stats;
     bool pictures, csv_stdout;      /* worked out from the above */
 } SimCli;
@@ -59,6 +60,11 @@ static const CliOption options[] = {
      .help = "integrator: rk8pd (default), rkf45 (explicit Runge-Kutta\n"
              "pairs), rk4imp or msbdf (implicit, for stiff springs and\n"
              "dampers; finite-difference Jacobian)"},
+    {"--linear", CLI_CHOICE_AT(SimCli, linear, sim_linear_names), .metavar = "L",
+     .help = "linear algebra: dense (null-space method, QR/SVD\n"
+             "projections) or sparse (KLU on the augmented matrix from\n"
+             "the generated kernels' nonzeros; jit, aot); default auto:\n"
+             "sparse above 100 coordinates"},
     {"--rtol", CLI_REAL_AT(SimCli, so.rtol), NONNEGATIVE, .metavar = "X",
      .help = "relative error per step (default 1e-10)"},
     {"--atol", CLI_REAL_AT(SimCli, so.atol), NONNEGATIVE, .metavar = "X",
@@ -118,17 +124,34 @@ static void print_stats(const SimResult *r, int nr)
     fprintf(stderr, "mechc sim: stats: %ld integrator steps, %ld rejected, %ld right-hand "
             "sides (forward-dynamics solves), %ld finite-difference Jacobians\n", r->steps,
             r->rejected, r->rhs_calls, r->jacobian_calls);
-    fprintf(stderr, "mechc sim: stats: %ld projections (%ld Newton iterations)\n",
-            r->projections, r->projection_iterations);
+    fprintf(stderr, "mechc sim: stats: %ld projections (%ld Newton iterations); dense "
+            "projection solves: %ld by QR, %ld by the SVD (near a rank drop)\n",
+            r->projections, r->projection_iterations, r->qr_solves, r->svd_solves);
+    if (r->sparse)
+        fprintf(stderr, "mechc sim: stats: sparse augmented matrix (KLU): %ld factorisations "
+                "with pivoting, %ld refactorisations, %ld reused at the same state, %ld "
+                "projection solves; rows chosen by its pivots %ld times, by the dense "
+                "elimination %ld times (near a rank drop); %ld dense fallbacks\n",
+                r->kkt_fresh, r->kkt_refactored, r->kkt_reused, r->kkt_solves, r->rows_sparse,
+                r->rows_dense, r->dense_fallbacks);
     fprintf(stderr, "mechc sim: stats: kernel calls: mass %ld, force %ld, all %ld, jac %ld, "
-            "gamma %ld, phi %ld, nu %ld\n", k->mass, k->force, k->all, k->jac, k->gamma,
+            "gamma %ld, phi %ld, nu %ld", k->mass, k->force, k->all, k->jac, k->gamma,
             k->phi, k->nu);
+    if (r->sparse)
+        fprintf(stderr, ", all_nz %ld, jac_nz %ld, mass_nz %ld", k->all_nz, k->jac_nz,
+                k->mass_nz);
+    fputc('\n', stderr);
     if (r->energy_scale > 0)
         fprintf(stderr, "mechc sim: stats: energy balance T - W drifted by %.3g (%.3g of the "
                 "largest kinetic energy or work, %.3g); for a conservative mechanism (no "
                 "dampers, no drivers) this is the energy drift\n", r->energy_drift,
                 r->energy_drift / r->energy_scale, r->energy_scale);
-    if (nr > 0)
+    if (nr > 0 && r->sparse)
+        fprintf(stderr, "mechc sim: stats: up to %d dependent %s; largest pivot spread of "
+                "[I Phi_q^T; Phi_q 0] with every row %.3g (about (sigma_max / sigma_min)^2 of "
+                "Phi_q; above 1e6 the dense elimination chose the rows)\n", r->max_redundant,
+                r->max_redundant == 1 ? "row" : "rows", r->max_screen_spread);
+    else if (nr > 0)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; smallest pivot ratio of "
                 "Phi_q %.3g (near 0: a singular position)\n", r->max_redundant,
                 r->max_redundant == 1 ? "row" : "rows", r->min_pivot_ratio);
@@ -207,6 +230,12 @@ static int report(const SimCli *c, const Model *m, const RunOutput *out, const R
     return status;
 }
 
+/* M's nonzeros through the compiled unit's context-free kernel. */
+static void code_mass_nz(void *ctx, const double *q, double *vals)
+{
+    ((const Kernels *)ctx)->mass_nz(q, vals);
+}
+
 /* The simulation with the open engine, the states going where c says. */
 static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p)
 {
@@ -221,6 +250,12 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     }
     run_output_open(&out, m);
     c->so.notes = stderr;
+    c->so.linear = (SimLinear)c->linear;
+    MechrtHostJacNz jnz;
+    MechrtHostMassNz mnz = {e->mech->kin.dyn.nnz, e->kernels.mass_row, e->kernels.mass_col,
+                            (void *)&e->kernels, code_mass_nz};
+    c->so.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
+    c->so.mass_nz = e->kernels.mass_nz && e->kernels.mass_row ? &mnz : NULL;
     SimResult res;
     progress_start(&out.progress, "sim", 1000);
     SimStatus st = sim_run(m, &e->k, &c->so, run_output_state, &out, &res);

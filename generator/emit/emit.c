@@ -17,6 +17,7 @@
 #include "templates.h"
 
 #include <ctype.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -161,6 +162,11 @@ static void put_literal(StrBuf *sb, double v, bool real_float)
         sb_putc(sb, ')');
 }
 
+void emit_put_literal(StrBuf *sb, double v, bool real_float)
+{
+    put_literal(sb, v, real_float);
+}
+
 typedef struct Emitter {
     const Kinematics *kin;
     const Dag *dag;
@@ -183,9 +189,13 @@ typedef struct Emitter {
     int chunk;                  /* the chunk being written */
     int fused;                  /* negations written into their product, this function */
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
+    bool pair_out_of_line;      /* the file calls one noinline copy of its pair */
     bool hoisting;              /* in put_calls_first */
     const RollHooks *roll;      /* a loop body's leaves and stores (roll.c) */
     bool rolled;                /* some function has loops (roll.c) */
+    int *call_rank;             /* per node: its call's number among the chunk's
+                                   sin/cos that may go first (rank_calls) */
+    int hoist;                  /* how many of those go first */
 } Emitter;
 
 static int c_precedence(const Emitter *e, NodeId id)
@@ -428,35 +438,81 @@ static void put_temporary(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, N
     put_export(e, sb, partner);
 }
 
-/* Where trigonometry is a call (libm, or the tool's sincos from the JIT),
-   the chunk's sin and cos come first: the callee returns them through
-   memory anyway, and arithmetic between calls would be spilled across
-   them. Inline sincos (the written file's default) stays next to its first
-   use, where it keeps few values live, unless the chunk has so few that
-   they all stay in registers (then the evaluations overlap). */
+/* A sin or cos that put_calls_first writes at the top of its chunk. */
+static bool goes_first(const void *ctx, NodeId id)
+{
+    const Emitter *e = ctx;
+    return e->call_rank[id] < e->hoist || e->call_rank[id] < 0;
+}
+
+/* Numbers the chunk's sin/cos calls that could go to its top (their
+   argument at hand), in order, a pair sharing its number; returns how
+   many. Where trig is a call, a pair whose two values share a factor
+   gets -1 instead: it always goes first (sched_pair_shares_factor). The
+   other nodes of the chunk get INT_MAX. */
+static int rank_calls(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
+{
+    int n = 0;
+    for (int at = 0; at < c->nnodes; at++) {
+        NodeId id = c->nodes[at];
+        DagOp op = dag_op(e->dag, id);
+        e->call_rank[id] = INT_MAX;
+        if ((op != OP_SIN && op != OP_COS) || e->sched.temp[id] < 0
+            || sched_is_import(&e->sched, id, e->chunk) || !at_hand(e, dag_node(e->dag, id)->a))
+            continue;
+        NodeId partner = sincos_partner(e, id);
+        if (partner != DAG_NONE && e->sched.pos[partner] < at)
+            e->call_rank[id] = e->call_rank[partner];
+        else if (e->trig_calls && sched_pair_shares_factor(&e->sched, fn, e->chunk, id))
+            e->call_rank[id] = -1;      /* always first */
+        else
+            e->call_rank[id] = n++;
+    }
+    return n;
+}
+
+/* How many of the chunk's first sin/cos calls go to its top (put_calls_first).
+   Where trigonometry is a call (libm, or the tool's sincos from the JIT),
+   the number that carries the fewest values across calls (spill.c), none
+   on a tie: hoisted, a sin or cos lives across the later calls (it
+   returns through memory anyway, but gcc copies it out of the shared
+   result slots); left next to its first use, what rows computed before it
+   and reuse after it is spilled instead. Inline sincos (the written
+   file's default) stays next to its first use, where it keeps few values
+   live, unless the chunk has so few that they all stay in registers (then
+   the evaluations overlap). */
 enum { EMIT_TRIG_IN_REGISTERS = 8 };
 
-static bool calls_first(const Emitter *e, const SchedChunk *c)
+static int calls_first(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
 {
-    if (e->trig_calls)
-        return true;
+    int ncalls = rank_calls(e, fn, c);
+    if (e->trig_calls) {
+        int best = 0, least = INT_MAX;
+        for (e->hoist = 0; e->hoist <= ncalls; e->hoist++) {
+            int across = sched_values_across_calls(&e->sched, fn, e->chunk, goes_first, e);
+            if (across < least) {
+                least = across;
+                best = e->hoist;
+            }
+        }
+        return best;
+    }
     int values = 0;
     for (int at = 0; at < c->nnodes; at++) {
         DagOp op = dag_op(e->dag, c->nodes[at]);
         if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
             values++;
     }
-    return values <= EMIT_TRIG_IN_REGISTERS;
+    return values <= EMIT_TRIG_IN_REGISTERS ? INT_MAX : 0;
 }
 
+/* Writes the chunk's first e->hoist sin/cos calls (rank_calls). */
 static void put_calls_first(Emitter *e, StrBuf *sb, const SchedChunk *c)
 {
     e->hoisting = true;
     for (int at = 0; at < c->nnodes; at++) {
         NodeId id = c->nodes[at];
-        DagOp op = dag_op(e->dag, id);
-        if ((op == OP_SIN || op == OP_COS) && e->sched.temp[id] >= 0 && !e->written[id]
-            && !sched_is_import(&e->sched, id, e->chunk) && at_hand(e, dag_node(e->dag, id)->a))
+        if (goes_first(e, id) && !e->written[id])
             put_temporary(e, sb, c, at, id);
     }
     e->hoisting = false;
@@ -470,12 +526,14 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     e->fused += sched_prepare_chunk(&e->sched, fn, chunk);
     e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
-    for (const Param *p = function_params[which]; p->name && !e->roll; p++)
-        sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "    " : " ", p->name);
-    if (!e->roll)
+    if (!e->roll) {     /* a loop body's parameters are the function's */
+        sb_puts(sb, "    ");
+        for (const Param *p = function_params[which]; p->name; p++)
+            sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
         sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
-    if (calls_first(e, c))
-        put_calls_first(e, sb, c);
+    }
+    e->hoist = calls_first(e, fn, c);
+    put_calls_first(e, sb, c);
     int at = 0;
     for (int i = 0; i < c->count; i++) {
         for (; at < c->ends[i]; at++)
@@ -738,6 +796,7 @@ static int put_roll_body(void *emitter, const Dag *dag, SchedOutput *outs, int n
     e.dag = dag;
     e.roll = hooks;
     e.written = xcalloc((size_t)dag->count + 1, sizeof *e.written);
+    e.call_rank = xcalloc((size_t)dag->count + 1, sizeof *e.call_rank);
     sched_init(&e.sched, dag, 1 << 28);     /* one chunk: a loop body is small */
     SchedFunction fn;
     sched_function(&e.sched, outs, n, &fn);
@@ -747,6 +806,7 @@ static int put_roll_body(void *emitter, const Dag *dag, SchedOutput *outs, int n
     sched_function_free(&fn);
     sched_free(&e.sched);
     free(e.written);
+    free(e.call_rank);
     return ops;
 }
 
@@ -789,6 +849,54 @@ bool emit_function_written(const EmitOptions *opt, EmitFunction f)
     return !(opt->sparse_only && (f == EMIT_JAC || f == EMIT_ALL));
 }
 
+/* True when function f has code of its own in the file (the dense
+   Jacobian is spread from jac_nz, jac_spread.tmpl, unless direct). */
+static bool is_written(const Emitter *e, EmitFunction f)
+{
+    return (int)f < emit_function_count(e->kin) && (f != EMIT_JAC || e->opt->direct_jac)
+           && emit_function_written(e->opt, f);
+}
+
+/* Fewest calls of the file's own sin/cos functions the written functions
+   can make: each evaluates every angle it uses, two at most a call. Above
+   EMIT_INLINE_TRIG_MAX the file is written once, its calls placed as
+   real calls from the start. */
+static long pair_calls_at_least(const Emitter *e)
+{
+    const Dag *dag = e->dag;
+    size_t n = (size_t)dag->count + 1;
+    uint32_t *mark = xcalloc(n, sizeof *mark), *angle = xcalloc(n, sizeof *angle);
+    NodeId *stack = xmalloc(n * sizeof *stack), *roots = NULL;
+    long calls = 0;
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        if (!is_written(e, (EmitFunction)f))
+            continue;
+        SchedOutput *outs;
+        int nout;
+        collect_outputs(e->kin, (EmitFunction)f, &outs, &nout);
+        roots = xrealloc(roots, (size_t)nout + 1, sizeof *roots);
+        for (int i = 0; i < nout; i++)
+            roots[i] = outs[i].value;
+        dag_mark_reachable(dag, roots, nout, mark, (uint32_t)f + 1, stack);
+        long angles = 0;
+        for (NodeId id = 0; id < dag->count; id++) {
+            DagOp op = dag_op(dag, id);
+            if (mark[id] == (uint32_t)f + 1 && (op == OP_SIN || op == OP_COS)
+                && angle[dag_node(dag, id)->a] != (uint32_t)f + 1) {
+                angle[dag_node(dag, id)->a] = (uint32_t)f + 1;
+                angles++;
+            }
+        }
+        calls += (angles + 1) / 2;
+        free(outs);
+    }
+    free(mark);
+    free(angle);
+    free(stack);
+    free(roots);
+    return calls;
+}
+
 /* Schedules and writes every function into parts and bodies (initialized
    here, freed by the caller); false when the code would pass max_ops. */
 static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
@@ -803,11 +911,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
-        if (f >= emit_function_count(e->kin))
-            continue;
-        if ((f == EMIT_JAC && !opt->direct_jac) || !fits)  /* jac_spread.tmpl: on jac_nz */
-            continue;
-        if (!emit_function_written(opt, (EmitFunction)f))
+        if (!is_written(e, (EmitFunction)f) || !fits)
             continue;
         SchedOutput *outs;
         int n;
@@ -845,6 +949,19 @@ static long count_calls(const StrBuf *parts, const StrBuf *bodies, const char *n
     return n;
 }
 
+/* Calls of the written file's own sin/cos functions. Inlined at every
+   call (gcc splits the pair function at its rare-case test and calls the
+   rest out of line, through memory, unless forced), the pair takes gcc
+   -O2 several times as long as libm calls would: files with more calls
+   than EMIT_INLINE_TRIG_MAX call one copy. */
+enum { EMIT_INLINE_TRIG_MAX = 64 };
+static long pair_calls(const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
+{
+    return count_calls(parts, bodies, e->sincos_name) + count_calls(parts, bodies, e->sincos2_name) +
+           count_calls(parts, bodies, e->sin_name) + count_calls(parts, bodies, e->cos_name) +
+           count_calls(parts, bodies, e->sincos2_some_name);
+}
+
 /* The calls that leave some values unused (sin_name, cos_name,
    sincos2_some_name) as macros, the firmware rules allowing no other
    static function: where optimising (opt) the pair itself, so the bits
@@ -879,9 +996,8 @@ static _Noreturn void placeholder_bug(const char *name)
 
 /* What the kernels call for math: libm declared (JIT) or included, and
    the sincos functions the emitter used, for written files chosen by the
-   compiler (templates/trig.tmpl). parts and bodies: the written functions. */
-enum { EMIT_INLINE_TRIG_MAX = 64 };
-static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const StrBuf *bodies)
+   compiler (templates/trig.tmpl), the pair inlined unless pair_out_of_line. */
+static void put_math(StrBuf *math, const Emitter *e)
 {
     const char *upper = e->prefix_upper;
     if (e->opt->declare_math) {
@@ -908,15 +1024,7 @@ static void put_math(StrBuf *math, const Emitter *e, const StrBuf *parts, const 
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
     if (!e->sincos_used && !e->single_used)
         return;
-    /* Inlined at every call (gcc splits the pair function at its rare-case
-       test and calls the rest out of line, through memory, unless forced),
-       the pair takes gcc -O2 several times as long as libm calls would:
-       large files call one copy. */
-    bool inline_pair = count_calls(parts, bodies, e->sincos_name) +
-                       count_calls(parts, bodies, e->sincos2_name) +
-                       count_calls(parts, bodies, e->sin_name) +
-                       count_calls(parts, bodies, e->cos_name) +
-                       count_calls(parts, bodies, e->sincos2_some_name) <= EMIT_INLINE_TRIG_MAX;
+    bool inline_pair = !e->pair_out_of_line;
     char trig[160];
     snprintf(trig, sizeof trig, "%s_TRIG ", upper);
     TemplateVar sv[] = {
@@ -1098,8 +1206,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
                   "    }", upper, out->prefix, out->prefix, upper, out->prefix);
     else if (!opt->direct_jac)
         put_jac_moves(&moves, e->kin);
-    put_math(&math, e, parts, bodies);
+    put_math(&math, e);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
+    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf);
 
     EmitSizes z;
     put_sizes(e, &z);
@@ -1176,6 +1285,14 @@ static bool check_dense_size(const Kinematics *kin, const EmitOptions *opt, Diag
     return false;
 }
 
+static void free_functions(StrBuf *parts, StrBuf *bodies)
+{
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        sb_free(&parts[f]);
+        sb_free(&bodies[f]);
+    }
+}
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResult *out, Diag *diag)
 {
     const Model *m = kin->model;
@@ -1217,18 +1334,27 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
     }
     e.trig_calls = opt->declare_math || opt->libm_trig || opt->real_float;
     e.written = xcalloc((size_t)m->dag.count + 1, sizeof *e.written);
+    e.call_rank = xcalloc((size_t)m->dag.count + 1, sizeof *e.call_rank);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
+    if (!e.trig_calls && e.sin_name && pair_calls_at_least(&e) > EMIT_INLINE_TRIG_MAX)
+        e.pair_out_of_line = e.trig_calls = true;
     bool fits = put_functions(&e, parts, bodies, out);
+    if (fits && !e.trig_calls && e.sin_name && pair_calls(&e, parts, bodies) > EMIT_INLINE_TRIG_MAX) {
+        /* Written again: the pair will be one out-of-line copy, so every
+           call is a real call, placed as libm's are (calls_first). */
+        e.pair_out_of_line = e.trig_calls = true;
+        e.sincos_used = e.sincos2_used = e.single_used = false;
+        free_functions(parts, bodies);
+        fits = put_functions(&e, parts, bodies, out);
+    }
     free(e.written);
+    free(e.call_rank);
     if (fits)
         render_files(&e, parts, bodies, out);
     else
         diag_error_nopos(diag, "the generated code would have more than %ld operations, "
                          "the limit (see --max-code-ops)", opt->max_ops);
-    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
-        sb_free(&parts[f]);
-        sb_free(&bodies[f]);
-    }
+    free_functions(parts, bodies);
     return fits;
 }
 

@@ -4,6 +4,7 @@
 
 #include "../base/diag.h"
 #include "../base/limits.h"
+#include "../base/strbuf.h"
 #include "../diff/kinematics.h"
 
 #include <stdbool.h>
@@ -37,6 +38,9 @@ typedef struct EmitOptions {
                                    interface defines PREFIX_SPARSE_ONLY 1
                                    (gen --sparse-only; engines above
                                    EMIT_DENSE_MAX_ENTRIES) */
+    bool lu;                    /* also PREFIX_lu_factor and PREFIX_lu_solve
+                                   (emit_lu.c; gen --lu): the Jacobian's LU
+                                   unrolled for its pattern */
 } EmitOptions;
 
 /* The most entries of a dense matrix a generated file indexes: its
@@ -91,6 +95,16 @@ const char *emit_check_prefix(const char *prefix);
 /* Checks a --header file name (the part after the last '/', which goes
    into #include "..."): NULL when usable, else the reason it is not. */
 const char *emit_check_header_name(const char *name);
+
+/* The shortest decimal of v that reads back exactly (as a float with
+   real_float), negative ones parenthesized: how constants are written. */
+void emit_put_literal(StrBuf *sb, double v, bool real_float);
+
+/* PREFIX_lu_factor and PREFIX_lu_solve (emit_lu.c) appended to decl and
+   def when opt->lu is set and the mechanism is square, without velocity
+   rows and small enough; nothing otherwise. */
+void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
+             const char *upper, StrBuf *decl, StrBuf *def);
 
 /* Writes the C source and header. Returns false (diag filled) for an
    unusable prefix or header name, code beyond max_ops, or a dense

@@ -130,6 +130,7 @@ static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag
     eo.direct_jac = mech->kin.nnz <= 4000;
     eo.all_nz = true;       /* run's sparse path */
     eo.sparse_only = pipeline_sparse_only(mech);
+    eo.lu = true;           /* run's dense path: the unrolled LU */
     eo.source_name = mech->model->file;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))

@@ -90,6 +90,11 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->eom = (KernelEom)kernel(find, handle, prefix, "eom");
     k->mass_row = kernel(find, handle, prefix, "mass_row");
     k->mass_col = kernel(find, handle, prefix, "mass_col");
+    k->lu_factor = (KernelLuFactor)kernel(find, handle, prefix, "lu_factor");
+    k->lu_solve = (KernelLuSolve)kernel(find, handle, prefix, "lu_solve");
+    k->lu_step = (KernelLuStep)kernel(find, handle, prefix, "step");
+    if (!k->lu_factor || !k->lu_solve || !k->lu_step)
+        k->lu_factor = NULL, k->lu_solve = NULL, k->lu_step = NULL;
     bool dynamics = k->mass && k->mass_nz && k->force && k->eom && k->mass_row && k->mass_col;
     bool none = !k->mass && !k->mass_nz && !k->force && !k->eom && !k->mass_row && !k->mass_col;
     /* a sparse-only unit has neither dense function, and all_nz instead */

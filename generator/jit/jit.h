@@ -9,6 +9,10 @@ typedef void (*KernelGamma)(const double *q, const double *qd, double t, double 
 typedef void (*KernelAll)(const double *q, const double *qd, double t,
                           double *phi, double *jac, double *nu, double *gamma);
 typedef void (*KernelMass)(const double *q, double *M);
+typedef int (*KernelLuFactor)(const double *a, double *lu, double pivot_tol, double *spread);
+typedef void (*KernelLuSolve)(const double *lu, const double *b, double *x);
+typedef int (*KernelLuStep)(double *q, double *qd, double *qdd, double t, double h,
+                            const double *tol, int max_iter, double *out, int *iout);
 typedef void (*KernelEom)(const double *q, const double *qd, double t,
                           double *M, double *Q, double *jac, double *gamma);
 
@@ -29,6 +33,12 @@ typedef struct Kernels {
     KernelGamma force;
     KernelEom eom;
     const int *mass_row, *mass_col;
+    /* The Jacobian's LU unrolled for its pattern (emit_lu.c); NULL in a
+       unit written without it or for a mechanism it does not serve. */
+    KernelLuFactor lu_factor;
+    KernelLuSolve lu_solve;
+    KernelLuStep lu_step;   /* PREFIX_step: the kinematic step over them
+                               (above 24 coordinates one that declines) */
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */

@@ -33,9 +33,16 @@ typedef struct Vec3 {
     NodeId x, y, z;
 } Vec3;
 
-/* A body-fixed frame of a joint side: its axis and two perpendiculars, global. */
+/* A body-fixed vector s of a joint side, not yet turned: A(p) s is built
+   only where a product needs it (see axis_dot). */
+typedef struct Axis3 {
+    Attach at;
+    double s[3];
+} Axis3;
+
+/* A joint side's axis and two perpendiculars, body-fixed. */
 typedef struct Frame3 {
-    Vec3 h, f, g;
+    Axis3 h, f, g;
 } Frame3;
 
 static Vec3 v3_const(Dag *d, const double v[3])
@@ -101,13 +108,16 @@ static Vec3 euler_vector(Dag *d, Attach at)
     return (Vec3){e1, e2, e3};
 }
 
-/* A(p) s = (2 e0^2 - 1) s + 2 (e (e^T s) + e0 (e x s)); ground and points
-   do not turn: s itself. */
+/* A(p) s = (2 e0^2 - 1) s + e (e^T 2s) + e0 (e x 2s): the factor 2 in
+   the constant vector, where it folds into s's components; ground and
+   points do not turn: s itself. */
 static Vec3 rotate3(Dag *d, Attach at, const double local[3])
 {
     Vec3 s = v3_const(d, local);
     if (!at.has_p)
         return s;
+    double twice[3] = {2 * local[0], 2 * local[1], 2 * local[2]};
+    Vec3 s2 = v3_const(d, twice);
     NodeId two = dag_const(d, 2.0);
     NodeId e0 = dag_var(d, at.q + 3);
     Vec3 e = euler_vector(d, at);
@@ -115,13 +125,12 @@ static Vec3 rotate3(Dag *d, Attach at, const double local[3])
     NodeId c2 = dag_mul(d, two, e00);
     NodeId c = dag_sub(d, c2, DAG_ONE);
     Vec3 cs = v3_scale(d, c, s);
-    NodeId es = v3_dot(d, e, s);
+    NodeId es = v3_dot(d, e, s2);
     Vec3 ees = v3_scale(d, es, e);
-    Vec3 exs = v3_cross(d, e, s);
+    Vec3 exs = v3_cross(d, e, s2);
     Vec3 e0exs = v3_scale(d, e0, exs);
     Vec3 sum = v3_add(d, ees, e0exs);
-    Vec3 twice = v3_scale(d, two, sum);
-    return v3_add(d, cs, twice);
+    return v3_add(d, cs, sum);
 }
 
 /* P = r + A(p) s (ground: s, the global point; a point: r). */
@@ -170,20 +179,67 @@ void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f
     g[2] = h[0] * f[1] - h[1] * f[0];
 }
 
-/* The global h, f, g of side A (b false: the axis (ux, uy, uz)) or B. */
-static Frame3 frame3(Dag *d, const Joint *j, bool b)
+/* The h, f, g of side A (b false: the axis (ux, uy, uz)) or B. */
+static Frame3 frame3(const Joint *j, bool b)
 {
-    double h[3], f[3], g[3];
-    if (b)
-        joints_spatial_frame(j->bx, j->by, j->bz, h, f, g);
-    else
-        joints_spatial_frame(j->ux, j->uy, j->uz, h, f, g);
-    Attach at = b ? j->b : j->a;
     Frame3 fr;
-    fr.h = rotate3(d, at, h);
-    fr.f = rotate3(d, at, f);
-    fr.g = rotate3(d, at, g);
+    if (b)
+        joints_spatial_frame(j->bx, j->by, j->bz, fr.h.s, fr.f.s, fr.g.s);
+    else
+        joints_spatial_frame(j->ux, j->uy, j->uz, fr.h.s, fr.f.s, fr.g.s);
+    fr.h.at = fr.f.at = fr.g.at = b ? j->b : j->a;
     return fr;
+}
+
+static Vec3 axis_global(Dag *d, Axis3 v)
+{
+    return rotate3(d, v.at, v.s);
+}
+
+/* c^T A(p) s for a constant c, written so each factor is linear in p:
+     (2 e0^2 - 1) c^T s + (c^T e)(2s^T e) + e0 e^T (2s x c)
+   (c^T (e x s) = e^T (s x c)). The same polynomial as c^T (A(p) s), in
+   fewer operations, and its derivatives stay products of linear forms
+   (a joint to ground or a driver against ground). */
+static NodeId fixed_dot(Dag *d, const double c[3], Axis3 v)
+{
+    const double *s = v.s;
+    double s2[3] = {2 * s[0], 2 * s[1], 2 * s[2]};
+    double sc2[3] = {s2[1] * c[2] - s2[2] * c[1], s2[2] * c[0] - s2[0] * c[2], s2[0] * c[1] - s2[1] * c[0]};
+    double cs = c[0] * s[0] + c[1] * s[1] + c[2] * s[2];
+    NodeId e0 = dag_var(d, v.at.q + 3);
+    Vec3 e = euler_vector(d, v.at);
+    NodeId sum = DAG_ZERO;
+    if (cs != 0.0) {
+        NodeId two = dag_const(d, 2.0);
+        NodeId e00 = dag_mul(d, e0, e0);
+        NodeId c2 = dag_mul(d, two, e00);
+        NodeId cc = dag_sub(d, c2, DAG_ONE);
+        NodeId k = dag_const(d, cs);
+        sum = dag_mul(d, k, cc);
+    }
+    Vec3 cv = v3_const(d, c);
+    Vec3 s2v = v3_const(d, s2);
+    NodeId ce = v3_dot(d, cv, e);
+    NodeId se = v3_dot(d, s2v, e);
+    NodeId quad = dag_mul(d, ce, se);
+    sum = dag_add(d, sum, quad);
+    Vec3 scv = v3_const(d, sc2);
+    NodeId esc = v3_dot(d, e, scv);
+    NodeId lin = dag_mul(d, e0, esc);
+    return dag_add(d, sum, lin);
+}
+
+/* (A(p_a) a)^T (A(p_b) b); one side fixed (ground or a point): fixed_dot. */
+static NodeId axis_dot(Dag *d, Axis3 a, Axis3 b)
+{
+    if (!a.at.has_p && b.at.has_p)
+        return fixed_dot(d, a.s, b);
+    if (a.at.has_p && !b.at.has_p)
+        return fixed_dot(d, b.s, a);
+    Vec3 ga = axis_global(d, a);
+    Vec3 gb = axis_global(d, b);
+    return v3_dot(d, ga, gb);
 }
 
 /* spherical: P_A - P_B = 0 (rows[0..2]) */
@@ -198,8 +254,8 @@ static void spherical(Dag *d, const Joint *j, NodeId rows[3])
 /* .f, .g: dot-1 fA^T hB = 0, gA^T hB = 0 (the axes stay parallel) */
 static void parallel(Dag *d, const Frame3 *a, const Frame3 *b, NodeId rows[2])
 {
-    rows[0] = v3_dot(d, a->f, b->h);
-    rows[1] = v3_dot(d, a->g, b->h);
+    rows[0] = axis_dot(d, a->f, b->h);
+    rows[1] = axis_dot(d, a->g, b->h);
 }
 
 /* cylindrical: .f, .g parallel axes; .df, .dg dot-2 fA^T d = 0, gA^T d = 0,
@@ -208,22 +264,21 @@ static void cylindrical(Dag *d, const Joint *j, const Frame3 *a, const Frame3 *b
 {
     parallel(d, a, b, rows);
     Vec3 e = difference3(d, j->b, j->a);
-    rows[2] = v3_dot(d, a->f, e);
-    rows[3] = v3_dot(d, a->g, e);
+    Vec3 fa = axis_global(d, a->f), ga = axis_global(d, a->g);
+    rows[2] = v3_dot(d, fa, e);
+    rows[3] = v3_dot(d, ga, e);
 }
 
 /* weld: .x .y .z spherical; .xy, .yz, .zx dot-1 xA^T yB, yA^T zB, zA^T xB
    (B's axes stay those of A: the relative orientation is the identity) */
 static void weld(Dag *d, const Joint *j, NodeId rows[6])
 {
-    static const double ex[3] = {1, 0, 0}, ey[3] = {0, 1, 0}, ez[3] = {0, 0, 1};
     spherical(d, j, rows);
-    Vec3 xa = rotate3(d, j->a, ex), yb = rotate3(d, j->b, ey);
-    rows[3] = v3_dot(d, xa, yb);
-    Vec3 ya = rotate3(d, j->a, ey), zb = rotate3(d, j->b, ez);
-    rows[4] = v3_dot(d, ya, zb);
-    Vec3 za = rotate3(d, j->a, ez), xb = rotate3(d, j->b, ex);
-    rows[5] = v3_dot(d, za, xb);
+    Axis3 xa = {j->a, {1, 0, 0}}, ya = {j->a, {0, 1, 0}}, za = {j->a, {0, 0, 1}};
+    Axis3 xb = {j->b, {1, 0, 0}}, yb = {j->b, {0, 1, 0}}, zb = {j->b, {0, 0, 1}};
+    rows[3] = axis_dot(d, xa, yb);
+    rows[4] = axis_dot(d, ya, zb);
+    rows[5] = axis_dot(d, za, xb);
 }
 
 /* omega = 2 E(p) p', E = [-e, e~ + e0 I]: a spatial body's angular velocity, global */
@@ -313,13 +368,13 @@ static NodeId norm(Dag *d, Attach at)
 /* The position-level kinds built on a frame pair. */
 static void framed(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(d, j, false);
-    Frame3 b = frame3(d, j, true);
+    Frame3 a = frame3(j, false);
+    Frame3 b = frame3(j, true);
     switch (j->kind) {
     /* universal: spherical; .dot dot-1 hA^T hB = 0 */
     case JOINT_S_UNIVERSAL:
         spherical(d, j, rows);
-        rows[3] = v3_dot(d, a.h, b.h);
+        rows[3] = axis_dot(d, a.h, b.h);
         return;
     /* revolute: spherical; .f, .g parallel axes */
     case JOINT_S_REVOLUTE:
@@ -332,12 +387,13 @@ static void framed(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
     /* translational: cylindrical; .rot dot-1 gA^T fB = 0 (no turning about h) */
     case JOINT_S_TRANSLATIONAL:
         cylindrical(d, j, &a, &b, rows);
-        rows[4] = v3_dot(d, a.g, b.f);
+        rows[4] = axis_dot(d, a.g, b.f);
         return;
     /* pointplane: dot-2 hA^T (P_B - P_A) = 0 */
     case JOINT_S_POINTPLANE: {
         Vec3 e = difference3(d, j->b, j->a);
-        rows[0] = v3_dot(d, a.h, e);
+        Vec3 ha = axis_global(d, a.h);
+        rows[0] = v3_dot(d, ha, e);
         return;
     }
     case JOINT_S_PARALLEL:
@@ -345,7 +401,7 @@ static void framed(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
         return;
     /* perpendicular: dot-1 hA^T hB = 0 */
     case JOINT_S_PERPENDICULAR:
-        rows[0] = v3_dot(d, a.h, b.h);
+        rows[0] = axis_dot(d, a.h, b.h);
         return;
     default:
         return;
@@ -362,10 +418,14 @@ void joints_spatial_lower(Model *model, const Joint *j, NodeId rows[JOINT_MAX_RO
     case JOINT_S_WELD:
         weld(d, j, rows);
         return;
-    /* distance: d^T d - L^2 = 0, d = P_B - P_A */
+    /* distance: d^T d - L^2 = 0, d = P_B - P_A; a length written as
+       sqrt(u) gives L^2 = u, without the square root and the divisions
+       its derivatives would bring into nu and gamma (a leg length from
+       closed-form inverse kinematics is one). */
     case JOINT_S_DISTANCE: {
         Vec3 e = difference3(d, j->b, j->a);
-        NodeId l2 = dag_mul(d, j->option, j->option);
+        const DagNode *len = dag_node(d, j->option);
+        NodeId l2 = len->op == OP_SQRT ? len->a : dag_mul(d, j->option, j->option);
         NodeId ee = v3_dot(d, e, e);
         rows[0] = dag_sub(d, ee, l2);
         return;
@@ -397,9 +457,10 @@ void joints_spatial_point(Model *model, Attach at, NodeId xyz[3])
 NodeId joints_spatial_slide(Model *model, const Joint *j)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(d, j, false);
+    Frame3 a = frame3(j, false);
     Vec3 e = difference3(d, j->b, j->a);
-    return v3_dot(d, a.h, e);
+    Vec3 ha = axis_global(d, a.h);
+    return v3_dot(d, ha, e);
 }
 
 /* With fB = cos(angle) fA + sin(angle) gA about the common axis:
@@ -407,10 +468,10 @@ NodeId joints_spatial_slide(Model *model, const Joint *j)
 NodeId joints_spatial_angle(Model *model, const Joint *j)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(d, j, false);
-    Frame3 b = frame3(d, j, true);
-    NodeId c = v3_dot(d, a.f, b.f);
-    NodeId s = v3_dot(d, a.g, b.f);
+    Frame3 a = frame3(j, false);
+    Frame3 b = frame3(j, true);
+    NodeId c = axis_dot(d, a.f, b.f);
+    NodeId s = axis_dot(d, a.g, b.f);
     return dag_call(d, OP_ATAN2, s, c);
 }
 
@@ -419,10 +480,10 @@ NodeId joints_spatial_angle(Model *model, const Joint *j)
 NodeId joints_spatial_angle_row(Model *model, const Joint *j, NodeId theta)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(d, j, false);
-    Frame3 b = frame3(d, j, true);
-    NodeId c = v3_dot(d, a.f, b.f);
-    NodeId s = v3_dot(d, a.g, b.f);
+    Frame3 a = frame3(j, false);
+    Frame3 b = frame3(j, true);
+    NodeId c = axis_dot(d, a.f, b.f);
+    NodeId s = axis_dot(d, a.g, b.f);
     NodeId ct = dag_call(d, OP_COS, theta, DAG_NONE);
     NodeId st = dag_call(d, OP_SIN, theta, DAG_NONE);
     NodeId left = dag_mul(d, ct, s);

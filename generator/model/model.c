@@ -504,6 +504,53 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     }
 }
 
+/* A side's axis u at the start, global: turned by its body's initial
+   Euler parameters (ground and points do not turn). */
+static void initial_axis(const Model *m, Attach at, const double u[3], double out[3])
+{
+    if (!at.has_p) {
+        for (int i = 0; i < 3; i++)
+            out[i] = u[i];
+        return;
+    }
+    orient_rotate(m->q0 + at.q + 3, u, out);
+}
+
+/* A universal's or perpendicular's row hA^T hB = 0 has no gradient in the
+   orientations where the two axes are parallel (d(hA^T hB) = (wA - wB)^T
+   (hA x hB)): assembly cannot start there, and the joint as written is
+   not what was meant. Parallel: |hA x hB| <= 1e-9 |hA| |hB|. */
+static void check_not_parallel(Builder *b, const Stmt *s, const Joint *j, double u[2][3])
+{
+    double ha[3], hb[3];
+    initial_axis(b->model, j->a, u[0], ha);
+    initial_axis(b->model, j->b, u[1], hb);
+    double c[3] = {ha[1] * hb[2] - ha[2] * hb[1], ha[2] * hb[0] - ha[0] * hb[2],
+                   ha[0] * hb[1] - ha[1] * hb[0]};
+    double na = sqrt(ha[0] * ha[0] + ha[1] * ha[1] + ha[2] * ha[2]);
+    double nb = sqrt(hb[0] * hb[0] + hb[1] * hb[1] + hb[2] * hb[2]);
+    double nc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (nc <= 1e-9 * na * nb)
+        diag_fail(b->diag, s->axis_b_pos,
+                  "the two axes of %s '%s' are parallel in the initial orientations: its "
+                  "row keeps them perpendicular and has no gradient where they are parallel",
+                  joint_info[s->joint].keyword, s->name);
+}
+
+/* A rolling disk lying flat (its axle vertical) has no lowest rim point:
+   its rows divide by the axle's horizontal length (joints_spatial.c). */
+static void check_not_flat(Builder *b, const Stmt *s, const Joint *j, const double u[3])
+{
+    double a[3];
+    initial_axis(b->model, j->a, u, a);
+    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (sqrt(a[0] * a[0] + a[1] * a[1]) <= 1e-9 * n)
+        diag_fail(b->diag, s->axis_pos,
+                  "the disk of rolling '%s' lies flat in its initial orientation (its axle "
+                  "is vertical): it has no lowest rim point, and its rows are not defined",
+                  s->name);
+}
+
 /* A spatial joint's axes: A's (ux, uy, uz), B's (bx, by, bz), neither zero. */
 static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
 {
@@ -519,6 +566,10 @@ static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
     }
     j->ux = u[0][0], j->uy = u[0][1], j->uz = u[0][2];
     j->bx = u[1][0], j->by = u[1][1], j->bz = u[1][2];
+    if (s->joint == JOINT_S_UNIVERSAL || s->joint == JOINT_S_PERPENDICULAR)
+        check_not_parallel(b, s, j, u);
+    if (s->joint == JOINT_S_ROLLING)
+        check_not_flat(b, s, j, u[0]);
 }
 
 /* A rolling disk's holonomic companion: its contact point on the plane

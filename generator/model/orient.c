@@ -51,3 +51,13 @@ bool orient_to_euler(int kind, const double arg[4], double p[4])
         p[i] /= n;
     return true;
 }
+
+void orient_rotate(const double p[4], const double u[3], double out[3])
+{
+    const double *e = p + 1;
+    double c = 2 * p[0] * p[0] - 1;
+    double eu = e[0] * u[0] + e[1] * u[1] + e[2] * u[2];
+    double exu[3] = {e[1] * u[2] - e[2] * u[1], e[2] * u[0] - e[0] * u[2], e[0] * u[1] - e[1] * u[0]};
+    for (int i = 0; i < 3; i++)
+        out[i] = c * u[i] + 2 * (e[i] * eu + p[0] * exu[i]);
+}

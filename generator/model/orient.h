@@ -15,4 +15,8 @@
    False (p the identity) for a zero or non-finite axis. */
 bool orient_to_euler(int kind, const double arg[4], double p[4]);
 
+/* out = A(p) u, A(p) = (2 e0^2 - 1) I + 2 (e e^T + e0 e~): the body-fixed
+   vector u in the global frame (out may not be u). */
+void orient_rotate(const double p[4], const double u[3], double out[3]);
+
 #endif

@@ -93,4 +93,21 @@ int sched_prepare_chunk(Scheduler *s, const SchedFunction *fn, int chunk);
    multiplication is symmetric in sign). */
 bool sched_fused_negation(const Scheduler *s, NodeId id);
 
+/* In the prepared chunk: how many temporaries would be computed before a
+   call and used after it (so spilled across it), the calls written where
+   the chunk's order puts them, except those at_top(ctx, id) says go to the
+   chunk's top (at_top NULL: none). A sin and cos of one angle are one call
+   (spill.c). */
+int sched_values_across_calls(const Scheduler *s, const SchedFunction *fn, int chunk,
+                              bool (*at_top)(const void *ctx, NodeId id), const void *ctx);
+
+/* In the prepared chunk: the sin or cos id and its partner (both
+   computed here) are multiplied by one and the same computed factor, as
+   in γ's 0.5 qd² (cos, sin): gcc's SLP vectorizer then multiplies them as
+   one vector, loaded in one piece from the two results sincos stored
+   just before, a store-forwarding stall of a dozen cycles where they are
+   used next to the call; a copy out of the result slots (the pair
+   hoisted above a later call) avoids it (spill.c). */
+bool sched_pair_shares_factor(const Scheduler *s, const SchedFunction *fn, int chunk, NodeId id);
+
 #endif

@@ -173,19 +173,45 @@ static int fr_reads_back(const FrScaled *sc, uint64_t cx)
     return -1;
 }
 
-/* printf's %.<p>g of the p digits q (value q 10^(exp10 - p + 1)). */
+/* Bytes of buffer the fast path needs (fr_put_g's fixed copies). */
+#define FR_ROOM 36
+
+static const char fr_pairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/* The 4 digits of v < 10^4 at d. */
+static void fr_put4(char *d, uint32_t v)
+{
+    memcpy(d, fr_pairs + 2 * (v / 100), 2);
+    memcpy(d + 2, fr_pairs + 2 * (v % 100), 2);
+}
+
+/* The 18 digits of q < 10^18 at d (leading zeros included): three
+   independent chains of 32-bit divisions by constants, not 9 dependent
+   64-bit ones. */
+static void fr_put18(char *d, uint64_t q)
+{
+    uint32_t lo = (uint32_t)(q % 100000000u);
+    uint64_t rest = q / 100000000u;
+    uint32_t mid = (uint32_t)(rest % 100000000u), hi = (uint32_t)(rest / 100000000u);
+    memcpy(d, fr_pairs + 2 * hi, 2);
+    fr_put4(d + 2, mid / 10000);
+    fr_put4(d + 6, mid % 10000);
+    fr_put4(d + 10, lo / 10000);
+    fr_put4(d + 14, lo % 10000);
+}
+
+/* printf's %.<p>g of the p digits q (value q 10^(exp10 - p + 1)). buf has
+   room for FR_ROOM bytes: the digits go by fixed-size copies (a copy of a
+   variable length is a library call), the length counted apart; the
+   copies reach at most buf + 35. */
 static int fr_put_g(char *buf, bool neg, uint64_t q, int p, int exp10)
 {
-    static const char pairs[] =
-        "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
-        "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
-        "8081828384858687888990919293949596979899";
-    char dig[20];
-    int at = p;
-    for (; at >= 2; at -= 2, q /= 100)   /* two digits a division */
-        memcpy(dig + at - 2, pairs + 2 * (q % 100), 2);
-    if (at)
-        dig[0] = (char)('0' + q);
+    char all[40];   /* 18 digits; the fixed copies read up to all + 34 */
+    fr_put18(all, q);
+    const char *dig = all + 18 - p;
     int len = p, n = 0;
     while (len > 1 && dig[len - 1] == '0')
         len--;
@@ -195,7 +221,7 @@ static int fr_put_g(char *buf, bool neg, uint64_t q, int p, int exp10)
         buf[n++] = dig[0];
         if (len > 1) {
             buf[n++] = '.';
-            memcpy(buf + n, dig + 1, (size_t)len - 1);
+            memcpy(buf + n, dig + 1, 16);
             n += len - 1;
         }
         int a = exp10 < 0 ? -exp10 : exp10;
@@ -206,19 +232,17 @@ static int fr_put_g(char *buf, bool neg, uint64_t q, int p, int exp10)
         buf[n++] = (char)('0' + a / 10 % 10);
         buf[n++] = (char)('0' + a % 10);
     } else if (exp10 >= 0) {
-        memcpy(buf + n, dig, (size_t)exp10 + 1);
+        memcpy(buf + n, dig, 17);
         n += exp10 + 1;
         if (len > exp10 + 1) {
             buf[n++] = '.';
-            memcpy(buf + n, dig + exp10 + 1, (size_t)(len - exp10 - 1));
+            memcpy(buf + n, dig + exp10 + 1, 16);
             n += len - exp10 - 1;
         }
     } else {
-        buf[n++] = '0';
-        buf[n++] = '.';
-        for (int i = 0; i < -exp10 - 1; i++)
-            buf[n++] = '0';
-        memcpy(buf + n, dig, (size_t)len);
+        memcpy(buf + n, "0.0000", 6);
+        n += 1 - exp10;
+        memcpy(buf + n, dig, 17);
         n += len;
     }
     buf[n] = '\0';
@@ -241,7 +265,7 @@ static bool fr_emit(char *buf, const FrScaled *sc, bool neg, int p, uint64_t q, 
 static bool format_fast(char *buf, size_t size, double v, int digits, int *n)
 {
     FrScaled sc;
-    if (size < 32 || digits > 17 || !fr_scale(v, &sc))
+    if (size < FR_ROOM || digits > 17 || !fr_scale(v, &sc))
         return false;
     bool neg = v < 0;
     uint64_t q, cx;

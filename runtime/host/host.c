@@ -14,7 +14,10 @@
  * Newton method for underdetermined systems).
  *
  * Workspaces are allocated once in mechrt_host_new; the calls per step
- * allocate nothing. GSL's error handler (abort by default) is switched off
+ * allocate nothing. mechrt_host_new_sparse keeps no dense matrix: its
+ * velocity solves are KLU's (sparse_klu.c) and its projection steps
+ * SuiteSparseQR's minimum-norm ones (sparse_qr.c, which allocates its
+ * factors per step, as SuiteSparseQR does). GSL's error handler (abort by default) is switched off
  * around every GSL call and restored afterwards: failures come back as
  * statuses, never as an abort.
  */
@@ -36,6 +39,9 @@ struct MechrtHost {
     double *jac;                /* nr * nq */
     double *dq, *y;             /* nq each */
     MechrtSvd *svd;             /* nh x nq (svd.c) */
+    /* the sparse host (mechrt_host_new_sparse): no jac, svd or dense work */
+    MechrtHostSparse *sp;       /* KLU of [Phi_q; A] (sparse_klu.c) */
+    MechrtHostMinNorm *mn;      /* SuiteSparseQR of Phi_q^T (sparse_qr.c) */
     /* integration */
     gsl_odeiv2_step *step;
     MechrtOdeMethod step_method;
@@ -85,6 +91,8 @@ void mechrt_host_free(MechrtHost *h)
     free(h->y);
     free(h->fail_q);
     mechrt_svd_free(h->svd);
+    mechrt_host_sparse_free(h->sp);
+    mechrt_host_minnorm_free(h->mn);
     if (h->step)
         gsl_odeiv2_step_free(h->step);
     if (h->control)
@@ -94,9 +102,12 @@ void mechrt_host_free(MechrtHost *h)
     free(h);
 }
 
-MechrtHost *mechrt_host_new(const MechrtKernels *k)
+/* The host of k with its dense workspaces (jnz NULL) or its sparse
+   factorisations. */
+static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz)
 {
-    if (!k || k->nq < 1 || k->nh < 0 || k->nv < 0 || k->nh > k->nq)
+    if (!k || k->nq < 1 || k->nh < 0 || k->nv < 0 || k->nh > k->nq
+        || (jnz && k->nh + k->nv != k->nq))
         return NULL;
     MechrtHost *h = calloc(1, sizeof *h);
     if (!h)
@@ -107,15 +118,20 @@ MechrtHost *mechrt_host_new(const MechrtKernels *k)
     h->nq = k->nq;
     h->nh = k->nh;
     h->nr = k->nh + k->nv;
-    h->lwork = mechrt_workspace_size(k->nq, h->nr > k->nq ? h->nr : k->nq);
+    /* sparse: mechrt_host_sparse_velocity's 3 nq */
+    h->lwork = jnz ? 3 * nq : mechrt_workspace_size(k->nq, h->nr > k->nq ? h->nr : k->nq);
     h->work = h->lwork ? malloc(h->lwork * sizeof *h->work) : NULL;
     h->phi = malloc((nh + 1) * sizeof *h->phi);
-    h->jac = malloc((size_t)h->nr * nq * sizeof *h->jac + 1);
+    h->jac = jnz ? NULL : malloc((size_t)h->nr * nq * sizeof *h->jac + 1);
     h->dq = malloc(nq * sizeof *h->dq);
     h->y = malloc(nq * sizeof *h->y);
     h->fail_q = calloc(nq, sizeof *h->fail_q);
-    bool ok = h->work && h->phi && h->jac && h->dq && h->y && h->fail_q;
-    if (ok && nh > 0) {
+    bool ok = h->work && h->phi && (jnz || h->jac) && h->dq && h->y && h->fail_q;
+    if (ok && jnz) {
+        h->sp = mechrt_host_sparse_new(k->nq, jnz);
+        h->mn = nh > 0 ? mechrt_host_minnorm_new(k->nh, k->nq, jnz) : NULL;
+        ok = h->sp && (nh == 0 || h->mn);
+    } else if (ok && nh > 0) {
         h->svd = mechrt_svd_new(k->nh, k->nq);
         ok = h->svd != NULL;
     }
@@ -130,6 +146,30 @@ MechrtHost *mechrt_host_new(const MechrtKernels *k)
         return NULL;
     }
     return h;
+}
+
+MechrtHost *mechrt_host_new(const MechrtKernels *k)
+{
+    return host_new(k, NULL);
+}
+
+MechrtHost *mechrt_host_new_sparse(const MechrtKernels *k, const MechrtHostJacNz *jnz)
+{
+    return jnz ? host_new(k, jnz) : NULL;
+}
+
+MechrtHostSparse *mechrt_host_sparse_of(MechrtHost *h)
+{
+    return h ? h->sp : NULL;
+}
+
+MechrtStatus mechrt_host_velocity_acceleration(MechrtHost *h, const MechrtOptions *o,
+                                               const double *q, double t, double *qd,
+                                               double *qdd, MechrtReport *report)
+{
+    if (h->sp)
+        return mechrt_host_sparse_velocity(h->sp, h->k, o, q, t, qd, qdd, h->work, report);
+    return mechrt_velocity_acceleration(h->k, o, q, t, qd, qdd, h->work, h->lwork, report);
 }
 
 const MechrtHostStats *mechrt_host_stats(const MechrtHost *h) { return &h->stats; }
@@ -173,6 +213,8 @@ static MechrtStatus min_norm_step(MechrtHost *h, const MechrtOptions *o, const d
 {
     const MechrtKernels *k = h->k;
     MechrtSvdResult sv;
+    if (h->mn)
+        return mechrt_host_minnorm_step(h->mn, q, t, h->phi, o->pivot_tol, h->dq);
     k->jac(k->ctx, q, t, h->jac);
     if (!mechrt_svd(h->svd, h->jac, h->nh, h->nq, h->nq, -1, &sv))
         return MECHRT_ENOTFINITE;
@@ -250,7 +292,10 @@ static int ode_rhs(double t, const double y[], double dydt[], void *params)
     MechrtHost *h = params;
     h->stats.rhs_calls++;
     MechrtReport rep;
-    MechrtStatus st = mechrt_velocity(h->k, &h->rhs_opts, y, t, dydt, h->work, h->lwork, &rep);
+    MechrtStatus st = h->sp ? mechrt_host_sparse_velocity(h->sp, h->k, &h->rhs_opts, y, t, dydt,
+                                                          NULL, h->work, &rep)
+                            : mechrt_velocity(h->k, &h->rhs_opts, y, t, dydt, h->work, h->lwork,
+                                              &rep);
     if (st == MECHRT_OK)
         return GSL_SUCCESS;
     if (h->fail_status == MECHRT_OK) {

@@ -53,11 +53,28 @@ typedef struct MechrtHostStats {
 /* ---- The host object (host.c) ------------------------------------------ */
 
 typedef struct MechrtHost MechrtHost;
+/* Defined below (the sparse Jacobian). */
+typedef struct MechrtHostJacNz MechrtHostJacNz;
+typedef struct MechrtHostSparse MechrtHostSparse;
 
 /* Workspaces for the mechanism of k (which must outlive the host).
    NULL when out of memory or k is malformed. */
 MechrtHost *mechrt_host_new(const MechrtKernels *k);
 void mechrt_host_free(MechrtHost *h);
+/* The same on the sparse Jacobian of pattern jnz (whose arrays must outlive
+   the host): velocity solves by KLU, the projection's minimum-norm steps
+   by SuiteSparseQR; nothing of size nr x nq or nq x nq is allocated.
+   Needs nh + nv == nq. */
+MechrtHost *mechrt_host_new_sparse(const MechrtKernels *k, const MechrtHostJacNz *jnz);
+/* Velocity and acceleration at (q, t) (mechrt_velocity_acceleration, dense
+   or on the sparse host's KLU). */
+MechrtStatus mechrt_host_velocity_acceleration(MechrtHost *h, const MechrtOptions *o,
+                                               const double *q, double t, double *qd,
+                                               double *qdd, MechrtReport *report);
+/* The sparse host's factorisation (NULL for a dense host): the failing
+   pivot of its last ESING, its counts. */
+MechrtHostSparse *mechrt_host_sparse_of(MechrtHost *h);
+
 const MechrtHostStats *mechrt_host_stats(const MechrtHost *h);
 
 /* Gauss-Newton on the nh holonomic rows, any nh <= nq (nh == 0: nothing
@@ -156,7 +173,7 @@ double mechrt_host_singular_direction(int m, int n, const double *a, double *row
    PREFIX_jac_nz with its fixed pattern PREFIX_jac_row, PREFIX_jac_col):
    entry e sits at (row[e], col[e]); jac_nz writes the nnz values in that
    order. The arrays must outlive every user. */
-typedef struct MechrtHostJacNz {
+struct MechrtHostJacNz {
     int nnz;
     const int *row, *col;
     void *ctx;              /* passed unchanged to jac_nz and all_nz */
@@ -165,9 +182,13 @@ typedef struct MechrtHostJacNz {
        (PREFIX_all_nz); may be NULL */
     void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
                    double *vals, double *nu, double *gamma);
-} MechrtHostJacNz;
-
-typedef struct MechrtHostSparse MechrtHostSparse;
+    /* The pattern's unrolled LU (PREFIX_lu_factor, PREFIX_lu_solve, as
+       MechrtLuGen's: factors in at most nq*nq reals); both may be NULL */
+    int (*lu_factor)(void *ctx, const double *a, double *lu, double pivot_tol, double *spread);
+    void (*lu_solve)(void *ctx, const double *lu, const double *b, double *x);
+    int (*lu_step)(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                   const double *tol, int max_iter, double *out, int *iout);
+};
 
 /* The n x n matrix of pattern jnz (copied; its arrays are kept by
    pointer), analysed once. NULL when out of memory, or an index is out of
@@ -201,6 +222,60 @@ double mechrt_host_sparse_condest(MechrtHostSparse *s);
 void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col);
 /* Fresh factorisations (with pivot search) and refactorisations done. */
 void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored);
+/* Drops the factors: the next factorisation searches its pivots afresh. */
+void mechrt_host_sparse_refresh(MechrtHostSparse *s);
+
+/* ---- Sparse augmented matrix (sparse_kkt.c) -------------------------------
+   [W Phi_A^T; Phi_A 0] for forward dynamics (W = M) and minimum-norm
+   projections (W = I) of large mechanisms: M's and Phi_q's nonzeros, the
+   rows left out as identity rows (their unknown y_i = b_i), KLU. */
+
+/* M's nonzeros as generated code gives them (PREFIX_mass_nz with its
+   pattern PREFIX_mass_row, PREFIX_mass_col; both triangles). */
+typedef struct MechrtHostMassNz {
+    int nnz;
+    const int *row, *col;
+    void *ctx;
+    void (*mass_nz)(void *ctx, const double *q, double *vals);
+} MechrtHostMassNz;
+
+typedef enum MechrtKktWeight { MECHRT_KKT_MASS, MECHRT_KKT_IDENTITY } MechrtKktWeight;
+
+typedef struct MechrtHostKkt MechrtHostKkt;
+
+/* For nq coordinates and nr rows with the two patterns (kept by pointer
+   only while this call runs); NULL when out of memory or a pattern is bad. */
+MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
+                                   const MechrtHostMassNz *mnz);
+void mechrt_host_kkt_free(MechrtHostKkt *s);
+/* Where the caller writes Phi_q's nonzeros (jac_nz, all_nz) and M's
+   (mass_nz) for the next factorisation. */
+double *mechrt_host_kkt_jac(MechrtHostKkt *s);
+double *mechrt_host_kkt_mass(MechrtHostKkt *s);
+/* Factors the matrix of weight w keeping row r where r < rows and
+   active[r] (active NULL: every one of the first rows); the statuses of
+   mechrt_host_sparse_factor. */
+MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
+                                    const unsigned char *active, int rows, double pivot_tol);
+/* The rank screen: [I Phi_q^T; Phi_q 0] with the first `rows` rows
+   factored with a fresh pivot search, into factors of its own. Partial
+   pivoting shows a rank drop near as a small pivot; a refactorisation's
+   old order need not (a drop of many ranks can spread over many moderate
+   pivots). *spread = max|u_kk| / min|u_kk|; the statuses of
+   mechrt_host_kkt_factor. */
+MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
+                                    double *spread);
+/* x (nq + nr) <- the solution for right side x, with the last factors of w. */
+MechrtStatus mechrt_host_kkt_solve(MechrtHostKkt *s, MechrtKktWeight w, double *x);
+/* The same with one step of iterative refinement (a residual over the
+   nonzeros and a second solve); work: 2 (nq + nr) doubles. */
+MechrtStatus mechrt_host_kkt_solve_refined(MechrtHostKkt *s, MechrtKktWeight w, double *x,
+                                           double *work);
+/* max|u_kk| / min|u_kk| of w's last factors (INFINITY without). */
+double mechrt_host_kkt_spread(const MechrtHostKkt *s, MechrtKktWeight w);
+/* Factorisations with pivot search and refactorisations, both weights and
+   the screen. */
+void mechrt_host_kkt_counts(const MechrtHostKkt *s, long *fresh, long *refactored);
 
 /* Workspace length, in doubles, of mechrt_host_sparse_step. */
 #define MECHRT_HOST_SPARSE_WORK_LEN(nq) (4u * (size_t)(nq))
@@ -214,6 +289,30 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
                                      const MechrtOptions *opts, double *q, double *qd,
                                      double *qdd, double t, double h, double *work, size_t lwork,
                                      MechrtReport *report);
+
+/* mechrt_velocity_acceleration (runtime/analysis.c) on the sparse
+   Jacobian s: one evaluation at (q, t), one factorisation with the same
+   pivot test and condition screen, qd from nu and, when qdd is not NULL,
+   qdd from gamma at the new qd (qdd NULL: mechrt_velocity). work: 3 nq
+   doubles. */
+MechrtStatus mechrt_host_sparse_velocity(MechrtHostSparse *s, const MechrtKernels *k,
+                                         const MechrtOptions *opts, const double *q, double t,
+                                         double *qd, double *qdd, double *work,
+                                         MechrtReport *report);
+
+/* The minimum-norm Gauss-Newton step of the projection over the nh
+   holonomic rows of pattern jnz (sparse_qr.c: SuiteSparseQR of Phi_q^T;
+   its velocity-level rows, row >= nh, are left out). NULL when out of
+   memory or an index is out of range. */
+typedef struct MechrtHostMinNorm MechrtHostMinNorm;
+MechrtHostMinNorm *mechrt_host_minnorm_new(int nh, int nq, const MechrtHostJacNz *jnz);
+void mechrt_host_minnorm_free(MechrtHostMinNorm *m);
+/* dq = -pinv(Phi_q) phi at (q, t), the rows whose remaining norm is at most
+   pivot_tol times the largest row norm dropped (redundant rows).
+   MECHRT_ESING when Phi_q = 0, MECHRT_ENOTFINITE for NaN or Inf,
+   MECHRT_EINVAL when out of memory. */
+MechrtStatus mechrt_host_minnorm_step(MechrtHostMinNorm *m, const double *q, double t,
+                                      const double *phi, double pivot_tol, double *dq);
 
 /* ---- Output (output.c; numbers: format_real.c) ---------------------------- */
 

@@ -247,6 +247,12 @@ void mechrt_host_sparse_singular(const MechrtHostSparse *s, int *row, int *col)
     *col = s->sing_col;
 }
 
+void mechrt_host_sparse_refresh(MechrtHostSparse *s)
+{
+    if (s->numeric)
+        klu_free_numeric(&s->numeric, &s->common);
+}
+
 void mechrt_host_sparse_counts(const MechrtHostSparse *s, long *fresh, long *refactored)
 {
     *fresh = s->fresh;

@@ -6,7 +6,10 @@
  * is cheap, and a chord iteration that kept an old one would change the
  * iteration counts that run's branch check relies on, so the two paths
  * step alike), then one factorisation at the converged q for the velocity
- * and the acceleration, with the same condition screen and estimate. Phi
+ * and the acceleration, with the same condition screen and estimate -
+ * unless Newton's last correction was below SPARSE_REUSE_STEP, where the
+ * last iteration's factorisation serves (at N = 1000, 2.8 factorisations
+ * a step become 1.8). Phi
  * and the Jacobian's nonzeros come from one all_nz call where the kernels
  * have it (nu comes with them: the last one, at the converged q, serves;
  * gamma needs the new velocities and is called after), else from the phi
@@ -16,6 +19,17 @@
 
 #include <math.h>
 #include <string.h>
+
+/* Newton's last correction at most this (in every coordinate): the
+   factorisation of its iteration, at a q this near the converged one,
+   serves the velocity and the acceleration (their relative change is of
+   the order of the correction times the condition number: 1e-14 where
+   the correction is 1e-14, as the second of two iterations' usually is),
+   instead of a refactorisation at the converged q. */
+#define SPARSE_REUSE_STEP 1e-12
+/* ... while the pivots' spread max|u_kk| / min|u_kk| (a lower bound of the
+   condition number) stays below this. */
+#define SPARSE_REUSE_SPREAD 1e3
 
 /* Where the fused kernel writes what a Newton evaluation does not need:
    nu (kept: the last one is at the converged q) and gamma (at the old qd). */
@@ -82,11 +96,13 @@ static MechrtStatus sp_newton(MechrtHostSparse *s, const MechrtKernels *k, const
     }
 }
 
-/* Factors the Jacobian last evaluated, with the condition estimate of
-   an_factor (runtime/analysis.c): screened by the pivot spread. */
-static MechrtStatus sp_factor_cond(MechrtHostSparse *s, const MechrtOptions *o, MechrtReport *r)
+/* Factors the Jacobian last evaluated (reuse: keeps the last
+   factorisation), with the condition estimate of an_factor
+   (runtime/analysis.c): screened by the pivot spread. */
+static MechrtStatus sp_factor_cond(MechrtHostSparse *s, const MechrtOptions *o, MechrtReport *r,
+                                   bool reuse)
 {
-    MechrtStatus st = sp_factor(s, o, r);
+    MechrtStatus st = reuse ? MECHRT_OK : sp_factor(s, o, r);
     if (st != MECHRT_OK || !(o->cond_warn > 0))
         return st;
     if (o->cond_screen > 0 && mechrt_host_sparse_spread(s) <= o->cond_screen * o->cond_warn)
@@ -121,7 +137,11 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
     MechrtStatus st = sp_newton(s, k, &o, q, tn, phi, rhs, &x, r);
     if (st != MECHRT_OK)
         return st;
-    if ((st = sp_factor_cond(s, &o, r)) != MECHRT_OK)
+    /* near a singular position (the pivots spread past the condition
+       screen) the change would be large: factor at the converged q */
+    bool reuse = r->iterations > 0 && r->step <= SPARSE_REUSE_STEP
+                 && mechrt_host_sparse_spread(s) <= SPARSE_REUSE_SPREAD;
+    if ((st = sp_factor_cond(s, &o, r, reuse)) != MECHRT_OK)
         return st;
     if (x.have_nu)
         memcpy(qd, x.nu, (size_t)n * sizeof *qd);
@@ -130,5 +150,32 @@ MechrtStatus mechrt_host_sparse_step(MechrtHostSparse *s, const MechrtKernels *k
     if ((st = mechrt_host_sparse_solve(s, qd)) != MECHRT_OK)
         return st;
     k->gamma(k->ctx, q, qd, tn, qdd);   /* gamma needs the velocities just found */
+    return mechrt_host_sparse_solve(s, qdd);
+}
+
+MechrtStatus mechrt_host_sparse_velocity(MechrtHostSparse *s, const MechrtKernels *k,
+                                         const MechrtOptions *opts, const double *q, double t,
+                                         double *qd, double *qdd, double *work,
+                                         MechrtReport *report)
+{
+    MechrtOptions o = opts ? *opts : mechrt_default_options();
+    MechrtReport dummy;
+    MechrtReport *r = report ? report : &dummy;
+    mechrt_report_clear(r);
+    if (!s || !k || !k->nu || !k->gamma || !q || !qd || !work)
+        return MECHRT_EINVAL;
+    int n = k->nq;
+    double *zero = work, *phi = work + n, *gamma = work + 2 * n;
+    memset(zero, 0, (size_t)n * sizeof *zero);
+    /* the fused kernel's gamma (at qd = 0) is not used: gamma needs the
+       velocities solved for */
+    if (!mechrt_host_sparse_eval_all(s, q, zero, t, phi, qd, gamma)) {
+        mechrt_host_sparse_eval(s, q, t);
+        k->nu(k->ctx, q, t, qd);
+    }
+    MechrtStatus st = sp_factor_cond(s, &o, r, false);
+    if (st != MECHRT_OK || (st = mechrt_host_sparse_solve(s, qd)) != MECHRT_OK || !qdd)
+        return st;
+    k->gamma(k->ctx, q, qd, t, qdd);
     return mechrt_host_sparse_solve(s, qdd);
 }
