@@ -842,6 +842,13 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
     return ops;
 }
 
+bool emit_direct_jac_default(const Kinematics *kin, int roll)
+{
+    bool rolls = roll == EMIT_ROLL_ALWAYS
+                 || (roll == EMIT_ROLL_AUTO && kin->model->nr >= EMIT_ROLL_AUTO_ROWS);
+    return kin->nnz <= EMIT_DIRECT_JAC_NNZ || rolls;
+}
+
 /* True when function f has code of its own in the file (the dense
    Jacobian is spread from jac_nz, jac_spread.tmpl, unless direct). */
 static bool is_written(const Emitter *e, EmitFunction f)
