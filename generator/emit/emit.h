@@ -56,6 +56,13 @@ typedef struct EmitOptions {
 typedef enum EmitRoll { EMIT_ROLL_AUTO, EMIT_ROLL_NEVER, EMIT_ROLL_ALWAYS } EmitRoll;
 enum { EMIT_ROLL_AUTO_ROWS = 500, EMIT_ROLL_AUTO_MEMBERS = 8 };
 
+/* gen --jac auto (the default): the direct dense Jacobian, faster under
+   every compiler (no moves after the fill), unless its second copy of the
+   Jacobian's expressions would be large: more than EMIT_DIRECT_JAC_NNZ
+   nonzeros in straight-line code (a rolled file's copy is a loop). */
+enum { EMIT_DIRECT_JAC_NNZ = 4000 };
+bool emit_direct_jac_default(const Kinematics *kin, int roll);
+
 /* The spec's function order, for op counts and reports (jac and all count
    0 in a sparse-only file); then all_nz, an extension (written only with
    EmitOptions.all_nz or sparse_only: its ops count 0 without),
