@@ -26,6 +26,7 @@
 #include "mechrt_host.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 struct MechrtHostKkt {
     int nq, nr, mnz, jnz, nxd;      /* sizes; nxd: diagonal slots M's pattern lacks */
@@ -138,15 +139,21 @@ static void kkt_fill(const MechrtHostKkt *s, MechrtKktWeight w, const unsigned c
                      int rows, double *v)
 {
     int e = 0;
-    for (int k = 0; k < s->mnz; k++, e++)
-        v[e] = w == MECHRT_KKT_MASS ? s->mass[k] : s->mdiag[k] ? 1.0 : 0.0;
+    if (w == MECHRT_KKT_MASS)
+        memcpy(v, s->mass, (size_t)s->mnz * sizeof *v), e = s->mnz;
+    else
+        for (int k = 0; k < s->mnz; k++, e++)
+            v[e] = s->mdiag[k] ? 1.0 : 0.0;
     for (int k = 0; k < s->nxd; k++, e++)
         v[e] = w == MECHRT_KKT_MASS ? 0.0 : 1.0;
     const int *jrow = s->row + s->mnz + s->nxd;     /* nq + r */
-    for (int k = 0; k < s->jnz; k++, e++)
-        v[e] = kkt_kept(active, rows, jrow[k] - s->nq) ? s->jac[k] : 0.0;
-    for (int k = 0; k < s->jnz; k++, e++)
-        v[e] = v[e - s->jnz];
+    if (!active && rows >= s->nr)   /* every row kept: the values as they are */
+        memcpy(v + e, s->jac, (size_t)s->jnz * sizeof *v);
+    else
+        for (int k = 0; k < s->jnz; k++)
+            v[e + k] = kkt_kept(active, rows, jrow[k] - s->nq) ? s->jac[k] : 0.0;
+    memcpy(v + e + s->jnz, v + e, (size_t)s->jnz * sizeof *v);
+    e += 2 * s->jnz;
     for (int r = 0; r < s->nr; r++, e++)
         v[e] = kkt_kept(active, rows, r) ? 0.0 : 1.0;
 }
