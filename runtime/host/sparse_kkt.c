@@ -25,6 +25,8 @@
  */
 #include "mechrt_host.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -158,21 +160,44 @@ static void kkt_fill(const MechrtHostKkt *s, MechrtKktWeight w, const unsigned c
         v[e] = kkt_kept(active, rows, r) ? 0.0 : 1.0;
 }
 
+/* max |v_e| over the values kkt_fill wrote, Phi_q's once (its transpose
+   holds the same); false for a value not finite. */
+static bool kkt_amax(const MechrtHostKkt *s, const double *v, double *amax)
+{
+    int head = s->mnz + s->nxd + s->jnz, tail = head + s->jnz, end = tail + s->nr;
+    double m = 0;
+    bool finite = true;
+    for (int e = 0; e < head; e++) {
+        double a = fabs(v[e]);
+        m = a > m ? a : m;
+        finite &= a <= DBL_MAX;     /* false for NaN too */
+    }
+    for (int e = tail; e < end; e++)
+        m = v[e] > m ? v[e] : m;    /* the rows' diagonal: 0 or 1 */
+    *amax = m;
+    return finite;
+}
+
 MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
                                     const unsigned char *active, int rows, double pivot_tol)
 {
     MechrtHostSparse *lu = s->lu[w == MECHRT_KKT_MASS ? 0 : 1];
-    kkt_fill(s, w, active, rows, mechrt_host_sparse_values(lu));
-    return mechrt_host_sparse_factor(lu, pivot_tol);
+    double *v = mechrt_host_sparse_values(lu), amax;
+    kkt_fill(s, w, active, rows, v);
+    if (!kkt_amax(s, v, &amax))
+        return mechrt_host_sparse_factor(lu, pivot_tol);    /* names the entry */
+    return mechrt_host_sparse_factor_known(lu, pivot_tol, amax);
 }
 
 MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
                                     double *spread)
 {
     MechrtHostSparse *lu = s->lu[2];
-    kkt_fill(s, MECHRT_KKT_IDENTITY, NULL, rows, mechrt_host_sparse_values(lu));
+    double *v = mechrt_host_sparse_values(lu), amax;
+    kkt_fill(s, MECHRT_KKT_IDENTITY, NULL, rows, v);
     mechrt_host_sparse_refresh(lu);
-    MechrtStatus st = mechrt_host_sparse_factor(lu, pivot_tol);
+    MechrtStatus st = kkt_amax(s, v, &amax) ? mechrt_host_sparse_factor_known(lu, pivot_tol, amax)
+                                            : mechrt_host_sparse_factor(lu, pivot_tol);
     *spread = mechrt_host_sparse_spread(lu);
     return st;
 }

@@ -174,23 +174,26 @@ static bool sparse_bad_pivot(MechrtHostSparse *s, double thresh)
 MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol)
 {
     double amax = 0;
+    for (int e = 0; e < s->nnz; e++) {
+        double a = fabs(s->vals[e]);
+        if (!(a <= DBL_MAX)) {      /* NaN too */
+            s->sing_row = s->jnz.row[e];
+            s->sing_col = -1;
+            return MECHRT_ENOTFINITE;
+        }
+        amax = a > amax ? a : amax;
+    }
+    return mechrt_host_sparse_factor_known(s, pivot_tol, amax);
+}
+
+MechrtStatus mechrt_host_sparse_factor_known(MechrtHostSparse *s, double pivot_tol, double amax)
+{
     s->sing_row = s->sing_col = -1;
     const double *vals = s->vals;
     const int *map = s->map;
     double *ax = s->ax;
-    bool finite = true;     /* one pass; the culprit is looked for only on failure */
-    for (int e = 0; e < s->nnz; e++) {
-        double v = vals[e], a = fabs(v);
-        ax[map[e]] = v;
-        amax = a > amax ? a : amax;
-        finite &= a <= DBL_MAX;     /* false for NaN too */
-    }
-    if (!finite)
-        for (int e = 0; e < s->nnz; e++)
-            if (!isfinite(vals[e])) {
-                s->sing_row = s->jnz.row[e];
-                return MECHRT_ENOTFINITE;
-            }
+    for (int e = 0; e < s->nnz; e++)
+        ax[map[e]] = vals[e];
     double thresh = pivot_tol * amax;
     if (s->numeric) {
         if (klu_refactor(s->ap, s->ai, s->ax, s->symbolic, s->numeric, &s->common)
