@@ -1059,8 +1059,12 @@ static bool end_rhs(Sim *s, const double *y, double t, double *f)
 {
     if (sim_rhs(t, y, f, s) == GSL_SUCCESS)
         return true;
-    fail(s, s->fail_status != MECHRT_OK ? s->fail_status : MECHRT_ENOTFINITE, t,
-         "forward dynamics");
+    if (s->fail_status == MECHRT_OK) {     /* sim_rhs records every failure; defensive */
+        fail(s, MECHRT_ENOTFINITE, t, "forward dynamics");
+        msgf(s, "%s", mechrt_strerror(MECHRT_ENOTFINITE));
+        return false;
+    }
+    fail(s, s->fail_status, s->fail_t, "forward dynamics");
     explain_dynamics(s, s->fail_status, &s->fail_rep);
     return false;
 }
