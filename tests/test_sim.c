@@ -666,19 +666,30 @@ static double max_energy_change(const Collect *c)
 /* (b) The free double pendulum over 10 s, released from rest: chaotic, and
    its energy kept to 1e-8 of the energy exchanged (rk8pd, tolerances 1e-12,
    projection after every step). */
+/* The energy tests' double pendulum, released at rest from angles 0.2
+   and 1.0: its kernels on tm, q and qd, sim's defaults with qd0 = qd. */
+static SimOptions double_pendulum_release(TMech *tm, MechrtKernels *k, double *q, double *qd)
+{
+    double a1 = 0.3, b1 = 0.25, a2 = 0.4;
+    *tm = double_pendulum(a1, b1, a2);
+    *k = t_kernels(tm);
+    double ang[2] = {0.2, 1.0}, w[2] = {0, 0};
+    double_state(a1, a1 + b1, a2, ang, w, q, qd);
+    SimOptions o = sim_default_options();
+    o.qd0 = qd;
+    return o;
+}
+
 static void test_double_pendulum_energy(void **state)
 {
     (void)state;
-    double a1 = 0.3, b1 = 0.25, a2 = 0.4, L1 = a1 + b1;
-    TMech tm = double_pendulum(a1, b1, a2);
-    MechrtKernels k = t_kernels(&tm);
-    double ang[2] = {0.2, 1.0}, w[2] = {0, 0}, q[6], qd[6];
-    double_state(a1, L1, a2, ang, w, q, qd);
-    SimOptions o = sim_default_options();
+    TMech tm;
+    MechrtKernels k;
+    double q[6], qd[6];
+    SimOptions o = double_pendulum_release(&tm, &k, q, qd);
     o.t1 = 10;
     o.steps = 1000;
     o.rtol = o.atol = 1e-12;
-    o.qd0 = qd;
     Collect *c = calloc(1, sizeof *c);
     c->tm = &tm;
     SimResult res;
@@ -709,15 +720,12 @@ static void test_double_pendulum_energy(void **state)
 static void test_double_pendulum_interpolated(void **state)
 {
     (void)state;
-    double a1 = 0.3, b1 = 0.25, a2 = 0.4, L1 = a1 + b1;
-    TMech tm = double_pendulum(a1, b1, a2);
-    MechrtKernels k = t_kernels(&tm);
-    double ang[2] = {0.2, 1.0}, w[2] = {0, 0}, q[6], qd[6];
-    double_state(a1, L1, a2, ang, w, q, qd);
-    SimOptions o = sim_default_options();
+    TMech tm;
+    MechrtKernels k;
+    double q[6], qd[6];
+    SimOptions o = double_pendulum_release(&tm, &k, q, qd);
     o.t1 = 2;
     o.steps = 400;
-    o.qd0 = qd;
     Collect *ref = calloc(1, sizeof *ref), *c = calloc(1, sizeof *c);
     ref->tm = c->tm = &tm;
     SimResult rres, res;
