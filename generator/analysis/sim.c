@@ -473,11 +473,16 @@ static void cache_store(Sim *s, double t, const double *y, const double *f)
     s->cache_ok = true;
 }
 
+/* The cache holds f at (t, y). */
+static bool cache_has(const Sim *s, double t, const double *y)
+{
+    return s->cache_ok && t == s->ct && memcmp(y, s->cy, 2 * (size_t)s->nq * sizeof *y) == 0;
+}
+
 static int sim_rhs(double t, const double y[], double f[], void *params)
 {
     Sim *s = params;
-    int n = s->nq;
-    if (s->cache_ok && t == s->ct && memcmp(y, s->cy, 2 * (size_t)n * sizeof *y) == 0) {
+    if (cache_has(s, t, y)) {
         memcpy(f, s->cf, (size_t)s->dim * sizeof *f);
         return GSL_SUCCESS;
     }
@@ -1020,10 +1025,10 @@ static bool one_step(Sim *s, double *y, double *t, double tn, double *h)
     unsigned long failed0 = d->e->failed_steps;
     /* GSL's evolve starts a step from the last one's dydt_out, f at the
        unprojected end with the old rows; where f at the projected state
-       is at hand (the cache, filled since the last settle by an output
-       state or the interpolant's end), count = 0 makes it evaluate f
-       there instead, which the cache answers */
-    if (s->cache_ok)
+       is at hand (an output state or the interpolant's end solved it
+       there), count = 0 makes it evaluate f there instead, which the
+       cache answers */
+    if (cache_has(s, *t, y))
         d->e->count = 0;
     int gs = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &s->sys, t, tn, h, y);
     s->res->rejected += (long)(d->e->failed_steps - failed0);
