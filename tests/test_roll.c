@@ -119,6 +119,20 @@ static void unit_close(Unit *u)
         aot_unload(u->aot);
 }
 
+/* No row pointer of a rolled loop starts before its array: q + -3 * i
+   would be undefined in C99 (6.5.6p8) even where the element read is in
+   range. */
+static void assert_pointers_in_range(const char *name, const char *c)
+{
+    for (const char *line = c; (line = strstr(line, "*const ")); line++) {
+        const char *end = strchr(line, '\n');
+        const char *minus = strstr(line, "+ -");
+        if (minus && (!end || minus < end))
+            fail_msg("%s: a row pointer before its array: %.*s", name,
+                     (int)(end ? end - line : 80), line);
+    }
+}
+
 /* mech never against always, under the JIT or (aot) the system compiler
    (gcc -O2, the file's own sincos); returns whether always rolled. */
 static bool check(const char *name, const Mech *mech, bool jit, bool direct_jac)
@@ -128,6 +142,7 @@ static bool check(const char *name, const Mech *mech, bool jit, bool direct_jac)
     emit(mech, EMIT_ROLL_ALWAYS, jit, direct_jac, &rolled);
     assert_null(strstr(straight.c_text, "one shape: one loop"));
     bool loops = strstr(rolled.c_text, "one shape: one loop") != NULL;
+    assert_pointers_in_range(name, rolled.c_text);
     Unit a, b;
     const Kernels *ka = unit_open(&a, &straight, jit, name);
     const Kernels *kb = unit_open(&b, &rolled, jit, name);

@@ -266,15 +266,24 @@ static bool rolled(const Roll *r, int g)
     return r->groups[g].count >= r->c->min_members;
 }
 
+/* Whether v[0 .. count) grows by a fixed step (into *step; 0 for one
+   value). */
+static bool affine_step(const int *v, int count, long long *step)
+{
+    *step = count > 1 ? (long long)v[1] - v[0] : 0;
+    for (int i = 1; i < count; i++)
+        if ((long long)v[i] - v[i - 1] != *step)
+            return false;
+    return true;
+}
+
 /* Writes into text the int sequence v[0 .. count) as the loop's value for
    row i: a number, base + step * i, or a static table (written to parts). */
 static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *table,
                      const int *v, int count)
 {
-    bool affine = true;
-    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
-    for (int i = 1; i < count && affine; i++)
-        affine = (long long)v[i] - v[i - 1] == step;
+    long long step;
+    bool affine = affine_step(v, count, &step);
     if (affine && step == 0) {
         sb_printf(text, "%d", v[0]);
         return;
@@ -296,16 +305,16 @@ static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *tab
    whose indices over the rows are v[0 .. count): array[v0] for one index,
    through a pointer that moves with i (declared in decls, once per array
    and step: libtcc then loads each element by one instruction) where they
-   grow by a fixed step, else through a table. */
+   grow by a fixed step, else through a table. A falling index's pointer
+   moves down from array + |step| (count - 1) to array, read at the last
+   row's index: array + step * i would point before the array, undefined
+   in C99 (6.5.6p8) even where the element read is inside it. */
 static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decls,
                         const char *table, const char *array, bool output, const int *v,
                         int count)
 {
-    bool affine = true;
-    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
-    for (int i = 1; i < count && affine; i++)
-        affine = (long long)v[i] - v[i - 1] == step;
-    if (!affine || step == 0) {
+    long long step;
+    if (!affine_step(v, count, &step) || step == 0) {
         sb_printf(text, "%s[", array);
         put_ints(r, parts, text, table, v, count);
         sb_putc(text, ']');
@@ -315,10 +324,15 @@ static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decl
     snprintf(name, sizeof name, "%s_%s%lld", array, step < 0 ? "m" : "", step < 0 ? -step : step);
     char decl[160];
     snprintf(decl, sizeof decl, " %s = ", name);
-    if (!strstr(decls->data, decl))
-        sb_printf(decls, "        %s%s_real *const%s%s + %lld * i;\n", output ? "" : "const ",
-                  r->c->prefix, decl, array, step);
-    sb_printf(text, "%s[%d]", name, v[0]);
+    if (!strstr(decls->data, decl)) {
+        sb_printf(decls, "        %s%s_real *const%s%s + ", output ? "" : "const ", r->c->prefix,
+                  decl, array);
+        if (step > 0)
+            sb_printf(decls, "%lld * i;\n", step);
+        else
+            sb_printf(decls, "%lld * (%d - i);\n", -step, count - 1);
+    }
+    sb_printf(text, "%s[%d]", name, step > 0 ? v[0] : v[count - 1]);
 }
 
 /* A constant as C text that reads back as the same double (or float). */
