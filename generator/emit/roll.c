@@ -24,6 +24,7 @@
  */
 #include "roll.h"
 
+#include "emit.h"
 #include "../base/arena.h"
 #include "../base/hashmap.h"
 
@@ -266,15 +267,21 @@ static bool rolled(const Roll *r, int g)
     return r->groups[g].count >= r->c->min_members;
 }
 
-/* Whether v[0 .. count) grows by a fixed step (into *step; 0 for one
-   value). */
-static bool affine_step(const int *v, int count, long long *step)
+/* The length of the longest start of v[0 .. count) that grows by a fixed
+   step (into *step; 0 for one value). */
+static int affine_run(const int *v, int count, long long *step)
 {
     *step = count > 1 ? (long long)v[1] - v[0] : 0;
-    for (int i = 1; i < count; i++)
-        if ((long long)v[i] - v[i - 1] != *step)
-            return false;
-    return true;
+    int i = 1;
+    while (i < count && (long long)v[i] - v[i - 1] == *step)
+        i++;
+    return count < 1 ? 0 : i;
+}
+
+/* Whether all of v[0 .. count) grows by a fixed step (into *step). */
+static bool affine_step(const int *v, int count, long long *step)
+{
+    return affine_run(v, count, step) == count;
 }
 
 /* Writes into text the int sequence v[0 .. count) as the loop's value for
@@ -333,22 +340,6 @@ static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decl
             sb_printf(decls, "%lld * (%d - i);\n", -step, count - 1);
     }
     sb_printf(text, "%s[%d]", name, step > 0 ? v[0] : v[count - 1]);
-}
-
-/* A constant as C text that reads back as the same double (or float). */
-static void put_real(StrBuf *sb, double v, bool real_float)
-{
-    char buf[64];
-    if (real_float && isinf((float)v)) {
-        sb_puts(sb, v > 0 ? "HUGE_VALF" : "-HUGE_VALF");
-        return;
-    }
-    snprintf(buf, sizeof buf, real_float ? "%.9g" : "%.17g", real_float ? (double)(float)v : v);
-    if (!strpbrk(buf, ".eEn"))
-        strcat(buf, ".0");     /* a floating constant, -0.0 included */
-    sb_puts(sb, buf);
-    if (real_float)
-        sb_putc(sb, 'f');
 }
 
 /* The angles of coordinates v[0 .. count) whose sin and cos are both
@@ -570,7 +561,7 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
                 sb_printf(parts, "static const %s_real %s[%d] = {\n", P, table, count);
                 for (int j = 0; j < count; j++) {
                     sb_puts(parts, j % 8 ? " " : "    ");
-                    put_real(parts, r->vals[r->members[members[j]].val_at + s], r->c->real_float);
+                    emit_put_literal(parts, r->vals[r->members[members[j]].val_at + s], r->c->real_float);
                     sb_puts(parts, j % 8 == 7 || j == count - 1 ? ",\n" : ",");
                 }
                 sb_puts(parts, "};\n");
@@ -654,19 +645,20 @@ static long put_group(Roll *r, int g, int *number, StrBuf *parts, StrBuf *body)
     int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     slot_kinds(r, rep, kind);
     int *left = xmalloc((size_t)count * sizeof *left);
+    int *ints = xmalloc((size_t)(ns ? ns : 1) * (size_t)count * sizeof *ints);
+    for (int s = 0; s < ns; s++)
+        if (kind[s] != W_CONST)
+            for (int j = 0; j < count; j++)
+                ints[(size_t)s * count + j] = slot_int(r, grp->members[j], s, kind[s]);
     long ops = 0;
     for (int j = 0; j < count;) {
-        int k = j + 1;
-        for (; k < count; k++) {
-            bool steady = true;
-            for (int s = 0; s < ns && steady; s++)
-                if (kind[s] != W_CONST)
-                    steady = k == j + 1 ||
-                             (long long)slot_int(r, grp->members[k], s, kind[s]) - slot_int(r, grp->members[k - 1], s, kind[s])
-                             == (long long)slot_int(r, grp->members[j + 1], s, kind[s]) - slot_int(r, grp->members[j], s, kind[s]);
-            if (!steady)
-                break;
-        }
+        int k = count;      /* the run from j: every index slot steady */
+        long long step;
+        for (int s = 0; s < ns; s++)
+            if (kind[s] != W_CONST) {
+                int run = affine_run(ints + (size_t)s * count + j, count - j, &step);
+                k = j + run < k ? j + run : k;
+            }
         if (k - j >= RUN_MIN || (j == 0 && k == count)) {
             ops += put_loop(r, grp->members + j, k - j, (*number)++, parts, body);
             j = k;
@@ -680,6 +672,7 @@ static long put_group(Roll *r, int g, int *number, StrBuf *parts, StrBuf *body)
         for (int j = 0; j < nleft; j++)
             r->members[left[j]].group = -1;
     free(left);
+    free(ints);
     free(kind);
     return ops;
 }
