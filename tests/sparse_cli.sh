@@ -301,6 +301,15 @@ check "velocity rows singular, sparse: the time, the pivot's coordinate and row"
 check "gen: no lu without --lu" sh -c "! grep -q lu_factor '$tmp/fb.c'"
 run_mechc gen "$ex/knife_cart.mech" --lu -o "$tmp/kc.c"
 check "gen --lu, velocity rows: exit 0, no lu" sh -c "[ $rc = 0 ] && ! grep -q lu_factor '$tmp/kc.c'"
+check "gen --lu, velocity rows: a note says why" \
+    err_has "mechc gen: note: --lu not written: the mechanism has 3 velocity-level rows"
+sh "$ex/chain.sh" 100 "$tmp/c100.mech"
+run_mechc gen "$tmp/c100.mech" --lu -o "$tmp/c100.c"
+check "gen --lu, 603 coordinates: exit 0, no lu" sh -c "[ $rc = 0 ] && ! grep -q lu_factor '$tmp/c100.c'"
+check "gen --lu, 603 coordinates: a note says why" \
+    err_has "mechc gen: note: --lu not written: 603 coordinates, more than 100"
+run_mechc gen "$ex/slider_crank.mech" --lu -o "$tmp/sc_note.c"
+check "gen --lu on a mechanism that qualifies: no note" sh -c "! grep -q note '$tmp/err'"
 run_mechc gen "$ex/slider_crank.mech" --prefix sc --lu -o "$tmp/sclu.c" --header "$tmp/sclu.h"
 check "gen --lu: exit 0" status_is 0
 check "gen --lu: factor, solve and step declared" sh -c "grep -q '^int sc_lu_factor(' '$tmp/sclu.h' \
