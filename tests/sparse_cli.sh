@@ -240,6 +240,20 @@ deck_closed() {
           rows++ }
         END { exit bad || rows != 101 }' "$2"
 }
+# the generators' N: bounded by what the default --max-coords admits, exit 2
+sh "$ex/scissor.sh" 99999999999 "$tmp/sc_huge.mech" 2> "$tmp/err"
+rc=$?
+check "scissor.sh 99999999999: exit 2" status_is 2
+check "scissor.sh 99999999999: names the bound" \
+    err_has "gives more than 200000 coordinates (mechc's default --max-coords): N is at most 33332"
+check "scissor.sh 99999999999: no file written" test ! -s "$tmp/sc_huge.mech"
+sh "$ex/train.sh" 66666 "$tmp/tr_big.mech" 2> "$tmp/err"
+rc=$?
+check "train.sh 66666 (200001 coordinates): exit 2" status_is 2
+check "train.sh 66666: names its bound" err_has "N is at most 66665"
+sh "$ex/chain.sh" 0 "$tmp/c0.mech" 2> "$tmp/err"
+rc=$?
+check "chain.sh 0: the usage, exit 2" sh -c "[ $rc = 2 ] && grep -q 'positive integer' '$tmp/err'"
 sh "$ex/scissor.sh" 5 "$tmp/sc5.mech"
 run "$tmp/sc5.mech" --csv "$tmp/sc5.csv"
 check "scissor 5: exit 0" status_is 0
