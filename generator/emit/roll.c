@@ -378,14 +378,13 @@ static void put_pairs(const Roll *r, StrBuf *parts, StrBuf *loops, const char *t
     free(odd);
 }
 
-/* The angles the rolled groups read: positions in the sin and cos arrays
-   (pairs, then sin only, then cos only, each by coordinate), set in
-   r->angle_pos; then the loops that fill them. Returns their operations. */
-static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
+/* Which angles the rolled groups read, into used[nq]: 1 sin, 2 cos, 3
+   both, as the function's straight-line code would use them (the pair,
+   or a single function); false when they read none. */
+static bool angles_used(const Roll *r, uint8_t *used)
 {
     const Dag *dag = r->dag;
     int nq = r->c->kin->model->nq;
-    uint8_t *used = xcalloc((size_t)(nq ? nq : 1), 1);     /* 1 sin, 2 cos: in the function */
     bool any = false;
     for (int g = 0; g < r->ngroups; g++) {
         if (!rolled(r, g))
@@ -403,10 +402,8 @@ static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
             }
         }
     }
-    if (!any) {
-        free(used);
-        return 0;
-    }
+    if (!any)
+        return false;
     /* which of sin and cos the whole function uses, as its straight-line
        code would choose the pair or a single function */
     uint32_t *mark = xcalloc((size_t)dag->count, sizeof *mark);
@@ -423,6 +420,20 @@ static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
         used[k] = (uint8_t)((s != DAG_NONE && mark[s] == 1) | (c != DAG_NONE && mark[c] == 1) << 1);
     }
     free(mark);
+    return true;
+}
+
+/* The angles the rolled groups read: positions in the sin and cos arrays
+   (pairs, then sin only, then cos only, each by coordinate), set in
+   r->angle_pos; then the loops that fill them. Returns their operations. */
+static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
+{
+    int nq = r->c->kin->model->nq;
+    uint8_t *used = xcalloc((size_t)(nq ? nq : 1), 1);
+    if (!angles_used(r, used)) {
+        free(used);
+        return 0;
+    }
     int *coords = xmalloc((size_t)nq * sizeof *coords);
     int n = 0;
     StrBuf loops;
@@ -516,18 +527,18 @@ static int slot_int(const Roll *r, int m, int s, int32_t k)
     return (int)v;
 }
 
-/* The loop over members[0 .. count) (of one shape): its tables (parts)
-   and loop (body); returns its operations per call. */
-static long put_loop(Roll *r, const int *members, int count, int number, StrBuf *parts,
-                     StrBuf *body)
+/* The texts of the slots of the loop over members[0 .. count): a
+   constant the same for all (uniform[s]: the body's graph holds it, text
+   NULL), a table of constants, an index (put_element: row pointers into
+   decls, tables into parts). */
+static char **slot_texts(const Roll *r, const int *members, int count, int number,
+                         StrBuf *parts, StrBuf *decls, bool *uniform)
 {
     const Member *rep = &r->members[members[0]];
     int ns = rep->nslots;
     const char *P = r->c->prefix;
     char **texts = xcalloc((size_t)(ns ? ns : 1), sizeof *texts);
-    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
     int *ints = xmalloc((size_t)count * sizeof *ints);
-    /* the slots' kinds, from the shape */
     int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     slot_kinds(r, rep, kind);
     const char **array = xcalloc((size_t)(ns ? ns : 1), sizeof *array);  /* what a slot indexes */
@@ -540,9 +551,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
                                   : word == W_SIN ? "roll_s" : "roll_c";
         w += word == W_OUT ? 4 : word == W_TIME ? 1 : word < 0 ? 2 : 3;
     }
-    StrBuf decls;      /* the loop's row pointers */
-    sb_init(&decls);
-    sb_puts(&decls, "");
     for (int s = 0; s < ns; s++) {
         StrBuf t;
         sb_init(&t);
@@ -571,22 +579,31 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
             for (int j = 0; j < count; j++)
                 ints[j] = slot_int(r, members[j], s, kind[s]);
             snprintf(table, sizeof table, "%s_r%d_x%d", r->c->function, number, s);
-            put_element(r, parts, &t, &decls, table, array[s], kind[s] == W_OUT, ints, count);
+            put_element(r, parts, &t, decls, table, array[s], kind[s] == W_OUT, ints, count);
         }
         texts[s] = sb_take(&t);
     }
-    /* the body's graph: the shape with the slots as leaves */
-    int nodes_cap = rep->code_len / 2 + 1, nnodes = 0, nouts = 0;
-    Dag graph = {.nodes = xmalloc((size_t)nodes_cap * sizeof(DagNode)), .cap = nodes_cap};
-    SchedOutput *outs = xmalloc((size_t)rep->count * sizeof *outs);
+    free(array);
+    free(ints);
+    free(kind);
+    return texts;
+}
+
+/* The loop body's graph: rep's shape with the slots as leaves (a uniform
+   constant as itself), into graph and outs (*nouts). */
+static void body_graph(const Roll *r, const Member *rep, const bool *uniform, Dag *graph,
+                       SchedOutput *outs, int *nouts)
+{
+    int nnodes = 0;
+    *nouts = 0;
     for (int w = rep->code_at; w < rep->code_at + rep->code_len;) {
         int32_t word = r->code[w];
         if (word == W_OUT) {
-            outs[nouts++] = (SchedOutput){arrays[r->code[w + 1]], r->code[w + 3], r->code[w + 2]};
+            outs[(*nouts)++] = (SchedOutput){arrays[r->code[w + 1]], r->code[w + 3], r->code[w + 2]};
             w += 4;
             continue;
         }
-        DagNode *n = &graph.nodes[nnodes++];
+        DagNode *n = &graph->nodes[nnodes++];
         if (word == W_TIME) {
             *n = (DagNode){.op = OP_TIME, .a = -1, .b = -1};
             w += 1;
@@ -602,7 +619,25 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
             w += 3;
         }
     }
-    graph.count = nnodes;
+    graph->count = nnodes;
+}
+
+/* The loop over members[0 .. count) (of one shape): its tables (parts)
+   and loop (body); returns its operations per call. */
+static long put_loop(Roll *r, const int *members, int count, int number, StrBuf *parts,
+                     StrBuf *body)
+{
+    const Member *rep = &r->members[members[0]];
+    int ns = rep->nslots;
+    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
+    StrBuf decls;      /* the loop's row pointers */
+    sb_init(&decls);
+    sb_puts(&decls, "");
+    char **texts = slot_texts(r, members, count, number, parts, &decls, uniform);
+    int nodes_cap = rep->code_len / 2 + 1, nouts = 0;
+    Dag graph = {.nodes = xmalloc((size_t)nodes_cap * sizeof(DagNode)), .cap = nodes_cap};
+    SchedOutput *outs = xmalloc((size_t)rep->count * sizeof *outs);     /* write_body's */
+    body_graph(r, rep, uniform, &graph, outs, &nouts);
     SlotTexts st = {texts};
     RollHooks hooks = {leaf_hook, store_hook, &st};
     StrBuf stmts;
@@ -612,7 +647,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
     sb_printf(body, "    /* %d joints' rows of one shape: one loop */\n"
               "    for (int i = 0; i < %d; i++) {\n%s", count, count, decls.data);
     sb_free(&decls);
-    free(array);
     for (const char *line = stmts.data; *line;) {     /* one level deeper */
         const char *end = strchr(line, '\n');
         size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
@@ -627,8 +661,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
         free(texts[s]);
     free(texts);
     free(uniform);
-    free(ints);
-    free(kind);
     return (long)ops * count;
 }
 
