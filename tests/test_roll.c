@@ -371,6 +371,21 @@ static void test_auto(void **state)
     pipeline_free(mech);
 }
 
+/* A rolled table's constants print as the straight-line code's do, the
+   shortest decimal that reads back (emit_put_literal): 0.2, not
+   0.20000000000000001. */
+static void test_table_literals(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("suspension.mech");
+    EmitResult rolled;
+    emit(mech, EMIT_ROLL_ALWAYS, true, true, &rolled);
+    assert_non_null(strstr(rolled.c_text, "_phi_r1_k2[2] = {\n    0.2, 0.32,\n};"));
+    assert_null(strstr(rolled.c_text, "0000000000"));
+    emit_result_free(&rolled);
+    pipeline_free(mech);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -380,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_unoptimised),
         cmocka_unit_test(test_float),
         cmocka_unit_test(test_auto),
+        cmocka_unit_test(test_table_literals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
