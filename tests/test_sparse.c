@@ -196,6 +196,11 @@ static void test_minnorm_step(void **state)
         mechrt_host_minnorm_free(m);
     }
     assert_null(mechrt_host_minnorm_new(4, 3, &j));     /* more rows than coordinates */
+    MechrtHostJacNz no_rows = j, no_cols = j;               /* entries but no pattern */
+    no_rows.row = NULL;
+    no_cols.col = NULL;
+    assert_null(mechrt_host_minnorm_new(2, 3, &no_rows));
+    assert_null(mechrt_host_minnorm_new(2, 3, &no_cols));
 }
 
 static void test_klu_singular_named(void **state)

@@ -80,7 +80,8 @@ static const CliOption options[] = {
      .help = "also write PREFIX_lu_factor and PREFIX_lu_solve: the\n"
              "Jacobian's LU unrolled for its pattern, constants folded,\n"
              "with run-time pivot checks (square mechanisms without\n"
-             "velocity rows, up to 100 coordinates; what run calls)"},
+             "velocity rows, up to 100 coordinates; what run calls;\n"
+             "otherwise a note on stderr says why none was written)"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"
@@ -248,6 +249,8 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_USAGE;
     }
     double emit_seconds = pipeline_now() - t0;
+    if (res.lu_skipped[0])  /* the file is whole without it; a caller of P_lu_factor is not */
+        fprintf(stderr, "mechc gen: note: --lu not written: %s\n", res.lu_skipped);
     bool ok = write_outputs(c, &res);
     if (c->stats)
         print_stats(mech, c, &res, emit_seconds, diag);

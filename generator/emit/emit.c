@@ -1230,7 +1230,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         put_jac_moves(&moves, e->kin);
     put_math(&math, e);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
-    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf);
+    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf, out->lu_skipped, sizeof out->lu_skipped);
 
     EmitSizes z;
     put_sizes(e, &z);

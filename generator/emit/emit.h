@@ -91,6 +91,7 @@ typedef struct EmitResult {
     char prefix[128];           /* the prefix used */
     int ops[EMIT_FUNCTION_COUNT];
     int chunks[EMIT_FUNCTION_COUNT];
+    char lu_skipped[128];       /* opt->lu set but no LU written: why; "" otherwise */
 } EmitResult;
 
 EmitOptions emit_default_options(void);
@@ -109,9 +110,10 @@ void emit_put_literal(StrBuf *sb, double v, bool real_float);
 
 /* PREFIX_lu_factor and PREFIX_lu_solve (emit_lu.c) appended to decl and
    def when opt->lu is set and the mechanism is square, without velocity
-   rows and small enough; nothing otherwise. */
+   rows and small enough; nothing otherwise, with the reason in why ("":
+   written, or not asked for). */
 void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
-             const char *upper, StrBuf *decl, StrBuf *def);
+             const char *upper, StrBuf *decl, StrBuf *def, char *why, size_t why_size);
 
 /* Writes the C source and header. Returns false (diag filled) for an
    unusable prefix or header name, code beyond max_ops, or a dense
