@@ -7,7 +7,8 @@
  * their hand-written M(q) and Q(q, qd, t) at random states, in every
  * engine; a file with every force kind has its engines agree to 1e-12
  * and its springs' Q equal -dV/dq of their potential; the fused eom
- * kernel equals the separate ones; a body with its centre of mass at its
+ * kernel equals the separate ones, and the generic engine's mass_nz the
+ * jit's on every example with masses; a body with its centre of mass at its
  * origin costs M no operation; bad input fails at its line and column.
  */
 #include "testutil.h"
@@ -22,6 +23,8 @@
 #include "../generator/engine/engine.h"
 #include "../generator/eval/generic.h"
 
+#include <dirent.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -230,6 +233,79 @@ static void test_engines_agree(void **state)
     }
 }
 
+/* The generic engine's mass_nz, from its jets, equals the jit's (to
+   1e-12) in the generated kernel's pattern, and scattered gives its own
+   dense M (no product falls outside the pattern), at random states. */
+static void assert_mass_nz_agree(const char *name, const Mech *mech)
+{
+    const Model *m = mech->model;
+    size_t nq = (size_t)m->nq;
+    Engine gen, jit;
+    open_engine(&gen, ENGINE_GENERIC, mech);
+    open_engine(&jit, ENGINE_JIT, mech);
+    int nnz = mech->kin.dyn.nnz;
+    assert_true(nnz > 0);
+    assert_int_equal(gen.mass_nnz, nnz);
+    assert_int_equal(jit.mass_nnz, nnz);
+    for (int k = 0; k < nnz; k++) {
+        assert_int_equal(gen.mass_row[k], jit.mass_row[k]);
+        assert_int_equal(gen.mass_col[k], jit.mass_col[k]);
+    }
+    double *q = xcalloc(nq, 8), *qd = xcalloc(nq, 8), t, *M = xcalloc(nq * nq, 8);
+    double *M0 = xcalloc(nq * nq, 8), *vals = xcalloc((size_t)nnz, 8), *want = xcalloc((size_t)nnz, 8);
+    uint64_t rng = 11;
+    for (int s = 0; s < 10; s++) {
+        random_state(&rng, (int)nq, m->q0, q, qd, &t);
+        for (int k = 0; k < nnz; k++)
+            vals[k] = NAN;  /* every slot must be written */
+        engine_mass_nz(&gen, q, vals);
+        engine_mass_nz(&jit, q, want);
+        assert_matrix(name, vals, want, nnz);
+        gen.k.mass(gen.k.ctx, q, M0);
+        memset(M, 0, nq * nq * 8);
+        for (int k = 0; k < nnz; k++)
+            M[(size_t)gen.mass_row[k] * nq + (size_t)gen.mass_col[k]] = vals[k];
+        assert_matrix(name, M, M0, (int)(nq * nq));
+    }
+    engine_close(&gen);
+    engine_close(&jit);
+    free(q), free(qd), free(M), free(M0), free(vals), free(want);
+}
+
+static void test_generic_mass_nz(void **state)
+{
+    (void)state;
+    const char *dir = getenv("MECHC_EXAMPLES") ? getenv("MECHC_EXAMPLES") : "examples";
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int checked = 0;
+    bool top = false;
+    for (struct dirent *ent; (ent = readdir(d));) {
+        size_t len = strlen(ent->d_name);
+        if (len < 5 || strcmp(ent->d_name + len - 5, ".mech") != 0)
+            continue;
+        Mech *mech = load_example(ent->d_name);
+        if (mech->model->nmasses > 0) {
+            assert_mass_nz_agree(ent->d_name, mech);
+            checked++;
+            top |= strcmp(ent->d_name, "heavy_top.mech") == 0;
+        }
+        pipeline_free(mech);
+    }
+    closedir(d);
+    assert_true(checked >= 9);
+    assert_true(top);       /* a spatial one: the Euler block */
+    Mech *mech = load_script("a02_four_bar.sh", 4);
+    assert_mass_nz_agree("a02 N = 4", mech);
+    pipeline_free(mech);
+    mech = load_text(every_force, "every_force.mech");
+    assert_mass_nz_agree("every_force", mech);
+    pipeline_free(mech);
+    mech = load_text(every_spatial_force, "every_spatial_force.mech");
+    assert_mass_nz_agree("every_spatial_force", mech);
+    pipeline_free(mech);
+}
+
 /* A spring without damping or actuator is conservative: its Q is -dV/dq,
    V = k/2 (l - L0)^2, by central differences. */
 static void test_spring_potential(void **state)
@@ -410,6 +486,7 @@ int main(void)
         cmocka_unit_test(test_compound_pendulum),
         cmocka_unit_test(test_double_pendulum),
         cmocka_unit_test(test_engines_agree),
+        cmocka_unit_test(test_generic_mass_nz),
         cmocka_unit_test(test_spring_potential),
         cmocka_unit_test(test_constant_mass_costs_nothing),
         cmocka_unit_test(test_check_catches_mass_mistakes),

@@ -168,20 +168,6 @@ static void check_aot(const char *name, const Mech *mech, bool direct_jac)
     assert_true(check(name, mech, false, direct_jac));
 }
 
-/* A mechanism written by one of the examples' shell scripts. */
-static Mech *load_script(const char *script, int n)
-{
-    char path[256], cmd[600];
-    const char *dir = getenv("MECHC_EXAMPLES");
-    snprintf(path, sizeof path, "%s/mechc_test_roll_%d_%d.mech",
-             getenv("TMPDIR") && *getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", (int)getpid(), n);
-    snprintf(cmd, sizeof cmd, "sh '%s/%s' %d '%s'", dir ? dir : "examples", script, n, path);
-    assert_int_equal(system(cmd), 0);
-    Mech *mech = load_file(path);
-    unlink(path);
-    return mech;
-}
-
 static void test_every_example(void **state)
 {
     (void)state;

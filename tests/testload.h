@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 static inline Mech *load_file(const char *path)
 {
@@ -34,6 +35,21 @@ static inline Mech *load_text(const char *text, const char *name)
     if (!m)
         fail_msg("%s: %s", name, diag.message);
     return m;
+}
+
+/* A mechanism written by one of the examples' shell scripts (script N FILE). */
+static inline Mech *load_script(const char *script, int n)
+{
+    char path[256], cmd[600];
+    const char *dir = getenv("MECHC_EXAMPLES");
+    snprintf(path, sizeof path, "%s/mechc_test_script_%d_%d.mech",
+             getenv("TMPDIR") && *getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", (int)getpid(), n);
+    snprintf(cmd, sizeof cmd, "sh '%s/%s' %d '%s'", dir ? dir : "examples", script, n, path);
+    if (system(cmd) != 0)
+        fail_msg("%s failed", cmd);
+    Mech *mech = load_file(path);
+    unlink(path);
+    return mech;
 }
 
 #endif

@@ -141,6 +141,7 @@ typedef struct Checker {
     bool dyn;                                   /* the file has masses: */
     double *mass[ENGINE_KIND_COUNT];            /* each engine's M (nq*nq) */
     double *force[ENGINE_KIND_COUNT];           /* and Q (nq) at the sample */
+    double *mass_nz[ENGINE_KIND_COUNT];         /* and M's nonzeros (engine_mass_nz) */
     double *mw, *mw2, *qv, *qv_fd;              /* M elsewhere; Q's velocity terms */
     gsl_eigen_symm_workspace *eigen;
     double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
@@ -172,6 +173,7 @@ static void under_test(Checker *c)
     if (c->dyn) {
         e->k.mass(e->k.ctx, c->q, c->mass[ENGINE_JIT]);
         e->k.force(e->k.ctx, c->q, c->qd, c->t, c->force[ENGINE_JIT]);
+        engine_mass_nz(e, c->q, c->mass_nz[ENGINE_JIT]);
     }
     const CheckFault *f = &c->opt->fault;
     if (f->kind == CHECK_FAULT_MASS_SCALE && c->dyn && f->row >= 0 && f->row < c->nq
@@ -593,6 +595,7 @@ static void eval_engine(Checker *c, EngineKind k)
         const MechrtKernels *mk = &c->eng[k].k;
         mk->mass(mk->ctx, c->q, c->mass[k]);
         mk->force(mk->ctx, c->q, c->qd, c->t, c->force[k]);
+        engine_mass_nz(&c->eng[k], c->q, c->mass_nz[k]);
     }
 }
 
@@ -620,6 +623,12 @@ static void compare_pair(Checker *c, int pair)
         for (int i = 0; i < (qty == 0 ? nq * nq : nq); i++)
             record(c, what, -1, i % nq, va[i], vb[i], 0.0);
     }
+    /* M's nonzeros (what sim's sparse path calls) count under M: every
+       engine writes them in the generated kernel's pattern. */
+    const Engine *ea = &c->eng[a];
+    for (int i = 0; c->dyn && i < ea->mass_nnz; i++)
+        record(c, CHECK_DYN_FIRST + 2 * pair, -1, ea->mass_col[i], c->mass_nz[a][i],
+               c->mass_nz[b][i], 0.0);
 }
 
 /* ---- dynamics: M's symmetry and definiteness, Q's velocity terms ---- */
@@ -992,6 +1001,7 @@ static void take_buffers(Checker *c)
     for (int k = 0; k < ENGINE_KIND_COUNT && c->dyn; k++) {
         c->mass[k] = take(c, nq * nq);
         c->force[k] = take(c, nq);
+        c->mass_nz[k] = take(c, (size_t)c->eng[ENGINE_JIT].mass_nnz + 1);
     }
     if (c->dyn) {
         c->mw = take(c, nq * nq);

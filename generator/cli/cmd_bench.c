@@ -10,7 +10,9 @@
  * (Q), m+q (both, what a forward-dynamics step needs of them) and eom
  * (M, Q, Phi_q and gamma: the generated P_eom, which shares sin and cos;
  * for the generic engine, which has no fused kernel, its four calls) and
- * mass_nz (M's nonzeros: generated code only).
+ * mass_nz (M's nonzeros in the generated kernel's pattern, what the
+ * sparse path of sim calls; the generic engine's from its jets) and
+ * m+q_nz (mass_nz and force).
  */
 #include "cli.h"
 
@@ -37,7 +39,8 @@ static const char usage[] =
     "by the system compiler, $CC or cc, with " AOT_FLAGS "). Reports ns per call\n"
     "(median of interleaved repeats), the speed-up against generic, generation and\n"
     "compile times, code size and operation counts. With masses in the file also\n"
-    "mass, force, m+q (both), eom (M, Q, Phi_q and gamma in one call) and mass_nz.\n"
+    "mass, force, m+q (both), eom (M, Q, Phi_q and gamma in one call), mass_nz\n"
+    "(M's nonzeros, what sim's sparse path calls) and m+q_nz (mass_nz and force).\n"
     "\n";
 
 static const CliOption options[] = {
@@ -52,14 +55,15 @@ static const CliOption options[] = {
 /* jac_nz (the sparse Jacobian) exists only in generated code; the
    dynamics rows only for a file with masses. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_MASS, FN_FORCE, FN_MQ, FN_EOM,
-       FN_MASS_NZ, FN_COUNT };
+       FN_MASS_NZ, FN_MQ_NZ, FN_COUNT };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz",
-                                               "mass", "force", "m+q", "eom", "mass_nz"};
+                                               "mass", "force", "m+q", "eom", "mass_nz",
+                                               "m+q_nz"};
 
 /* Functions only generated code has (no generic counterpart, no ratio). */
 static bool generated_only(int fn)
 {
-    return fn == FN_JAC_NZ || fn == FN_MASS_NZ;
+    return fn == FN_JAC_NZ;
 }
 static const EngineKind order[ENGINE_KIND_COUNT] = {ENGINE_GENERIC, ENGINE_JIT, ENGINE_AOT};
 
@@ -80,10 +84,10 @@ static void call_dynamics(Bench *b, const Engine *e, int fn)
     const MechrtKernels *k = &e->k;
     if (fn == FN_MASS || fn == FN_MQ)
         k->mass(k->ctx, b->q, b->mass);
-    if (fn == FN_FORCE || fn == FN_MQ)
+    if (fn == FN_MASS_NZ || fn == FN_MQ_NZ)
+        engine_mass_nz(e, b->q, b->mass);
+    if (fn == FN_FORCE || fn == FN_MQ || fn == FN_MQ_NZ)
         k->force(k->ctx, b->q, b->qd, b->t, b->force);
-    if (fn == FN_MASS_NZ)
-        e->kernels.mass_nz(b->q, b->mass);
     if (fn != FN_EOM)
         return;
     if (e->kind != ENGINE_GENERIC) {
@@ -190,9 +194,11 @@ static int ops_of(const EmitResult *er, int fn)
 {
     static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL,
                                       EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM,
-                                      EMIT_MASS_NZ};
+                                      EMIT_MASS_NZ, -1};
     if (fn == FN_MQ)
         return er->ops[EMIT_MASS] + er->ops[EMIT_FORCE];
+    if (fn == FN_MQ_NZ)
+        return er->ops[EMIT_MASS_NZ] + er->ops[EMIT_FORCE];
     return er->ops[map[fn]];
 }
 

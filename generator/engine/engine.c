@@ -11,7 +11,10 @@
  */
 #include "engine.h"
 
+#include "../base/arena.h"
+
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 const char *const engine_names[ENGINE_KIND_COUNT] = {"jit", "generic", "aot"};
@@ -116,7 +119,26 @@ static void bind_code(Engine *e, const Kernels *code)
     if (code->mass) {       /* the file has masses */
         e->k.mass = code_mass;
         e->k.force = code_force;
+        e->mass_row = code->mass_row;
+        e->mass_col = code->mass_col;
+        e->mass_nnz = e->mech->kin.dyn.nnz;
     }
+}
+
+/* The generic engine's mass_nz in the generated kernel's pattern: only
+   the positions of M's structural nonzeros, not their symbolic values. */
+static void bind_generic_pattern(Engine *e, const Dynamics *dyn)
+{
+    int n = dyn->nnz;
+    e->pattern = xcalloc(2 * (size_t)n + 1, sizeof *e->pattern);
+    for (int k = 0; k < n; k++) {
+        e->pattern[k] = dyn->mass[k].row;
+        e->pattern[n + k] = dyn->mass[k].col;
+    }
+    e->mass_row = e->pattern;
+    e->mass_col = e->pattern + n;
+    e->mass_nnz = n;
+    generic_mass_pattern(e->generic, e->mass_row, e->mass_col, n);
 }
 
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
@@ -177,6 +199,7 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
         if (mech->model->nmasses > 0) {
             e->k.mass = gen_mass;
             e->k.force = gen_force;
+            bind_generic_pattern(e, &mech->kin.dyn);
         }
         return true;
     }
@@ -214,6 +237,7 @@ void engine_close(Engine *e)
     jit_free(e->jit);
     aot_unload(e->aot);
     generic_free(e->generic);
+    free(e->pattern);
     emit_result_free(&e->emitted);
     memset(e, 0, sizeof *e);
 }

@@ -26,6 +26,11 @@ typedef struct Engine {
     Jit *jit;
     Aot *aot;
     Generic *generic;       /* generic evaluator state (check uses its Psi) */
+    /* M's nonzeros (engine_mass_nz), a file with masses: their pattern,
+       the generated PREFIX_mass_row/col; mass_nnz 0 without masses. */
+    const int *mass_row, *mass_col;
+    int mass_nnz;
+    int *pattern;           /* generic: its own copy of mass_row, mass_col */
     EmitResult emitted;     /* jit and aot: the source compiled */
     double gen_seconds;     /* emission time (generic: set-up time) */
     double compile_seconds; /* libtcc or cc time (aot: with the cache lookup and dlopen) */
@@ -85,6 +90,16 @@ static inline void engine_all(const Engine *e, const double *q, const double *qd
                               double *phi, double *jac, double *nu, double *gamma)
 {
     e->k.all(e->k.ctx, q, qd, t, phi, jac, nu, gamma);
+}
+
+/* M's nonzeros (e->mass_nnz, in e->mass_row/col's order): the generated
+   PREFIX_mass_nz, or the generic evaluator's from its jets. */
+static inline void engine_mass_nz(const Engine *e, const double *q, double *vals)
+{
+    if (e->kind == ENGINE_GENERIC)
+        generic_mass_nz(e->generic, q, vals);
+    else
+        e->kernels.mass_nz(q, vals);
 }
 
 #endif

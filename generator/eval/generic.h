@@ -38,6 +38,12 @@ void generic_psi(Generic *g, const double *q, const double *qd, double t, double
    derivatives of their expressions, not from the symbolic ones. */
 void generic_mass(Generic *g, const double *q, double *M);
 void generic_force(Generic *g, const double *q, const double *qd, double t, double *Q);
+/* M's nonzeros in a given pattern (row-major, rows then columns
+   ascending: the generated PREFIX_mass_nz's, generator/diff/dynamics.c),
+   which generic_mass_pattern takes once (it keeps no pointer to it);
+   a product outside the pattern is left out (check compares M too). */
+void generic_mass_pattern(Generic *g, const int *row, const int *col, int nnz);
+void generic_mass_nz(Generic *g, const double *q, double *vals);
 /* Q's velocity terms alone, -m p_q^T D(D(p)) - J theta_q^T D(D(theta)). */
 void generic_velocity_terms(Generic *g, const double *q, const double *qd, double *Qv);
 

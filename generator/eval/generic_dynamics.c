@@ -41,6 +41,12 @@ struct GenericDyn {
     Jet *jreg;
     double *vreg;
     double *dp;         /* 3 nq: one element's (px, py, theta)_q */
+    /* mass_nz: per mass element, where each of its (qcols[a], qcols[b])
+       products lands in the pattern (nqcols^2 slots, then 16 for the
+       Euler block of a spatial body), slot_at[i] its first; -1: outside
+       the pattern. NULL until generic_mass_pattern. */
+    int *slot, *slot_at;
+    int nnz;
 };
 
 enum { FORCE_ROOTS = 9 };
@@ -80,8 +86,8 @@ static double tensor_at(const double t[6], int i, int j)
     return t[at[i][j]];
 }
 
-/* M_ee += W^T J' W, W = 2 G(e). */
-static void add_rotation_mass(const MassElement *e, const double *q, size_t nq, double *M)
+/* W^T J' W, W = 2 G(e): the Euler block M_ee of one body. */
+static void rotation_mass(const MassElement *e, const double *q, double blk[4][4])
 {
     double W[3][4];
     euler_matrix(q + e->euler, false, W);
@@ -91,7 +97,7 @@ static void add_rotation_mass(const MassElement *e, const double *q, size_t nq, 
             for (int i = 0; i < 3; i++)
                 for (int j = 0; j < 3; j++)
                     sum += 4 * W[i][a] * tensor_at(e->inertia, i, j) * W[j][b];
-            M[(size_t)(e->euler + a) * nq + (size_t)(e->euler + b)] += sum;
+            blk[a][b] = sum;
         }
 }
 
@@ -170,6 +176,8 @@ void generic_dynamics_free(GenericDyn *d)
     free(d->jreg);
     free(d->vreg);
     free(d->dp);
+    free(d->slot);
+    free(d->slot_at);
     free(d);
 }
 
@@ -192,26 +200,96 @@ static void root_gradients(GenericDyn *d, const Tape *p, const double *q, const 
     }
 }
 
-void generic_mass(Generic *g, const double *q, double *M)
+/* M's contributions, dense (slot NULL: M nq*nq row-major) or into the
+   pattern's slots (vals, generic_mass_pattern's). */
+static void add_mass(GenericDyn *d, const double *q, const int *slot, double *out)
 {
-    GenericDyn *d = g->dyn;
     const Model *m = d->m;
     size_t nq = (size_t)m->nq;
-    memset(M, 0, nq * nq * sizeof *M);
     for (int i = 0; i < m->nmasses; i++) {
         const MassElement *e = &m->masses[i];
         const Tape *p = &d->mass_tapes[i];
+        const int *at = slot ? slot + d->slot_at[i] : NULL;
+        int n = p->nqcols;
         root_gradients(d, p, q, NULL, 0.0, 3, d->dp);
         double mz = e->spatial ? e->m : e->J;   /* the third root: pz, or theta */
-        for (int a = 0; a < p->nqcols; a++)
-            for (int b = 0; b < p->nqcols; b++) {
+        for (int a = 0; a < n; a++)
+            for (int b = 0; b < n; b++) {
                 const double *u = d->dp + 3 * a, *v = d->dp + 3 * b;
-                M[(size_t)p->qcols[a] * nq + (size_t)p->qcols[b]] +=
-                    e->m * (u[0] * v[0] + u[1] * v[1]) + mz * u[2] * v[2];
+                long k = at ? at[a * n + b] : (long)((size_t)p->qcols[a] * nq + (size_t)p->qcols[b]);
+                if (k >= 0)
+                    out[k] += e->m * (u[0] * v[0] + u[1] * v[1]) + mz * u[2] * v[2];
             }
-        if (e->euler >= 0)
-            add_rotation_mass(e, q, nq, M);
+        if (e->euler < 0)
+            continue;
+        double blk[4][4];
+        rotation_mass(e, q, blk);
+        for (int a = 0; a < 4; a++)
+            for (int b = 0; b < 4; b++) {
+                long k = at ? at[n * n + 4 * a + b]
+                            : (long)((size_t)(e->euler + a) * nq + (size_t)(e->euler + b));
+                if (k >= 0)
+                    out[k] += blk[a][b];
+            }
     }
+}
+
+void generic_mass(Generic *g, const double *q, double *M)
+{
+    size_t nq = (size_t)g->dyn->m->nq;
+    memset(M, 0, nq * nq * sizeof *M);
+    add_mass(g->dyn, q, NULL, M);
+}
+
+/* The index of (r, c) in a row-major pattern, -1 when absent. */
+static int pattern_find(const int *row, const int *col, int nnz, int r, int c)
+{
+    int lo = 0, hi = nnz - 1;
+    while (lo <= hi) {
+        int mid = lo + (hi - lo) / 2;
+        int cmp = row[mid] != r ? (row[mid] > r) - (row[mid] < r) : (col[mid] > c) - (col[mid] < c);
+        if (cmp == 0)
+            return mid;
+        if (cmp < 0)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
+void generic_mass_pattern(Generic *g, const int *row, const int *col, int nnz)
+{
+    GenericDyn *d = g->dyn;
+    const Model *m = d->m;
+    free(d->slot);
+    free(d->slot_at);
+    d->slot_at = xcalloc((size_t)m->nmasses + 1, sizeof *d->slot_at);
+    size_t total = 0;
+    for (int i = 0; i < m->nmasses; i++) {
+        size_t n = (size_t)d->mass_tapes[i].nqcols;
+        d->slot_at[i] = (int)total;
+        total += n * n + (m->masses[i].euler >= 0 ? 16 : 0);
+    }
+    d->slot = xcalloc(total + 1, sizeof *d->slot);
+    for (int i = 0; i < m->nmasses; i++) {
+        const Tape *p = &d->mass_tapes[i];
+        const MassElement *e = &m->masses[i];
+        int *at = d->slot + d->slot_at[i], n = p->nqcols;
+        for (int a = 0; a < n; a++)
+            for (int b = 0; b < n; b++)
+                at[a * n + b] = pattern_find(row, col, nnz, p->qcols[a], p->qcols[b]);
+        for (int k = 0; e->euler >= 0 && k < 16; k++)
+            at[n * n + k] = pattern_find(row, col, nnz, e->euler + k / 4, e->euler + k % 4);
+    }
+    d->nnz = nnz;
+}
+
+void generic_mass_nz(Generic *g, const double *q, double *vals)
+{
+    GenericDyn *d = g->dyn;
+    memset(vals, 0, (size_t)d->nnz * sizeof *vals);
+    add_mass(d, q, d->slot, vals);
 }
 
 /* Q's velocity terms (with_gravity: and the weights) of every mass element. */
