@@ -199,7 +199,8 @@ static void test_minnorm_step(void **state)
 }
 
 /* Phi = (q0 + q2 - 1, q1 + q2 - 2) at t, Phi_q's nonzeros those of mn_row's
-   first two rows: the projector's kernels (only phi is called). */
+   first two rows (its third row, past nh, is left out as a velocity-level
+   row would be): the projector's kernels (only phi is called). */
 static void pr_phi(void *ctx, const double *q, double t, double *phi)
 {
     (void)ctx, (void)t;
@@ -214,7 +215,7 @@ static void pr_phi(void *ctx, const double *q, double t, double *phi)
 static void test_projector(void **state)
 {
     (void)state;
-    MechrtHostJacNz j = {.nnz = 4, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
+    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
     MechrtKernels k = {3, 2, 0, NULL, pr_phi, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_null(mechrt_host_new_sparse(&k, &j));
     MechrtHost *h = mechrt_host_new_projector(&k, &j);
