@@ -18,7 +18,9 @@
 #    dense path once: the integration's CPU time, the largest error
 #    of B0's position and velocity against the exact solution of the
 #    published definition (the one-angle equation of the parallelogram
-#    branch; the benchmark's data file was not available), and the energy.
+#    branch; the benchmark's data file was not available), and the energy;
+#    then the same with `--interpolate` (rk8pd's own steps across the
+#    output times, the states there interpolated; A02_INTERP=0 skips it).
 # 3. `mechc bench` on Andrews, the double pendulum, A02 and two spatial
 #    files (heavy_top, slider_crank_spatial_torque): ns per call of
 #    mass, force, m+q (both) and eom for generic, jit and aot, and the
@@ -32,6 +34,7 @@ a02_n=${A02_N:-40}
 a02_t1=${A02_T1:-20}
 a02_rtol=${A02_RTOL:-1e-6}
 a02_dense=${A02_DENSE:-0}
+a02_interp=${A02_INTERP:-1}
 if [ ! -x "$mechc" ]; then
     echo "usage: sh bench/dynamics.sh MECHC   ('$mechc' is not an executable; run make first)" >&2
     exit 2
@@ -65,28 +68,34 @@ echo "== IFToMM A02, N = $a02_n, ${a02_t1} s (jit, rk8pd, --rtol $a02_rtol --ato
 sh "$root/examples/a02_four_bar.sh" "$a02_n" "$tmp/a02.mech"
 steps=$(awk -v t="$a02_t1" 'BEGIN { s = int(t * 20 + 0.5); print s < 1 ? 1 : s }')
 qd=$(sh "$root/examples/a02_four_bar.sh" --qd "$a02_n")
-# a02_sim LINEAR: one simulation, its stats in a02.err, states in a02.csv
+# a02_sim LINEAR [OPTION]: one simulation, its stats in a02.err, states in a02.csv
 a02_sim() {
     "$mechc" sim "$tmp/a02.mech" --linear "$1" --t1 "$a02_t1" --steps "$steps" --rtol "$a02_rtol" \
-        --atol "$a02_rtol" --qd "$qd" --stats --csv "$tmp/a02.csv" 2> "$tmp/a02.err" \
+        --atol "$a02_rtol" --qd "$qd" --stats --csv "$tmp/a02.csv" ${2:+"$2"} 2> "$tmp/a02.err" \
         || { tail -3 "$tmp/a02.err" >&2; exit 1; }
+}
+# a02_timed [OPTION]: REPEAT simulations on the sparse path, best and median CPU
+a02_timed() {
+    i=0
+    : > "$tmp/a02.ms"
+    while [ "$i" -lt "$repeat" ]; do
+        a02_sim auto ${1:+"$1"}
+        cpu_ms "$tmp/a02.err" >> "$tmp/a02.ms"
+        i=$((i + 1))
+    done
+    sort -g "$tmp/a02.ms" | awk -v o="${1:-}" '{ v[NR] = $1 } END {
+        printf "%sintegration CPU: best %.1f ms, median %.1f ms of %d runs (target: under 100 ms for 20 s at N = 40)\n",
+               o == "" ? "" : o ": ", v[1], v[int((NR + 1) / 2)], NR }'
+    grep 'integrator steps\|dependent row\|augmented matrix' "$tmp/a02.err" | sed 's/^mechc sim: stats: /  /'
+    a02_check
 }
 if [ "$a02_dense" = 1 ]; then
     a02_sim dense
     printf 'dense path (null-space method, QR/SVD projections): integration CPU %s ms\n' \
         "$(cpu_ms "$tmp/a02.err")"
 fi
-i=0
-: > "$tmp/a02.ms"
-while [ "$i" -lt "$repeat" ]; do
-    a02_sim auto
-    cpu_ms "$tmp/a02.err" >> "$tmp/a02.ms"
-    i=$((i + 1))
-done
-sort -g "$tmp/a02.ms" | awk '{ v[NR] = $1 } END {
-    printf "integration CPU: best %.1f ms, median %.1f ms of %d runs (target: under 100 ms for 20 s at N = 40)\n",
-           v[1], v[int((NR + 1) / 2)], NR }'
-grep 'integrator steps\|dependent row\|augmented matrix' "$tmp/a02.err" | sed 's/^mechc sim: stats: /  /'
+# a02_check: B0 in a02.csv against the exact solution, and the energy
+a02_check() {
 awk -F, -v n="$a02_n" '
     BEGIN { pi = atan2(0, -1); ii = (n + 1) / 3 + n; k = 9.81 * ((n + 1) / 2 + n)
             th = pi / 2; w = -1; tt = 0; h = 1e-4 }
@@ -113,6 +122,9 @@ awk -F, -v n="$a02_n" '
     }
     END { printf "B0 against the exact solution: largest error %.3g over %d states (benchmark: 1e-3)\n", worst, NR - 1
           printf "energy: largest |E - E0| %.3g J of E0 = %.12g J\n", we, ii / 2 + k }' "$tmp/a02.csv"
+}
+a02_timed
+[ "$a02_interp" = 1 ] && a02_timed --interpolate
 
 echo
 echo "== dynamics kernels per call (mechc bench; target: generated / generic >= 3x jit, 5x aot)"

@@ -16,7 +16,7 @@
 # N = 100 gives 700 coordinates and 700 rows. POSIX sh and awk only.
 
 . "$(dirname "$0")/size_arg.sh"
-size_arg "$@"
+size_arg 7 0 "$@"      # NQ = 7N
 
 gen() {
     awk -v n="$n" 'BEGIN {

@@ -11,7 +11,7 @@
 # POSIX sh and awk only.
 
 . "$(dirname "$0")/size_arg.sh"
-size_arg "$@"
+size_arg 6 3 "$@"      # NQ = 6N + 3
 
 gen() {
     awk -v n="$n" 'BEGIN {

@@ -13,7 +13,7 @@
 # POSIX sh and awk only.
 
 . "$(dirname "$0")/size_arg.sh"
-size_arg "$@"
+size_arg 3 3 "$@"      # NQ = 3N + 3
 
 gen() {
     awk -v n="$n" 'BEGIN {

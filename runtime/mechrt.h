@@ -568,15 +568,6 @@ MechrtStatus mechrt_dynamics_rows(const MechrtKernels *k, const MechrtDynOptions
 #define MECHRT_LUP_ABS(x) MECHRT_FABS(x)
 #endif
 
-/* ---- Pattern LU (lu_pattern.c) -----------------------------------------
-   The LU of n x n matrices that share a sparsity pattern (entry e at
-   (row[e], col[e]); every entry outside it must be zero), with the dense
-   LU's results bit for bit: the first factorisation is mechrt_lu_factor's,
-   whose pivot order and fill are recorded (on the integer workspace) and
-   replayed by the later ones over the nonzeros only, as long as partial
-   pivoting would choose the same pivots; otherwise that factorisation is
-   the dense one again, and its order is recorded. The state is the
-   caller's; its fields are for reading (counts, tests). */
 /* The unrolled LU that `mechc gen --lu` writes for the Jacobian's pattern
    (P_lu_factor, P_lu_solve; MECHRT_DEFINE_LU): a pivot order fixed when
    the file was written, checked at run time. factor reads the pattern's
@@ -600,6 +591,17 @@ typedef struct MechrtLuGen {
                 int *iout);
 } MechrtLuGen;
 
+/* ---- Pattern LU (lu_pattern.c) -----------------------------------------
+   The LU of n x n matrices that share a sparsity pattern (entry e at
+   (row[e], col[e]); every entry outside it must be zero), with the dense
+   LU's results bit for bit (unless mechrt_lup_use gave it an unrolled LU,
+   whose results agree to rounding, not bit for bit): the first
+   factorisation is mechrt_lu_factor's, whose pivot order and fill are
+   recorded (on the integer workspace) and replayed by the later ones over
+   the nonzeros only, as long as partial pivoting would choose the same
+   pivots; otherwise that factorisation is the dense one again, and its
+   order is recorded. The state is the
+   caller's; its fields are for reading (counts, tests). */
 typedef struct MechrtLup {
     int n, nnz;
     const int *row, *col;   /* the pattern, kept by pointer */

@@ -267,7 +267,18 @@ run gen "$ex/four_bar.mech" --jac direct --prefix fbd -o "$tmp/fbd.c"
 check "gen --jac direct exits 0" status_is 0
 check "gen --jac direct: the dense Jacobian stores its own entries" \
     sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "fbd_jac_nz(q, t, packed);" "$1"' _ "$tmp/fbd.c"
-check "gen default: the dense Jacobian is spread from jac_nz" grep -q "fb_jac_nz(q, t, packed);" "$tmp/fb.c"
+check "gen default (--jac auto), small: the dense Jacobian stores in place" \
+    sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "fb_jac_nz(q, t, packed);" "$1"' _ "$tmp/fb.c"
+run gen "$ex/four_bar.mech" --jac spread --prefix fbs -o "$tmp/fbs.c"
+check "gen --jac spread: the dense Jacobian is spread from jac_nz" grep -q "fbs_jac_nz(q, t, packed);" "$tmp/fbs.c"
+# 4005 nonzeros (chain of 200 loops): straight-line, over EMIT_DIRECT_JAC_NNZ, spread;
+# rolled (the default for its 1206 rows), direct
+sh "$ex/chain.sh" 200 "$tmp/chain200.mech"
+run gen "$tmp/chain200.mech" --roll never --prefix cs -o "$tmp/cs.c"
+check "gen --jac auto, over 4000 nonzeros straight-line: spread" grep -q "cs_jac_nz(q, t, packed);" "$tmp/cs.c"
+run gen "$tmp/chain200.mech" --prefix cr -o "$tmp/cr.c"
+check "gen --jac auto, over 4000 nonzeros rolled: direct" \
+    sh -c 'grep -q "Zero-filled, then every nonzero stored in place" "$1" && ! grep -q "cr_jac_nz(q, t, packed);" "$1"' _ "$tmp/cr.c"
 if have gcc; then
     check "gcc compiles gen --jac direct output" gcc $cflags -c "$tmp/fbd.c" -o "$tmp/fbd.o"
 fi
@@ -278,7 +289,7 @@ check "gen --real float with a constant float rounds to 0: the file and why" \
     err_has "tiny.mech: error: the constant 1e-50 is too small for float"
 run gen "$ex/four_bar.mech" --jac sideways
 check "gen --jac sideways exits 2" status_is 2
-check "gen --jac sideways names the choices" err_has "spread or direct"
+check "gen --jac sideways names the choices" err_has "auto, spread or direct"
 run gen "$ex/four_bar.mech" --prefix 1bad -o "$tmp/bad_prefix.c"
 check "gen --prefix 1bad exits 2" status_is 2
 check "gen --prefix 1bad says why" err_has "error:"

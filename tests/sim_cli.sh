@@ -223,6 +223,15 @@ run "$tmp/a02_40bad.mech" --t1 0.01 --qd "$(sh "$ex/a02_four_bar.sh" --qd 40)"
 check "a02 N = 40, a pivot moved: exit 1" status_is 1
 check "a02 N = 40, a pivot moved: could not assemble, in which row" err_matches \
     "t = 0: could not assemble from these initial values: after [0-9]* iterations of minimum-norm Newton the largest residual is [0-9.e+-]* in row [ab][0-9]*\.[xy]"
+# --interpolate: rk8pd's own steps across the 400 output times, the states
+# there from the steps' Hermite interpolant
+run "$tmp/a02_40.mech" --t1 20 --steps 400 --rtol 1e-6 --atol 1e-6 --interpolate \
+    --qd "$(sh "$ex/a02_four_bar.sh" --qd 40)" --csv "$tmp/a02_40i.csv" --stats
+check "a02 N = 40 --interpolate: exit 0" status_is 0
+check "a02 N = 40 --interpolate: fewer integrator steps than output intervals" awk '
+    /integrator steps/ { n = $4 } END { exit !(n > 0 && n < 400) }' "$tmp/err"
+check "a02 N = 40 --interpolate: B0 = the exact solution within 1e-3, 20 s" \
+    a02_exact 40 "$tmp/a02_40i.csv"
 run "$tmp/a02_4.mech" --linear sparse --engine generic --t1 0.1
 check "--linear sparse with the generic engine: exit 2" status_is 2
 check "--linear sparse with the generic engine: says why" err_has "needs the generated kernels"
@@ -239,6 +248,14 @@ check "double pendulum: E from the states within 1e-8 of E0 = 0 over 10 s" awk -
       if (e < 0) e = -e; if (e > w) w = e }
     END { printf "  double pendulum: max |E - E0| %.3g\n", w > "/dev/stderr"; exit !(NR == 1002 && w <= 1e-8) }' "$tmp/dp.csv"
 check "double pendulum: --stats energy balance within 1e-8" close_abs "$(energy_drift_ratio)" 0 1e-8
+run "$ex/double_pendulum.mech" --t1 10 --steps 1000 --interpolate --csv "$tmp/dpi.csv"
+check "double pendulum --interpolate: exit 0, 1001 states" awk 'END { exit !(NR == 1002) }' \
+    "$tmp/dpi.csv"
+# t = 1 falls inside a step: the interpolant against the reference below
+check "double pendulum --interpolate: th1(1) between steps" close_abs \
+    "$(value_at 1 rod1.phi "$tmp/dpi.csv")" -2.7785125649854966 1e-9
+check "double pendulum --interpolate: th1'(1) between steps" close_abs \
+    "$(value_at 1 "d(rod1.phi)" "$tmp/dpi.csv")" -3.406517532972 1e-8
 # th = phi + pi/2 at t = 1 (the example's header; RK4 and mpmath agree to 1e-12)
 check "double pendulum: th1(1)" close_abs "$(value_at 1 rod1.phi "$tmp/dp.csv")" \
     -2.7785125649854966 1e-9

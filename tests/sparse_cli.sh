@@ -240,6 +240,20 @@ deck_closed() {
           rows++ }
         END { exit bad || rows != 101 }' "$2"
 }
+# the generators' N: bounded by what the default --max-coords admits, exit 2
+sh "$ex/scissor.sh" 99999999999 "$tmp/sc_huge.mech" 2> "$tmp/err"
+rc=$?
+check "scissor.sh 99999999999: exit 2" status_is 2
+check "scissor.sh 99999999999: names the bound" \
+    err_has "gives more than 200000 coordinates (mechc's default --max-coords): N is at most 33332"
+check "scissor.sh 99999999999: no file written" test ! -s "$tmp/sc_huge.mech"
+sh "$ex/train.sh" 66666 "$tmp/tr_big.mech" 2> "$tmp/err"
+rc=$?
+check "train.sh 66666 (200001 coordinates): exit 2" status_is 2
+check "train.sh 66666: names its bound" err_has "N is at most 66665"
+sh "$ex/chain.sh" 0 "$tmp/c0.mech" 2> "$tmp/err"
+rc=$?
+check "chain.sh 0: the usage, exit 2" sh -c "[ $rc = 2 ] && grep -q 'positive integer' '$tmp/err'"
 sh "$ex/scissor.sh" 5 "$tmp/sc5.mech"
 run "$tmp/sc5.mech" --csv "$tmp/sc5.csv"
 check "scissor 5: exit 0" status_is 0
@@ -301,6 +315,15 @@ check "velocity rows singular, sparse: the time, the pivot's coordinate and row"
 check "gen: no lu without --lu" sh -c "! grep -q lu_factor '$tmp/fb.c'"
 run_mechc gen "$ex/knife_cart.mech" --lu -o "$tmp/kc.c"
 check "gen --lu, velocity rows: exit 0, no lu" sh -c "[ $rc = 0 ] && ! grep -q lu_factor '$tmp/kc.c'"
+check "gen --lu, velocity rows: a note says why" \
+    err_has "mechc gen: note: --lu not written: the mechanism has 3 velocity-level rows"
+sh "$ex/chain.sh" 100 "$tmp/c100.mech"
+run_mechc gen "$tmp/c100.mech" --lu -o "$tmp/c100.c"
+check "gen --lu, 603 coordinates: exit 0, no lu" sh -c "[ $rc = 0 ] && ! grep -q lu_factor '$tmp/c100.c'"
+check "gen --lu, 603 coordinates: a note says why" \
+    err_has "mechc gen: note: --lu not written: 603 coordinates, more than 100"
+run_mechc gen "$ex/slider_crank.mech" --lu -o "$tmp/sc_note.c"
+check "gen --lu on a mechanism that qualifies: no note" sh -c "! grep -q note '$tmp/err'"
 run_mechc gen "$ex/slider_crank.mech" --prefix sc --lu -o "$tmp/sclu.c" --header "$tmp/sclu.h"
 check "gen --lu: exit 0" status_is 0
 check "gen --lu: factor, solve and step declared" sh -c "grep -q '^int sc_lu_factor(' '$tmp/sclu.h' \

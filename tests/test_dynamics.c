@@ -368,6 +368,9 @@ static const BadCase bad_cases[] = {
     {SPRE "mass a m = 1 J = (1, 1, 1) Jxy = 2\n", 5, 14,
      "the inertia tensor of 'a' is not positive definite: its principal moments are -1, 1, 3"},
     {SPRE "mass a m = 1 J = (1, 1, 0)\n", 5, 14, "the inertia tensor of 'a' is not positive definite"},
+    /* a diagonal tensor's moments exactly (not -1.1e-16); entries near 1e200 scaled first */
+    {SPRE "mass a m = 1 J = (0, 1, 1)\n", 5, 14, "its principal moments are 0, 1, 1"},
+    {SPRE "mass a m = 1 J = (1e200, 1e200, 1e200) Jxy = 1e200\n", 5, 14, ", 1e+200, 2e+200"},
     {SPRE "mass a m = 1 J = (1, 1, 3)\n", 5, 14, "1 + 1 < 3 break the triangle inequality"},
     {SPRE "mass a m = 1 Jxy = 0.1\n", 5, 14, "'Jxy' without J = (Jxx, Jyy, Jzz)"},
     {SPRE "mass a m = 1 J = 2\n", 5, 18, "expected '(' after J = (Jxx, Jyy, Jzz)"},

@@ -119,6 +119,20 @@ static void unit_close(Unit *u)
         aot_unload(u->aot);
 }
 
+/* No row pointer of a rolled loop starts before its array: q + -3 * i
+   would be undefined in C99 (6.5.6p8) even where the element read is in
+   range. */
+static void assert_pointers_in_range(const char *name, const char *c)
+{
+    for (const char *line = c; (line = strstr(line, "*const ")); line++) {
+        const char *end = strchr(line, '\n');
+        const char *minus = strstr(line, "+ -");
+        if (minus && (!end || minus < end))
+            fail_msg("%s: a row pointer before its array: %.*s", name,
+                     (int)(end ? end - line : 80), line);
+    }
+}
+
 /* mech never against always, under the JIT or (aot) the system compiler
    (gcc -O2, the file's own sincos); returns whether always rolled. */
 static bool check(const char *name, const Mech *mech, bool jit, bool direct_jac)
@@ -128,6 +142,7 @@ static bool check(const char *name, const Mech *mech, bool jit, bool direct_jac)
     emit(mech, EMIT_ROLL_ALWAYS, jit, direct_jac, &rolled);
     assert_null(strstr(straight.c_text, "one shape: one loop"));
     bool loops = strstr(rolled.c_text, "one shape: one loop") != NULL;
+    assert_pointers_in_range(name, rolled.c_text);
     Unit a, b;
     const Kernels *ka = unit_open(&a, &straight, jit, name);
     const Kernels *kb = unit_open(&b, &rolled, jit, name);
@@ -356,6 +371,21 @@ static void test_auto(void **state)
     pipeline_free(mech);
 }
 
+/* A rolled table's constants print as the straight-line code's do, the
+   shortest decimal that reads back (emit_put_literal): 0.2, not
+   0.20000000000000001. */
+static void test_table_literals(void **state)
+{
+    (void)state;
+    Mech *mech = load_example("suspension.mech");
+    EmitResult rolled;
+    emit(mech, EMIT_ROLL_ALWAYS, true, true, &rolled);
+    assert_non_null(strstr(rolled.c_text, "_phi_r1_k2[2] = {\n    0.2, 0.32,\n};"));
+    assert_null(strstr(rolled.c_text, "0000000000"));
+    emit_result_free(&rolled);
+    pipeline_free(mech);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -365,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_unoptimised),
         cmocka_unit_test(test_float),
         cmocka_unit_test(test_auto),
+        cmocka_unit_test(test_table_literals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -196,6 +196,11 @@ static void test_minnorm_step(void **state)
         mechrt_host_minnorm_free(m);
     }
     assert_null(mechrt_host_minnorm_new(4, 3, &j));     /* more rows than coordinates */
+    MechrtHostJacNz no_rows = j, no_cols = j;               /* entries but no pattern */
+    no_rows.row = NULL;
+    no_cols.col = NULL;
+    assert_null(mechrt_host_minnorm_new(2, 3, &no_rows));
+    assert_null(mechrt_host_minnorm_new(2, 3, &no_cols));
 }
 
 /* Phi = (q0 + q2 - 1, q1 + q2 - 2) at t, Phi_q's nonzeros those of mn_row's

@@ -7,8 +7,8 @@
 # A written file picks its trig when it is compiled (libm's sin and cos
 # under tcc and without optimisation, its own sincos pair otherwise) and
 # zero-fills the dense Jacobian with memset (or, optimised and small, with
-# stores). For four-bar (spread and --jac direct Jacobian), slider-crank,
-# all_statements and a chain of 20 loops (a large Jacobian; a sincos pair
+# stores). For four-bar (the default direct and --jac spread Jacobian), slider-crank,
+# all_statements and a chain of 20 loops (both Jacobians; a sincos pair
 # called out of line under gcc -O2), each build is linked with a driver
 # that evaluates every function at a state near q0 with velocities, the
 # Jacobian outputs first filled with NaN, and prints Phi, Phi_q, nu and
@@ -97,10 +97,11 @@ same_values() {
 
 sh "$ex/chain.sh" 20 "$tmp/chain_20.mech"
 cases="four_bar:$ex/four_bar.mech:
-four_bar_direct:$ex/four_bar.mech:--jac direct
+four_bar_spread:$ex/four_bar.mech:--jac spread
 slider_crank:$ex/slider_crank.mech:
 all_statements:$ex/all_statements.mech:
-chain_20:$tmp/chain_20.mech:"
+chain_20:$tmp/chain_20.mech:
+chain_20_spread:$tmp/chain_20.mech:--jac spread"
 compilers="gcc_O2|gcc -std=c99 -O2 -Wall -Wextra -Wpedantic -Werror
 gcc_O0|gcc -std=c99 -O0 -Wall -Wextra -Wpedantic -Werror"
 if have tcc; then
@@ -205,8 +206,8 @@ elif "$mechc" gen "$tmp/lone.mech" --prefix m -o "$tmp/lone.c" 2> "$tmp/err" &&
 else
     bad "lone: gen"
 fi
-# every case and compiler gave its 3 results (all 5 cases use sin/cos)
+# every case and compiler gave its 3 results (all 6 cases use sin/cos)
 n=$(grep -c . "$tmp/results")
-want=$(($(echo "$compilers" | grep -c .) * 5 * 3))
+want=$(($(echo "$compilers" | grep -c .) * 6 * 3))
 if [ "$n" = "$want" ]; then ok; else bad "$n results, expected $want"; fi
 suite_end

@@ -164,6 +164,13 @@ typedef struct Sim {
     bool mq_valid;               /* ... with this step's rows */
     bool vel_ready;              /* Phi_q's nonzeros and nu at the state, for the
                                     velocity projection */
+    /* the last right side, (t, y) -> f, valid while the rows stay: GSL
+       evaluates f at a step's start, where an output state or the
+       interpolant's end has just solved it */
+    double *cy, *cf, ct;
+    bool cache_ok;
+    double *yc, *fc, *ya, *fa;   /* --interpolate: the last two steps' starts, f there */
+    double *fb, *yi;             /* f at the step's end, the output state */
 } Sim;
 
 /* Counting wrappers: every kernel call of the simulation goes through these. */
@@ -331,7 +338,8 @@ static MechrtStatus sparse_mass_factor(Sim *s, const double *q, double t)
         return MECHRT_OK;
     }
     s->mq_valid = false;
-    MechrtStatus st = mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_MASS, s->active, s->nr,
+    MechrtStatus st = mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_MASS,
+                                             s->all_active ? NULL : s->active, s->nr,
                                              s->o->dyn.pivot_tol);
     if (st == MECHRT_OK) {
         memcpy(s->mq, q, bytes);
@@ -474,9 +482,38 @@ static const double *dyn_mass(const Sim *s)
     return s->work + (size_t)s->nr * (size_t)s->nq;
 }
 
+static int sim_rhs_solve(Sim *s, double t, const double y[], double f[]);
+
+/* f = (qd, qdd, dE/dt) at (t, y) kept for a repeated evaluation. */
+static void cache_store(Sim *s, double t, const double *y, const double *f)
+{
+    memcpy(s->cy, y, 2 * (size_t)s->nq * sizeof *y);
+    memcpy(s->cf, f, (size_t)s->dim * sizeof *f);
+    s->ct = t;
+    s->cache_ok = true;
+}
+
+/* The cache holds f at (t, y). */
+static bool cache_has(const Sim *s, double t, const double *y)
+{
+    return s->cache_ok && t == s->ct && memcmp(y, s->cy, 2 * (size_t)s->nq * sizeof *y) == 0;
+}
+
 static int sim_rhs(double t, const double y[], double f[], void *params)
 {
     Sim *s = params;
+    if (cache_has(s, t, y)) {
+        memcpy(f, s->cf, (size_t)s->dim * sizeof *f);
+        return GSL_SUCCESS;
+    }
+    int st0 = sim_rhs_solve(s, t, y, f);
+    if (st0 == GSL_SUCCESS)
+        cache_store(s, t, y, f);
+    return st0;
+}
+
+static int sim_rhs_solve(Sim *s, double t, const double y[], double f[])
+{
     int n = s->nq;
     const double *q = y, *qd = y + n;
     MechrtDynReport rep;
@@ -791,8 +828,9 @@ static bool choose_rows(Sim *s, const double *y, double t, MechrtDynReport *out)
     MechrtDynReport rep;
     MechrtDynOptions ro = s->o->dyn;
     ro.rank_tol = fmax(ro.rank_tol, s->o->row_tol);
-    MechrtStatus st = !dense_ready(s) ? MECHRT_EINVAL : mechrt_dynamics_rows(&s->kc, &ro, y, t, s->active, s->work, s->lwork,
-                                           &rep);
+    MechrtStatus st = !dense_ready(s) ? MECHRT_EINVAL
+                      : mechrt_dynamics_rows(&s->kc, &ro, y, t, s->active, s->work,
+                                             s->lwork, &rep);
     if (st != MECHRT_OK) {
         fail(s, st, t, "the rank of the Jacobian");
         msgf(s, "%s", mechrt_strerror(st));
@@ -841,6 +879,7 @@ static bool sparse_rows(Sim *s, const double *y, double t)
    uses them. */
 static bool settle(Sim *s, double *y, double t, bool project)
 {
+    s->cache_ok = false;    /* y and the rows change */
     if (!s->kkt)
         return (!project || (settle_positions(s, y, t) && settle_velocities(s, y, t)))
                && choose_rows(s, y, t, NULL);
@@ -896,6 +935,14 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->f0 = xcalloc((size_t)s->dim, sizeof *s->f0);
     s->f1 = xcalloc((size_t)s->dim, sizeof *s->f1);
     s->y = xcalloc((size_t)s->dim, sizeof *s->y);
+    s->cy = xcalloc((size_t)s->dim, sizeof *s->cy);
+    s->cf = xcalloc((size_t)s->dim, sizeof *s->cf);
+    s->ya = xcalloc((size_t)s->dim, sizeof *s->ya);
+    s->yc = xcalloc((size_t)s->dim, sizeof *s->yc);
+    s->fc = xcalloc((size_t)s->dim, sizeof *s->fc);
+    s->fa = xcalloc((size_t)s->dim, sizeof *s->fa);
+    s->yi = xcalloc((size_t)s->dim, sizeof *s->yi);
+    s->fb = xcalloc((size_t)s->dim, sizeof *s->fb);
     s->active = xcalloc(m + 1, sizeof *s->active);
     memset(s->active, 1, m + 1);
     s->dyn = o->dyn;
@@ -937,6 +984,7 @@ static void sim_close(Sim *s)
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
     free(s->y), free(s->active);
+    free(s->cy), free(s->cf), free(s->ya), free(s->fa), free(s->fb), free(s->yi), free(s->yc), free(s->fc);
     free(s->qrw);
     mechrt_svd_free(s->svd);
     if (s->kkt)
@@ -956,8 +1004,10 @@ static double time_at(const SimOptions *o, int i)
     return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
 }
 
-/* The state y at t out: its accelerations and multipliers, then the callback. */
-static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void *ctx)
+/* The state y at t out: its accelerations and multipliers, then the
+   callback; with cache, the right side there is kept for the next step. */
+static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void *ctx,
+                      bool cache)
 {
     int n = s->nq;
     MechrtDynReport rep;
@@ -965,6 +1015,14 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
        them; near a rank drop the dense method's minimum-norm ones */
     if (s->kkt && s->all_active
         && sparse_accel(s, y, y + n, t, NULL, s->f0, s->lambda) == MECHRT_OK) {
+        if (cache) {    /* the right side the next step starts from, as sim_rhs solves it */
+            memcpy(s->f1, y + n, (size_t)n * sizeof *s->f1);
+            memcpy(s->f1 + n, s->f0, (size_t)n * sizeof *s->f1);
+            if (s->o->energy)
+                s->f1[2 * n] = sparse_mass_form(s, mechrt_host_kkt_mass(s->kkt), y + n, s->f0)
+                               + half_mdot(s, y, y + n);
+            cache_store(s, t, y, s->f1);
+        }
         state(ctx, t, y, y + n, s->f0, s->lambda);
         s->res->states++;
         return true;
@@ -982,13 +1040,73 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
     return true;
 }
 
+/* One accepted step from *t towards t1 with GSL's stepper and control,
+   retried with the control's smaller h (or half h on a stepper failure)
+   as gsl_odeiv2_evolve_apply does, but asking the stepper for no f at
+   the step's unprojected end (dydt_out NULL: rk8pd and rkf45 then skip
+   that evaluation, one in 13 and in 6): --interpolate solves f at the
+   projected end anyway, for the interpolant and the next step's start.
+   The control's derivative weight is 0 (sim_open), so dydt_in stands in
+   for the dydt it is given. GSL's status. */
+static int step_without_end_f(Sim *s, double *t, double t1, double *h, double *y)
+{
+    gsl_odeiv2_driver *d = s->drv;
+    gsl_odeiv2_evolve *e = d->e;
+    size_t bytes = (size_t)s->dim * sizeof *y;
+    double t0 = *t, span = t1 - t0;
+    int st = sim_rhs(t0, y, e->dydt_in, s);
+    if (st != GSL_SUCCESS)
+        return st;
+    memcpy(e->y0, y, bytes);
+    for (;;) {
+        double hs = *h;
+        bool last = span >= 0 ? hs > span : hs < span;
+        if (last)
+            hs = span;
+        st = gsl_odeiv2_step_apply(d->s, t0, hs, y, e->yerr, e->dydt_in, NULL, &s->sys);
+        if (st == GSL_EFAULT || st == GSL_EBADFUNC)
+            return st;
+        double hn = hs;
+        bool again = st != GSL_SUCCESS;
+        if (again)
+            hn = 0.5 * hs;
+        else
+            again = gsl_odeiv2_control_hadjust(d->c, d->s, y, e->yerr, e->dydt_in, &hn)
+                    == GSL_ODEIV_HADJ_DEC;
+        if (again) {
+            memcpy(y, e->y0, bytes);
+            *h = hn;
+            if (!(fabs(hn) < fabs(hs)) || t0 + hn == t0)
+                return st != GSL_SUCCESS ? st : GSL_FAILURE;
+            e->failed_steps++;
+            continue;
+        }
+        e->count++;
+        e->last_step = hs;
+        *t = last ? t1 : t0 + hs;
+        if (!last)
+            *h = hn;
+        return GSL_SUCCESS;
+    }
+}
+
 /* One accepted integrator step from *t towards tn; false with the message set. */
 static bool one_step(Sim *s, double *y, double *t, double tn, double *h)
 {
     gsl_odeiv2_driver *d = s->drv;
     double hmin = SIM_HMIN_SHARE * fabs(s->o->t1 - s->o->t0), t_before = *t;
     unsigned long failed0 = d->e->failed_steps;
-    int gs = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &s->sys, t, tn, h, y);
+    /* GSL's evolve starts a step from the last one's dydt_out, f at the
+       unprojected end with the old rows; where f at the projected state
+       is at hand (an output state or the interpolant's end solved it
+       there), count = 0 makes it evaluate f there instead, which the
+       cache answers */
+    if (cache_has(s, *t, y))
+        d->e->count = 0;
+    bool explicit_rk = s->o->method == SIM_RK8PD || s->o->method == SIM_RKF45;
+    int gs = s->o->interpolate && explicit_rk ? step_without_end_f(s, t, tn, h, y)
+                                              : gsl_odeiv2_evolve_apply(d->e, d->c, d->s,
+                                                                        &s->sys, t, tn, h, y);
     s->res->rejected += (long)(d->e->failed_steps - failed0);
     if (gs != GSL_SUCCESS) {
         if (s->fail_status != MECHRT_OK) {
@@ -1016,14 +1134,162 @@ static bool one_step(Sim *s, double *y, double *t, double tn, double *h)
     return true;
 }
 
+/* f at the settled state y (t) into f, kept for the next step's first
+   stage; false with the message set. */
+static bool end_rhs(Sim *s, const double *y, double t, double *f)
+{
+    if (sim_rhs(t, y, f, s) == GSL_SUCCESS)
+        return true;
+    if (s->fail_status == MECHRT_OK) {     /* sim_rhs records every failure; defensive */
+        fail(s, MECHRT_ENOTFINITE, t, "forward dynamics");
+        msgf(s, "%s", mechrt_strerror(MECHRT_ENOTFINITE));
+        return false;
+    }
+    fail(s, s->fail_status, s->fail_t, "forward dynamics");
+    explain_dynamics(s, s->fail_status, &s->fail_rep);
+    return false;
+}
+
+/* The weights at t of the Hermite interpolant through nk (2 or 3) nodes
+   tk (the last the newest) with value, first and second derivative at
+   each, for the value (w) and its derivative (wd): 3 nk each, in the
+   order (value, derivative, second derivative) per node. In the
+   variable x = (t - t_last) / hs, hs the last interval, the monomial
+   basis' confluent Vandermonde A gives P = phi(x)^T A^-1 d, so w solves
+   A^T w = phi(x); Gaussian elimination with partial pivoting (9 x 9). */
+static void hermite_weights(int nk, const double *tk, double t, double *w, double *wd)
+{
+    enum { NMAX = 9 };
+    int nn = 3 * nk;
+    double hs = tk[nk - 1] - tk[nk - 2], at[NMAX][NMAX + 2];
+    for (int k = 0; k < nk; k++) {
+        double xk = (tk[k] - tk[nk - 1]) / hs, pw[NMAX + 1];
+        pw[0] = 1;
+        for (int m = 1; m <= nn; m++)
+            pw[m] = pw[m - 1] * xk;
+        for (int m = 0; m < nn; m++) {      /* column 3k + i of A is row 3k + i of A^T */
+            at[m][3 * k] = pw[m];
+            at[m][3 * k + 1] = m >= 1 ? m * pw[m - 1] / hs : 0;          /* d/dt = d/dx / hs */
+            at[m][3 * k + 2] = m >= 2 ? m * (m - 1) * pw[m - 2] / (hs * hs) : 0;
+        }
+    }
+    double x = (t - tk[nk - 1]) / hs, pw = 1;
+    for (int m = 0; m < nn; m++) {
+        at[m][nn] = pw;                                     /* phi(x) */
+        at[m][nn + 1] = m >= 1 ? m * (pw / (x != 0 ? x : 1)) : 0;
+        pw *= x;
+    }
+    if (x == 0)     /* phi'(0) = (0, 1, 0, ...) */
+        for (int m = 0; m < nn; m++)
+            at[m][nn + 1] = m == 1;
+    for (int m = 0; m < nn; m++)
+        at[m][nn + 1] /= hs;
+    for (int c = 0; c < nn; c++) {
+        int p = c;
+        for (int r = c + 1; r < nn; r++)
+            if (fabs(at[r][c]) > fabs(at[p][c]))
+                p = r;
+        for (int j = 0; j < nn + 2; j++) {
+            double tmp = at[c][j];
+            at[c][j] = at[p][j];
+            at[p][j] = tmp;
+        }
+        for (int r = c + 1; r < nn; r++) {
+            double f = at[r][c] / at[c][c];
+            for (int j = c; j < nn + 2; j++)
+                at[r][j] -= f * at[c][j];
+        }
+    }
+    for (int c = nn - 1; c >= 0; c--) {
+        double v = at[c][nn], vd = at[c][nn + 1];
+        for (int j = c + 1; j < nn; j++)
+            v -= at[c][j] * w[j], vd -= at[c][j] * wd[j];
+        w[c] = v / at[c][c];
+        wd[c] = vd / at[c][c];
+    }
+}
+
+/* yi at t: per coordinate the Hermite interpolant of q, qd, qdd at the
+   nk nodes (tk[k], yk[k], fk[k]; f = (qd, qdd, ...)): quintic on one
+   step, degree 8 on the last two (errors O(h^9) and O(h^8) in q and qd
+   against the quintic's O(h^6) and O(h^5): at rk8pd's own steps on A02
+   the quintic's velocities were off by 5e-4). The energy slot is linear
+   on the last step. */
+static void hermite(const Sim *s, int nk, const double *tk, double t, double *const *yk,
+                    double *const *fk, double *yi)
+{
+    int n = s->nq;
+    double w[9], wd[9];
+    hermite_weights(nk, tk, t, w, wd);
+    for (int j = 0; j < n; j++) {
+        double q = 0, qd = 0;
+        for (int k = 0; k < nk; k++) {
+            double p = yk[k][j], v = fk[k][j], a = fk[k][n + j];
+            q += w[3 * k] * p + w[3 * k + 1] * v + w[3 * k + 2] * a;
+            qd += wd[3 * k] * p + wd[3 * k + 1] * v + wd[3 * k + 2] * a;
+        }
+        yi[j] = q;
+        yi[n + j] = qd;
+    }
+    if (s->dim > 2 * n) {
+        const double *ya = yk[nk - 2], *yb = yk[nk - 1];
+        double u = (t - tk[nk - 2]) / (tk[nk - 1] - tk[nk - 2]);
+        yi[2 * n] = ya[2 * n] + u * (yb[2 * n] - ya[2 * n]);
+    }
+}
+
+/* --interpolate: steps towards t1 across the output times, settling
+   after each; the output states in a step from hermite(). */
+static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, void *ctx)
+{
+    const SimOptions *o = s->o;
+    size_t bytes = (size_t)s->dim * sizeof *y;
+    double t = o->t0, h = s->drv->h, dir = o->t1 > o->t0 ? 1 : -1;
+    /* the nodes, oldest first: two steps back, one step back, the end */
+    double tk[3] = {0, t, 0}, *yk[3] = {s->yc, s->ya, y}, *fk[3] = {s->fc, s->fa, s->fb};
+    int nk = 1;
+    watch_energy(s, y, true);
+    if (!put_state(s, y, t, state, ctx, false) || !end_rhs(s, y, t, s->fa))
+        return SIM_FAILED;
+    memcpy(s->ya, y, bytes);
+    for (int i = 1; i <= o->steps;) {
+        if (!one_step(s, y, &t, o->t1, &h) || !settle(s, y, t, o->project)
+            || !end_rhs(s, y, t, s->fb))
+            return SIM_FAILED;
+        watch_energy(s, y, false);
+        tk[2] = t;
+        nk = nk < 3 ? nk + 1 : 3;
+        for (; i <= o->steps && dir * (time_at(o, i) - t) <= 0; i++) {
+            double tn = time_at(o, i);
+            if (tn == t)
+                memcpy(s->yi, y, bytes);
+            else
+                hermite(s, nk, tk + 3 - nk, tn, yk + 3 - nk, fk + 3 - nk, s->yi);
+            if (!put_state(s, s->yi, tn, state, ctx, false))
+                return SIM_FAILED;
+        }
+        /* shift the nodes: c <- a, a <- the end */
+        double *ty = s->yc, *tf = s->fc;
+        s->yc = s->ya, s->fc = s->fa;
+        s->ya = ty, s->fa = tf;
+        memcpy(s->ya, y, bytes);
+        memcpy(s->fa, s->fb, bytes);
+        yk[0] = s->yc, fk[0] = s->fc, yk[1] = s->ya, fk[1] = s->fa;
+        tk[0] = tk[1], tk[1] = t;
+    }
+    return SIM_OK;
+}
+
 /* From the consistent state in y: the output times, stepping and projecting. */
 static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
 {
     const SimOptions *o = s->o;
+    if (o->interpolate && o->method != SIM_MSBDF)
+        return integrate_interpolated(s, y, state, ctx);
     bool per_step = o->project && o->method != SIM_MSBDF;
     double t = o->t0, h = s->drv->h;
     watch_energy(s, y, true);
-    if (!put_state(s, y, t, state, ctx))
+    if (!put_state(s, y, t, state, ctx, true))
         return SIM_FAILED;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
@@ -1039,7 +1305,7 @@ static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
                 gsl_odeiv2_driver_reset(s->drv);    /* the multistep history is stale */
             watch_energy(s, y, false);
         }
-        if (!put_state(s, y, t, state, ctx))
+        if (!put_state(s, y, t, state, ctx, true))
             return SIM_FAILED;
     }
     return SIM_OK;

@@ -51,6 +51,12 @@ typedef struct SimOptions {
     /* the projections' Newton: tol_phi, tol_dq, max_iter; and assembly's */
     MechrtOptions mechrt;
     bool project;           /* coordinate projection; true */
+    /* Steps across the output times instead of ending a step at each one;
+       the state at an output time is the quintic Hermite interpolant of
+       the enclosing step's ends (q, qd, qdd at both), its accelerations
+       and multipliers solved there (not projected: Phi = 0 holds to the
+       interpolation error). false: every output time is a step's end */
+    bool interpolate;
     /* At the start of every step (on the manifold), rows whose pivot in
        the rank-revealing elimination is <= row_tol * max|Phi_q_ij| are left
        out for the step's stages: redundant rows, and near a singular

@@ -22,7 +22,7 @@ typedef struct GenCli {
 
 static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
-    "                 [--real double|float] [--trig own|libm] [--jac spread|direct]\n"
+    "                 [--real double|float] [--trig own|libm] [--jac auto|spread|direct]\n"
     "                 [--sparse | --sparse-only] [--roll auto|never|always] [--lu]\n"
     "                 [--chunk N] [--stats]\n"
     "\n"
@@ -33,7 +33,7 @@ static const char usage[] =
 
 static const char *const reals[] = {"double", "float", NULL};
 static const char *const trigs[] = {"own", "libm", NULL};
-static const char *const jacs[] = {"spread", "direct", NULL};
+static const char *const jacs[] = {"auto", "spread", "direct", NULL};
 static const char *const dumps[] = {"rows", NULL};
 static const char *const rolls[] = {"auto", "never", "always", NULL};
 
@@ -54,10 +54,12 @@ static const CliOption options[] = {
              "or sin and cos of <math.h> as written (libm); float\n"
              "kernels always call sinf and cosf"},
     {"--jac", CLI_CHOICE_AT(GenCli, jac, jacs), .metavar = "HOW",
-     .help = "the dense PREFIX_jac: spread (default) fills it from\n"
-             "PREFIX_jac_nz, one copy of the Jacobian's expressions;\n"
-             "direct stores every entry itself, zeros included: more\n"
-             "code, a faster dense Jacobian (what jit and aot use)"},
+     .help = "the dense PREFIX_jac: direct stores every entry in place\n"
+             "after one zero fill: a second copy of the Jacobian's\n"
+             "expressions, the faster dense Jacobian (what jit and aot\n"
+             "use); spread fills it from PREFIX_jac_nz, one copy, and\n"
+             "moves the values into place; auto (default) is direct\n"
+             "unless the copy is large (over 4000 nonzeros, not rolled)"},
     {"--sparse", CLI_FLAG_AT(GenCli, emit.all_nz),
      .help = "also write PREFIX_all_nz: Phi, the Jacobian's nonzeros, nu\n"
              "and gamma in one call (the sparse counterpart of _all,\n"
@@ -78,7 +80,8 @@ static const CliOption options[] = {
      .help = "also write PREFIX_lu_factor and PREFIX_lu_solve: the\n"
              "Jacobian's LU unrolled for its pattern, constants folded,\n"
              "with run-time pivot checks (square mechanisms without\n"
-             "velocity rows, up to 100 coordinates; what run calls)"},
+             "velocity rows, up to 100 coordinates; what run calls;\n"
+             "otherwise a note on stderr says why none was written)"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"
@@ -139,7 +142,7 @@ static bool finish(Args *a, void *opts)
     (void)a;
     c->emit.real_float = c->real == 1;
     c->emit.libm_trig = c->trig == 1;
-    c->emit.direct_jac = c->jac == 1;
+    c->emit.direct_jac = c->jac == 2;     /* auto: gen_file, once the size is known */
     c->emit.roll = c->roll;     /* rolls[] is in EmitRoll's order */
     c->emit.max_ops = c->limits.max_code_ops;
     if (c->emit.sparse_only) {      /* checked in gen_file, where it binds */
@@ -237,6 +240,8 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         diag_print(diag, stderr);
         return EXIT_USAGE;
     }
+    if (c->jac == 0)
+        c->emit.direct_jac = emit_direct_jac_default(&mech->kin, c->emit.roll);
     EmitResult res;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &c->emit, &res, diag)) {     /* about the file: "FILE: error: ..." */
@@ -244,6 +249,8 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_USAGE;
     }
     double emit_seconds = pipeline_now() - t0;
+    if (res.lu_skipped[0])  /* the file is whole without it; a caller of P_lu_factor is not */
+        fprintf(stderr, "mechc gen: note: --lu not written: %s\n", res.lu_skipped);
     bool ok = write_outputs(c, &res);
     if (c->stats)
         print_stats(mech, c, &res, emit_seconds, diag);

@@ -72,7 +72,8 @@ static const CliOption options[] = {
      .help = "jit (default), generic or aot, as for eval"},
     {"--linear", CLI_CHOICE_AT(RunCli, linear, run_linear_names), .metavar = "L",
      .help = "linear algebra: dense (LU), sparse (KLU on the Jacobian's\n"
-             "nonzeros; jit and aot, holonomic rows only) or auto\n"
+             "nonzeros; jit and aot; velocity-level rows integrated,\n"
+             "KLU for the velocities) or auto\n"
              "(default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates when it can)"},
     {"--csv", CLI_STRING_AT(RunCli, csv_path), .metavar = "FILE",
      .help = "write the CSV to FILE ('-': stdout; the default when\n"

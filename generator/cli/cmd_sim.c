@@ -72,6 +72,10 @@ static const CliOption options[] = {
     {"--qd", CLI_STRING_AT(SimCli, qd_text), .metavar = "V1,V2,...",
      .help = "initial velocities, one per coordinate (default 0);\n"
              "projected onto the velocity equations"},
+    {"--interpolate", CLI_FLAG_AT(SimCli, so.interpolate),
+     .help = "step across the output times: states there from the\n"
+             "steps' quintic Hermite interpolant (fewer steps when\n"
+             "outputs are dense; default: a step ends at each)"},
     {"--baumgarte", CLI_STRING_AT(SimCli, baumgarte), .metavar = "A,B",
      .help = "Baumgarte stabilisation gamma - 2A Phi' - B^2 Phi\n"
              "(1/s; default off: projection alone)"},

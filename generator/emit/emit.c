@@ -189,6 +189,9 @@ typedef struct Emitter {
     int chunk;                  /* the chunk being written */
     int fused;                  /* negations written into their product, this function */
     bool trig_calls;            /* sin and cos are calls, not inlined (calls_first) */
+    bool place_as_calls;        /* this function, if split into parts,
+                                   places its inline pairs as calls where
+                                   they cannot all go first */
     bool pair_out_of_line;      /* the file calls one noinline copy of its pair */
     bool hoisting;              /* in put_calls_first */
     const RollHooks *roll;      /* a loop body's leaves and stores (roll.c) */
@@ -463,7 +466,8 @@ static int rank_calls(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
         NodeId partner = sincos_partner(e, id);
         if (partner != DAG_NONE && e->sched.pos[partner] < at)
             e->call_rank[id] = e->call_rank[partner];
-        else if (e->trig_calls && sched_pair_shares_factor(&e->sched, fn, e->chunk, id))
+        else if ((e->trig_calls || e->place_as_calls)
+                 && sched_pair_shares_factor(&e->sched, fn, e->chunk, id))
             e->call_rank[id] = -1;      /* always first */
         else
             e->call_rank[id] = n++;
@@ -486,24 +490,27 @@ enum { EMIT_TRIG_IN_REGISTERS = 8 };
 static int calls_first(Emitter *e, const SchedFunction *fn, const SchedChunk *c)
 {
     int ncalls = rank_calls(e, fn, c);
-    if (e->trig_calls) {
-        int best = 0, least = INT_MAX;
-        for (e->hoist = 0; e->hoist <= ncalls; e->hoist++) {
-            int across = sched_values_across_calls(&e->sched, fn, e->chunk, goes_first, e);
-            if (across < least) {
-                least = across;
-                best = e->hoist;
-            }
+    if (!e->trig_calls) {
+        int values = 0;
+        for (int at = 0; at < c->nnodes; at++) {
+            DagOp op = dag_op(e->dag, c->nodes[at]);
+            if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
+                values++;
         }
-        return best;
+        if (values <= EMIT_TRIG_IN_REGISTERS)
+            return INT_MAX;
+        if (!e->place_as_calls)
+            return 0;
     }
-    int values = 0;
-    for (int at = 0; at < c->nnodes; at++) {
-        DagOp op = dag_op(e->dag, c->nodes[at]);
-        if ((op == OP_SIN || op == OP_COS) && !sched_is_import(&e->sched, c->nodes[at], e->chunk))
-            values++;
+    int best = 0, least = INT_MAX;
+    for (e->hoist = 0; e->hoist <= ncalls; e->hoist++) {
+        int across = sched_values_across_calls(&e->sched, fn, e->chunk, goes_first, e);
+        if (across < least) {
+            least = across;
+            best = e->hoist;
+        }
     }
-    return values <= EMIT_TRIG_IN_REGISTERS ? INT_MAX : 0;
+    return best;
 }
 
 /* Writes the chunk's first e->hoist sin/cos calls (rank_calls). */
@@ -849,6 +856,13 @@ bool emit_function_written(const EmitOptions *opt, EmitFunction f)
     return !(opt->sparse_only && (f == EMIT_JAC || f == EMIT_ALL));
 }
 
+bool emit_direct_jac_default(const Kinematics *kin, int roll)
+{
+    bool rolls = roll == EMIT_ROLL_ALWAYS
+                 || (roll == EMIT_ROLL_AUTO && kin->model->nr >= EMIT_ROLL_AUTO_ROWS);
+    return kin->nnz <= EMIT_DIRECT_JAC_NNZ || rolls;
+}
+
 /* True when function f has code of its own in the file (the dense
    Jacobian is spread from jac_nz, jac_spread.tmpl, unless direct). */
 static bool is_written(const Emitter *e, EmitFunction f)
@@ -918,8 +932,15 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         collect_outputs(e->kin, (EmitFunction)f, &outs, &n);
         long rolled = roll_outputs(e, (EmitFunction)f, &outs, &n, &parts[f], &bodies[f]);
         SchedFunction fn;
+        /* gamma split into parts places its inline pairs as calls
+           (calls_first) where they cannot all go first: chain N = 10
+           1.04-1.05x its --trig libm twin under gcc -O0 rather than
+           1.11-1.12x, and 3-5% faster under gcc -O2; the other functions
+           lost up to 3% so, and one-part gammas up to 10% (Andrews',
+           gcc -O2) (README, "Written files") */
         if (sched_function(&e->sched, outs, n, &fn)) {
             e->fused = 0;
+            e->place_as_calls = f == EMIT_GAMMA && e->sin_name && fn.nchunks > 1;
             put_function(e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
             out->ops[f] = (int)(fn.ops - e->fused + rolled);
             out->chunks[f] = fn.nchunks;
@@ -927,6 +948,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
             fits = false;
         }
         sched_function_free(&fn);
+        e->place_as_calls = false;
     }
     sched_free(&e->sched);
     if (!opt->direct_jac && !opt->sparse_only) {
@@ -1208,7 +1230,7 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
         put_jac_moves(&moves, e->kin);
     put_math(&math, e);
     put_all_nz(e, parts, bodies, &nzd, &nzf);
-    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf);
+    emit_lu(e->kin, opt, out->prefix, upper, &nzd, &nzf, out->lu_skipped, sizeof out->lu_skipped);
 
     EmitSizes z;
     put_sizes(e, &z);

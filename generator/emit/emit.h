@@ -56,6 +56,13 @@ typedef struct EmitOptions {
 typedef enum EmitRoll { EMIT_ROLL_AUTO, EMIT_ROLL_NEVER, EMIT_ROLL_ALWAYS } EmitRoll;
 enum { EMIT_ROLL_AUTO_ROWS = 500, EMIT_ROLL_AUTO_MEMBERS = 8 };
 
+/* gen --jac auto (the default): the direct dense Jacobian, faster under
+   every compiler (no moves after the fill), unless its second copy of the
+   Jacobian's expressions would be large: more than EMIT_DIRECT_JAC_NNZ
+   nonzeros in straight-line code (a rolled file's copy is a loop). */
+enum { EMIT_DIRECT_JAC_NNZ = 4000 };
+bool emit_direct_jac_default(const Kinematics *kin, int roll);
+
 /* The spec's function order, for op counts and reports (jac and all count
    0 in a sparse-only file); then all_nz, an extension (written only with
    EmitOptions.all_nz or sparse_only: its ops count 0 without),
@@ -84,6 +91,7 @@ typedef struct EmitResult {
     char prefix[128];           /* the prefix used */
     int ops[EMIT_FUNCTION_COUNT];
     int chunks[EMIT_FUNCTION_COUNT];
+    char lu_skipped[128];       /* opt->lu set but no LU written: why; "" otherwise */
 } EmitResult;
 
 EmitOptions emit_default_options(void);
@@ -102,9 +110,10 @@ void emit_put_literal(StrBuf *sb, double v, bool real_float);
 
 /* PREFIX_lu_factor and PREFIX_lu_solve (emit_lu.c) appended to decl and
    def when opt->lu is set and the mechanism is square, without velocity
-   rows and small enough; nothing otherwise. */
+   rows and small enough; nothing otherwise, with the reason in why ("":
+   written, or not asked for). */
 void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
-             const char *upper, StrBuf *decl, StrBuf *def);
+             const char *upper, StrBuf *decl, StrBuf *def, char *why, size_t why_size);
 
 /* Writes the C source and header. Returns false (diag filled) for an
    unusable prefix or header name, code beyond max_ops, or a dense

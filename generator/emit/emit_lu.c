@@ -43,6 +43,7 @@
 #include "../eval/interp.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -613,14 +614,32 @@ static void lu_free(LuGen *g)
     free(g->row_done), free(g->col_done);
 }
 
+/* Why the mechanism gets no LU, into why (NULL: it qualifies). */
+static bool lu_refused(const Kinematics *kin, char *why, size_t size)
+{
+    const Model *m = kin->model;
+    if (m->nv != 0)
+        snprintf(why, size, "the mechanism has %d velocity-level rows", m->nv);
+    else if (m->nh != m->nq)
+        snprintf(why, size, "the Jacobian is not square (%d rows, %d coordinates)", m->nh, m->nq);
+    else if (m->nq > LU_MAX_N)
+        snprintf(why, size, "%d coordinates, more than %d", m->nq, LU_MAX_N);
+    else if (m->nq < 1 || kin->nnz < 1)
+        snprintf(why, size, "the Jacobian has no nonzero entries");
+    else
+        return false;
+    return true;
+}
+
 /* Declarations (decl) and definitions (def) appended for the mechanism,
    when it is square without velocity rows and small enough. */
 void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
-             const char *upper, StrBuf *decl, StrBuf *def)
+             const char *upper, StrBuf *decl, StrBuf *def, char *why, size_t why_size)
 {
     const Model *m = kin->model;
     int n = m->nq;
-    if (!opt->lu || m->nv != 0 || m->nh != n || n < 1 || n > LU_MAX_N || kin->nnz < 1)
+    why[0] = '\0';
+    if (!opt->lu || lu_refused(kin, why, why_size))
         return;
     size_t nn = (size_t)n * (size_t)n, ntemp = (size_t)kin->nnz + LU_MAX_OPS + 64;
     LuGen g = {.n = n, .opt = opt, .prefix = prefix, .upper = upper};
@@ -685,6 +704,10 @@ void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
                       prefix, prefix, prefix, prefix, prefix, prefix, prefix, prefix,
                       LU_STEP_MAX_N);
         sb_puts(def, "/* ---- end lu ---- */");
+    } else if (g.ops > LU_MAX_OPS) {
+        snprintf(why, why_size, "the elimination needs more than %d operations", LU_MAX_OPS);
+    } else {
+        snprintf(why, why_size, "the Jacobian's pattern is structurally singular");
     }
     for (int i = 0; i < 3; i++)
         sb_free(bufs[i]);

@@ -24,6 +24,7 @@
  */
 #include "roll.h"
 
+#include "emit.h"
 #include "../base/arena.h"
 #include "../base/hashmap.h"
 
@@ -266,15 +267,30 @@ static bool rolled(const Roll *r, int g)
     return r->groups[g].count >= r->c->min_members;
 }
 
+/* The length of the longest start of v[0 .. count) that grows by a fixed
+   step (into *step; 0 for one value). */
+static int affine_run(const int *v, int count, long long *step)
+{
+    *step = count > 1 ? (long long)v[1] - v[0] : 0;
+    int i = 1;
+    while (i < count && (long long)v[i] - v[i - 1] == *step)
+        i++;
+    return count < 1 ? 0 : i;
+}
+
+/* Whether all of v[0 .. count) grows by a fixed step (into *step). */
+static bool affine_step(const int *v, int count, long long *step)
+{
+    return affine_run(v, count, step) == count;
+}
+
 /* Writes into text the int sequence v[0 .. count) as the loop's value for
    row i: a number, base + step * i, or a static table (written to parts). */
 static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *table,
                      const int *v, int count)
 {
-    bool affine = true;
-    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
-    for (int i = 1; i < count && affine; i++)
-        affine = (long long)v[i] - v[i - 1] == step;
+    long long step;
+    bool affine = affine_step(v, count, &step);
     if (affine && step == 0) {
         sb_printf(text, "%d", v[0]);
         return;
@@ -296,16 +312,16 @@ static void put_ints(const Roll *r, StrBuf *parts, StrBuf *text, const char *tab
    whose indices over the rows are v[0 .. count): array[v0] for one index,
    through a pointer that moves with i (declared in decls, once per array
    and step: libtcc then loads each element by one instruction) where they
-   grow by a fixed step, else through a table. */
+   grow by a fixed step, else through a table. A falling index's pointer
+   moves down from array + |step| (count - 1) to array, read at the last
+   row's index: array + step * i would point before the array, undefined
+   in C99 (6.5.6p8) even where the element read is inside it. */
 static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decls,
                         const char *table, const char *array, bool output, const int *v,
                         int count)
 {
-    bool affine = true;
-    long long step = count > 1 ? (long long)v[1] - v[0] : 0;
-    for (int i = 1; i < count && affine; i++)
-        affine = (long long)v[i] - v[i - 1] == step;
-    if (!affine || step == 0) {
+    long long step;
+    if (!affine_step(v, count, &step) || step == 0) {
         sb_printf(text, "%s[", array);
         put_ints(r, parts, text, table, v, count);
         sb_putc(text, ']');
@@ -315,26 +331,15 @@ static void put_element(const Roll *r, StrBuf *parts, StrBuf *text, StrBuf *decl
     snprintf(name, sizeof name, "%s_%s%lld", array, step < 0 ? "m" : "", step < 0 ? -step : step);
     char decl[160];
     snprintf(decl, sizeof decl, " %s = ", name);
-    if (!strstr(decls->data, decl))
-        sb_printf(decls, "        %s%s_real *const%s%s + %lld * i;\n", output ? "" : "const ",
-                  r->c->prefix, decl, array, step);
-    sb_printf(text, "%s[%d]", name, v[0]);
-}
-
-/* A constant as C text that reads back as the same double (or float). */
-static void put_real(StrBuf *sb, double v, bool real_float)
-{
-    char buf[64];
-    if (real_float && isinf((float)v)) {
-        sb_puts(sb, v > 0 ? "HUGE_VALF" : "-HUGE_VALF");
-        return;
+    if (!strstr(decls->data, decl)) {
+        sb_printf(decls, "        %s%s_real *const%s%s + ", output ? "" : "const ", r->c->prefix,
+                  decl, array);
+        if (step > 0)
+            sb_printf(decls, "%lld * i;\n", step);
+        else
+            sb_printf(decls, "%lld * (%d - i);\n", -step, count - 1);
     }
-    snprintf(buf, sizeof buf, real_float ? "%.9g" : "%.17g", real_float ? (double)(float)v : v);
-    if (!strpbrk(buf, ".eEn"))
-        strcat(buf, ".0");     /* a floating constant, -0.0 included */
-    sb_puts(sb, buf);
-    if (real_float)
-        sb_putc(sb, 'f');
+    sb_printf(text, "%s[%d]", name, step > 0 ? v[0] : v[count - 1]);
 }
 
 /* The angles of coordinates v[0 .. count) whose sin and cos are both
@@ -373,14 +378,13 @@ static void put_pairs(const Roll *r, StrBuf *parts, StrBuf *loops, const char *t
     free(odd);
 }
 
-/* The angles the rolled groups read: positions in the sin and cos arrays
-   (pairs, then sin only, then cos only, each by coordinate), set in
-   r->angle_pos; then the loops that fill them. Returns their operations. */
-static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
+/* Which angles the rolled groups read, into used[nq]: 1 sin, 2 cos, 3
+   both, as the function's straight-line code would use them (the pair,
+   or a single function); false when they read none. */
+static bool angles_used(const Roll *r, uint8_t *used)
 {
     const Dag *dag = r->dag;
     int nq = r->c->kin->model->nq;
-    uint8_t *used = xcalloc((size_t)(nq ? nq : 1), 1);     /* 1 sin, 2 cos: in the function */
     bool any = false;
     for (int g = 0; g < r->ngroups; g++) {
         if (!rolled(r, g))
@@ -398,10 +402,8 @@ static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
             }
         }
     }
-    if (!any) {
-        free(used);
-        return 0;
-    }
+    if (!any)
+        return false;
     /* which of sin and cos the whole function uses, as its straight-line
        code would choose the pair or a single function */
     uint32_t *mark = xcalloc((size_t)dag->count, sizeof *mark);
@@ -418,6 +420,20 @@ static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
         used[k] = (uint8_t)((s != DAG_NONE && mark[s] == 1) | (c != DAG_NONE && mark[c] == 1) << 1);
     }
     free(mark);
+    return true;
+}
+
+/* The angles the rolled groups read: positions in the sin and cos arrays
+   (pairs, then sin only, then cos only, each by coordinate), set in
+   r->angle_pos; then the loops that fill them. Returns their operations. */
+static long put_angles(Roll *r, StrBuf *parts, StrBuf *body)
+{
+    int nq = r->c->kin->model->nq;
+    uint8_t *used = xcalloc((size_t)(nq ? nq : 1), 1);
+    if (!angles_used(r, used)) {
+        free(used);
+        return 0;
+    }
     int *coords = xmalloc((size_t)nq * sizeof *coords);
     int n = 0;
     StrBuf loops;
@@ -511,18 +527,18 @@ static int slot_int(const Roll *r, int m, int s, int32_t k)
     return (int)v;
 }
 
-/* The loop over members[0 .. count) (of one shape): its tables (parts)
-   and loop (body); returns its operations per call. */
-static long put_loop(Roll *r, const int *members, int count, int number, StrBuf *parts,
-                     StrBuf *body)
+/* The texts of the slots of the loop over members[0 .. count): a
+   constant the same for all (uniform[s]: the body's graph holds it, text
+   NULL), a table of constants, an index (put_element: row pointers into
+   decls, tables into parts). */
+static char **slot_texts(const Roll *r, const int *members, int count, int number,
+                         StrBuf *parts, StrBuf *decls, bool *uniform)
 {
     const Member *rep = &r->members[members[0]];
     int ns = rep->nslots;
     const char *P = r->c->prefix;
     char **texts = xcalloc((size_t)(ns ? ns : 1), sizeof *texts);
-    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
     int *ints = xmalloc((size_t)count * sizeof *ints);
-    /* the slots' kinds, from the shape */
     int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     slot_kinds(r, rep, kind);
     const char **array = xcalloc((size_t)(ns ? ns : 1), sizeof *array);  /* what a slot indexes */
@@ -535,9 +551,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
                                   : word == W_SIN ? "roll_s" : "roll_c";
         w += word == W_OUT ? 4 : word == W_TIME ? 1 : word < 0 ? 2 : 3;
     }
-    StrBuf decls;      /* the loop's row pointers */
-    sb_init(&decls);
-    sb_puts(&decls, "");
     for (int s = 0; s < ns; s++) {
         StrBuf t;
         sb_init(&t);
@@ -556,7 +569,7 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
                 sb_printf(parts, "static const %s_real %s[%d] = {\n", P, table, count);
                 for (int j = 0; j < count; j++) {
                     sb_puts(parts, j % 8 ? " " : "    ");
-                    put_real(parts, r->vals[r->members[members[j]].val_at + s], r->c->real_float);
+                    emit_put_literal(parts, r->vals[r->members[members[j]].val_at + s], r->c->real_float);
                     sb_puts(parts, j % 8 == 7 || j == count - 1 ? ",\n" : ",");
                 }
                 sb_puts(parts, "};\n");
@@ -566,22 +579,31 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
             for (int j = 0; j < count; j++)
                 ints[j] = slot_int(r, members[j], s, kind[s]);
             snprintf(table, sizeof table, "%s_r%d_x%d", r->c->function, number, s);
-            put_element(r, parts, &t, &decls, table, array[s], kind[s] == W_OUT, ints, count);
+            put_element(r, parts, &t, decls, table, array[s], kind[s] == W_OUT, ints, count);
         }
         texts[s] = sb_take(&t);
     }
-    /* the body's graph: the shape with the slots as leaves */
-    int nodes_cap = rep->code_len / 2 + 1, nnodes = 0, nouts = 0;
-    Dag graph = {.nodes = xmalloc((size_t)nodes_cap * sizeof(DagNode)), .cap = nodes_cap};
-    SchedOutput *outs = xmalloc((size_t)rep->count * sizeof *outs);
+    free(array);
+    free(ints);
+    free(kind);
+    return texts;
+}
+
+/* The loop body's graph: rep's shape with the slots as leaves (a uniform
+   constant as itself), into graph and outs (*nouts). */
+static void body_graph(const Roll *r, const Member *rep, const bool *uniform, Dag *graph,
+                       SchedOutput *outs, int *nouts)
+{
+    int nnodes = 0;
+    *nouts = 0;
     for (int w = rep->code_at; w < rep->code_at + rep->code_len;) {
         int32_t word = r->code[w];
         if (word == W_OUT) {
-            outs[nouts++] = (SchedOutput){arrays[r->code[w + 1]], r->code[w + 3], r->code[w + 2]};
+            outs[(*nouts)++] = (SchedOutput){arrays[r->code[w + 1]], r->code[w + 3], r->code[w + 2]};
             w += 4;
             continue;
         }
-        DagNode *n = &graph.nodes[nnodes++];
+        DagNode *n = &graph->nodes[nnodes++];
         if (word == W_TIME) {
             *n = (DagNode){.op = OP_TIME, .a = -1, .b = -1};
             w += 1;
@@ -597,7 +619,25 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
             w += 3;
         }
     }
-    graph.count = nnodes;
+    graph->count = nnodes;
+}
+
+/* The loop over members[0 .. count) (of one shape): its tables (parts)
+   and loop (body); returns its operations per call. */
+static long put_loop(Roll *r, const int *members, int count, int number, StrBuf *parts,
+                     StrBuf *body)
+{
+    const Member *rep = &r->members[members[0]];
+    int ns = rep->nslots;
+    bool *uniform = xcalloc((size_t)(ns ? ns : 1), sizeof *uniform);
+    StrBuf decls;      /* the loop's row pointers */
+    sb_init(&decls);
+    sb_puts(&decls, "");
+    char **texts = slot_texts(r, members, count, number, parts, &decls, uniform);
+    int nodes_cap = rep->code_len / 2 + 1, nouts = 0;
+    Dag graph = {.nodes = xmalloc((size_t)nodes_cap * sizeof(DagNode)), .cap = nodes_cap};
+    SchedOutput *outs = xmalloc((size_t)rep->count * sizeof *outs);     /* write_body's */
+    body_graph(r, rep, uniform, &graph, outs, &nouts);
     SlotTexts st = {texts};
     RollHooks hooks = {leaf_hook, store_hook, &st};
     StrBuf stmts;
@@ -607,7 +647,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
     sb_printf(body, "    /* %d joints' rows of one shape: one loop */\n"
               "    for (int i = 0; i < %d; i++) {\n%s", count, count, decls.data);
     sb_free(&decls);
-    free(array);
     for (const char *line = stmts.data; *line;) {     /* one level deeper */
         const char *end = strchr(line, '\n');
         size_t len = end ? (size_t)(end - line) + 1 : strlen(line);
@@ -622,8 +661,6 @@ static long put_loop(Roll *r, const int *members, int count, int number, StrBuf 
         free(texts[s]);
     free(texts);
     free(uniform);
-    free(ints);
-    free(kind);
     return (long)ops * count;
 }
 
@@ -640,19 +677,20 @@ static long put_group(Roll *r, int g, int *number, StrBuf *parts, StrBuf *body)
     int32_t *kind = xmalloc((size_t)(ns ? ns : 1) * sizeof *kind);
     slot_kinds(r, rep, kind);
     int *left = xmalloc((size_t)count * sizeof *left);
+    int *ints = xmalloc((size_t)(ns ? ns : 1) * (size_t)count * sizeof *ints);
+    for (int s = 0; s < ns; s++)
+        if (kind[s] != W_CONST)
+            for (int j = 0; j < count; j++)
+                ints[(size_t)s * count + j] = slot_int(r, grp->members[j], s, kind[s]);
     long ops = 0;
     for (int j = 0; j < count;) {
-        int k = j + 1;
-        for (; k < count; k++) {
-            bool steady = true;
-            for (int s = 0; s < ns && steady; s++)
-                if (kind[s] != W_CONST)
-                    steady = k == j + 1 ||
-                             (long long)slot_int(r, grp->members[k], s, kind[s]) - slot_int(r, grp->members[k - 1], s, kind[s])
-                             == (long long)slot_int(r, grp->members[j + 1], s, kind[s]) - slot_int(r, grp->members[j], s, kind[s]);
-            if (!steady)
-                break;
-        }
+        int k = count;      /* the run from j: every index slot steady */
+        long long step;
+        for (int s = 0; s < ns; s++)
+            if (kind[s] != W_CONST) {
+                int run = affine_run(ints + (size_t)s * count + j, count - j, &step);
+                k = j + run < k ? j + run : k;
+            }
         if (k - j >= RUN_MIN || (j == 0 && k == count)) {
             ops += put_loop(r, grp->members + j, k - j, (*number)++, parts, body);
             j = k;
@@ -666,6 +704,7 @@ static long put_group(Roll *r, int g, int *number, StrBuf *parts, StrBuf *body)
         for (int j = 0; j < nleft; j++)
             r->members[left[j]].group = -1;
     free(left);
+    free(ints);
     free(kind);
     return ops;
 }

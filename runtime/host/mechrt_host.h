@@ -215,6 +215,10 @@ bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const dou
    mechrt_host_sparse_singular; MECHRT_ENOTFINITE for NaN or Inf (its row
    named); MECHRT_EINVAL when out of memory. */
 MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol);
+/* The same for values the caller knows finite, amax their largest
+   magnitude: no pass over them but the copy (the augmented matrix holds
+   Phi_q twice, and its caller checked the kernels' output already). */
+MechrtStatus mechrt_host_sparse_factor_known(MechrtHostSparse *s, double pivot_tol, double amax);
 /* b = A^-1 b with the last factorisation; MECHRT_ENOTFINITE when b or the
    solution is not finite, MECHRT_EINVAL without a factorisation. */
 MechrtStatus mechrt_host_sparse_solve(MechrtHostSparse *s, double *b);

@@ -25,7 +25,10 @@
  */
 #include "mechrt_host.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 struct MechrtHostKkt {
     int nq, nr, mnz, jnz, nxd;      /* sizes; nxd: diagonal slots M's pattern lacks */
@@ -138,34 +141,63 @@ static void kkt_fill(const MechrtHostKkt *s, MechrtKktWeight w, const unsigned c
                      int rows, double *v)
 {
     int e = 0;
-    for (int k = 0; k < s->mnz; k++, e++)
-        v[e] = w == MECHRT_KKT_MASS ? s->mass[k] : s->mdiag[k] ? 1.0 : 0.0;
+    if (w == MECHRT_KKT_MASS)
+        memcpy(v, s->mass, (size_t)s->mnz * sizeof *v), e = s->mnz;
+    else
+        for (int k = 0; k < s->mnz; k++, e++)
+            v[e] = s->mdiag[k] ? 1.0 : 0.0;
     for (int k = 0; k < s->nxd; k++, e++)
         v[e] = w == MECHRT_KKT_MASS ? 0.0 : 1.0;
     const int *jrow = s->row + s->mnz + s->nxd;     /* nq + r */
-    for (int k = 0; k < s->jnz; k++, e++)
-        v[e] = kkt_kept(active, rows, jrow[k] - s->nq) ? s->jac[k] : 0.0;
-    for (int k = 0; k < s->jnz; k++, e++)
-        v[e] = v[e - s->jnz];
+    if (!active && rows >= s->nr)   /* every row kept: the values as they are */
+        memcpy(v + e, s->jac, (size_t)s->jnz * sizeof *v);
+    else
+        for (int k = 0; k < s->jnz; k++)
+            v[e + k] = kkt_kept(active, rows, jrow[k] - s->nq) ? s->jac[k] : 0.0;
+    memcpy(v + e + s->jnz, v + e, (size_t)s->jnz * sizeof *v);
+    e += 2 * s->jnz;
     for (int r = 0; r < s->nr; r++, e++)
         v[e] = kkt_kept(active, rows, r) ? 0.0 : 1.0;
+}
+
+/* max |v_e| over the values kkt_fill wrote, Phi_q's once (its transpose
+   holds the same); false for a value not finite. */
+static bool kkt_amax(const MechrtHostKkt *s, const double *v, double *amax)
+{
+    int head = s->mnz + s->nxd + s->jnz, tail = head + s->jnz, end = tail + s->nr;
+    double m = 0;
+    bool finite = true;
+    for (int e = 0; e < head; e++) {
+        double a = fabs(v[e]);
+        m = a > m ? a : m;
+        finite &= a <= DBL_MAX;     /* false for NaN too */
+    }
+    for (int e = tail; e < end; e++)
+        m = v[e] > m ? v[e] : m;    /* the rows' diagonal: 0 or 1 */
+    *amax = m;
+    return finite;
 }
 
 MechrtStatus mechrt_host_kkt_factor(MechrtHostKkt *s, MechrtKktWeight w,
                                     const unsigned char *active, int rows, double pivot_tol)
 {
     MechrtHostSparse *lu = s->lu[w == MECHRT_KKT_MASS ? 0 : 1];
-    kkt_fill(s, w, active, rows, mechrt_host_sparse_values(lu));
-    return mechrt_host_sparse_factor(lu, pivot_tol);
+    double *v = mechrt_host_sparse_values(lu), amax;
+    kkt_fill(s, w, active, rows, v);
+    if (!kkt_amax(s, v, &amax))
+        return mechrt_host_sparse_factor(lu, pivot_tol);    /* names the entry */
+    return mechrt_host_sparse_factor_known(lu, pivot_tol, amax);
 }
 
 MechrtStatus mechrt_host_kkt_screen(MechrtHostKkt *s, int rows, double pivot_tol,
                                     double *spread)
 {
     MechrtHostSparse *lu = s->lu[2];
-    kkt_fill(s, MECHRT_KKT_IDENTITY, NULL, rows, mechrt_host_sparse_values(lu));
+    double *v = mechrt_host_sparse_values(lu), amax;
+    kkt_fill(s, MECHRT_KKT_IDENTITY, NULL, rows, v);
     mechrt_host_sparse_refresh(lu);
-    MechrtStatus st = mechrt_host_sparse_factor(lu, pivot_tol);
+    MechrtStatus st = kkt_amax(s, v, &amax) ? mechrt_host_sparse_factor_known(lu, pivot_tol, amax)
+                                            : mechrt_host_sparse_factor(lu, pivot_tol);
     *spread = mechrt_host_sparse_spread(lu);
     return st;
 }

@@ -22,6 +22,7 @@
 #include "mechrt_host.h"
 
 #include <klu.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -40,6 +41,7 @@ struct MechrtHostSparse {
     klu_symbolic *symbolic;
     klu_numeric *numeric;   /* NULL: the next factorisation is fresh */
     double spread_fresh;    /* pivot spread of the last fresh factorisation */
+    double spread_last;     /* ... of the current factors (one pass with the pivot test) */
     int sing_row, sing_col; /* the failing pivot of the last ESING, else -1 */
     long fresh, refactored; /* factorisations of each kind */
 };
@@ -148,51 +150,55 @@ bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const dou
     return true;
 }
 
-/* max|u_kk| / min|u_kk| (INFINITY with a zero pivot). */
-static double sparse_spread(const MechrtHostSparse *s)
-{
-    const double *u = s->numeric->Udiag;
-    double lo = fabs(u[0]), hi = lo;
-    for (int k = 1; k < s->n; k++) {
-        double a = fabs(u[k]);
-        lo = a < lo ? a : lo;
-        hi = a > hi ? a : hi;
-    }
-    return lo > 0 ? hi / lo : INFINITY;
-}
-
 /* The first pivot at or below thresh (NaN included), named by its original
-   row and column; false when there is none. */
+   row and column; false when there is none, and then spread_last set in
+   the same pass (sparse_spread's value: every pivot is nonzero). */
 static bool sparse_bad_pivot(MechrtHostSparse *s, double thresh)
 {
     const double *u = s->numeric->Udiag;
-    for (int k = 0; k < s->n; k++)
-        if (!(fabs(u[k]) > thresh)) {
+    double lo = INFINITY, hi = 0;
+    for (int k = 0; k < s->n; k++) {
+        double a = fabs(u[k]);
+        if (!(a > thresh)) {
             s->sing_row = s->numeric->Pnum[k];
             s->sing_col = s->symbolic->Q[k];
             return true;
         }
+        lo = a < lo ? a : lo;
+        hi = a > hi ? a : hi;
+    }
+    s->spread_last = hi / lo;
     return false;
 }
 
 MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol)
 {
     double amax = 0;
-    s->sing_row = s->sing_col = -1;
     for (int e = 0; e < s->nnz; e++) {
-        double v = s->vals[e];
-        if (!isfinite(v)) {
+        double a = fabs(s->vals[e]);
+        if (!(a <= DBL_MAX)) {      /* NaN too */
             s->sing_row = s->jnz.row[e];
+            s->sing_col = -1;
             return MECHRT_ENOTFINITE;
         }
-        s->ax[s->map[e]] = v;
-        amax = fabs(v) > amax ? fabs(v) : amax;
+        amax = a > amax ? a : amax;
     }
+    return mechrt_host_sparse_factor_known(s, pivot_tol, amax);
+}
+
+MechrtStatus mechrt_host_sparse_factor_known(MechrtHostSparse *s, double pivot_tol, double amax)
+{
+    s->sing_row = s->sing_col = -1;
+    const double *vals = s->vals;
+    const int *map = s->map;
+    double *ax = s->ax;
+    for (int e = 0; e < s->nnz; e++)
+        ax[map[e]] = vals[e];
     double thresh = pivot_tol * amax;
     if (s->numeric) {
         if (klu_refactor(s->ap, s->ai, s->ax, s->symbolic, s->numeric, &s->common)
             && !sparse_bad_pivot(s, thresh)
-            && sparse_spread(s) <= SPARSE_REFRESH * s->spread_fresh) {
+            && s->spread_last <= SPARSE_REFRESH * s->spread_fresh) {
             s->refactored++;
             return MECHRT_OK;
         }
@@ -207,7 +213,7 @@ MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol)
         klu_free_numeric(&s->numeric, &s->common);
         return MECHRT_ESING;
     }
-    s->spread_fresh = sparse_spread(s);
+    s->spread_fresh = s->spread_last;
     return MECHRT_OK;
 }
 
@@ -231,7 +237,7 @@ MechrtStatus mechrt_host_sparse_solve(MechrtHostSparse *s, double *b)
 
 double mechrt_host_sparse_spread(const MechrtHostSparse *s)
 {
-    return s->numeric ? sparse_spread(s) : INFINITY;
+    return s->numeric ? s->spread_last : INFINITY;
 }
 
 double mechrt_host_sparse_condest(MechrtHostSparse *s)

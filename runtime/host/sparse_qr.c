@@ -94,7 +94,8 @@ static bool minnorm_layout(MechrtHostMinNorm *m)
 
 MechrtHostMinNorm *mechrt_host_minnorm_new(int nh, int nq, const MechrtHostJacNz *jnz)
 {
-    if (nh < 1 || nq < nh || !jnz || jnz->nnz < 0 || !jnz->jac_nz)
+    if (nh < 1 || nq < nh || !jnz || jnz->nnz < 0 || !jnz->jac_nz
+        || (jnz->nnz > 0 && (!jnz->row || !jnz->col)))
         return NULL;
     MechrtHostMinNorm *m = calloc(1, sizeof *m);
     if (!m)
