@@ -203,6 +203,40 @@ static void test_minnorm_step(void **state)
     assert_null(mechrt_host_minnorm_new(2, 3, &no_cols));
 }
 
+/* Phi = (q0 + q2 - 1, q1 + q2 - 2) at t, Phi_q's nonzeros those of mn_row's
+   first two rows (its third row, past nh, is left out as a velocity-level
+   row would be): the projector's kernels (only phi is called). */
+static void pr_phi(void *ctx, const double *q, double t, double *phi)
+{
+    (void)ctx, (void)t;
+    phi[0] = q[0] + q[2] - 1;
+    phi[1] = q[1] + q[2] - 2;
+}
+
+/* The projector host (what sim assembles with on its sparse path): two
+   rows, three coordinates, which the sparse host refuses; from q = 0 its
+   Newton lands on the nearest solution pinv(Phi_q) (1, 2) = (0, 1, 1);
+   no velocity solve. */
+static void test_projector(void **state)
+{
+    (void)state;
+    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
+    MechrtKernels k = {3, 2, 0, NULL, pr_phi, NULL, NULL, NULL, NULL, NULL, NULL};
+    assert_null(mechrt_host_new_sparse(&k, &j));
+    MechrtHost *h = mechrt_host_new_projector(&k, &j);
+    assert_non_null(h);
+    double q[3] = {0, 0, 0}, qd[3], qdd[3];
+    MechrtReport rep;
+    assert_int_equal(mechrt_host_project(h, NULL, q, 0, &rep), MECHRT_OK);
+    assert_near(q[0], 0, 0, 1e-14);
+    assert_near(q[1], 1, 1e-14, 0);
+    assert_near(q[2], 1, 1e-14, 0);
+    assert_true(rep.iterations >= 1 && rep.residual <= 1e-14);
+    assert_int_equal(mechrt_host_velocity_acceleration(h, NULL, q, 0, qd, qdd, &rep),
+                     MECHRT_EINVAL);
+    mechrt_host_free(h);
+}
+
 static void test_klu_singular_named(void **state)
 {
     (void)state;
@@ -613,6 +647,7 @@ int main(void)
         cmocka_unit_test(test_klu_solve),
         cmocka_unit_test(test_klu_singular_named),
         cmocka_unit_test(test_minnorm_step),
+        cmocka_unit_test(test_projector),
         cmocka_unit_test(test_klu_repivots),
         cmocka_unit_test(test_klu_bad_pattern),
         cmocka_unit_test(test_examples_agree),

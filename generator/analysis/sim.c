@@ -382,6 +382,26 @@ static MechrtStatus sparse_accel(Sim *s, const double *q, const double *qd, doub
     return MECHRT_OK;
 }
 
+/* The dense method's arrays (nr x nq, nq x nq, the SVD): at the start on
+   the dense path, at the first dense fallback on the sparse one, which
+   otherwise never reads them (at 10 000 coordinates they are gigabytes).
+   False when out of memory. */
+static bool dense_ready(Sim *s)
+{
+    if (s->work)
+        return s->nr == 0 || s->svd;
+    size_t n = (size_t)s->nq, m = (size_t)s->nr;
+    s->lwork = mechrt_dynamics_workspace_size(s->nq, s->nr);
+    s->work = xcalloc(s->lwork, sizeof *s->work);
+    s->jac = xcalloc(m * n + 1, sizeof *s->jac);
+    s->mass = xcalloc(n * n, sizeof *s->mass);
+    s->mass2 = xcalloc(n * n, sizeof *s->mass2);
+    s->lqrw = m > 0 ? mechrt_qr_work_len(s->nr, s->nq) : 0;
+    s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
+    s->svd = m > 0 ? mechrt_svd_new(s->nr, s->nq) : NULL;
+    return m == 0 || s->svd;
+}
+
 /* ---- energy --------------------------------------------------------------- */
 
 /* 1/2 qd^T Mdot qd by a central difference of M along qd (qs scratch; M
@@ -509,6 +529,11 @@ static int sim_rhs_solve(Sim *s, double t, const double y[], double f[])
             return GSL_SUCCESS;
         }
         s->res->dense_fallbacks++;     /* the dense method decides, or names the cause */
+        if (!dense_ready(s)) {
+            s->fail_status = MECHRT_EINVAL;
+            s->fail_t = t;
+            return GSL_EBADFUNC;
+        }
     }
     MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->dyn, q, qd, t, f + n, NULL,
                                               s->work, s->lwork, &rep);
@@ -608,6 +633,8 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
     bool zero;
     if (m == 0)
         return MECHRT_OK;
+    if (!dense_ready(s))
+        return MECHRT_EINVAL;
     s->kc.jac(s->kc.ctx, q, t, s->jac);
     s->kc.nu(s->kc.ctx, q, t, s->nu);
     for (int i = 0; i < m; i++) {
@@ -672,6 +699,8 @@ static MechrtStatus position_correction(Sim *s, const MechrtOptions *o, const do
             }
         }
         s->res->dense_fallbacks++;
+        if (!dense_ready(s))
+            return MECHRT_EINVAL;
     }
     s->kc.jac(s->kc.ctx, q, t, s->jac);
     return min_norm_solve(s, nh, o->pivot_tol, s->resid, s->dqd, zero);
@@ -799,8 +828,9 @@ static bool choose_rows(Sim *s, const double *y, double t, MechrtDynReport *out)
     MechrtDynReport rep;
     MechrtDynOptions ro = s->o->dyn;
     ro.rank_tol = fmax(ro.rank_tol, s->o->row_tol);
-    MechrtStatus st = mechrt_dynamics_rows(&s->kc, &ro, y, t, s->active, s->work, s->lwork,
-                                           &rep);
+    MechrtStatus st = !dense_ready(s) ? MECHRT_EINVAL
+                      : mechrt_dynamics_rows(&s->kc, &ro, y, t, s->active, s->work,
+                                             s->lwork, &rep);
     if (st != MECHRT_OK) {
         fail(s, st, t, "the rank of the Jacobian");
         msgf(s, "%s", mechrt_strerror(st));
@@ -897,15 +927,10 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->dim = 2 * k->nq + (o->energy ? 1 : 0);
     s->kc = (MechrtKernels){k->nq, k->nh, k->nv, s, c_phi, c_jac, c_nu, c_gamma,
                             k->all ? c_all : NULL, c_mass, c_force};
-    s->lwork = mechrt_dynamics_workspace_size(k->nq, (int)m);
-    s->work = xcalloc(s->lwork, sizeof *s->work);
-    s->jac = xcalloc(m * n + 1, sizeof *s->jac);
     s->nu = xcalloc(m + 1, sizeof *s->nu);
     s->resid = xcalloc(m + 1, sizeof *s->resid);
     s->lambda = xcalloc(m + 1, sizeof *s->lambda);
     s->dqd = xcalloc(n, sizeof *s->dqd);
-    s->mass = xcalloc(n * n, sizeof *s->mass);
-    s->mass2 = xcalloc(n * n, sizeof *s->mass2);
     s->qs = xcalloc(n, sizeof *s->qs);
     s->f0 = xcalloc((size_t)s->dim, sizeof *s->f0);
     s->f1 = xcalloc((size_t)s->dim, sizeof *s->f1);
@@ -937,10 +962,7 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
         s->sforce = xcalloc(n, sizeof *s->sforce);
         s->smass = xcalloc((size_t)o->mass_nz->nnz + 1, sizeof *s->smass);
     }
-    s->lqrw = m > 0 ? mechrt_qr_work_len((int)m, k->nq) : 0;
-    s->qrw = xcalloc(s->lqrw + 1, sizeof *s->qrw);
-    s->svd = m > 0 ? mechrt_svd_new((int)m, k->nq) : NULL;
-    if (m > 0 && !s->svd)
+    if (!s->kkt && !dense_ready(s))
         return false;
     /* W's error must not steer the step: its absolute scale is huge */
     double *scale = xcalloc((size_t)s->dim, sizeof *scale);
@@ -1005,8 +1027,9 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
         s->res->states++;
         return true;
     }
-    MechrtStatus st = mechrt_forward_dynamics(&s->kc, &s->o->dyn, y, y + n, t, s->f0,
-                                              s->lambda, s->work, s->lwork, &rep);
+    MechrtStatus st = !dense_ready(s) ? MECHRT_EINVAL
+                      : mechrt_forward_dynamics(&s->kc, &s->o->dyn, y, y + n, t, s->f0,
+                                                s->lambda, s->work, s->lwork, &rep);
     if (st != MECHRT_OK) {
         fail(s, st, t, "forward dynamics");
         explain_dynamics(s, st, &rep);
@@ -1367,7 +1390,9 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
                            double *q, SimResult *res)
 {
     res->constructed = construct_with_kernels(m, k, o->t0, q);
-    MechrtHost *host = mechrt_host_new(k);
+    /* the sparse path's Newton by SuiteSparseQR: the dense SVD is O(nq^3) */
+    MechrtHost *host = sim_sparse_wanted(k, o) ? mechrt_host_new_projector(k, o->jac_nz)
+                                               : mechrt_host_new(k);
     if (!host) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
         return false;
@@ -1378,7 +1403,15 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
     mechrt_host_free(host);
     bool ok = st == MECHRT_OK;
-    if (!ok) {
+    if (!ok && sim_sparse_wanted(k, o) && m->nq > SIM_DENSE_MAX_NQ) {
+        /* the restarts' dense SVDs would take hours here: the sparse
+           Newton's own failure, in the same words */
+        snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
+                 "these initial values: after %d iterations of minimum-norm Newton the "
+                 "largest residual is %.3g in row %s (%s)", o->t0, rep.iterations,
+                 rep.residual, rep.worst_row >= 0 ? m->rows[rep.worst_row].name : "?",
+                 mechrt_strerror(st));
+    } else if (!ok) {
         AnalysisOptions ao = analysis_default_options();
         AssembleResult ar;
         ao.tol_phi = o->mechrt.tol_phi;

@@ -102,12 +102,13 @@ void mechrt_host_free(MechrtHost *h)
     free(h);
 }
 
-/* The host of k with its dense workspaces (jnz NULL) or its sparse
-   factorisations. */
-static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz)
+/* The host of k with its dense workspaces (jnz NULL), its sparse
+   factorisations, or (project_only, jnz set) only the sparse projection. */
+static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                            bool project_only)
 {
     if (!k || k->nq < 1 || k->nh < 0 || k->nv < 0 || k->nh > k->nq
-        || (jnz && k->nh + k->nv != k->nq))
+        || (jnz && !project_only && k->nh + k->nv != k->nq))
         return NULL;
     MechrtHost *h = calloc(1, sizeof *h);
     if (!h)
@@ -119,18 +120,20 @@ static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz)
     h->nh = k->nh;
     h->nr = k->nh + k->nv;
     /* sparse: mechrt_host_sparse_velocity's 3 nq */
-    h->lwork = jnz ? 3 * nq : mechrt_workspace_size(k->nq, h->nr > k->nq ? h->nr : k->nq);
+    h->lwork = project_only ? 0
+               : jnz ? 3 * nq : mechrt_workspace_size(k->nq, h->nr > k->nq ? h->nr : k->nq);
     h->work = h->lwork ? malloc(h->lwork * sizeof *h->work) : NULL;
     h->phi = malloc((nh + 1) * sizeof *h->phi);
     h->jac = jnz ? NULL : malloc((size_t)h->nr * nq * sizeof *h->jac + 1);
     h->dq = malloc(nq * sizeof *h->dq);
     h->y = malloc(nq * sizeof *h->y);
     h->fail_q = calloc(nq, sizeof *h->fail_q);
-    bool ok = h->work && h->phi && (jnz || h->jac) && h->dq && h->y && h->fail_q;
+    bool ok = (h->work || project_only) && h->phi && (jnz || h->jac) && h->dq && h->y
+              && h->fail_q;
     if (ok && jnz) {
-        h->sp = mechrt_host_sparse_new(k->nq, jnz);
+        h->sp = project_only ? NULL : mechrt_host_sparse_new(k->nq, jnz);
         h->mn = nh > 0 ? mechrt_host_minnorm_new(k->nh, k->nq, jnz) : NULL;
-        ok = h->sp && (nh == 0 || h->mn);
+        ok = (h->sp || project_only) && (nh == 0 || h->mn);
     } else if (ok && nh > 0) {
         h->svd = mechrt_svd_new(k->nh, k->nq);
         ok = h->svd != NULL;
@@ -150,12 +153,17 @@ static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz)
 
 MechrtHost *mechrt_host_new(const MechrtKernels *k)
 {
-    return host_new(k, NULL);
+    return host_new(k, NULL, false);
 }
 
 MechrtHost *mechrt_host_new_sparse(const MechrtKernels *k, const MechrtHostJacNz *jnz)
 {
-    return jnz ? host_new(k, jnz) : NULL;
+    return jnz ? host_new(k, jnz, false) : NULL;
+}
+
+MechrtHost *mechrt_host_new_projector(const MechrtKernels *k, const MechrtHostJacNz *jnz)
+{
+    return jnz ? host_new(k, jnz, true) : NULL;
 }
 
 MechrtHostSparse *mechrt_host_sparse_of(MechrtHost *h)
@@ -167,6 +175,8 @@ MechrtStatus mechrt_host_velocity_acceleration(MechrtHost *h, const MechrtOption
                                                const double *q, double t, double *qd,
                                                double *qdd, MechrtReport *report)
 {
+    if (!h->work)
+        return MECHRT_EINVAL;   /* a projector: no velocity solve */
     if (h->sp)
         return mechrt_host_sparse_velocity(h->sp, h->k, o, q, t, qd, qdd, h->work, report);
     return mechrt_velocity_acceleration(h->k, o, q, t, qd, qdd, h->work, h->lwork, report);
@@ -316,6 +326,8 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
         return MECHRT_EINVAL;
     if (h->nr != h->nq)
         return MECHRT_ENOTSQUARE;
+    if (!h->work)
+        return MECHRT_EINVAL;   /* a projector */
     o = o ? o : &def;
     oo = oo ? oo : &odef;
     if (!(oo->tol > 0))

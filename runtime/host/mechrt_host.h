@@ -66,6 +66,12 @@ void mechrt_host_free(MechrtHost *h);
    by SuiteSparseQR; nothing of size nr x nq or nq x nq is allocated.
    Needs nh + nv == nq. */
 MechrtHost *mechrt_host_new_sparse(const MechrtKernels *k, const MechrtHostJacNz *jnz);
+/* Only mechrt_host_project on the sparse Jacobian of pattern jnz
+   (SuiteSparseQR's minimum-norm steps, nh <= nq rows, any nv): for
+   assembling a mechanism with free degrees of freedom, which the sparse
+   host's square velocity solve cannot take. Velocity calls and
+   mechrt_host_integrate return MECHRT_EINVAL or MECHRT_ENOTSQUARE. */
+MechrtHost *mechrt_host_new_projector(const MechrtKernels *k, const MechrtHostJacNz *jnz);
 /* Velocity and acceleration at (q, t) (mechrt_velocity_acceleration, dense
    or on the sparse host's KLU). */
 MechrtStatus mechrt_host_velocity_acceleration(MechrtHost *h, const MechrtOptions *o,
