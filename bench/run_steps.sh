@@ -55,7 +55,7 @@ time_file() {
                 ok=0
                 break
             fi
-            sed -n 's/.*: \([0-9.]*\) ns per step.*/\1/p' "$tmp/err" >> "$tmp/ns"
+            sed -n 's/.*of analysis: \([0-9.]*\) ns per step.*/\1/p' "$tmp/err" >> "$tmp/ns"
             sed -n 's/.*stats: \([0-9.e+-]*\) Newton iterations per step.*/\1/p' "$tmp/err" >> "$tmp/it"
             sed -n 's/.*takes \([0-9.]*\) ns: a step costs \([0-9.]*\) of them.*/\1 \2/p' "$tmp/err" > "$tmp/line"
             cut -d' ' -f1 "$tmp/line" >> "$tmp/all"
