@@ -44,11 +44,7 @@ typedef struct Work {
 
 static void open_lib(Lib *l, const char *path)
 {
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        fprintf(stderr, "roll_time: %s\n", dlerror());
-        exit(2);
-    }
+    void *h = timing_open("roll_time", path);
     l->path = path;
     for (int f = 0; f < FN_COUNT; f++) {
         char name[32];

@@ -47,11 +47,7 @@ typedef struct Work {
 
 static void *open_lib(Lib *l, const char *path)
 {
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        fprintf(stderr, "sympy_time: %s\n", dlerror());
-        exit(2);
-    }
+    void *h = timing_open("sympy_time", path);
     l->path = path;
     *(void **)&l->phi = timing_sym("sympy_time", h, path, "m_phi");
     *(void **)&l->jac_nz = timing_sym("sympy_time", h, path, "m_jac_nz");

@@ -14,6 +14,17 @@ static double timing_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* dlopen, or exit 2 naming the program and dlerror's reason. */
+static void *timing_open(const char *prog, const char *path)
+{
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        fprintf(stderr, "%s: %s\n", prog, dlerror());
+        exit(2);
+    }
+    return h;
+}
+
 /* dlsym, or exit 2 naming the program, the library and the symbol. */
 static void *timing_sym(const char *prog, void *h, const char *path, const char *name)
 {

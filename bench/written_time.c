@@ -52,11 +52,7 @@ typedef struct Work {
 
 static void open_lib(Lib *l, const char *path)
 {
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        fprintf(stderr, "written_time: %s\n", dlerror());
-        exit(2);
-    }
+    void *h = timing_open("written_time", path);
     l->path = path;
     *(void **)&l->phi = timing_sym("written_time", h, path, "m_phi");
     *(void **)&l->jac = timing_sym("written_time", h, path, "m_jac");
