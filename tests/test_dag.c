@@ -10,12 +10,9 @@
 #include "testutil.h"
 
 #include "../generator/base/diag.h"
-#include "../generator/base/realfmt.h"
 #include "../generator/base/strbuf.h"
 #include "../generator/dag/dag.h"
-#include "../runtime/host/mechrt_host.h"
 
-#include <float.h>
 #include <math.h>
 
 #include <stdlib.h>
@@ -542,36 +539,6 @@ static void test_format_shortest_numbers(void **state)
     free(s);
 }
 
-/* The graph's formatter and the host runtime's are two copies (runtime/
-   must not depend on generator/): the same text for every kind of value. */
-static void test_realfmt_matches_host(void **state)
-{
-    (void)state;
-    double fixed[] = {0.0, -0.0, 0.3, 0.1 + 0.2, M_PI, -M_PI, 1e-300, -4.9e-324, DBL_MAX, DBL_MIN,
-                      1e21, 123456789012345678.0, 2.5, -1.0 / 3.0, INFINITY, -INFINITY, NAN};
-    char a[40], b[40];
-    int nfixed = (int)(sizeof fixed / sizeof fixed[0]);
-    uint64_t state_bits = 0x9E3779B97F4A7C15ull;
-    for (int i = 0; i < nfixed + 2000; i++) {
-        double v;
-        if (i < nfixed) {
-            v = fixed[i];
-        } else {            /* random bit patterns: every exponent and mantissa */
-            state_bits = state_bits * 6364136223846793005ull + 1442695040888963407ull;
-            memcpy(&v, &state_bits, sizeof v);
-        }
-        int na = realfmt_shortest(a, sizeof a, v), nb = mechrt_format_real(b, sizeof b, v, 0);
-        assert_string_equal(a, b);
-        assert_int_equal(na, nb);
-        if (isfinite(v))
-            assert_true(strtod(a, NULL) == v);
-    }
-    realfmt_shortest(a, sizeof a, -0.0);
-    assert_string_equal(a, "0");
-    realfmt_shortest(a, sizeof a, 0.3);
-    assert_string_equal(a, "0.3");
-}
-
 /* Past the limit the graph makes no node: a new one comes back as
    DAG_ZERO and sets the sticky overflow flag, existing ones are still
    found, and dag_check_limit reports it (the ferror idiom). */
@@ -653,7 +620,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_mark_reachable, setup, teardown),
         cmocka_unit_test_setup_teardown(test_format, setup, teardown),
         cmocka_unit_test_setup_teardown(test_format_shortest_numbers, setup, teardown),
-        cmocka_unit_test(test_realfmt_matches_host),
         cmocka_unit_test(test_node_limit),
         cmocka_unit_test(test_node_limit_names_statement),
     };

@@ -6,7 +6,9 @@
  * random angles, tiny residues, decimal fractions), on powers of two and
  * ten and their neighbours (the uneven gap below a power of two), and on
  * exact ties of %.<p>g (2.5, 0.125, 1e23), each at every precision 1..17
- * and the shortest; then the text of a few values written out.
+ * and the shortest; floats (--real float literals) against the first of
+ * %.6g .. %.9g that reads back as the float; then the text of a few
+ * values written out.
  */
 #include "testutil.h"
 
@@ -16,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../runtime/host/mechrt_host.h"
+#include "../runtime/host/format_real.h"
 
 static int reference(char *buf, size_t size, double v, int digits)
 {
@@ -41,7 +43,7 @@ static int compare(double v, unsigned i, bool all)
         if (!all && digits && (i + (unsigned)digits) % 6 != 0)
             continue;
         char a[40], b[40];
-        int na = mechrt_format_real(a, sizeof a, v, digits);
+        int na = mechrt_format_real(a, sizeof a, v, digits, false);
         int nb = reference(b, sizeof b, v, digits);
         if (na != nb || strcmp(a, b) != 0) {
             if (bad++ < 5)
@@ -129,28 +131,76 @@ static void ties_and_edges(void **state)
     assert_int_equal(bad, 0);
 }
 
+/* The float definition: the first of %.6g .. %.9g of (float)v that reads back as that float. */
+static int reference_float(char *buf, size_t size, double v)
+{
+    float f = (float)v;
+    if (f == 0)
+        f = 0;
+    int n = 0;
+    for (int d = 6; d <= 9; d++) {
+        n = snprintf(buf, size, "%.*g", d, (double)f);
+        if (d == 9 || (float)strtod(buf, NULL) == f)
+            break;
+    }
+    return n;
+}
+
+static void floats_shortest(void **state)
+{
+    (void)state;
+    uint64_t s = 0x2545f4914f6cdd1du;
+    int bad = 0;
+    for (unsigned i = 0; i < 100000; i++) {
+        uint32_t bits = (uint32_t)next64(&s);
+        float f;
+        memcpy(&f, &bits, sizeof f);
+        /* random floats, and doubles between floats (rounded first) */
+        double v = i % 2 ? (double)f : (double)f * (1 + 0x1p-30);
+        if (!isfinite(f))
+            continue;
+        char a[40], b[40];
+        int na = mechrt_format_real(a, sizeof a, v, 0, true), nb = reference_float(b, sizeof b, v);
+        if ((na != nb || strcmp(a, b) != 0) && bad++ < 5)
+            fprintf(stderr, "%a as float: got %s, printf %s\n", v, a, b);
+        if ((float)strtod(a, NULL) != (float)v && bad++ < 5)
+            fprintf(stderr, "%a as float: %s does not read back\n", v, a);
+    }
+    assert_int_equal(bad, 0);
+}
+
 static void known_texts(void **state)
 {
     (void)state;
     char b[40];
-    assert_int_equal(mechrt_format_real(b, sizeof b, 0.3, 0), 3);
+    assert_int_equal(mechrt_format_real(b, sizeof b, 0.3, 0, false), 3);
     assert_string_equal(b, "0.3");
-    mechrt_format_real(b, sizeof b, 0.1 + 0.2, 0);
+    mechrt_format_real(b, sizeof b, 0.1 + 0.2, 0, false);
     assert_string_equal(b, "0.30000000000000004");
-    mechrt_format_real(b, sizeof b, 1e15, 0);
+    mechrt_format_real(b, sizeof b, 1e15, 0, false);
     assert_string_equal(b, "1e+15");
-    mechrt_format_real(b, sizeof b, 1234567890123456.0, 0);
+    mechrt_format_real(b, sizeof b, 1234567890123456.0, 0, false);
     assert_string_equal(b, "1234567890123456");
-    mechrt_format_real(b, sizeof b, -1.5e-7, 0);
+    mechrt_format_real(b, sizeof b, -1.5e-7, 0, false);
     assert_string_equal(b, "-1.5e-07");
-    mechrt_format_real(b, sizeof b, 0.000123, 0);
+    mechrt_format_real(b, sizeof b, 0.000123, 0, false);
     assert_string_equal(b, "0.000123");
-    mechrt_format_real(b, sizeof b, 2.5, 1);
+    mechrt_format_real(b, sizeof b, 2.5, 1, false);
     assert_string_equal(b, "2");
-    mechrt_format_real(b, sizeof b, 9.96, 2);
+    mechrt_format_real(b, sizeof b, 9.96, 2, false);
     assert_string_equal(b, "10");
-    mechrt_format_real(b, sizeof b, -0.0, 0);
+    mechrt_format_real(b, sizeof b, -0.0, 0, false);
     assert_string_equal(b, "0");
+    mechrt_format_real(b, sizeof b, 0.1, 0, true);
+    assert_string_equal(b, "0.1");
+    mechrt_format_real(b, sizeof b, 1.0 / 3, 0, true);
+    assert_string_equal(b, "0.33333334");
+    mechrt_format_real(b, sizeof b, 16777217.0, 0, true);
+    assert_string_equal(b, "16777216");
+    mechrt_format_real(b, sizeof b, -2.5e-7, 0, true);
+    assert_string_equal(b, "-2.5e-07");
+    mechrt_format_real(b, sizeof b, 1e39, 0, true);    /* finite only as a double */
+    assert_string_equal(b, "inf");
 }
 
 int main(void)
@@ -160,6 +210,7 @@ int main(void)
         cmocka_unit_test(simulation_like_numbers),
         cmocka_unit_test(powers_and_neighbours),
         cmocka_unit_test(ties_and_edges),
+        cmocka_unit_test(floats_shortest),
         cmocka_unit_test(known_texts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

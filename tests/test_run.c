@@ -1055,15 +1055,15 @@ static void test_output_formats(void **state)
 {
     (void)state;
     char buf[64];
-    mechrt_format_real(buf, sizeof buf, 0.3, 0);
+    mechrt_format_real(buf, sizeof buf, 0.3, 0, false);
     assert_string_equal(buf, "0.3");
-    mechrt_format_real(buf, sizeof buf, 0.1 + 0.2, 0);
+    mechrt_format_real(buf, sizeof buf, 0.1 + 0.2, 0, false);
     assert_string_equal(buf, "0.30000000000000004");
-    mechrt_format_real(buf, sizeof buf, M_PI, 6);
+    mechrt_format_real(buf, sizeof buf, M_PI, 6, false);
     assert_string_equal(buf, "3.14159");
-    mechrt_format_real(buf, sizeof buf, -0.0, 0);
+    mechrt_format_real(buf, sizeof buf, -0.0, 0, false);
     assert_string_equal(buf, "0");
-    mechrt_format_real(buf, sizeof buf, -INFINITY, 0);
+    mechrt_format_real(buf, sizeof buf, -INFINITY, 0, false);
     assert_string_equal(buf, "-inf");
 
     char text[1024];

@@ -12,7 +12,7 @@ void json_number(FILE *out, double v)
         fputs("null", out);
         return;
     }
-    mechrt_format_real(buf, sizeof buf, v, 0);  /* as run's JSON: 0.3, not 0.29999999999999999 */
+    mechrt_format_real(buf, sizeof buf, v, 0, false);  /* as run's JSON: 0.3, not 0.29999999999999999 */
     fputs(buf, out);
 }
 

@@ -10,8 +10,8 @@
 #include "dag.h"
 
 #include "../base/arena.h"
-#include "../base/realfmt.h"
 #include "../base/strbuf.h"
+#include "../../runtime/host/format_real.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -587,7 +587,7 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
     switch (op) {
     case OP_CONST: {
         char buf[40];
-        realfmt_shortest(buf, sizeof buf, n->value);     /* reads back exactly */
+        mechrt_format_real(buf, sizeof buf, n->value, 0, false);    /* reads back exactly */
         sb_printf(out, n->value < 0 ? "(%s)" : "%s", buf);
         return;
     }

@@ -1,4 +1,4 @@
-/* format_real.c - doubles as the text of run's CSV and JSON, mostly without printf or strtod.
+/* format_real.c - doubles as text (run's CSV and JSON, reports, generated C), mostly without printf or strtod.
  *
  * The text is defined by printf: "%.<P>g" with P = digits, or with the
  * shortest P of 15, 16, 17 whose text reads back as v. glibc computes
@@ -13,27 +13,30 @@
  * candidate is nearer to v than half the gap to v's neighbours). Every
  * quantity is known to within 2 units of 2^-64; a decision that close to
  * its boundary (a tie, say) is left to printf and strtod, as are
- * subnormals, |v| >= 1e16 and compilers without a 128-bit integer. So the
- * text is byte for byte printf's (tests/test_format_real.c compares them).
+ * subnormals, |v| >= 1e16, floats and compilers without a 128-bit
+ * integer. So the text is byte for byte printf's (tests/test_format_real.c
+ * compares them).
  */
-#include "mechrt_host.h"
+#include "format_real.h"
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* printf and strtod: the definition, and the path for what the fast one leaves. */
-static int format_slow(char *buf, size_t size, double v, int digits)
+static int format_slow(char *buf, size_t size, double v, int digits, bool as_float)
 {
     if (digits > 0)
         return snprintf(buf, size, "%.*g", digits, v);
-    /* 17 significant digits always round-trip a double; fewer usually do
-       and read better (0.3, not 0.29999999999999999) */
-    int n = 0;
-    for (int d = 15; d <= 17; d++) {
+    /* 17 significant digits always round-trip a double (9 a float); fewer
+       usually do and read better (0.3, not 0.29999999999999999) */
+    int least = as_float ? 6 : 15, most = as_float ? 9 : 17, n = 0;
+    for (int d = least; d <= most; d++) {
         n = snprintf(buf, size, "%.*g", d, v);
-        if (d == 17 || strtod(buf, NULL) == v)
+        double back = strtod(buf, NULL);
+        if (d == most || (as_float ? (float)back == (float)v : back == v))
             break;
     }
     return n;
@@ -290,8 +293,10 @@ static bool format_fast(char *buf, size_t size, double v, int digits, int *n)
 }
 #endif
 
-int mechrt_format_real(char *buf, size_t size, double v, int digits)
+int mechrt_format_real(char *buf, size_t size, double v, int digits, bool as_float)
 {
+    if (as_float)
+        v = (float)v;   /* then v is exactly the float, reads back or not */
     if (isnan(v))
         return snprintf(buf, size, "nan");
     if (isinf(v))
@@ -299,7 +304,8 @@ int mechrt_format_real(char *buf, size_t size, double v, int digits)
     if (v == 0)
         v = 0;   /* -0 prints as 0: a sign on zero is noise to a reader */
     int n;
-    if (v != 0 && format_fast(buf, size, v, digits, &n))
+    /* floats are written once each, into generated files: printf serves */
+    if (v != 0 && !as_float && format_fast(buf, size, v, digits, &n))
         return n;
-    return format_slow(buf, size, v, digits);
+    return format_slow(buf, size, v, digits, as_float);
 }

@@ -21,6 +21,7 @@
 #include <stdio.h>
 
 #include "../mechrt.h"
+#include "format_real.h"
 
 /* ---- Integrator options ------------------------------------------------ */
 
@@ -326,10 +327,6 @@ MechrtStatus mechrt_host_minnorm_step(MechrtHostMinNorm *m, const double *q, dou
 
 /* ---- Output (output.c; numbers: format_real.c) ---------------------------- */
 
-/* v as text: with digits == 0 the shortest of %.15g, %.16g, %.17g that
-   reads back as v (0.3 stays "0.3"), else %.<digits>g. -0 is "0"; NaN
-   and infinities are "nan", "inf", "-inf". Returns the length written. */
-int mechrt_format_real(char *buf, size_t size, double v, int digits);
 
 /* CSV (RFC 4180, no quoting needed: coordinate names are identifiers with
    dots). Header: t, the coordinate names, d(NAME) for each velocity,

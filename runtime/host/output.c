@@ -15,7 +15,7 @@
 static void put_real(FILE *out, double v, int digits)
 {
     char buf[40];
-    mechrt_format_real(buf, sizeof buf, v, digits);
+    mechrt_format_real(buf, sizeof buf, v, digits, false);
     fputs(buf, out);
 }
 
@@ -69,7 +69,7 @@ static void rowbuf_real(RowBuf *rb, char sep, double v, int digits)
     }
     if (sep)
         rb->buf[rb->len++] = sep;
-    rb->len += (size_t)mechrt_format_real(rb->buf + rb->len, 40, v, digits);
+    rb->len += (size_t)mechrt_format_real(rb->buf + rb->len, 40, v, digits, false);
 }
 
 void mechrt_csv_row_omega(FILE *out, int nq, double t, const double *q, const double *qd,
