@@ -37,10 +37,11 @@
  * unrolled and the factorisations and solves written in place: nonzero,
  * the state untouched, wherever the runtime must step instead.
  */
-#include "emit.h"
+#include "emit_lu.h"
 
 #include "../base/arena.h"
 #include "../eval/interp.h"
+#include "literal.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -24,7 +24,7 @@
  */
 #include "roll.h"
 
-#include "emit.h"
+#include "literal.h"
 #include "../base/arena.h"
 #include "../base/hashmap.h"
 

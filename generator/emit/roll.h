@@ -19,7 +19,7 @@ typedef struct RollHooks {
 } RollHooks;
 
 /* Writes a loop body's statements with the emitter's scheduler and
-   printer (emit.c); takes outs and returns the body's operations. */
+   printer (emit.c, expr.c); takes outs and returns the body's operations. */
 typedef int (*RollBodyWriter)(void *emitter, const Dag *body, SchedOutput *outs, int n,
                               const RollHooks *hooks, StrBuf *sb);
 
@@ -28,11 +28,11 @@ typedef struct RollContext {
     const char *prefix;         /* P: the tables are P_FUNCTION_r... */
     const char *function;       /* "phi", "jac_nz", ... */
     bool real_float;
-    /* The emitter's trigonometry (emit.c): the pair function (NULL: sin
+    /* The emitter's trigonometry (trig.c): the pair function (NULL: sin
        and cos as written), and the names for an angle of which only the
        sin or only the cos is used (NULL: the pair). */
     const char *sincos_name, *sin_name, *cos_name;
-    const char *sincos2_name;   /* two angles a call (emit.c), or NULL */
+    const char *sincos2_name;   /* two angles a call (trig.c), or NULL */
     int min_members;            /* fewest rows of one shape worth a loop */
     RollBodyWriter write_body;
     void *emitter;

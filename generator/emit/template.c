@@ -56,3 +56,9 @@ void template_set(TemplateVar *vars, int nvars, const char *name, const char *va
     fprintf(stderr, "mechc: internal error: no template variable '%s'\n", name);
     abort();
 }
+
+_Noreturn void template_placeholder_bug(const char *name)
+{
+    fprintf(stderr, "mechc: internal error: template placeholder '%.20s' has no value\n", name);
+    abort();
+}

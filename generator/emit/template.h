@@ -19,4 +19,8 @@ const char *template_render(StrBuf *out, const char *tmpl, const TemplateVar *va
    in mechc: aborts. */
 void template_set(TemplateVar *vars, int nvars, const char *name, const char *value);
 
+/* Every placeholder of a template is given a value: one without (a name
+   template_render returned) is a bug in mechc; says so and aborts. */
+_Noreturn void template_placeholder_bug(const char *name);
+
 #endif
