@@ -485,6 +485,20 @@ static void free_functions(StrBuf *parts, StrBuf *bodies)
     }
 }
 
+/* The file's source and header (files.c), the banner counting the
+   operations of each function written. */
+static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
+{
+    StrBuf ops;
+    sb_init(&ops);
+    sb_puts(&ops, "");
+    for (int f = 0; f < emit_function_count(e->kin); f++)
+        if (emit_function_written(e->opt, (EmitFunction)f))
+            sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
+    emit_render_files(e, parts, bodies, ops.data, out);
+    sb_free(&ops);
+}
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResult *out, Diag *diag)
 {
     const Model *m = kin->model;
@@ -516,7 +530,7 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
     }
     trig_free(&e.trig);
     if (fits)
-        emit_render_files(&e, parts, bodies, out);
+        render_files(&e, parts, bodies, out);
     else
         diag_error_nopos(diag, "the generated code would have more than %ld operations, "
                          "the limit (see --max-code-ops)", opt->max_ops);

@@ -632,6 +632,33 @@ static bool lu_refused(const Kinematics *kin, char *why, size_t size)
     return true;
 }
 
+/* The interface's part: P_lu_factor, P_lu_solve and P_step declared,
+   P_LU_NSLOTS defined. */
+static void lu_declarations(StrBuf *decl, const char *prefix, const char *upper, int slots)
+{
+    sb_printf(decl, "/* The Jacobian's LU for its pattern (an extension of spec section 4):\n"
+              "   %s_lu_factor factors the %s_NNZ values a of %s_jac_nz into lu\n"
+              "   (%s_LU_NSLOTS reals) in a pivot order chosen when the file was\n"
+              "   written; it returns 0, or nonzero when a pivot is below %g times\n"
+              "   a candidate of its column or pivot_tol times the largest entry\n"
+              "   (-1: an entry is not finite): then factor with partial pivoting\n"
+              "   instead. *spread = max|u_kk| / min|u_kk|. %s_lu_solve: x = A^-1 b\n"
+              "   (x may be b). */\n#define %s_LU_NSLOTS %d\n",
+              prefix, upper, prefix, upper, LU_TAU, prefix, upper, slots);
+    sb_printf(decl, "int %s_lu_factor(const %s_real *a, %s_real *lu, %s_real pivot_tol, "
+              "%s_real *spread);\n", prefix, prefix, prefix, prefix, prefix);
+    sb_printf(decl, "void %s_lu_solve(const %s_real *lu, const %s_real *b, %s_real *x);\n",
+              prefix, prefix, prefix, prefix);
+    sb_printf(decl, "/* One kinematic step over these kernels and this LU (the runtime's\n"
+              "   mechrt_step_lup with every call direct): 0, or nonzero with the state\n"
+              "   untouched when the runtime must take the step itself. tol: tol_phi,\n"
+              "   tol_dq, pivot_tol, the largest pivot spread; out: ||Phi||_inf, the\n"
+              "   last ||dq||_inf; iout: iterations, worst row. */\n"
+              "int %s_step(%s_real *q, %s_real *qd, %s_real *qdd, %s_real t, %s_real h,\n"
+              "            const %s_real *tol, int max_iter, %s_real *out, int *iout);\n",
+              prefix, prefix, prefix, prefix, prefix, prefix, prefix, prefix);
+}
+
 /* Declarations (decl) and definitions (def) appended for the mechanism,
    when it is square without velocity rows and small enough. */
 void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
@@ -663,28 +690,7 @@ void emit_lu(const Kinematics *kin, const EmitOptions *opt, const char *prefix,
     double cmax, cmin;
     if (lu_eliminate(&g, kin, &loads, &steps, &cmax, &cmin)) {
         lu_solve_body(&g, &solve);
-        int slots = g.nslots > 0 ? g.nslots : 1;
-        sb_printf(decl, "/* The Jacobian's LU for its pattern (an extension of spec section 4):\n"
-                  "   %s_lu_factor factors the %s_NNZ values a of %s_jac_nz into lu\n"
-                  "   (%s_LU_NSLOTS reals) in a pivot order chosen when the file was\n"
-                  "   written; it returns 0, or nonzero when a pivot is below %g times\n"
-                  "   a candidate of its column or pivot_tol times the largest entry\n"
-                  "   (-1: an entry is not finite): then factor with partial pivoting\n"
-                  "   instead. *spread = max|u_kk| / min|u_kk|. %s_lu_solve: x = A^-1 b\n"
-                  "   (x may be b). */\n#define %s_LU_NSLOTS %d\n",
-                  prefix, upper, prefix, upper, LU_TAU, prefix, upper, slots);
-        sb_printf(decl, "int %s_lu_factor(const %s_real *a, %s_real *lu, %s_real pivot_tol, "
-                  "%s_real *spread);\n", prefix, prefix, prefix, prefix, prefix);
-        sb_printf(decl, "void %s_lu_solve(const %s_real *lu, const %s_real *b, %s_real *x);\n",
-                  prefix, prefix, prefix, prefix);
-        sb_printf(decl, "/* One kinematic step over these kernels and this LU (the runtime's\n"
-                  "   mechrt_step_lup with every call direct): 0, or nonzero with the state\n"
-                  "   untouched when the runtime must take the step itself. tol: tol_phi,\n"
-                  "   tol_dq, pivot_tol, the largest pivot spread; out: ||Phi||_inf, the\n"
-                  "   last ||dq||_inf; iout: iterations, worst row. */\n"
-                  "int %s_step(%s_real *q, %s_real *qd, %s_real *qdd, %s_real t, %s_real h,\n"
-                  "            const %s_real *tol, int max_iter, %s_real *out, int *iout);\n",
-                  prefix, prefix, prefix, prefix, prefix, prefix, prefix, prefix);
+        lu_declarations(decl, prefix, upper, g.nslots > 0 ? g.nslots : 1);
         sb_printf(def, "\n\n/* ---- begin lu ---- */\n/* |x|: one instruction where "
                   "optimising, no libm call elsewhere */\n#if %s_OPTIMIZED\n"
                   "#define %s_LU_ABS(x) %s(x)\n#else\n"

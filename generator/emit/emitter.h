@@ -27,8 +27,9 @@ void emit_put_expr(const Emitter *e, StrBuf *sb, NodeId id, bool top);
    later chunk of the function imports it); nothing for DAG_NONE. */
 void emit_put_export(const Emitter *e, StrBuf *sb, NodeId id);
 
-/* Fills the templates with the written functions (files.c): out's
-   source and header. */
-void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out);
+/* Fills the templates with the written functions and ops, their
+   operation counts for the banner (files.c): out's source and header. */
+void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const char *ops,
+                       EmitResult *out);
 
 #endif

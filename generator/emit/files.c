@@ -228,7 +228,7 @@ static void put_moves(StrBuf *moves, const Emitter *e)
 
 /* The texts the templates take besides the functions, in b[FILE_*]. */
 enum {
-    FILE_BANNER, FILE_OPS, FILE_Q0, FILE_COORDS, FILE_ROWS, FILE_JROW, FILE_JCOL, FILE_MATH,
+    FILE_BANNER, FILE_Q0, FILE_COORDS, FILE_ROWS, FILE_JROW, FILE_JCOL, FILE_MATH,
     FILE_IFACE, FILE_ZERO, FILE_JAC, FILE_INC, FILE_MOVES, FILE_NZ_DECL, FILE_NZ_DEF,
     FILE_MROW, FILE_MCOL, FILE_DYN_C, FILE_DYN_H, FILE_JAC_DECL, FILE_ALL_DECL, FILE_ALL_DEF,
     FILE_MARK, FILE_COUNT
@@ -240,9 +240,6 @@ static void put_pieces(const Emitter *e, const StrBuf *parts, const StrBuf *bodi
     const EmitOptions *opt = e->opt;
     const Model *m = e->kin->model;
     put_banner(&b[FILE_BANNER], opt->source_name ? opt->source_name : m->file);
-    for (int f = 0; f < emit_function_count(e->kin); f++)
-        if (emit_function_written(opt, (EmitFunction)f))
-            sb_printf(&b[FILE_OPS], "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     put_data(e, &b[FILE_Q0], &b[FILE_COORDS], &b[FILE_ROWS], &b[FILE_JROW], &b[FILE_JCOL],
              &b[FILE_MROW], &b[FILE_MCOL]);
     put_zero_fill(&b[FILE_ZERO], e->kin, opt, e->prefix, e->prefix_upper);
@@ -285,7 +282,8 @@ static const char *render(const Emitter *e, TemplateVar *vars, int nvars, StrBuf
     return bad;
 }
 
-void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult *out)
+void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const char *ops,
+                       EmitResult *out)
 {
     StrBuf b[FILE_COUNT];
     for (int i = 0; i < FILE_COUNT; i++) {
@@ -296,7 +294,7 @@ void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResu
     EmitSizes z;
     put_sizes(e, &z);
     TemplateVar vars[] = {
-        {"BANNER", b[FILE_BANNER].data}, {"OPS", b[FILE_OPS].data}, {"P", e->prefix},
+        {"BANNER", b[FILE_BANNER].data}, {"OPS", ops}, {"P", e->prefix},
         {"PU", e->prefix_upper}, {"REAL", e->opt->real_float ? "float" : "double"},
         {"NQ", z.nq}, {"NH", z.nh}, {"NV", z.nv}, {"NNZ", z.nnz}, {"GUARD", z.guard},
         {"MATH", b[FILE_MATH].data}, {"INTERFACE", ""}, {"Q0", b[FILE_Q0].data},

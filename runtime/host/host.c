@@ -297,6 +297,14 @@ MechrtStatus mechrt_host_project(MechrtHost *h, const MechrtOptions *o, double *
 /* q' = qd(q, t) for GSL: the velocity solve of the square system. A failure
    (singular [Phi_q; A], NaN) is kept with its time and state, and reported
    as GSL_EBADFUNC, which stops the integrator at once. */
+/* Where and why the integration stopped (mechrt_host_failure). */
+static void record_failure(MechrtHost *h, MechrtStatus st, double t, const double *q)
+{
+    h->fail_status = st;
+    h->fail_t = t;
+    memcpy(h->fail_q, q, (size_t)h->nq * sizeof *q);
+}
+
 static int ode_rhs(double t, const double y[], double dydt[], void *params)
 {
     MechrtHost *h = params;
@@ -308,12 +316,27 @@ static int ode_rhs(double t, const double y[], double dydt[], void *params)
                                               &rep);
     if (st == MECHRT_OK)
         return GSL_SUCCESS;
-    if (h->fail_status == MECHRT_OK) {
-        h->fail_status = st;
-        h->fail_t = t;
-        memcpy(h->fail_q, y, (size_t)h->nq * sizeof *y);
-    }
+    if (h->fail_status == MECHRT_OK)
+        record_failure(h, st, t, y);
     return GSL_EBADFUNC;
+}
+
+/* The stepper of oo's method (a new one when the method changed), the
+   control and the evolution reset for a fresh integration. */
+static MechrtStatus ode_prepare(MechrtHost *h, const MechrtOdeOptions *oo)
+{
+    if (!h->step || h->step_method != oo->method) {
+        if (h->step)
+            gsl_odeiv2_step_free(h->step);
+        h->step = gsl_odeiv2_step_alloc(ode_type(oo->method), (size_t)h->nq);
+        h->step_method = oo->method;
+        if (!h->step)
+            return MECHRT_EINVAL;
+    }
+    gsl_odeiv2_control_init(h->control, oo->tol, oo->tol, 1.0, 0.0);
+    gsl_odeiv2_evolve_reset(h->evolve);
+    gsl_odeiv2_step_reset(h->step);
+    return MECHRT_OK;
 }
 
 MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
@@ -338,20 +361,7 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
         return MECHRT_OK;
 
     gsl_error_handler_t *old = gsl_set_error_handler_off();
-    MechrtStatus st = MECHRT_OK;
-    if (!h->step || h->step_method != oo->method) {
-        if (h->step)
-            gsl_odeiv2_step_free(h->step);
-        h->step = gsl_odeiv2_step_alloc(ode_type(oo->method), (size_t)h->nq);
-        h->step_method = oo->method;
-        if (!h->step)
-            st = MECHRT_EINVAL;
-    }
-    if (st == MECHRT_OK) {
-        gsl_odeiv2_control_init(h->control, oo->tol, oo->tol, 1.0, 0.0);
-        gsl_odeiv2_evolve_reset(h->evolve);
-        gsl_odeiv2_step_reset(h->step);
-    }
+    MechrtStatus st = ode_prepare(h, oo);
     h->rhs_opts = *o;
     h->rhs_opts.cond_warn = 0;   /* estimates are for the output times */
     h->fail_status = MECHRT_OK;
@@ -363,14 +373,11 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
     while (st == MECHRT_OK && *t * dir < t_end * dir) {
         int gs = gsl_odeiv2_evolve_apply(h->evolve, h->control, h->step, &sys, t, t_end, &hh, q);
         if (gs != GSL_SUCCESS) {
-            if (h->fail_status != MECHRT_OK) {
-                st = h->fail_status;
-            } else {
-                /* step size underflow: keep where the integrator gave up */
-                st = MECHRT_ESTEP;
-                h->fail_t = *t;
-                memcpy(h->fail_q, q, (size_t)h->nq * sizeof *q);
-            }
+            /* not the right-hand side: step size underflow, where the
+               integrator gave up */
+            if (h->fail_status == MECHRT_OK)
+                record_failure(h, MECHRT_ESTEP, *t, q);
+            st = h->fail_status;
             break;
         }
         h->stats.ode_steps++;
@@ -380,9 +387,7 @@ MechrtStatus mechrt_host_integrate(MechrtHost *h, const MechrtOptions *o,
         if (report && pr.iterations > report->iterations)
             *report = pr;   /* the hardest projection of the call */
         if (st != MECHRT_OK) {
-            h->fail_status = st;
-            h->fail_t = *t;
-            memcpy(h->fail_q, h->y, (size_t)h->nq * sizeof *q);
+            record_failure(h, st, *t, h->y);
             if (report)
                 *report = pr;
             break;
