@@ -1,7 +1,7 @@
 /* test_emit.c - the generated C: it compiles cleanly with gcc for every example, in double and
  * float, with and without a separate header; names from the input cannot break it; the prefix
- * rules; the banner; byte-identical output; the fused kernel's sharing; and the C built by gcc
- * computes what the in-process JIT computes.
+ * rules; constants as literals; the banner; byte-identical output; the fused kernel's sharing;
+ * and the C built by gcc computes what the in-process JIT computes.
  *
  * gcc runs through system() in a mkdtemp directory removed at the end; the
  * compile tests skip (cmocka skip()) only when gcc is not installed. Paths
@@ -13,6 +13,7 @@
 #include "../generator/base/limits.h"
 #include "../generator/base/sincos.h"
 #include "../generator/emit/emit.h"
+#include "../generator/emit/literal.h"
 #include "../generator/pipeline/pipeline.h"
 
 #include <dirent.h>
@@ -769,10 +770,33 @@ static void test_sincos_pairs(void **state)
     }
 }
 
+/* Constants as C literals: the shared formatter's shortest text, a ".0"
+   where it would read as an int, negative ones parenthesized, float ones
+   suffixed, zero's sign kept, and HUGE_VALF past float's range. */
+static void test_literals(void **state)
+{
+    (void)state;
+    static const struct { double v; bool real_float; const char *text; } cases[] = {
+        {0.3, false, "0.3"}, {0.1 + 0.2, false, "0.30000000000000004"}, {2, false, "2.0"},
+        {-1.5, false, "(-1.5)"}, {1e20, false, "1e+20"}, {0.0, false, "0.0"},
+        {-0.0, false, "(-0.0)"}, {0.1, true, "0.1f"}, {2, true, "2.0f"},
+        {1.0 / 3, true, "0.33333334f"}, {-0.0, true, "(-0.0f)"}, {1e39, true, "HUGE_VALF"},
+        {-1e39, true, "(-HUGE_VALF)"}, {-2.5e-7, true, "(-2.5e-07f)"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        StrBuf sb;
+        sb_init(&sb);
+        emit_put_literal(&sb, cases[i].v, cases[i].real_float);
+        assert_string_equal(sb.data, cases[i].text);
+        sb_free(&sb);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_check_prefix),
+        cmocka_unit_test(test_literals),
         cmocka_unit_test(test_banner),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_op_counts),
