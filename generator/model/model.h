@@ -165,10 +165,9 @@ char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag
 /* The file stem of a path: "dir/slider_crank.mech" -> "slider_crank". */
 char *model_file_stem(Arena *arena, const char *path);
 
-/* Lowers one joint's rows into the graph (generator/model/joints.c). */
+/* Lowers one joint's rows into the graph, by its kind's builder
+   (generator/model/joints.c, joints_spatial.c). */
 void joints_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
-/* The same for the spatial kinds (generator/model/joints_spatial.c). */
-void joints_spatial_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
 /* A spatial axis (ux, uy, uz) made unit, h, and its perpendiculars f and g
    (the generic evaluator's formulas use the builder's very frame). */
 void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3]);
