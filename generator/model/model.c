@@ -741,7 +741,7 @@ static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *wh
     double v = constant_value(b, s->key[key], what);
     if (nonnegative && v < 0)
         diag_fail(b->diag, s->key_pos[key], "%s of %s '%s' is negative (%g)", what,
-                  dyn_keywords[s->dyn], s->name, v);
+                  dyn_keyword(s), s->name, v);
     return v;
 }
 
@@ -975,7 +975,7 @@ static void refuse_ground(Builder *b, const Stmt *s, int n)
         if (s->attach[i].name && strcmp(s->attach[i].name, "ground") == 0
             && (n == 1 || (s->attach[1 - i].name && strcmp(s->attach[1 - i].name, "ground") == 0)))
             diag_fail(b->diag, s->attach[i].pos, "%s '%s' acts on ground only: it does no work",
-                      dyn_keywords[s->dyn], s->name);
+                      dyn_keyword(s), s->name);
 }
 
 /* Whether any of the n expressions depends on a coordinate. A point or
@@ -999,18 +999,18 @@ static bool depends_on_q(Builder *b, const NodeId *e, int n)
    ids, and its length would be 0 at every state). */
 static void refuse_idle(Builder *b, const Stmt *s, const AppliedForce *f)
 {
-    const char *kw = dyn_keywords[s->dyn];
+    const char *kw = dyn_keyword(s);
     NodeId a[3] = {f->ax, f->ay, f->az}, ab[6] = {f->ax, f->ay, f->bx, f->by, f->az, f->bz};
-    if (s->dyn == DYN_FORCE && !depends_on_q(b, a, 3))
+    if (f->kind == FORCE_POINT && !depends_on_q(b, a, 3))
         diag_fail(b->diag, s->attach[0].pos, "%s '%s' is applied at a fixed point (it depends "
                   "on no coordinate): it does no work", kw, s->name);
-    if (s->dyn == DYN_TORQUE && s->lhs && !depends_on_q(b, a, 1))
+    if (f->kind == FORCE_TORQUE && s->lhs && !depends_on_q(b, a, 1))
         diag_fail(b->diag, s->lhs->pos, "%s '%s' acts on an angle that depends on no "
                   "coordinate: it does no work", kw, s->name);
-    if (s->dyn == DYN_SPRING && f->ax == f->bx && f->ay == f->by && f->az == f->bz)
+    if (f->kind == FORCE_SPRING && f->ax == f->bx && f->ay == f->by && f->az == f->bz)
         diag_fail(b->diag, s->attach[1].pos, "%s '%s' joins a point to itself: its length is "
                   "always 0", kw, s->name);
-    if (s->dyn == DYN_SPRING && !depends_on_q(b, ab, 6))
+    if (f->kind == FORCE_SPRING && !depends_on_q(b, ab, 6))
         diag_fail(b->diag, s->attach[0].pos, "%s '%s' joins two fixed points (they depend on no "
                   "coordinate): it does no work", kw, s->name);
 }
@@ -1033,92 +1033,108 @@ static NodeId torque_angle(Builder *b, const Ast *lhs)
     return lower(b, lhs, EXPR_HOLONOMIC);
 }
 
+/* force NAME: ATTACHMENT (fx, fy): Q += p_q^T (fx, fy) */
+static void build_POINT(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    NodeId xy[3];
+    dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, dyn_keyword(s), xy);
+    f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
+    refuse_idle(b, s, f);
+    if (b->spatial)
+        f->fz = dyn_expr(b, s->vec[2]);
+    f->fy = dyn_expr(b, s->vec[1]);
+    f->fx = dyn_expr(b, s->vec[0]);
+}
+
+/* torque NAME: BODY = tau | angle(e) = tau */
+static void build_TORQUE(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    f->ax = s->lhs ? torque_angle(b, s->lhs) : dyn_angle(b, &s->attach[0], dyn_keyword(s));
+    refuse_idle(b, s, f);
+    f->fx = dyn_expr(b, s->value);
+}
+
 /* torque NAME: BODY = (tx, ty, tz) in a spatial file: a torque in global
    axes on a body, Q[e] += 2 E(e)^T tau (the virtual work tau . w, w = 2 E ed). */
-static void spatial_body_torque(Builder *b, const Stmt *s, AppliedForce *f)
+static void build_BODY_TORQUE(Builder *b, const Stmt *s, AppliedForce *f)
 {
-    Attach a = resolve_attach(b, &s->attach[0], ATTACH_FRAME, dyn_keywords[s->dyn]);
-    f->kind = FORCE_BODY_TORQUE;
+    Attach a = resolve_attach(b, &s->attach[0], ATTACH_FRAME, dyn_keyword(s));
     f->coord = a.q + 3;
     f->fz = dyn_expr(b, s->vec[2]);
     f->fy = dyn_expr(b, s->vec[1]);
     f->fx = dyn_expr(b, s->vec[0]);
 }
 
-/* force, torque, spring, rspring, gforce: one applied force. */
+/* spring NAME: A B k = .. c = .. length = .. force = .. */
+static void build_SPRING(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    const char *kw = dyn_keyword(s);
+    NodeId xy[3];
+    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
+    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
+    f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true);
+    dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
+    f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
+    dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
+    f->bx = xy[0], f->by = xy[1], f->bz = xy[2];
+    refuse_idle(b, s, f);
+    f->fx = dyn_expr(b, s->key[DKEY_FORCE]);
+}
+
+/* rspring NAME: A B k = .. c = .. angle = .. torque = ..: B's angle less
+   A's; in a spatial file rspring NAME: R ..., about a joint's axis: B's
+   angle is angle(R), A's 0. */
+static void build_RSPRING(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
+    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
+    f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
+    if (b->spatial) {
+        Entity *e = lookup(b, s->attach[0].name, s->attach[0].pos);
+        const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
+        if (!j || (j->kind != JOINT_S_REVOLUTE && j->kind != JOINT_S_CYLINDRICAL))
+            diag_fail(b->diag, s->attach[0].pos, "a spatial rspring acts about a revolute's "
+                      "or cylindrical's axis; '%s' is %s", e->name,
+                      j ? joint_info[j->kind].keyword : entity_word(e->kind));
+        f->bx = joints_spatial_angle(b->model, j);
+        check_nodes(b);
+    } else {
+        f->ax = dyn_angle(b, &s->attach[0], dyn_keyword(s));
+        f->bx = dyn_angle(b, &s->attach[1], dyn_keyword(s));
+    }
+    f->fx = dyn_expr(b, s->key[DKEY_TORQUE]);
+}
+
+/* gforce NAME: COORDINATE = e: Q[coord] += e */
+static void build_GENERAL(Builder *b, const Stmt *s, AppliedForce *f)
+{
+    if (s->lhs->kind != AST_NAME && s->lhs->kind != AST_MEMBER)
+        diag_fail(b->diag, s->lhs->pos, "gforce '%s' acts on a coordinate (a coord, or a "
+                  "body's x, y or phi), not on %s", s->name, ast_describe(s->lhs));
+    f->coord = coordinate_of(b, s->lhs);
+    f->fx = dyn_expr(b, s->value);
+}
+
+typedef void ForceBuilder(Builder *b, const Stmt *s, AppliedForce *f);
+
+/* Every force kind's builder, by kind (forces.def). */
+static ForceBuilder *const force_builders[FORCE_KIND_COUNT] = {
+#define X(e, ...) [FORCE_##e] = build_##e,
+#include "../parse/forces.def"
+#undef X
+};
+
+/* One applied force: its attachments must move, then its kind's builder. */
 static void build_force(Builder *b, const Stmt *s)
 {
-    static const ForceKind kinds[DYN_KIND_COUNT] = {
-        [DYN_FORCE] = FORCE_POINT, [DYN_TORQUE] = FORCE_TORQUE, [DYN_SPRING] = FORCE_SPRING,
-        [DYN_RSPRING] = FORCE_RSPRING, [DYN_GFORCE] = FORCE_GENERAL,
-    };
-    const char *kw = dyn_keywords[s->dyn];
-    refuse_ground(b, s, s->dyn == DYN_FORCE || s->dyn == DYN_TORQUE ? 1 : 2);
-    AppliedForce *f = new_force(b, s, kinds[s->dyn]);
-    NodeId xy[3];
-    switch (s->dyn) {
-    case DYN_FORCE:
-        dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
-        f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
-        refuse_idle(b, s, f);
-        if (b->spatial)
-            f->fz = dyn_expr(b, s->vec[2]);
-        f->fy = dyn_expr(b, s->vec[1]);
-        f->fx = dyn_expr(b, s->vec[0]);
-        return;
-    case DYN_TORQUE:
-        if (b->spatial && !s->lhs) {
-            spatial_body_torque(b, s, f);
-            return;
-        }
-        f->ax = s->lhs ? torque_angle(b, s->lhs) : dyn_angle(b, &s->attach[0], kw);
-        refuse_idle(b, s, f);
-        f->fx = dyn_expr(b, s->value);
-        return;
-    case DYN_SPRING: case DYN_RSPRING:
-        f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
-        f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
-        if (s->dyn == DYN_SPRING) {
-            f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true);
-            dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
-            f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
-            dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
-            f->bx = xy[0], f->by = xy[1], f->bz = xy[2];
-            refuse_idle(b, s, f);
-            f->fx = dyn_expr(b, s->key[DKEY_FORCE]);
-        } else if (b->spatial) {   /* about a joint's axis: B's angle is angle(R), A's 0 */
-            f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
-            Entity *e = lookup(b, s->attach[0].name, s->attach[0].pos);
-            const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
-            if (!j || (j->kind != JOINT_S_REVOLUTE && j->kind != JOINT_S_CYLINDRICAL))
-                diag_fail(b->diag, s->attach[0].pos, "a spatial rspring acts about a revolute's "
-                          "or cylindrical's axis; '%s' is %s", e->name,
-                          j ? joint_info[j->kind].keyword : entity_word(e->kind));
-            f->bx = joints_spatial_angle(b->model, j);
-            check_nodes(b);
-            f->fx = dyn_expr(b, s->key[DKEY_TORQUE]);
-        } else {
-            f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
-            f->ax = dyn_angle(b, &s->attach[0], kw);
-            f->bx = dyn_angle(b, &s->attach[1], kw);
-            f->fx = dyn_expr(b, s->key[DKEY_TORQUE]);
-        }
-        return;
-    case DYN_GFORCE:
-        if (s->lhs->kind != AST_NAME && s->lhs->kind != AST_MEMBER)
-            diag_fail(b->diag, s->lhs->pos, "gforce '%s' acts on a coordinate (a coord, or a "
-                      "body's x, y or phi), not on %s", s->name, ast_describe(s->lhs));
-        f->coord = coordinate_of(b, s->lhs);
-        f->fx = dyn_expr(b, s->value);
-        return;
-    case DYN_MASS: case DYN_GRAVITY: case DYN_KIND_COUNT:
-        break;
-    }
+    refuse_ground(b, s, force_info[s->force].attachments);
+    AppliedForce *f = new_force(b, s, s->force);
+    force_builders[s->force](b, s, f);
 }
 
 static void build_dynamics(Builder *b, const Stmt *s)
 {
-    if (s->dyn == DYN_MASS) {
+    if (s->kind == STMT_MASS) {
         if (s->declares)
             build_element_mass(b, s);
         else
@@ -1127,7 +1143,7 @@ static void build_dynamics(Builder *b, const Stmt *s)
     }
     if (!b->first_force)
         b->first_force = s;
-    if (s->dyn != DYN_GRAVITY) {
+    if (s->kind == STMT_FORCE) {
         build_force(b, s);
         return;
     }
@@ -1147,7 +1163,8 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     m->name = default_name;
     const Stmt *last = NULL;
     for (const Stmt *s = prog->first; s; s = s->next) {
-        if (s->kind != STMT_OUTPUT && s->kind != STMT_DYNAMICS)  /* messages about the rows point at a row */
+        if (s->kind != STMT_OUTPUT && s->kind != STMT_MASS && s->kind != STMT_GRAVITY
+            && s->kind != STMT_FORCE)   /* messages about the rows point at a row */
             last = s;
         m->dag.where = s->pos.offset;
         switch (s->kind) {
@@ -1171,7 +1188,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
         case STMT_OUTPUT:
             build_output(b, s);
             break;
-        case STMT_DYNAMICS:
+        case STMT_MASS: case STMT_GRAVITY: case STMT_FORCE:
             build_dynamics(b, s);
             break;
         }
@@ -1185,7 +1202,7 @@ static void build(Builder *b, const Program *prog, const char *default_name)
                   (long long)m->nq * m->nq, b->limits->max_jac_entries);
     if (b->first_force && m->nmasses == 0)
         diag_fail(b->diag, b->first_force->pos, "%s without masses: the file has no 'mass' "
-                  "statement, so there is nothing for it to move", b->first_force->dyn == DYN_GRAVITY
+                  "statement, so there is nothing for it to move", b->first_force->kind == STMT_GRAVITY
                   ? "gravity" : "a force");
     m->dag.where = -1;
     collect_bodies(b);

@@ -94,16 +94,8 @@ typedef struct MassElement {
     double inertia[6];  /* J' in body axes: xx, yy, zz, xy, xz, yz */
 } MassElement;
 
-typedef enum ForceKind {
-    FORCE_POINT,        /* Q += p_q^T (fx, fy) */
-    FORCE_TORQUE,       /* Q += theta_q^T tau, theta = a, tau = fx */
-    FORCE_SPRING,       /* l = |B - A|, f = k (l - L0) + c ldot + fx, Q += -f l_q */
-    FORCE_RSPRING,      /* a = theta_B - theta_A, tau = k (a - a0) + c adot + fx, Q += -tau a_q */
-    FORCE_GENERAL,      /* Q[coord] += fx */
-    FORCE_BODY_TORQUE,  /* spatial: Q[e0..e3] += 2 E(e)^T (fx, fy, fz), e at coord */
-} ForceKind;
-
-/* An applied force, every kind by virtual work. Expressions (fx, fy) may
+/* An applied force, every kind by virtual work (its kind's maths:
+   generator/parse/forces.def). Expressions (fx, fy) may
    use q, der(q) and t. In a spatial file points and forces have z
    components too (az, bz, fz; DAG_ZERO in a planar file). */
 typedef struct AppliedForce {

@@ -731,12 +731,8 @@ static void output(Parser *p, Stmt *s)
 
 #define KEYBIT(k) (1u << (k))
 
-/* The `key = value` options each dynamics statement takes. */
-static const unsigned dyn_allowed[DYN_KIND_COUNT] = {
-    [DYN_MASS] = KEYBIT(DKEY_M) | KEYBIT(DKEY_J) | KEYBIT(DKEY_ANGLE),
-    [DYN_SPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_LENGTH) | KEYBIT(DKEY_FORCE),
-    [DYN_RSPRING] = KEYBIT(DKEY_K) | KEYBIT(DKEY_C) | KEYBIT(DKEY_ANGLE) | KEYBIT(DKEY_TORQUE),
-};
+/* The keys of a mass (a force's are its row's in forces.def). */
+static const unsigned mass_keys = KEYBIT(DKEY_M) | KEYBIT(DKEY_J) | KEYBIT(DKEY_ANGLE);
 
 /* A spatial body's own mass: J is the tensor's diagonal, the products
    its off-diagonal entries; a spatial mass element has no angle, no J. */
@@ -785,7 +781,7 @@ static void vector(Parser *p, const char *what, const char *spatial_what, Ast **
 static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_only)
 {
     AstAttach *a = &s->attach[slot];
-    const char *kw = dyn_keywords[s->dyn];
+    const char *kw = dyn_keyword(s);
     const char *nth = count == 1 ? "" : slot == 0 ? "first " : "second ";
     if (p->tok.kind != TOK_IDENT || (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
         expected(p, "%s as the %sattachment of %s '%s'",
@@ -821,14 +817,15 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
    com, turns with the body: no angle key). */
 static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
 {
-    unsigned allowed = dyn_allowed[s->dyn] & (com ? ~KEYBIT(DKEY_ANGLE) : ~0u);
-    if (p->spatial && s->dyn == DYN_MASS)
+    bool mass = s->kind == STMT_MASS;
+    unsigned allowed = (mass ? mass_keys : force_info[s->force].keys) & (com ? ~KEYBIT(DKEY_ANGLE) : ~0u);
+    if (p->spatial && mass)
         allowed = com ? spatial_body_mass : KEYBIT(DKEY_M);
     while (p->tok.kind == TOK_IDENT) {
         bool is_com = com && lex_is_word(&p->tok, "com"), is_at = at && lex_is_word(&p->tok, "at");
         if ((is_com && s->vec[0]) || (is_at && s->attach[0].at))
             diag_fail(p->diag, p->tok.pos, "'%.*s' given twice for %s '%s'", p->tok.len,
-                      p->tok.start, dyn_keywords[s->dyn], s->name);
+                      p->tok.start, dyn_keyword(s), s->name);
         if (is_com) {
             s->vec_pos = p->tok.pos;
             advance(p);
@@ -847,10 +844,10 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
                   : at ? (p->spatial ? "at(x, y, z)" : "at(x, y)") : NULL);
         if (k == DKEY_COUNT || !(allowed & KEYBIT(k)))
             diag_fail(p->diag, p->tok.pos, "unknown key '%.*s' for %s '%s': expected %s",
-                      p->tok.len, p->tok.start, dyn_keywords[s->dyn], s->name, list);
+                      p->tok.len, p->tok.start, dyn_keyword(s), s->name, list);
         if (s->key[k])
             diag_fail(p->diag, p->tok.pos, "'%s' given twice for %s '%s'", dyn_key_names[k],
-                      dyn_keywords[s->dyn], s->name);
+                      dyn_keyword(s), s->name);
         s->key_pos[k] = p->tok.pos;
         advance(p);
         if (p->tok.kind != TOK_EQ)
@@ -910,6 +907,7 @@ static void dyn_torque(Parser *p, Stmt *s)
         expected(p, "'=' and the torque of '%s'", s->name);
     advance(p);
     if (p->spatial && !s->lhs) {    /* a spatial body's torque: global components */
+        s->force = FORCE_BODY_TORQUE;
         s->vec_pos = p->tok.pos;
         components(p, "the torque (tx, ty, tz)", 3, s->vec);
         return;
@@ -931,60 +929,66 @@ static void dyn_spatial_rspring(Parser *p, Stmt *s)
     dyn_keys(p, s, false, false);
 }
 
-/* dynamics = mass | torque | gravity pair
-            | 'force' NAME ':' attachment pair
-            | ('spring' | 'rspring') NAME ':' attachment attachment keys
-            | 'gforce' NAME ':' COORDINATE '=' expr */
-static void dynamics(Parser *p, Stmt *s, DynKind kind)
+/* gravity = 'gravity' pair */
+static void gravity(Parser *p, Stmt *s)
 {
-    s->kind = STMT_DYNAMICS;
-    s->dyn = kind;
-    const char *kw = dyn_keywords[kind];
+    s->kind = STMT_GRAVITY;
     advance(p);
-    if (kind == DYN_GRAVITY) {
-        s->vec_pos = p->tok.pos;
-        vector(p, "gravity (gx, gy)", "gravity (gx, gy, gz)", s->vec);
+    s->vec_pos = p->tok.pos;
+    vector(p, "gravity (gx, gy)", "gravity (gx, gy, gz)", s->vec);
+}
+
+/* force = 'force' NAME ':' attachment pair */
+static void point_force(Parser *p, Stmt *s)
+{
+    AstAttach *a = &s->attach[0];
+    SrcPos offset_pos = p->tok.pos;
+    dyn_attachment(p, s, 0, 1, false);
+    if (p->tok.kind != TOK_LPAREN && a->has_offset && !a->at) {
+        /* `force F: body (fx, fy)`: the pair was the force, not an offset */
+        a->has_offset = false;
+        s->vec[0] = a->sx, s->vec[1] = a->sy, s->vec[2] = a->sz;
+        a->sx = a->sy = a->sz = NULL;
+        s->vec_pos = offset_pos;
         return;
     }
-    if (kind == DYN_MASS) {
-        dyn_mass(p, s);
-        return;
-    }
-    s->name = declared_name(p, kw, &s->name_pos);
+    s->vec_pos = p->tok.pos;
+    vector(p, "the force (fx, fy)", "the force (fx, fy, fz)", s->vec);
+}
+
+/* force element = KIND NAME ':' operands, by kind (forces.def):
+     'force' NAME ':' attachment pair
+   | 'torque' NAME ':' (BODY | 'angle' '(' expr ')') '=' expr
+   | ('spring' | 'rspring') NAME ':' attachment attachment keys
+   | 'gforce' NAME ':' COORDINATE '=' expr */
+static void force(Parser *p, Stmt *s, ForceKind kind)
+{
+    const ForceInfo *info = &force_info[kind];
+    s->kind = STMT_FORCE;
+    s->force = kind;
+    advance(p);
+    s->name = declared_name(p, info->keyword, &s->name_pos);
     s->declares = true;
     if (p->tok.kind != TOK_COLON)
-        expected(p, "':' after the %s name '%s'", kw, s->name);
+        expected(p, "':' after the %s name '%s'", info->keyword, s->name);
     advance(p);
     switch (kind) {
-    case DYN_FORCE: {
-        AstAttach *a = &s->attach[0];
-        SrcPos offset_pos = p->tok.pos;
-        dyn_attachment(p, s, 0, 1, false);
-        if (p->tok.kind != TOK_LPAREN && a->has_offset && !a->at) {
-            /* `force F: body (fx, fy)`: the pair was the force, not an offset */
-            a->has_offset = false;
-            s->vec[0] = a->sx, s->vec[1] = a->sy, s->vec[2] = a->sz;
-            a->sx = a->sy = a->sz = NULL;
-            s->vec_pos = offset_pos;
-            return;
-        }
-        s->vec_pos = p->tok.pos;
-        vector(p, "the force (fx, fy)", "the force (fx, fy, fz)", s->vec);
+    case FORCE_POINT:
+        point_force(p, s);
         return;
-    }
-    case DYN_TORQUE:
+    case FORCE_TORQUE: case FORCE_BODY_TORQUE:
         dyn_torque(p, s);
         return;
-    case DYN_SPRING: case DYN_RSPRING:
-        if (p->spatial && kind == DYN_RSPRING) {
+    case FORCE_SPRING: case FORCE_RSPRING:
+        if (p->spatial && kind == FORCE_RSPRING) {
             dyn_spatial_rspring(p, s);
             return;
         }
-        dyn_attachment(p, s, 0, 2, kind == DYN_RSPRING);
-        dyn_attachment(p, s, 1, 2, kind == DYN_RSPRING);
+        for (int i = 0; i < info->attachments; i++)
+            dyn_attachment(p, s, i, info->attachments, info->frame);
         dyn_keys(p, s, false, false);
         return;
-    case DYN_GFORCE:
+    case FORCE_GENERAL:
         s->lhs = expr(p);
         if (p->tok.kind != TOK_EQ)
             expected(p, "'=' after the coordinate of gforce '%s'", s->name);
@@ -992,17 +996,9 @@ static void dynamics(Parser *p, Stmt *s, DynKind kind)
         advance(p);
         s->value = expr(p);
         return;
-    case DYN_MASS: case DYN_GRAVITY: case DYN_KIND_COUNT:
+    case FORCE_KIND_COUNT:
         break;
     }
-}
-
-static int dyn_kind_lookup(const Token *tok)
-{
-    for (int k = 0; k < DYN_KIND_COUNT; k++)
-        if (lex_is_word(tok, dyn_keywords[k]))
-            return k;
-    return -1;
 }
 
 /* Appends the statement keywords of the file's dimension to buf, for the
@@ -1011,13 +1007,16 @@ static void list_keywords(char *buf, size_t size, bool spatial)
 {
     int n = snprintf(buf, size, "mechanism, %sparam, body, point, coord, output",
                      spatial ? "spatial, " : "");
-    const char *words[JOINT_KIND_COUNT + DYN_KIND_COUNT];
+    const char *words[JOINT_KIND_COUNT + FORCE_KIND_COUNT + 2];
     int count = 0;
     for (int k = 0; k < JOINT_KIND_COUNT; k++)
         if (joint_kind_in((JointKind)k, spatial))
             words[count++] = joint_info[k].keyword;
-    for (int k = 0; k < DYN_KIND_COUNT; k++)
-        words[count++] = dyn_keywords[k];
+    words[count++] = "mass";
+    for (int k = 0; k < FORCE_KIND_COUNT; k++)
+        if (force_info[k].own)
+            words[count++] = force_info[k].keyword;
+    words[count++] = "gravity";
     for (int k = 0; k < count && n > 0 && (size_t)n < size; k++)
         n += snprintf(buf + n, size - (size_t)n, "%s %s", k == count - 1 ? " or" : ",", words[k]);
 }
@@ -1108,8 +1107,14 @@ static Stmt *statement(Parser *p)
         s->kind = STMT_OUTPUT;
         advance(p);
         output(p, s);
-    } else if (dyn_kind_lookup(&kw) >= 0) {
-        dynamics(p, s, (DynKind)dyn_kind_lookup(&kw));
+    } else if (lex_is_word(&kw, "mass")) {
+        s->kind = STMT_MASS;
+        advance(p);
+        dyn_mass(p, s);
+    } else if (lex_is_word(&kw, "gravity")) {
+        gravity(p, s);
+    } else if (force_kind_lookup(kw.start, kw.len) >= 0) {
+        force(p, s, (ForceKind)force_kind_lookup(kw.start, kw.len));
     } else if (kind >= 0) {
         s->kind = STMT_JOINT;
         s->joint = (JointKind)kind;
