@@ -33,7 +33,7 @@ fails_naming() {
     ! compiles "$1" && grep -q "$2" "$tmp/err"
 }
 
-tables="model/joints.c eval/generic_joints.c diff/dynamics.c eval/generic_dynamics.c model/model.c"
+tables="model/joints.c eval/generic_joints.c diff/dynamics.c eval/generic_dynamics.c model/dynamics.c"
 for f in $tables; do
     check "$f compiles as it is" compiles "$f"
 done
@@ -52,7 +52,7 @@ check "a force without its symbolic maths: diff/dynamics.c names add_TWIST" \
     fails_naming diff/dynamics.c "add_TWIST"
 check "a force without its generic maths: generic_dynamics.c names apply_TWIST" \
     fails_naming eval/generic_dynamics.c "apply_TWIST"
-check "a force without its builder: model.c names build_TWIST" \
-    fails_naming model/model.c "build_TWIST"
+check "a force without its builder: model/dynamics.c names build_TWIST" \
+    fails_naming model/dynamics.c "build_TWIST"
 
 suite_end
