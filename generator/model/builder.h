@@ -49,35 +49,35 @@ typedef enum ExprContext {
 /* ---- names and arrays (model.c) ---- */
 
 /* "a param", "a body", ...: what a name is, for messages. */
-const char *entity_word(EntityKind kind);
+const char *build_entity_word(EntityKind kind);
 /* Makes room for need elements of size bytes in *p (capacity *cap), in arena. */
-void grow(Arena *arena, void **p, int *cap, int need, size_t size);
+void build_grow(Arena *arena, void **p, int *cap, int need, size_t size);
 /* Fails at the statement when the graph has reached its node limit. */
-void check_nodes(Builder *b);
-int line_of(const Builder *b, SrcPos pos);
+void build_check_nodes(Builder *b);
+int build_line(const Builder *b, SrcPos pos);
 /* The entity a declared name names, or fails at pos. */
-Entity *lookup(Builder *b, const char *name, SrcPos pos);
+Entity *build_lookup(Builder *b, const char *name, SrcPos pos);
 /* A new name, or fails when it is taken (or was used as a unit). */
-Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos);
+Entity *build_declare(Builder *b, EntityKind kind, const char *name, SrcPos pos);
 /* A joint's or force's operand, checked against rule; keyword names the statement. */
-Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule, const char *keyword);
+Attach build_attach(Builder *b, const AstAttach *at, AttachRule rule, const char *keyword);
 
 /* ---- expressions (expr.c) ---- */
 
 /* The index of a unit name (deg, rpm), or -1. */
-int unit_index(const char *name);
+int build_unit_index(const char *name);
 /* The coordinate index an AST_NAME or AST_MEMBER names, or fails. */
-int coordinate_of(Builder *b, const Ast *ast);
+int build_coordinate(Builder *b, const Ast *ast);
 /* The joint of slide(T) or angle(R) in a spatial file (e names it, j its
    joint or NULL), or fails. */
-const Joint *spatial_joint_of(Builder *b, const Ast *ast, const Entity *e, const Joint *j);
+const Joint *build_spatial_joint(Builder *b, const Ast *ast, const Entity *e, const Joint *j);
 /* An expression's node, the node limit checked before each operand. */
-NodeId lower_expr(Builder *b, const Ast *ast, ExprContext ctx);
+NodeId build_lower_expr(Builder *b, const Ast *ast, ExprContext ctx);
 /* The same, the node limit checked once the expression is built. */
-NodeId lower(Builder *b, const Ast *ast, ExprContext ctx);
+NodeId build_lower(Builder *b, const Ast *ast, ExprContext ctx);
 /* A constant expression's value (NULL: 0), or fails naming what. */
-double constant_value(Builder *b, const Ast *ast, const char *what);
-bool mentions_der(const Ast *ast);
+double build_constant(Builder *b, const Ast *ast, const char *what);
+bool build_mentions_der(const Ast *ast);
 
 /* ---- masses, gravity and forces (dynamics.c) ---- */
 

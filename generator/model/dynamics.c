@@ -20,7 +20,7 @@
 /* A constant key's value (0 when absent), refused when negative. */
 static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *what, bool nonnegative)
 {
-    double v = constant_value(b, s->key[key], what);
+    double v = build_constant(b, s->key[key], what);
     if (nonnegative && v < 0)
         diag_fail(b->diag, s->key_pos[key], "%s of %s '%s' is negative (%g)", what,
                   dyn_keyword(s), s->name, v);
@@ -30,7 +30,7 @@ static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *wh
 /* A key's expression of q, der(q) and t (absent: 0). */
 static NodeId dyn_expr(Builder *b, const Ast *ast)
 {
-    return ast ? lower(b, ast, EXPR_VELOCITY) : DAG_ZERO;
+    return ast ? build_lower(b, ast, EXPR_VELOCITY) : DAG_ZERO;
 }
 
 /* The global position of a dynamics attachment: a body point, a
@@ -40,26 +40,26 @@ static void dyn_point(Builder *b, const AstAttach *at, ExprContext ctx, const ch
                       NodeId xy[3])
 {
     if (at->at) {
-        NodeId z = b->spatial ? lower(b, at->sz, ctx) : DAG_ZERO;
-        NodeId y = lower(b, at->sy, ctx);    /* sequenced: see AST_BINARY */
-        xy[0] = lower(b, at->sx, ctx);
+        NodeId z = b->spatial ? build_lower(b, at->sz, ctx) : DAG_ZERO;
+        NodeId y = build_lower(b, at->sy, ctx);    /* sequenced: see AST_BINARY */
+        xy[0] = build_lower(b, at->sx, ctx);
         xy[1] = y;
         xy[2] = z;
         return;
     }
-    Attach a = resolve_attach(b, at, ATTACH_ANY, keyword);
+    Attach a = build_attach(b, at, ATTACH_ANY, keyword);
     xy[2] = DAG_ZERO;
     if (b->spatial)
         joints_spatial_point(b->model, a, xy);
     else
         joints_point(b->model, a, xy);
-    check_nodes(b);
+    build_check_nodes(b);
 }
 
 /* The angle of a body (ATTACH_FRAME, no offset): its phi, 0 for ground. */
 static NodeId dyn_angle(Builder *b, const AstAttach *at, const char *keyword)
 {
-    Attach a = resolve_attach(b, at, ATTACH_FRAME, keyword);
+    Attach a = build_attach(b, at, ATTACH_FRAME, keyword);
     return a.has_phi ? dag_var(&b->model->dag, a.q + 2) : DAG_ZERO;
 }
 
@@ -69,8 +69,8 @@ static MassElement *new_mass(Builder *b, const Stmt *s)
     for (int i = 0; i < m->nmasses; i++)
         if (!s->declares && strcmp(m->masses[i].name, s->name) == 0)
             diag_fail(b->diag, s->name_pos, "'%s' already has a mass (line %d): give a body one "
-                      "mass statement", s->name, line_of(b, m->masses[i].pos));
-    grow(&m->arena, (void **)&m->masses, &b->cap_masses, m->nmasses + 1, sizeof *m->masses);
+                      "mass statement", s->name, build_line(b, m->masses[i].pos));
+    build_grow(&m->arena, (void **)&m->masses, &b->cap_masses, m->nmasses + 1, sizeof *m->masses);
     MassElement *e = &m->masses[m->nmasses++];
     *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1,
                        .spatial = b->spatial, .pz = DAG_ZERO, .euler = -1};
@@ -99,7 +99,7 @@ static void spatial_inertia(Builder *b, const Stmt *s, MassElement *e)
     }
     for (int i = 0; i < 3; i++) {
         snprintf(what, sizeof what, "the moment of inertia %s", diag_names[i]);
-        e->inertia[i] = constant_value(b, s->inertia[i], what);
+        e->inertia[i] = build_constant(b, s->inertia[i], what);
         if (e->inertia[i] < 0)
             diag_fail(b->diag, s->inertia[i]->pos, "%s of mass '%s' is negative (%g)", what,
                       s->name, e->inertia[i]);
@@ -128,14 +128,14 @@ static void spatial_body_mass(Builder *b, const Stmt *s, const Entity *ent, Mass
     bool body = ent->kind == ENT_BODY;
     Attach at = {.q = ent->q, .spatial = true, .has_p = body};
     if (s->vec[0]) {
-        at.sx = constant_value(b, s->vec[0], "a centre-of-mass offset");
-        at.sy = constant_value(b, s->vec[1], "a centre-of-mass offset");
-        at.sz = constant_value(b, s->vec[2], "a centre-of-mass offset");
+        at.sx = build_constant(b, s->vec[0], "a centre-of-mass offset");
+        at.sy = build_constant(b, s->vec[1], "a centre-of-mass offset");
+        at.sz = build_constant(b, s->vec[2], "a centre-of-mass offset");
     }
     NodeId xyz[3];
     joints_spatial_point(b->model, at, xyz);
     e->px = xyz[0], e->py = xyz[1], e->pz = xyz[2];
-    check_nodes(b);
+    build_check_nodes(b);
     if (body) {
         e->euler = ent->q + 3;
         spatial_inertia(b, s, e);
@@ -146,11 +146,11 @@ static void spatial_body_mass(Builder *b, const Stmt *s, const Entity *ent, Mass
    r + A(phi) s, J about it; mass POINT m = ..: the particle itself. */
 static void build_body_mass(Builder *b, const Stmt *s)
 {
-    Entity *ent = lookup(b, s->name, s->name_pos);
+    Entity *ent = build_lookup(b, s->name, s->name_pos);
     if (ent->kind != ENT_BODY && ent->kind != ENT_POINT)
         diag_fail(b->diag, s->name_pos, "'%s' is %s; 'mass NAME m = ...' gives a body or point its "
                   "mass (write 'mass NAME: at(x, y) m = ...' for a mass element)", s->name,
-                  entity_word(ent->kind));
+                  build_entity_word(ent->kind));
     bool body = ent->kind == ENT_BODY;
     if (!body && s->key[DKEY_J])
         diag_fail(b->diag, s->key_pos[DKEY_J], "'%s' is a point (a particle): it has no angle, "
@@ -165,8 +165,8 @@ static void build_body_mass(Builder *b, const Stmt *s)
     }
     Attach at = {.q = ent->q, .has_phi = body};
     if (s->vec[0]) {
-        at.sx = constant_value(b, s->vec[0], "a centre-of-mass offset");
-        at.sy = constant_value(b, s->vec[1], "a centre-of-mass offset");
+        at.sx = build_constant(b, s->vec[0], "a centre-of-mass offset");
+        at.sy = build_constant(b, s->vec[1], "a centre-of-mass offset");
     }
     NodeId xy[2];
     joints_point(b->model, at, xy);
@@ -176,14 +176,14 @@ static void build_body_mass(Builder *b, const Stmt *s)
         e->body = ent->q;
         e->sx = at.sx, e->sy = at.sy;
     }
-    check_nodes(b);
+    build_check_nodes(b);
 }
 
 /* mass NAME: at(x, y) m = .. [J = .. angle = ..]: a mass element given by
    expressions of the coordinates (not of t). */
 static void build_element_mass(Builder *b, const Stmt *s)
 {
-    declare(b, ENT_MASS, s->name, s->name_pos);
+    build_declare(b, ENT_MASS, s->name, s->name_pos);
     if (s->key[DKEY_J] && !s->key[DKEY_ANGLE])
         diag_fail(b->diag, s->key_pos[DKEY_J], "mass '%s' has J but no 'angle = ...': the "
                   "angle whose rate J multiplies", s->name);
@@ -192,14 +192,14 @@ static void build_element_mass(Builder *b, const Stmt *s)
     dyn_point(b, &s->attach[0], EXPR_MASS, "mass", xy);
     e->px = xy[0], e->py = xy[1], e->pz = xy[2];
     if (s->key[DKEY_ANGLE])
-        e->theta = lower(b, s->key[DKEY_ANGLE], EXPR_MASS);
+        e->theta = build_lower(b, s->key[DKEY_ANGLE], EXPR_MASS);
 }
 
 static AppliedForce *new_force(Builder *b, const Stmt *s, ForceKind kind)
 {
     Model *m = b->model;
-    declare(b, ENT_FORCE, s->name, s->name_pos);
-    grow(&m->arena, (void **)&m->forces, &b->cap_forces, m->nforces + 1, sizeof *m->forces);
+    build_declare(b, ENT_FORCE, s->name, s->name_pos);
+    build_grow(&m->arena, (void **)&m->forces, &b->cap_forces, m->nforces + 1, sizeof *m->forces);
     AppliedForce *f = &m->forces[m->nforces++];
     *f = (AppliedForce){.kind = kind, .name = s->name, .pos = s->pos, .ax = DAG_ZERO,
                         .ay = DAG_ZERO, .bx = DAG_ZERO, .by = DAG_ZERO, .fx = DAG_ZERO,
@@ -267,10 +267,10 @@ static NodeId torque_angle(Builder *b, const Ast *lhs)
             diag_fail(b->diag, lhs->pos, "torque: angle(%s) takes a revolute or cylindrical "
                       "joint; '%s' is %s", lhs->name, lhs->name, joint_info[j->kind].keyword);
         NodeId a = joints_spatial_angle(b->model, j);
-        check_nodes(b);
+        build_check_nodes(b);
         return a;
     }
-    return lower(b, lhs, EXPR_HOLONOMIC);
+    return build_lower(b, lhs, EXPR_HOLONOMIC);
 }
 
 /* force NAME: ATTACHMENT (fx, fy): Q += p_q^T (fx, fy) */
@@ -298,7 +298,7 @@ static void build_TORQUE(Builder *b, const Stmt *s, AppliedForce *f)
    axes on a body, Q[e] += 2 E(e)^T tau (the virtual work tau . w, w = 2 E ed). */
 static void build_BODY_TORQUE(Builder *b, const Stmt *s, AppliedForce *f)
 {
-    Attach a = resolve_attach(b, &s->attach[0], ATTACH_FRAME, dyn_keyword(s));
+    Attach a = build_attach(b, &s->attach[0], ATTACH_FRAME, dyn_keyword(s));
     f->coord = a.q + 3;
     f->fz = dyn_expr(b, s->vec[2]);
     f->fy = dyn_expr(b, s->vec[1]);
@@ -330,14 +330,14 @@ static void build_RSPRING(Builder *b, const Stmt *s, AppliedForce *f)
     f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
     f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
     if (b->spatial) {
-        Entity *e = lookup(b, s->attach[0].name, s->attach[0].pos);
+        Entity *e = build_lookup(b, s->attach[0].name, s->attach[0].pos);
         const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
         if (!j || (j->kind != JOINT_S_REVOLUTE && j->kind != JOINT_S_CYLINDRICAL))
             diag_fail(b->diag, s->attach[0].pos, "a spatial rspring acts about a revolute's "
                       "or cylindrical's axis; '%s' is %s", e->name,
-                      j ? joint_info[j->kind].keyword : entity_word(e->kind));
+                      j ? joint_info[j->kind].keyword : build_entity_word(e->kind));
         f->bx = joints_spatial_angle(b->model, j);
-        check_nodes(b);
+        build_check_nodes(b);
     } else {
         f->ax = dyn_angle(b, &s->attach[0], dyn_keyword(s));
         f->bx = dyn_angle(b, &s->attach[1], dyn_keyword(s));
@@ -351,7 +351,7 @@ static void build_GENERAL(Builder *b, const Stmt *s, AppliedForce *f)
     if (s->lhs->kind != AST_NAME && s->lhs->kind != AST_MEMBER)
         diag_fail(b->diag, s->lhs->pos, "gforce '%s' acts on a coordinate (a coord, or a "
                   "body's x, y or phi), not on %s", s->name, ast_describe(s->lhs));
-    f->coord = coordinate_of(b, s->lhs);
+    f->coord = build_coordinate(b, s->lhs);
     f->fx = dyn_expr(b, s->value);
 }
 
@@ -390,11 +390,11 @@ void build_dynamics(Builder *b, const Stmt *s)
     if (b->gravity_line)
         diag_fail(b->diag, s->pos, "a second gravity statement (the first is on line %d)",
                   b->gravity_line);
-    b->gravity_line = line_of(b, s->pos);
-    b->model->gravity[0] = constant_value(b, s->vec[0], "the gravity component gx");
-    b->model->gravity[1] = constant_value(b, s->vec[1], "the gravity component gy");
+    b->gravity_line = build_line(b, s->pos);
+    b->model->gravity[0] = build_constant(b, s->vec[0], "the gravity component gx");
+    b->model->gravity[1] = build_constant(b, s->vec[1], "the gravity component gy");
     if (b->spatial)
-        b->model->gravity[2] = constant_value(b, s->vec[2], "the gravity component gz");
+        b->model->gravity[2] = build_constant(b, s->vec[2], "the gravity component gz");
 }
 
 /* After the statements: M is dense nq x nq in the engines and the

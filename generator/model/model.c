@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *entity_word(EntityKind kind)
+const char *build_entity_word(EntityKind kind)
 {
     switch (kind) {
     case ENT_PARAM: return "a param";
@@ -35,7 +35,7 @@ const char *entity_word(EntityKind kind)
 /* Arrays grow in an arena (the model's, or the builder's scratch), so an
    input error's escape leaves nothing to free; the old copies stay until
    the arena goes, at most as much again. */
-void grow(Arena *arena, void **p, int *cap, int need, size_t size)
+void build_grow(Arena *arena, void **p, int *cap, int need, size_t size)
 {
     if (need <= *cap)
         return;
@@ -52,20 +52,20 @@ void grow(Arena *arena, void **p, int *cap, int need, size_t size)
 /* The graph's node limit is sticky (dag.h): checked after each piece of
    lowering, before anything else in the statement can fail, so the error
    is the node limit at that statement, as when the graph jumped out. */
-void check_nodes(Builder *b)
+void build_check_nodes(Builder *b)
 {
     if (!dag_check_limit(&b->model->dag, b->diag))
         diag_throw(b->diag);
 }
 
-int line_of(const Builder *b, SrcPos pos)
+int build_line(const Builder *b, SrcPos pos)
 {
     int line, col;
     diag_locate(b->diag, pos.offset, &line, &col);
     return line;
 }
 
-Entity *lookup(Builder *b, const char *name, SrcPos pos)
+Entity *build_lookup(Builder *b, const char *name, SrcPos pos)
 {
     int index;
     if (!strmap_get(&b->names, name, &index))
@@ -73,20 +73,20 @@ Entity *lookup(Builder *b, const char *name, SrcPos pos)
     return &b->entities[index];
 }
 
-Entity *declare(Builder *b, EntityKind kind, const char *name, SrcPos pos)
+Entity *build_declare(Builder *b, EntityKind kind, const char *name, SrcPos pos)
 {
     int index;
     if (strmap_get(&b->names, name, &index))
         diag_fail(b->diag, pos, "duplicate name '%s' (first declared as %s on line %d)",
-                  name, entity_word(b->entities[index].kind),
-                  line_of(b, b->entities[index].pos));
-    grow(&b->scratch, (void **)&b->entities, &b->cap_entities, b->nentities + 1,
+                  name, build_entity_word(b->entities[index].kind),
+                  build_line(b, b->entities[index].pos));
+    build_grow(&b->scratch, (void **)&b->entities, &b->cap_entities, b->nentities + 1,
          sizeof *b->entities);
-    int u = unit_index(name);
+    int u = build_unit_index(name);
     if (u >= 0 && b->unit_use[u].offset >= 0)     /* one name, one meaning per file */
         diag_fail(b->diag, pos, "'%s' was used as the unit %s on line %d: declare it before "
                   "its first use, or choose another name", name, name,
-                  line_of(b, b->unit_use[u]));
+                  build_line(b, b->unit_use[u]));
     Entity *e = &b->entities[b->nentities];
     *e = (Entity){.kind = kind, .name = name, .pos = pos, .q = -1};
     strmap_put(&b->names, name, b->nentities++);
@@ -112,8 +112,8 @@ static int add_coord(Builder *b, const char *owner, const char *suffix, double q
         diag_fail(b->diag, pos, "too many coordinates (the limit is %d)", b->limits->max_coords);
     check_jacobian_size(b, b->npos + b->nvel, m->nq + 1, pos);
     int cap = b->cap_coords;    /* q0 shares the capacity of coord_names */
-    grow(&m->arena, (void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
-    grow(&m->arena, (void **)&m->q0, &cap, m->nq + 1, sizeof *m->q0);
+    build_grow(&m->arena, (void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
+    build_grow(&m->arena, (void **)&m->q0, &cap, m->nq + 1, sizeof *m->q0);
     char *name = arena_alloc(&m->arena, strlen(owner) + strlen(suffix) + 1);
     strcpy(name, owner);
     strcat(name, suffix);
@@ -130,7 +130,7 @@ static void lower_joint(Builder *b, Joint *j);
 static Joint *new_joint(Builder *b)
 {
     Model *m = b->model;
-    grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
+    build_grow(&m->arena, (void **)&m->joints, &b->cap_joints, m->njoints + 1, sizeof *m->joints);
     return &m->joints[m->njoints];
 }
 
@@ -146,16 +146,16 @@ static void declare_spatial(Builder *b, const Stmt *s)
     double v[7];
     for (int i = 0; i < 3; i++) {
         snprintf(what, sizeof what, "the initial %s", word[i]);
-        v[i] = constant_value(b, s->init[i], what);
+        v[i] = build_constant(b, s->init[i], what);
     }
     double arg[4] = {0, 0, 0, 0};
     int nargs = s->orient == ORIENT_AXIS ? 4 : s->orient == ORIENT_NONE ? 0 : 3;
     for (int i = 0; i < nargs; i++)
-        arg[i] = constant_value(b, s->orient_arg[i], "an orientation component");
+        arg[i] = build_constant(b, s->orient_arg[i], "an orientation component");
     if (body && !orient_to_euler(s->orient, arg, v + 3))
         diag_fail(b->diag, s->orient_pos, "the orientation of body '%s' cannot be normalised: "
                   "its axis is zero", s->name);
-    Entity *e = declare(b, body ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
+    Entity *e = build_declare(b, body ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
     for (int i = 0; i < (body ? 7 : 3); i++) {
         int q = add_coord(b, s->name, suffix[i], v[i], s->name_pos);
         if (i == 0)
@@ -175,8 +175,8 @@ static void declare_coordinates(Builder *b, const Stmt *s)
     static const char *const word[3] = {"x", "y", "phi"};
     char what[64];
     if (s->kind == STMT_COORD) {
-        Entity *e = declare(b, ENT_COORD, s->name, s->name_pos);
-        double v = constant_value(b, s->value, "the initial value");
+        Entity *e = build_declare(b, ENT_COORD, s->name, s->name_pos);
+        double v = build_constant(b, s->value, "the initial value");
         e->q = add_coord(b, s->name, "", v, s->name_pos);
         return;
     }
@@ -188,9 +188,9 @@ static void declare_coordinates(Builder *b, const Stmt *s)
     double v[3];
     for (int i = 0; i < n; i++) {
         snprintf(what, sizeof what, "the initial %s", word[i]);
-        v[i] = constant_value(b, s->init[i], what);
+        v[i] = build_constant(b, s->init[i], what);
     }
-    Entity *e = declare(b, s->kind == STMT_BODY ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
+    Entity *e = build_declare(b, s->kind == STMT_BODY ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
     for (int i = 0; i < n; i++) {
         int q = add_coord(b, s->name, suffix[i], v[i], s->name_pos);
         if (i == 0)
@@ -198,22 +198,22 @@ static void declare_coordinates(Builder *b, const Stmt *s)
     }
 }
 
-Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
+Attach build_attach(Builder *b, const AstAttach *at, AttachRule rule,
                              const char *keyword)
 {
     Attach r = {.q = -1, .spatial = b->spatial};
     if (at->has_offset) {
-        r.sx = constant_value(b, at->sx, "an attachment offset");
-        r.sy = constant_value(b, at->sy, "an attachment offset");
+        r.sx = build_constant(b, at->sx, "an attachment offset");
+        r.sy = build_constant(b, at->sy, "an attachment offset");
         if (b->spatial)
-            r.sz = constant_value(b, at->sz, "an attachment offset");
+            r.sz = build_constant(b, at->sz, "an attachment offset");
     }
     if (strcmp(at->name, "ground") == 0) {
         if (rule == ATTACH_BODY || rule == ATTACH_BODY_ONLY)
             diag_fail(b->diag, at->pos, "%s needs a body here, not ground", keyword);
         return r;
     }
-    Entity *e = lookup(b, at->name, at->pos);
+    Entity *e = build_lookup(b, at->name, at->pos);
     switch (e->kind) {
     case ENT_BODY:
         if (rule == ATTACH_BODY_ONLY && at->has_offset)
@@ -240,7 +240,7 @@ Attach resolve_attach(Builder *b, const AstAttach *at, AttachRule rule,
         [ATTACH_BODY] = "a body", [ATTACH_BODY_ONLY] = "a body", [ATTACH_NONE] = "nothing",
     };
     diag_fail(b->diag, at->pos, "'%s' is %s; %s attaches to %s",
-              e->name, entity_word(e->kind), keyword, takes[rule]);
+              e->name, build_entity_word(e->kind), keyword, takes[rule]);
 }
 
 static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
@@ -257,10 +257,10 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     Row row = {.name = name, .kind = j->kind, .velocity = j->velocity, .expr = expr,
                .joint = (int)(j - m->joints), .pos = j->pos};
     if (j->velocity) {
-        grow(&b->scratch, (void **)&b->vel_rows, &b->cap_vel, b->nvel + 1, sizeof *b->vel_rows);
+        build_grow(&b->scratch, (void **)&b->vel_rows, &b->cap_vel, b->nvel + 1, sizeof *b->vel_rows);
         b->vel_rows[b->nvel++] = row;
     } else {
-        grow(&b->scratch, (void **)&b->pos_rows, &b->cap_pos, b->npos + 1, sizeof *b->pos_rows);
+        build_grow(&b->scratch, (void **)&b->pos_rows, &b->cap_pos, b->npos + 1, sizeof *b->pos_rows);
         b->pos_rows[b->npos++] = row;
     }
 }
@@ -321,7 +321,7 @@ static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
         Ast *const *ax = k == 0 || !s->axis_b[0] ? s->axis : s->axis_b;
         SrcPos pos = k == 0 || !s->axis_b[0] ? s->axis_pos : s->axis_b_pos;
         for (int i = 0; i < 3; i++)
-            u[k][i] = constant_value(b, ax[i], "an axis component");
+            u[k][i] = build_constant(b, ax[i], "an axis component");
         if (u[k][0] == 0.0 && u[k][1] == 0.0 && u[k][2] == 0.0)
             diag_fail(b->diag, pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }
@@ -352,7 +352,7 @@ static void lower_joint(Builder *b, Joint *j)
     m->njoints++;
     NodeId rows[JOINT_MAX_ROWS];
     joints_lower(m, j, rows);
-    check_nodes(b);
+    build_check_nodes(b);
     j->nrows = info->rows;
     for (int i = 0; i < info->rows; i++)
         push_row(b, j, i, rows[i]);
@@ -365,18 +365,18 @@ static NodeId statement_row(Builder *b, const Stmt *s, ExprContext ctx, Joint *j
 {
     Model *m = b->model;
     if (b->spatial && s->joint == JOINT_DRIVER && s->lhs->kind == AST_ANGLE && ctx != EXPR_VELOCITY) {
-        NodeId theta = lower(b, s->rhs, ctx);
-        Entity *e = lookup(b, s->lhs->name, s->lhs->member_pos);
+        NodeId theta = build_lower(b, s->rhs, ctx);
+        Entity *e = build_lookup(b, s->lhs->name, s->lhs->member_pos);
         const Joint *r = e->kind == ENT_JOINT ? &m->joints[e->q] : NULL;
-        NodeId row = joints_spatial_angle_row(m, spatial_joint_of(b, s->lhs, e, r), theta);
-        check_nodes(b);
+        NodeId row = joints_spatial_angle_row(m, build_spatial_joint(b, s->lhs, e, r), theta);
+        build_check_nodes(b);
         j->measures = e->q + 1, j->option = theta;  /* for the generic evaluator's formula */
         return row;
     }
-    NodeId rhs = lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
-    NodeId lhs = lower(b, s->lhs, ctx);
+    NodeId rhs = build_lower(b, s->rhs, ctx);     /* sequenced: see AST_BINARY */
+    NodeId lhs = build_lower(b, s->lhs, ctx);
     if (b->spatial && s->joint == JOINT_DRIVER && s->lhs->kind == AST_SLIDE && ctx != EXPR_VELOCITY)
-        j->measures = -(lookup(b, s->lhs->name, s->lhs->member_pos)->q + 1), j->option = rhs;
+        j->measures = -(build_lookup(b, s->lhs->name, s->lhs->member_pos)->q + 1), j->option = rhs;
     return dag_sub(&m->dag, lhs, rhs);
 }
 
@@ -384,12 +384,12 @@ static void build_joint(Builder *b, const Stmt *s)
 {
     Model *m = b->model;
     const JointInfo *info = &joint_info[s->joint];
-    declare(b, ENT_JOINT, s->name, s->name_pos)->q = m->njoints;
+    build_declare(b, ENT_JOINT, s->name, s->name_pos)->q = m->njoints;
     Joint *j = new_joint(b);
     *j = (Joint){.kind = s->joint, .name = s->name, .pos = s->pos,
                  .option = DAG_ZERO, .expr = DAG_NONE};
     for (int i = 0; i < info->attachments; i++) {
-        Attach at = resolve_attach(b, &s->attach[i], info->slot[i], info->keyword);
+        Attach at = build_attach(b, &s->attach[i], info->slot[i], info->keyword);
         if (i == 0)
             j->a = at;
         else
@@ -405,21 +405,21 @@ static void build_joint(Builder *b, const Stmt *s)
     if (info->axis && b->spatial) {
         spatial_axes(b, s, j);
     } else if (info->axis) {
-        j->ux = constant_value(b, s->axis[0], "the axis component ux");
-        j->uy = constant_value(b, s->axis[1], "the axis component uy");
+        j->ux = build_constant(b, s->axis[0], "the axis component ux");
+        j->uy = build_constant(b, s->axis[1], "the axis component uy");
         if (j->ux == 0.0 && j->uy == 0.0)
             diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }
     if (s->option) {
-        j->option = lower(b, s->option, EXPR_TIMED);
+        j->option = build_lower(b, s->option, EXPR_TIMED);
     }
     switch (info->level) {
     case LEVEL_POSITION: j->velocity = false; break;
     case LEVEL_VELOCITY: j->velocity = true; break;
-    case LEVEL_EITHER:   j->velocity = mentions_der(s->lhs) || mentions_der(s->rhs); break;
+    case LEVEL_EITHER:   j->velocity = build_mentions_der(s->lhs) || build_mentions_der(s->rhs); break;
     }
     if (info->attachments == 0) {
-        if (s->joint == JOINT_VELOCITY && !mentions_der(s->lhs) && !mentions_der(s->rhs))
+        if (s->joint == JOINT_VELOCITY && !build_mentions_der(s->lhs) && !build_mentions_der(s->rhs))
             diag_fail(b->diag, s->pos, "velocity row '%s' contains no der(): "
                       "write it as a 'constraint' or use der(coordinate)", s->name);
         j->expr = statement_row(b, s, j->velocity ? EXPR_VELOCITY : EXPR_HOLONOMIC, j);
@@ -451,7 +451,7 @@ static void collect_bodies(Builder *b)
 static void push_output(Builder *b, const char *name, const char *suffix, NodeId expr)
 {
     Model *m = b->model;
-    grow(&m->arena, (void **)&m->outputs, &b->cap_outputs, m->nout + 1, sizeof *m->outputs);
+    build_grow(&m->arena, (void **)&m->outputs, &b->cap_outputs, m->nout + 1, sizeof *m->outputs);
     char *full = arena_alloc(&m->arena, strlen(name) + strlen(suffix) + 1);
     strcpy(full, name);
     strcat(full, suffix);
@@ -467,15 +467,15 @@ static ModelOutput *last_output(Builder *b)
    NAME.y, P = r + A(phi) s as in a joint. Outputs add no rows. */
 static void build_output(Builder *b, const Stmt *s)
 {
-    declare(b, ENT_OUTPUT, s->name, s->name_pos);
-    if (mentions_der(s->value))
+    build_declare(b, ENT_OUTPUT, s->name, s->name_pos);
+    if (build_mentions_der(s->value))
         diag_fail(b->diag, s->pos, "output '%s' contains der(): an output is a value of the "
                   "coordinates and t, whose velocity run reports anyway", s->name);
     if (s->value) {
-        push_output(b, s->name, "", lower_expr(b, s->value, EXPR_HOLONOMIC));
+        push_output(b, s->name, "", build_lower_expr(b, s->value, EXPR_HOLONOMIC));
         return;
     }
-    Attach at = resolve_attach(b, &s->attach[0], ATTACH_ANY, "output");
+    Attach at = build_attach(b, &s->attach[0], ATTACH_ANY, "output");
     if (b->spatial) {
         NodeId xyz[3];
         joints_spatial_point(b->model, at, xyz);
@@ -512,8 +512,8 @@ static void build(Builder *b, const Program *prog, const char *default_name)
             m->spatial = b->spatial = true;
             break;
         case STMT_PARAM: {
-            double v = constant_value(b, s->value, "the param value");
-            declare(b, ENT_PARAM, s->name, s->name_pos)->value = v;
+            double v = build_constant(b, s->value, "the param value");
+            build_declare(b, ENT_PARAM, s->name, s->name_pos)->value = v;
             break;
         }
         case STMT_BODY: case STMT_POINT: case STMT_COORD:

@@ -43,8 +43,8 @@ static void at_point(Parser *p, AstAttach *a)
     a->at = true;
     a->name = NULL;
     a->pos = p->tok.pos;
-    advance(p);
-    offset(p, p->spatial ? "at(x, y, z)" : "at(x, y)", a);
+    parse_advance(p);
+    parse_offset(p, p->spatial ? "at(x, y, z)" : "at(x, y)", a);
 }
 
 /* A vector of the file's dimension: (x, y), spatial (x, y, z); what
@@ -52,9 +52,9 @@ static void at_point(Parser *p, AstAttach *a)
 static void vector(Parser *p, const char *what, const char *spatial_what, Ast **out)
 {
     if (p->spatial)
-        components(p, spatial_what, 3, out);
+        parse_components(p, spatial_what, 3, out);
     else
-        pair(p, what, &out[0], &out[1]);
+        parse_pair(p, what, &out[0], &out[1]);
 }
 
 /* dyn_attachment = 'at' pair | NAME [pair]   (frame_only: a body or ground alone) */
@@ -63,13 +63,13 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
     AstAttach *a = &s->attach[slot];
     const char *kw = dyn_keyword(s);
     const char *nth = count == 1 ? "" : slot == 0 ? "first " : "second ";
-    if (p->tok.kind != TOK_IDENT || (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
-        expected(p, "%s as the %sattachment of %s '%s'",
+    if (p->tok.kind != TOK_IDENT || (parse_is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
+        parse_expected(p, "%s as the %sattachment of %s '%s'",
                  frame_only ? "a body or ground" : "a body, point, ground or at(x, y)", nth, kw,
                  s->name);
     Token name = p->tok;
     Lexer saved = p->lx;
-    advance(p);
+    parse_advance(p);
     if (frame_only && lex_is_word(&name, "at") && p->tok.kind == TOK_LPAREN)
         diag_fail(p->diag, name.pos, "%s '%s' acts on bodies' angles: at(x, y) is a point; "
                   "name a body or ground", kw, s->name);
@@ -79,7 +79,7 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
         at_point(p, a);
         return;
     }
-    a->name = token_text(p, &name);
+    a->name = parse_token_text(p, &name);
     a->pos = name.pos;
     if (p->tok.kind != TOK_LPAREN)
         return;
@@ -89,7 +89,7 @@ static void dyn_attachment(Parser *p, Stmt *s, int slot, int count, bool frame_o
     char what[DIAG_MESSAGE_MAX];
     snprintf(what, sizeof what, "the offset of '%s'", a->name);
     a->has_offset = true;
-    offset(p, what, a);
+    parse_offset(p, what, a);
 }
 
 /* keys = {KEY '=' expr | 'com' pair | 'at' pair}, each at most once;
@@ -108,7 +108,7 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
                       p->tok.start, dyn_keyword(s), s->name);
         if (is_com) {
             s->vec_pos = p->tok.pos;
-            advance(p);
+            parse_advance(p);
             vector(p, "com(sx, sy)", "com(sx, sy, sz)", s->vec);
             continue;
         }
@@ -129,16 +129,16 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
             diag_fail(p->diag, p->tok.pos, "'%s' given twice for %s '%s'", dyn_key_names[k],
                       dyn_keyword(s), s->name);
         s->key_pos[k] = p->tok.pos;
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after '%s'", dyn_key_names[k]);
-        advance(p);
+            parse_expected(p, "'=' after '%s'", dyn_key_names[k]);
+        parse_advance(p);
         if (p->spatial && k == DKEY_J) {    /* the tensor's diagonal; key[J] marks it given */
-            components(p, "J = (Jxx, Jyy, Jzz)", 3, s->inertia);
+            parse_components(p, "J = (Jxx, Jyy, Jzz)", 3, s->inertia);
             s->key[k] = s->inertia[0];
             continue;
         }
-        s->key[k] = expr(p);
+        s->key[k] = parse_expr(p);
     }
 }
 
@@ -147,21 +147,21 @@ static void dyn_keys(Parser *p, Stmt *s, bool com, bool at)
 void parse_mass(Parser *p, Stmt *s)
 {
     s->kind = STMT_MASS;
-    advance(p);
-    s->name = declared_name(p, "mass", &s->name_pos);
+    parse_advance(p);
+    s->name = parse_declared_name(p, "mass", &s->name_pos);
     if (p->tok.kind == TOK_COLON) {
         s->declares = true;
-        advance(p);
+        parse_advance(p);
         dyn_keys(p, s, false, true);
         if (!s->attach[0].at)
-            expected(p, "'%s' for the mass element '%s' (or 'mass BODY m = ...' "
+            parse_expected(p, "'%s' for the mass element '%s' (or 'mass BODY m = ...' "
                      "without ':' for a body's own mass)", p->spatial ? "at(x, y, z)" : "at(x, y)",
                      s->name);
     } else {
         dyn_keys(p, s, true, false);
     }
     if (!s->key[DKEY_M])
-        expected(p, "'m = ...' for mass '%s'", s->name);
+        parse_expected(p, "'m = ...' for mass '%s'", s->name);
 }
 
 /* torque = 'torque' NAME ':' (BODY | 'angle' '(' expr ')') '=' expr */
@@ -170,14 +170,14 @@ static void dyn_torque(Parser *p, Stmt *s)
     Lexer saved = p->lx;
     Token word = p->tok;
     if (lex_is_word(&word, "angle")) {
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind == TOK_LPAREN) {
             s->eq_pos = word.pos;
-            advance(p);
-            s->lhs = expr(p);
+            parse_advance(p);
+            s->lhs = parse_expr(p);
             if (p->tok.kind != TOK_RPAREN)
-                expected(p, "')' after the angle of torque '%s'", s->name);
-            advance(p);
+                parse_expected(p, "')' after the angle of torque '%s'", s->name);
+            parse_advance(p);
         } else {
             p->lx = saved;  /* a body called angle */
             p->tok = word;
@@ -186,15 +186,15 @@ static void dyn_torque(Parser *p, Stmt *s)
     if (!s->lhs)
         dyn_attachment(p, s, 0, 1, true);
     if (p->tok.kind != TOK_EQ)
-        expected(p, "'=' and the torque of '%s'", s->name);
-    advance(p);
+        parse_expected(p, "'=' and the torque of '%s'", s->name);
+    parse_advance(p);
     if (p->spatial && !s->lhs) {    /* a spatial body's torque: global components */
         s->force = FORCE_BODY_TORQUE;
         s->vec_pos = p->tok.pos;
-        components(p, "the torque (tx, ty, tz)", 3, s->vec);
+        parse_components(p, "the torque (tx, ty, tz)", 3, s->vec);
         return;
     }
-    s->value = expr(p);
+    s->value = parse_expr(p);
 }
 
 /* spatial rspring = 'rspring' NAME ':' JOINT keys   (about a revolute's or
@@ -202,12 +202,12 @@ static void dyn_torque(Parser *p, Stmt *s)
 static void dyn_spatial_rspring(Parser *p, Stmt *s)
 {
     AstAttach *a = &s->attach[0];
-    if (p->tok.kind != TOK_IDENT || is_reserved(&p->tok))
-        expected(p, "a revolute or cylindrical joint after 'rspring %s:' (a spatial rspring "
+    if (p->tok.kind != TOK_IDENT || parse_is_reserved(&p->tok))
+        parse_expected(p, "a revolute or cylindrical joint after 'rspring %s:' (a spatial rspring "
                  "acts about the joint's axis)", s->name);
-    a->name = token_text(p, &p->tok);
+    a->name = parse_token_text(p, &p->tok);
     a->pos = p->tok.pos;
-    advance(p);
+    parse_advance(p);
     dyn_keys(p, s, false, false);
 }
 
@@ -215,7 +215,7 @@ static void dyn_spatial_rspring(Parser *p, Stmt *s)
 void parse_gravity(Parser *p, Stmt *s)
 {
     s->kind = STMT_GRAVITY;
-    advance(p);
+    parse_advance(p);
     s->vec_pos = p->tok.pos;
     vector(p, "gravity (gx, gy)", "gravity (gx, gy, gz)", s->vec);
 }
@@ -248,12 +248,12 @@ void parse_force(Parser *p, Stmt *s, ForceKind kind)
     const ForceInfo *info = &force_info[kind];
     s->kind = STMT_FORCE;
     s->force = kind;
-    advance(p);
-    s->name = declared_name(p, info->keyword, &s->name_pos);
+    parse_advance(p);
+    s->name = parse_declared_name(p, info->keyword, &s->name_pos);
     s->declares = true;
     if (p->tok.kind != TOK_COLON)
-        expected(p, "':' after the %s name '%s'", info->keyword, s->name);
-    advance(p);
+        parse_expected(p, "':' after the %s name '%s'", info->keyword, s->name);
+    parse_advance(p);
     switch (kind) {
     case FORCE_POINT:
         point_force(p, s);
@@ -271,12 +271,12 @@ void parse_force(Parser *p, Stmt *s, ForceKind kind)
         dyn_keys(p, s, false, false);
         return;
     case FORCE_GENERAL:
-        s->lhs = expr(p);
+        s->lhs = parse_expr(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after the coordinate of gforce '%s'", s->name);
+            parse_expected(p, "'=' after the coordinate of gforce '%s'", s->name);
         s->eq_pos = p->tok.pos;
-        advance(p);
-        s->value = expr(p);
+        parse_advance(p);
+        s->value = parse_expr(p);
         return;
     case FORCE_KIND_COUNT:
         break;

@@ -26,19 +26,19 @@ static Ast *new_ast(Parser *p, AstKind kind, SrcPos pos)
     return ast;
 }
 
-void enter_level(Parser *p, SrcPos pos)
+void parse_enter_level(Parser *p, SrcPos pos)
 {
     if (++p->depth > p->limits->max_depth)
         diag_fail(p->diag, pos, "expression nested deeper than the limit of %d levels",
                   p->limits->max_depth);
 }
 
-void leave_level(Parser *p) { p->depth--; }
+void parse_leave_level(Parser *p) { p->depth--; }
 
 static Ast *subexpr(Parser *p, int limit);
 
 /* expr = subexpr(0) */
-Ast *expr(Parser *p) { return subexpr(p, 0); }
+Ast *parse_expr(Parser *p) { return subexpr(p, 0); }
 
 /* Binary operators: left and right priority (Lua lparser.c priority[]).
    '^' has right < left, so a chain nests to the right; its left priority is
@@ -70,23 +70,23 @@ static const BinaryPriority *binary_op(TokKind kind)
 /* coordinate = NAME ['.' NAME]   (the operand of der) */
 static Ast *coordinate(Parser *p)
 {
-    if (p->tok.kind != TOK_IDENT || is_reserved(&p->tok))
-        expected(p, "a coordinate name in der()");
+    if (p->tok.kind != TOK_IDENT || parse_is_reserved(&p->tok))
+        parse_expected(p, "a coordinate name in der()");
     Token name = p->tok;
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_DOT) {
         Ast *ast = new_ast(p, AST_NAME, name.pos);
-        ast->name = token_text(p, &name);
+        ast->name = parse_token_text(p, &name);
         return ast;
     }
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_IDENT)
-        expected(p, "a coordinate name after '%.*s.'", name.len, name.start);
+        parse_expected(p, "a coordinate name after '%.*s.'", name.len, name.start);
     Ast *ast = new_ast(p, AST_MEMBER, name.pos);
-    ast->name = token_text(p, &name);
-    ast->member = token_text(p, &p->tok);
+    ast->name = parse_token_text(p, &name);
+    ast->member = parse_token_text(p, &p->tok);
     ast->member_pos = p->tok.pos;
-    advance(p);
+    parse_advance(p);
     return ast;
 }
 
@@ -97,15 +97,15 @@ static Ast *coordinate(Parser *p)
 static Ast *slide(Parser *p, const Token *word)
 {
     Ast *ast = new_ast(p, AST_SLIDE, word->pos);
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_IDENT)
-        expected(p, "a joint name in %.*s(...)", word->len, word->start);
-    ast->name = token_text(p, &p->tok);
+        parse_expected(p, "a joint name in %.*s(...)", word->len, word->start);
+    ast->name = parse_token_text(p, &p->tok);
     ast->member_pos = p->tok.pos;
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "')' after the joint name in %.*s(%s", word->len, word->start, ast->name);
-    advance(p);
+        parse_expected(p, "')' after the joint name in %.*s(%s", word->len, word->start, ast->name);
+    parse_advance(p);
     return ast;
 }
 
@@ -113,16 +113,16 @@ static Ast *slide(Parser *p, const Token *word)
 static Ast *derivative(Parser *p)
 {
     Ast *ast = new_ast(p, AST_DER, p->tok.pos);
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_LPAREN)
-        expected(p, "'(' after 'der'");
-    enter_level(p, p->tok.pos);
-    advance(p);
+        parse_expected(p, "'(' after 'der'");
+    parse_enter_level(p, p->tok.pos);
+    parse_advance(p);
     ast->lhs = coordinate(p);
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "')' after the coordinate in der()");
-    advance(p);
-    leave_level(p);
+        parse_expected(p, "')' after the coordinate in der()");
+    parse_advance(p);
+    parse_leave_level(p);
     return ast;
 }
 
@@ -132,18 +132,18 @@ static Ast *call(Parser *p, DagOp op)
     const DagOpInfo *info = &dag_op_info[op];
     Ast *ast = new_ast(p, AST_CALL, p->tok.pos);
     ast->op = op;
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_LPAREN)
-        expected(p, "'(' after the function name '%s'", info->spelling);
+        parse_expected(p, "'(' after the function name '%s'", info->spelling);
     SrcPos open = p->tok.pos;
-    enter_level(p, open);
-    advance(p);
+    parse_enter_level(p, open);
+    parse_advance(p);
     int n = 0;
     SrcPos excess = {0};
     if (p->tok.kind != TOK_RPAREN) {
         for (;;) {
             SrcPos arg_pos = p->tok.pos;
-            Ast *arg = expr(p);
+            Ast *arg = parse_expr(p);
             if (n == 0)
                 ast->lhs = arg;
             else if (n == 1)
@@ -153,18 +153,18 @@ static Ast *call(Parser *p, DagOp op)
             n++;
             if (p->tok.kind != TOK_COMMA)
                 break;
-            advance(p);
+            parse_advance(p);
         }
     }
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "')' to close '%s(' at column %d", info->spelling, column_of(p, open));
+        parse_expected(p, "')' to close '%s(' at column %d", info->spelling, column_of(p, open));
     SrcPos close = p->tok.pos;
     if (n != info->arity)
         diag_fail(p->diag, n > info->arity ? excess : close,
                   "%s() takes %d argument%s, found %d", info->spelling, info->arity,
                   info->arity == 1 ? "" : "s", n);
-    advance(p);
-    leave_level(p);
+    parse_advance(p);
+    parse_leave_level(p);
     return ast;
 }
 
@@ -175,27 +175,27 @@ static Ast *primary(Parser *p)
     if (tok.kind == TOK_NUMBER) {
         Ast *ast = new_ast(p, AST_NUM, tok.pos);
         ast->num = tok.num;
-        advance(p);
+        parse_advance(p);
         return ast;
     }
     if (tok.kind == TOK_LPAREN) {
-        enter_level(p, tok.pos);
-        advance(p);
-        Ast *ast = expr(p);
+        parse_enter_level(p, tok.pos);
+        parse_advance(p);
+        Ast *ast = parse_expr(p);
         if (p->tok.kind != TOK_RPAREN)
-            expected(p, "')' to close the '(' at column %d", column_of(p, tok.pos));
-        advance(p);
-        leave_level(p);
+            parse_expected(p, "')' to close the '(' at column %d", column_of(p, tok.pos));
+        parse_advance(p);
+        parse_leave_level(p);
         return ast;
     }
     if (tok.kind != TOK_IDENT)
-        expected(p, "an expression");
+        parse_expected(p, "an expression");
     int op = dag_function_from_name(tok.start, tok.len);
     if (op >= 0 && dag_op_is_function((DagOp)op))
         return call(p, (DagOp)op);
     if (lex_is_word(&tok, "der"))
         return derivative(p);
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind == TOK_LPAREN && lex_is_word(&tok, "slide"))
         return slide(p, &tok);
     if (p->tok.kind == TOK_LPAREN && p->spatial && lex_is_word(&tok, "angle")) {
@@ -212,17 +212,17 @@ static Ast *primary(Parser *p)
     } else if (lex_is_word(&tok, "t")) {
         ast = new_ast(p, AST_TIME, tok.pos);
     } else if (p->tok.kind == TOK_DOT) {
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind != TOK_IDENT)
-            expected(p, "a member name after '%.*s.'", tok.len, tok.start);
+            parse_expected(p, "a member name after '%.*s.'", tok.len, tok.start);
         ast = new_ast(p, AST_MEMBER, tok.pos);
-        ast->name = token_text(p, &tok);
-        ast->member = token_text(p, &p->tok);
+        ast->name = parse_token_text(p, &tok);
+        ast->member = parse_token_text(p, &p->tok);
         ast->member_pos = p->tok.pos;
-        advance(p);
+        parse_advance(p);
     } else {
         ast = new_ast(p, AST_NAME, tok.pos);
-        ast->name = token_text(p, &tok);
+        ast->name = parse_token_text(p, &tok);
     }
     return ast;
 }
@@ -237,10 +237,10 @@ static Ast *subexpr(Parser *p, int limit)
     Ast *ast;
     if (p->tok.kind == TOK_MINUS || p->tok.kind == TOK_PLUS) {
         Token sign = p->tok;
-        enter_level(p, sign.pos);
-        advance(p);
+        parse_enter_level(p, sign.pos);
+        parse_advance(p);
         Ast *operand = subexpr(p, UNARY_PRIORITY);
-        leave_level(p);
+        parse_leave_level(p);
         if (sign.kind == TOK_PLUS) {
             ast = operand;      /* unary plus is dropped */
         } else {
@@ -259,11 +259,11 @@ static Ast *subexpr(Parser *p, int limit)
         node->lhs = ast;
         bool nests = bin->right < bin->left;    /* '^' chains recurse */
         if (nests)
-            enter_level(p, p->tok.pos);
-        advance(p);
+            parse_enter_level(p, p->tok.pos);
+        parse_advance(p);
         node->rhs = subexpr(p, bin->right);
         if (nests)
-            leave_level(p);
+            parse_leave_level(p);
         ast = node;
     }
 }

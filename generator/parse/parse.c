@@ -18,7 +18,7 @@
 
 /* ---- tokens and errors ---- */
 
-_Noreturn void expected(Parser *p, const char *fmt, ...)
+_Noreturn void parse_expected(Parser *p, const char *fmt, ...)
 {
     char what[DIAG_MESSAGE_MAX], buf[LEX_DESCRIBE_MAX];
     va_list ap;
@@ -29,7 +29,7 @@ _Noreturn void expected(Parser *p, const char *fmt, ...)
               lex_describe(&p->tok, buf));
 }
 
-void advance(Parser *p)
+void parse_advance(Parser *p)
 {
     if (p->tok.kind == TOK_NEWLINE)
         p->stmt_tokens = 0;     /* a new line starts a new statement */
@@ -40,18 +40,18 @@ void advance(Parser *p)
                   p->limits->max_expr_tokens);
 }
 
-bool at_end(const Parser *p)
+bool parse_at_end(const Parser *p)
 {
     return p->tok.kind == TOK_NEWLINE || p->tok.kind == TOK_EOF;
 }
 
-char *token_text(Parser *p, const Token *tok)
+char *parse_token_text(Parser *p, const Token *tok)
 {
     return arena_strndup(p->arena, tok->start, (size_t)tok->len);
 }
 
 /* The reserved words of spec section 2: never declarable. */
-bool is_reserved(const Token *tok)
+bool parse_is_reserved(const Token *tok)
 {
     static const char *const words[] = {"ground", "t", "pi", "der"};
     for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
@@ -62,11 +62,11 @@ bool is_reserved(const Token *tok)
 }
 
 /* name = IDENT, not reserved; a name being declared by 'after' */
-const char *declared_name(Parser *p, const char *after, SrcPos *pos)
+const char *parse_declared_name(Parser *p, const char *after, SrcPos *pos)
 {
     if (p->tok.kind != TOK_IDENT)
-        expected(p, "a name after '%s'", after);
-    if (is_reserved(&p->tok))
+        parse_expected(p, "a name after '%s'", after);
+    if (parse_is_reserved(&p->tok))
         diag_fail(p->diag, p->tok.pos, "'%.*s' is a reserved name and cannot be declared",
                   p->tok.len, p->tok.start);
     /* names become C string literals (row and coordinate names) */
@@ -74,8 +74,8 @@ const char *declared_name(Parser *p, const char *after, SrcPos *pos)
         diag_fail(p->diag, p->tok.pos, "name longer than the limit of %d characters",
                   p->limits->max_name_length);
     *pos = p->tok.pos;
-    const char *name = token_text(p, &p->tok);
-    advance(p);
+    const char *name = parse_token_text(p, &p->tok);
+    parse_advance(p);
     return name;
 }
 
@@ -83,7 +83,7 @@ const char *declared_name(Parser *p, const char *after, SrcPos *pos)
 static void expect_end(Parser *p)
 {
     char buf[LEX_DESCRIBE_MAX];
-    if (at_end(p))
+    if (parse_at_end(p))
         return;
     if (p->tok.kind == TOK_RPAREN)
         diag_fail(p->diag, p->tok.pos, "unmatched ')'");
@@ -117,61 +117,61 @@ static const char *attach_noun(AttachRule rule)
 }
 
 /* pair = '(' expr ',' expr ')'   (an offset or an axis; what names it) */
-void pair(Parser *p, const char *what, Ast **a, Ast **b)
+void parse_pair(Parser *p, const char *what, Ast **a, Ast **b)
 {
     if (p->tok.kind != TOK_LPAREN)
-        expected(p, "'(' after %s", what);
-    enter_level(p, p->tok.pos);
-    advance(p);
-    *a = expr(p);
+        parse_expected(p, "'(' after %s", what);
+    parse_enter_level(p, p->tok.pos);
+    parse_advance(p);
+    *a = parse_expr(p);
     if (p->tok.kind != TOK_COMMA)
-        expected(p, "',' between the two components of %s", what);
-    advance(p);
-    *b = expr(p);
+        parse_expected(p, "',' between the two components of %s", what);
+    parse_advance(p);
+    *b = parse_expr(p);
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "')' after the two components of %s", what);
-    advance(p);
-    leave_level(p);
+        parse_expected(p, "')' after the two components of %s", what);
+    parse_advance(p);
+    parse_leave_level(p);
 }
 
 /* components = '(' expr {',' expr} ')'   with exactly n expressions: a
    spatial offset, axis or orientation; what names it in messages */
-void components(Parser *p, const char *what, int n, Ast **out)
+void parse_components(Parser *p, const char *what, int n, Ast **out)
 {
     static const char *const count[] = {"no", "one", "two", "three", "four"};
     if (p->tok.kind != TOK_LPAREN)
-        expected(p, "'(' after %s", what);
-    enter_level(p, p->tok.pos);
-    advance(p);
+        parse_expected(p, "'(' after %s", what);
+    parse_enter_level(p, p->tok.pos);
+    parse_advance(p);
     int i = 0;
     for (;;) {
         SrcPos at = p->tok.pos;
-        Ast *e = expr(p);
+        Ast *e = parse_expr(p);
         if (i == n)
             diag_fail(p->diag, at, "%s has %s components, found more", what, count[n]);
         out[i++] = e;
         if (p->tok.kind != TOK_COMMA)
             break;
-        advance(p);
+        parse_advance(p);
     }
     if (p->tok.kind != TOK_RPAREN)
-        expected(p, "',' or ')' in %s", what);
+        parse_expected(p, "',' or ')' in %s", what);
     if (i < n)
         diag_fail(p->diag, p->tok.pos, "%s has %s components, found %s", what, count[n],
                   count[i]);
-    advance(p);
-    leave_level(p);
+    parse_advance(p);
+    parse_leave_level(p);
 }
 
 /* An offset: (sx, sy), or (sx, sy, sz) in a spatial file. */
-void offset(Parser *p, const char *what, AstAttach *a)
+void parse_offset(Parser *p, const char *what, AstAttach *a)
 {
     if (!p->spatial) {
-        pair(p, what, &a->sx, &a->sy);
+        parse_pair(p, what, &a->sx, &a->sy);
         return;
     }
     Ast *c[3];
-    components(p, what, 3, c);
+    parse_components(p, what, 3, c);
     a->sx = c[0], a->sy = c[1], a->sz = c[2];
 }
 
@@ -183,17 +183,17 @@ static void attachment(Parser *p, Stmt *s, int slot)
     const char *nth = info->attachments == 1 ? "" : slot == 0 ? "first " : "second ";
     char buf[LEX_DESCRIBE_MAX];
     if (p->tok.kind != TOK_IDENT)
-        expected(p, "%s as the %sattachment of %s '%s'", attach_noun(rule), nth,
+        parse_expected(p, "%s as the %sattachment of %s '%s'", attach_noun(rule), nth,
                  info->keyword, s->name);
-    if (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground"))
+    if (parse_is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground"))
         diag_fail(p->diag, p->tok.pos,
                   "expected %s as the %sattachment of %s '%s', found the reserved name %s",
                   attach_noun(rule), nth, info->keyword, s->name,
                   lex_describe(&p->tok, buf));
     AstAttach *a = &s->attach[slot];
-    a->name = token_text(p, &p->tok);
+    a->name = parse_token_text(p, &p->tok);
     a->pos = p->tok.pos;
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind != TOK_LPAREN)
         return;
     if (rule == ATTACH_BODY_ONLY)
@@ -202,7 +202,7 @@ static void attachment(Parser *p, Stmt *s, int slot)
     char what[DIAG_MESSAGE_MAX];
     snprintf(what, sizeof what, "the offset of '%s'", a->name);
     a->has_offset = true;
-    offset(p, what, a);
+    parse_offset(p, what, a);
 }
 
 /* axis = 'axis' pair */
@@ -211,15 +211,15 @@ static void axis(Parser *p, Stmt *s)
     const JointInfo *info = &joint_info[s->joint];
     if (!lex_is_word(&p->tok, "axis")) {
         const AstAttach *last = &s->attach[info->attachments - 1];
-        if (at_end(p) && last->has_offset && strcmp(last->name, "axis") == 0)
+        if (parse_at_end(p) && last->has_offset && strcmp(last->name, "axis") == 0)
             diag_fail(p->diag, p->tok.pos, "expected 'axis(ux, uy)' after the attachments "
                       "of %s '%s', found end of line ('axis(...)' was taken as an "
                       "attachment: is one missing?)", info->keyword, s->name);
-        expected(p, "'axis(ux, uy)' after the attachments of %s '%s'", info->keyword, s->name);
+        parse_expected(p, "'axis(ux, uy)' after the attachments of %s '%s'", info->keyword, s->name);
     }
     s->axis_pos = p->tok.pos;
-    advance(p);
-    pair(p, "the axis", &s->axis[0], &s->axis[1]);
+    parse_advance(p);
+    parse_pair(p, "the axis", &s->axis[0], &s->axis[1]);
 }
 
 /* option = KEYWORD '=' expr   (length and radius required, angle optional) */
@@ -231,13 +231,13 @@ static void option(Parser *p, Stmt *s)
         return;
     if (lex_is_word(&p->tok, word)) {
         s->option_pos = p->tok.pos;
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after '%s'", word);
-        advance(p);
-        s->option = expr(p);
+            parse_expected(p, "'=' after '%s'", word);
+        parse_advance(p);
+        s->option = parse_expr(p);
     } else if (info->option != OPTION_ANGLE) {
-        expected(p, "'%s = ...' for %s '%s'", word, info->keyword, s->name);
+        parse_expected(p, "'%s = ...' for %s '%s'", word, info->keyword, s->name);
     }
 }
 
@@ -279,8 +279,8 @@ static void spatial_tail(Parser *p, Stmt *s)
         if (lex_is_word(&p->tok, "axis") && info->axis && naxes < 2) {
             SrcPos *pos = naxes == 0 ? &s->axis_pos : &s->axis_b_pos;
             *pos = p->tok.pos;
-            advance(p);
-            components(p, naxes == 0 ? "the axis (A's)" : "B's axis", 3,
+            parse_advance(p);
+            parse_components(p, naxes == 0 ? "the axis (A's)" : "B's axis", 3,
                        naxes == 0 ? s->axis : s->axis_b);
             naxes++;
         } else if (word && lex_is_word(&p->tok, word) && !s->option) {
@@ -294,13 +294,13 @@ static void spatial_tail(Parser *p, Stmt *s)
         }
     }
     if (info->axis && naxes == 0)
-        expected(p, "'axis(ux, uy, uz)' after the attachments of %s '%s'", info->keyword,
+        parse_expected(p, "'axis(ux, uy, uz)' after the attachments of %s '%s'", info->keyword,
                  s->name);
     if (info->axis == 2 && naxes == 1)
-        expected(p, "B's axis: %s '%s' takes two axes, 'axis(...) axis(...)'", info->keyword,
+        parse_expected(p, "B's axis: %s '%s' takes two axes, 'axis(...) axis(...)'", info->keyword,
                  s->name);
     if (word && !s->option && info->option != OPTION_ANGLE)
-        expected(p, "'%s = ...' for %s '%s'", word, info->keyword, s->name);
+        parse_expected(p, "'%s = ...' for %s '%s'", word, info->keyword, s->name);
 }
 
 /* joint = KIND NAME ':' attachment{n} [axis] [option]   (n = attachments > 0)
@@ -308,17 +308,17 @@ static void spatial_tail(Parser *p, Stmt *s)
 static void joint(Parser *p, Stmt *s)
 {
     const JointInfo *info = &joint_info[s->joint];
-    s->name = declared_name(p, info->keyword, &s->name_pos);
+    s->name = parse_declared_name(p, info->keyword, &s->name_pos);
     if (p->tok.kind != TOK_COLON)
-        expected(p, "':' after the joint name '%s'", s->name);
-    advance(p);
+        parse_expected(p, "':' after the joint name '%s'", s->name);
+    parse_advance(p);
     if (info->attachments == 0) {
-        s->lhs = expr(p);
+        s->lhs = parse_expr(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' between the two sides of %s '%s'", info->keyword, s->name);
+            parse_expected(p, "'=' between the two sides of %s '%s'", info->keyword, s->name);
         s->eq_pos = p->tok.pos;
-        advance(p);
-        s->rhs = expr(p);
+        parse_advance(p);
+        s->rhs = parse_expr(p);
         return;
     }
     for (int i = 0; i < info->attachments; i++)
@@ -357,11 +357,11 @@ static void initial_values(Parser *p, Stmt *s, int nkeys)
             diag_fail(p->diag, p->tok.pos, "'%s' given twice for %s '%s'", keys[i], what,
                       s->name);
         s->init_pos[i] = p->tok.pos;
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after '%s'", keys[i]);
-        advance(p);
-        s->init[i] = expr(p);
+            parse_expected(p, "'=' after '%s'", keys[i]);
+        parse_advance(p);
+        s->init[i] = parse_expr(p);
     }
 }
 
@@ -375,10 +375,10 @@ static void orientation(Parser *p, Stmt *s)
     while (k < 3 && !lex_is_word(&p->tok, words[k]))
         k++;
     if (k == 3)
-        expected(p, "axis(ux, uy, uz, angle), xyz(a, b, c) or zyx(a, b, c) after 'orient ='");
+        parse_expected(p, "axis(ux, uy, uz, angle), xyz(a, b, c) or zyx(a, b, c) after 'orient ='");
     s->orient = kinds[k];
-    advance(p);
-    components(p, k == 0 ? "orient = axis(ux, uy, uz, angle)" : k == 1 ? "orient = xyz(a, b, c)"
+    parse_advance(p);
+    parse_components(p, k == 0 ? "orient = axis(ux, uy, uz, angle)" : k == 1 ? "orient = xyz(a, b, c)"
                : "orient = zyx(a, b, c)", k == 0 ? 4 : 3, s->orient_arg);
 }
 
@@ -408,14 +408,14 @@ static void spatial_values(Parser *p, Stmt *s, bool body)
             s->init_pos[i] = p->tok.pos;
         else
             s->orient_pos = p->tok.pos;
-        advance(p);
+        parse_advance(p);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after '%s'", orient ? "orient" : keys[i]);
-        advance(p);
+            parse_expected(p, "'=' after '%s'", orient ? "orient" : keys[i]);
+        parse_advance(p);
         if (orient)
             orientation(p, s);
         else
-            s->init[i] = expr(p);
+            s->init[i] = parse_expr(p);
     }
 }
 
@@ -423,24 +423,24 @@ static void spatial_values(Parser *p, Stmt *s, bool body)
           | 'output' NAME ':' NAME [pair]           (a point: body, point or ground) */
 static void output(Parser *p, Stmt *s)
 {
-    s->name = declared_name(p, "output", &s->name_pos);
+    s->name = parse_declared_name(p, "output", &s->name_pos);
     if (p->tok.kind == TOK_EQ) {
-        advance(p);
-        s->value = expr(p);
+        parse_advance(p);
+        s->value = parse_expr(p);
         return;
     }
     if (p->tok.kind != TOK_COLON)
-        expected(p, "'=' (a value) or ':' (a point) after 'output %s'", s->name);
-    advance(p);
+        parse_expected(p, "'=' (a value) or ':' (a point) after 'output %s'", s->name);
+    parse_advance(p);
     AstAttach *at = &s->attach[0];
-    if (p->tok.kind != TOK_IDENT || (is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
-        expected(p, "a body, point or ground after 'output %s:'", s->name);
-    at->name = token_text(p, &p->tok);
+    if (p->tok.kind != TOK_IDENT || (parse_is_reserved(&p->tok) && !lex_is_word(&p->tok, "ground")))
+        parse_expected(p, "a body, point or ground after 'output %s:'", s->name);
+    at->name = parse_token_text(p, &p->tok);
     at->pos = p->tok.pos;
-    advance(p);
+    parse_advance(p);
     if (p->tok.kind == TOK_LPAREN) {
         at->has_offset = true;
-        offset(p, "the point's offset", at);
+        parse_offset(p, "the point's offset", at);
     }
 }
 
@@ -478,7 +478,7 @@ static void spatial_statement(Parser *p, Stmt *s)
     p->spatial = true;
     p->spatial_line = line;
     s->kind = STMT_SPATIAL;
-    advance(p);
+    parse_advance(p);
 }
 
 /* A joint keyword of the other dimension: say which file it belongs in. */
@@ -519,36 +519,36 @@ static Stmt *statement(Parser *p)
                       "line %d)", p->mechanism_line);
         p->mechanism_line = line;
         s->kind = STMT_MECHANISM;
-        advance(p);
-        s->name = declared_name(p, "mechanism", &s->name_pos);
+        parse_advance(p);
+        s->name = parse_declared_name(p, "mechanism", &s->name_pos);
     } else if (lex_is_word(&kw, "param")) {
         s->kind = STMT_PARAM;
-        advance(p);
-        s->name = declared_name(p, "param", &s->name_pos);
+        parse_advance(p);
+        s->name = parse_declared_name(p, "param", &s->name_pos);
         if (p->tok.kind != TOK_EQ)
-            expected(p, "'=' after 'param %s'", s->name);
-        advance(p);
-        s->value = expr(p);
+            parse_expected(p, "'=' after 'param %s'", s->name);
+        parse_advance(p);
+        s->value = parse_expr(p);
     } else if (lex_is_word(&kw, "body") || lex_is_word(&kw, "point")) {
         bool body = lex_is_word(&kw, "body");
         s->kind = body ? STMT_BODY : STMT_POINT;
-        advance(p);
-        s->name = declared_name(p, body ? "body" : "point", &s->name_pos);
+        parse_advance(p);
+        s->name = parse_declared_name(p, body ? "body" : "point", &s->name_pos);
         if (p->spatial)
             spatial_values(p, s, body);
         else
             initial_values(p, s, body ? 3 : 2);
     } else if (lex_is_word(&kw, "coord")) {
         s->kind = STMT_COORD;
-        advance(p);
-        s->name = declared_name(p, "coord", &s->name_pos);
+        parse_advance(p);
+        s->name = parse_declared_name(p, "coord", &s->name_pos);
         if (p->tok.kind == TOK_EQ) {
-            advance(p);
-            s->value = expr(p);
+            parse_advance(p);
+            s->value = parse_expr(p);
         }
     } else if (lex_is_word(&kw, "output")) {
         s->kind = STMT_OUTPUT;
-        advance(p);
+        parse_advance(p);
         output(p, s);
     } else if (lex_is_word(&kw, "mass")) {
         parse_mass(p, s);
@@ -559,7 +559,7 @@ static Stmt *statement(Parser *p)
     } else if (kind >= 0) {
         s->kind = STMT_JOINT;
         s->joint = (JointKind)kind;
-        advance(p);
+        parse_advance(p);
         joint(p, s);
     } else if (joint_kind_lookup(kw.start, kw.len, !p->spatial) >= 0) {
         wrong_dimension(p, &kw);
@@ -577,10 +577,10 @@ static Stmt *statement(Parser *p)
 static void program(Parser *p, Program *out)
 {
     Stmt **tail = &out->first;
-    advance(p);
+    parse_advance(p);
     for (;;) {
         while (p->tok.kind == TOK_NEWLINE)
-            advance(p);
+            parse_advance(p);
         if (p->tok.kind == TOK_EOF)
             break;
         Stmt *s = statement(p);

@@ -23,31 +23,31 @@ typedef struct Parser {
 /* ---- tokens and errors (parse.c) ---- */
 
 /* Fails at the current token with "expected WHAT, found TOKEN". */
-_Noreturn void expected(Parser *p, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-void advance(Parser *p);
+_Noreturn void parse_expected(Parser *p, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void parse_advance(Parser *p);
 /* At the end of the statement's line. */
-bool at_end(const Parser *p);
-char *token_text(Parser *p, const Token *tok);
+bool parse_at_end(const Parser *p);
+char *parse_token_text(Parser *p, const Token *tok);
 /* One of the reserved words of spec section 2: never declarable. */
-bool is_reserved(const Token *tok);
+bool parse_is_reserved(const Token *tok);
 /* The name a statement 'after' declares, or fails. */
-const char *declared_name(Parser *p, const char *after, SrcPos *pos);
+const char *parse_declared_name(Parser *p, const char *after, SrcPos *pos);
 
 /* ---- operands (parse.c) ---- */
 
 /* '(' expr ',' expr ')': what names it in messages */
-void pair(Parser *p, const char *what, Ast **a, Ast **b);
+void parse_pair(Parser *p, const char *what, Ast **a, Ast **b);
 /* '(' expr {',' expr} ')' with exactly n expressions */
-void components(Parser *p, const char *what, int n, Ast **out);
+void parse_components(Parser *p, const char *what, int n, Ast **out);
 /* An offset of the file's dimension, into a. */
-void offset(Parser *p, const char *what, AstAttach *a);
+void parse_offset(Parser *p, const char *what, AstAttach *a);
 
 /* ---- expressions (expr.c) ---- */
 
-Ast *expr(Parser *p);
+Ast *parse_expr(Parser *p);
 /* Nesting, counted against limits->max_depth. */
-void enter_level(Parser *p, SrcPos pos);
-void leave_level(Parser *p);
+void parse_enter_level(Parser *p, SrcPos pos);
+void parse_leave_level(Parser *p);
 
 /* ---- dynamics statements (dynamics.c) ---- */
 
