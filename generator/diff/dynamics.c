@@ -1,7 +1,7 @@
 /* dynamics.c - the mass matrix M(q) and the force vector Q(q, qd, t) as graph nodes, by symbolic differentiation.
  *
  * Every mass statement is a mass element: mass m at p(q), moment of inertia
- * J about it for the angle theta(q) (DYN.md). With T = 1/2 m |p_q qd|^2 +
+ * J about it for the angle theta(q). With T = 1/2 m |p_q qd|^2 +
  * 1/2 J (theta_q qd)^2, Lagrange's equations give
  *
  *   M += m p_q^T p_q + J theta_q^T theta_q
@@ -10,8 +10,8 @@
  *
  * where pdot_q qd = D(D(p)), the total time derivative twice with qdd = 0:
  * the convective term gamma is made of (p never depends on t). Applied
- * forces enter by virtual work, Q += (d position / dq)^T force (model.h's
- * ForceKind). M is accumulated entry by entry over the coordinates each
+ * forces enter by virtual work, Q += (d position / dq)^T force, each kind
+ * by its add_KIND (generator/parse/forces.def). M is accumulated entry by entry over the coordinates each
  * element touches, so a body in body coordinates with its centre of mass
  * at its origin adds the constants m, m, J on the diagonal and nothing else.
  *
@@ -92,7 +92,7 @@ static NodeId dot2(Dag *d, NodeId a, NodeId b, NodeId c, NodeId e)
     return dag_add(d, ab, ce);
 }
 
-/* A planar body's own mass, the formula worked out (DYN.md's with
+/* A planar body's own mass, the formula worked out (the above with
    p = r + A(phi) s, u = A(phi) s, p_phi = B s = (-u_y, u_x), w = phi'):
    M(x, x) = M(y, y) = m, M(x, phi) = -m u_y, M(y, phi) = m u_x,
    M(phi, phi) = J + m s.s; velocity terms m u w^2 on (x, y), none on phi
@@ -280,7 +280,7 @@ static void add_spatial_element(DynWork *w, const MassElement *e)
 
 /* A torque tau in global axes on a spatial body: its virtual work
    tau . w, w = 2 E ed, so Q_e += 2 E^T tau. */
-static void add_body_torque(DynWork *w, const AppliedForce *f)
+static void add_BODY_TORQUE(DynWork *w, const AppliedForce *f)
 {
     Dag *d = w->dag;
     NodeId p[4], E[3][4], tau[3] = {f->fx, f->fy, f->fz};
@@ -371,45 +371,58 @@ static NodeId spring_force(DynWork *w, const AppliedForce *f, NodeId s)
     return dag_neg(d, total);
 }
 
-/* One applied force by virtual work. */
-static void add_force(DynWork *w, const AppliedForce *f)
+/* force: Q += p_q^T (fx, fy, fz) */
+static void add_POINT(DynWork *w, const AppliedForce *f)
+{
+    add_along(w, f->ax, f->fx);
+    add_along(w, f->ay, f->fy);
+    if (w->m->spatial)
+        add_along(w, f->az, f->fz);
+}
+
+/* torque: Q += theta_q^T tau */
+static void add_TORQUE(DynWork *w, const AppliedForce *f)
+{
+    add_along(w, f->ax, f->fx);
+}
+
+/* spring: l = |B - A|, Q += -(k (l - L0) + c ldot + F) l_q */
+static void add_SPRING(DynWork *w, const AppliedForce *f)
 {
     Dag *d = w->dag;
-    switch (f->kind) {
-    case FORCE_POINT:
-        add_along(w, f->ax, f->fx);
-        add_along(w, f->ay, f->fy);
-        if (w->m->spatial)
-            add_along(w, f->az, f->fz);
-        return;
-    case FORCE_TORQUE:
-        add_along(w, f->ax, f->fx);
-        return;
-    case FORCE_SPRING: {
-        NodeId ex = dag_sub(d, f->bx, f->ax);
-        NodeId ey = dag_sub(d, f->by, f->ay);
-        NodeId l2 = dot2(d, ex, ex, ey, ey);
-        if (w->m->spatial) {
-            NodeId ez = dag_sub(d, f->bz, f->az);
-            l2 = dag_add(d, l2, dag_mul(d, ez, ez));
-        }
-        NodeId l = dag_call(d, OP_SQRT, l2, DAG_NONE);
-        add_along(w, l, spring_force(w, f, l));
-        return;
+    NodeId ex = dag_sub(d, f->bx, f->ax);
+    NodeId ey = dag_sub(d, f->by, f->ay);
+    NodeId l2 = dot2(d, ex, ex, ey, ey);
+    if (w->m->spatial) {
+        NodeId ez = dag_sub(d, f->bz, f->az);
+        l2 = dag_add(d, l2, dag_mul(d, ez, ez));
     }
-    case FORCE_RSPRING: {
-        NodeId a = dag_sub(d, f->bx, f->ax);
-        add_along(w, a, spring_force(w, f, a));
-        return;
-    }
-    case FORCE_GENERAL:
-        accumulate(w, w->applied, f->coord, f->fx);
-        return;
-    case FORCE_BODY_TORQUE:
-        add_body_torque(w, f);
-        return;
-    }
+    NodeId l = dag_call(d, OP_SQRT, l2, DAG_NONE);
+    add_along(w, l, spring_force(w, f, l));
 }
+
+/* rspring: a = theta_B - theta_A, Q += -(k (a - a0) + c adot + T) a_q */
+static void add_RSPRING(DynWork *w, const AppliedForce *f)
+{
+    NodeId a = dag_sub(w->dag, f->bx, f->ax);
+    add_along(w, a, spring_force(w, f, a));
+}
+
+/* gforce: Q[coord] += fx */
+static void add_GENERAL(DynWork *w, const AppliedForce *f)
+{
+    accumulate(w, w->applied, f->coord, f->fx);
+}
+
+typedef void ForceMaths(DynWork *w, const AppliedForce *f);
+
+/* Every force kind's share of Q, by kind: a row of forces.def without its
+   add_KIND is an undeclared identifier, so the build names it. */
+static ForceMaths *const force_maths[FORCE_KIND_COUNT] = {
+#define X(e, ...) [FORCE_##e] = add_##e,
+#include "../parse/forces.def"
+#undef X
+};
 
 static int compare_entries(const void *x, const void *y)
 {
@@ -457,7 +470,7 @@ bool dynamics_build(Model *m, Dynamics *dyn, Diag *diag)
     }
     for (int i = 0; i < m->nforces && !w.dag->overflow; i++) {
         w.dag->where = m->forces[i].pos.offset;
-        add_force(&w, &m->forces[i]);
+        force_maths[m->forces[i].kind](&w, &m->forces[i]);
     }
     for (int j = 0; j < m->nq; j++)
         dyn->force[j] = dag_add(w.dag, dyn->velocity[j], w.applied[j]);

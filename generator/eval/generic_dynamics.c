@@ -386,6 +386,59 @@ static void add_body_torque(const AppliedForce *f, const double *q, const double
         Q[f->coord + a] += 2 * (E[0][a] * tau[0] + E[1][a] * tau[1] + E[2][a] * tau[2]);
 }
 
+/* force: Q += p_q^T (fx, fy, fz) */
+static void apply_POINT(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                        const double *qd, double t, double *Q)
+{
+    (void)f;
+    double fx = d->vreg[p->out[4]], fy = d->vreg[p->out[5]], fz = d->vreg[p->out[8]];
+    add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
+    add_gradient(d, p, q, qd, t, 1, -1, fy, Q);
+    if (d->m->spatial)
+        add_gradient(d, p, q, qd, t, 6, -1, fz, Q);
+}
+
+/* torque: Q += theta_q^T tau */
+static void apply_TORQUE(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                         const double *qd, double t, double *Q)
+{
+    (void)f;
+    add_gradient(d, p, q, qd, t, 0, -1, d->vreg[p->out[4]], Q);
+}
+
+#define apply_SPRING add_spring
+#define apply_RSPRING add_spring
+
+/* gforce: Q[coord] += fx */
+static void apply_GENERAL(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                          const double *qd, double t, double *Q)
+{
+    (void)q, (void)qd, (void)t;
+    Q[f->coord] += d->vreg[p->out[4]];
+}
+
+/* a spatial body torque: Q_e += 2 E(e)^T tau */
+static void apply_BODY_TORQUE(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                              const double *qd, double t, double *Q)
+{
+    (void)qd, (void)t;
+    double tau[3] = {d->vreg[p->out[4]], d->vreg[p->out[5]], d->vreg[p->out[8]]};
+    add_body_torque(f, q, tau, Q);
+}
+
+typedef void ForceApply(GenericDyn *d, const AppliedForce *f, const Tape *p, const double *q,
+                        const double *qd, double t, double *Q);
+
+/* Every force kind's share of Q, by kind: a row of forces.def without its
+   apply_KIND is an undeclared identifier, so the build names it. */
+static ForceApply *const force_apply[FORCE_KIND_COUNT] = {
+#define X(e, ...) [FORCE_##e] = apply_##e,
+#include "../parse/forces.def"
+#undef X
+};
+
+/* Each force's program runs once (apply_KIND reads its values in vreg),
+   then its kind adds its share. */
 static void add_applied(GenericDyn *d, const double *q, const double *qd, double t, double *Q)
 {
     const Model *m = d->m;
@@ -393,29 +446,7 @@ static void add_applied(GenericDyn *d, const double *q, const double *qd, double
         const AppliedForce *f = &m->forces[i];
         const Tape *p = &d->force_tapes[i];
         tape_run(p, q, qd, t, d->vreg);
-        double fx = d->vreg[p->out[4]], fy = d->vreg[p->out[5]];
-        switch (f->kind) {
-        case FORCE_POINT:
-            add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
-            add_gradient(d, p, q, qd, t, 1, -1, fy, Q);
-            if (m->spatial)
-                add_gradient(d, p, q, qd, t, 6, -1, d->vreg[p->out[8]], Q);
-            break;
-        case FORCE_TORQUE:
-            add_gradient(d, p, q, qd, t, 0, -1, fx, Q);
-            break;
-        case FORCE_SPRING: case FORCE_RSPRING:
-            add_spring(d, f, p, q, qd, t, Q);
-            break;
-        case FORCE_GENERAL:
-            Q[f->coord] += fx;
-            break;
-        case FORCE_BODY_TORQUE: {
-            double tau[3] = {fx, fy, d->vreg[p->out[8]]};
-            add_body_torque(f, q, tau, Q);
-            break;
-        }
-        }
+        force_apply[f->kind](d, f, p, q, qd, t, Q);
     }
 }
 

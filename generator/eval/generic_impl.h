@@ -95,8 +95,26 @@ GenericRows *generic_joint_formula(const Joint *j, char *need);
 /* need[k] of a spatial body's e0 (q + 3) when the formulas turn by its A(p). */
 enum { NEED_ROT = 3 };
 
-/* The spatial kinds' formulas (generic_spatial.c), NULL for any other kind. */
-GenericRows *generic_spatial_rows(JointKind kind);
+/* A kind's formulas and what they rotate, so that generic.c computes cos
+   and sin of those angles, or A(p), before a call. */
+enum {
+    TURN_SA = 1,        /* A's offset: P_A = r_A + A(phi_A) s_A */
+    TURN_SB = 2,        /* B's offset */
+    TURN_AXIS = 4,      /* A's axis: n_A = A(phi_A) (-uy, ux) */
+    TURN_P = 8,         /* spatial: both sides' A(p) */
+};
+
+typedef struct Formula {
+    GenericRows *rows;  /* NULL: the row is interpreted (generic.c) */
+    int turns;          /* TURN_* */
+} Formula;
+
+/* The spatial family's formulas (generic_spatial.c), one per spatial row
+   of joints.def; the planar ones are generic_joints.c's own. */
+extern const Formula formula_S_SPHERICAL, formula_S_UNIVERSAL, formula_S_REVOLUTE,
+    formula_S_CYLINDRICAL, formula_S_TRANSLATIONAL, formula_S_WELD, formula_S_DISTANCE,
+    formula_S_POINTPLANE, formula_S_PARALLEL, formula_S_PERPENDICULAR, formula_S_ROLLING,
+    formula_S_NORM, formula_S_CONTACT;
 /* A spatial `driver D: angle(R) = E` or `slide(T) = E` (driver->measures),
    R or T being of: its formulas, marking of's bodies in need; else NULL. */
 GenericRows *generic_measure_rows(const Joint *driver, const Joint *of, char *need);

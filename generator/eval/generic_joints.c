@@ -269,57 +269,27 @@ static void weld_joint(const Call *c, const Plan *p)
     angle_row(c, p, p->row + 2);
 }
 
-/* What a kind's formulas rotate by A(phi), so that generic.c computes cos
-   and sin of those angles before a call: */
-enum {
-    TURN_SA = 1,        /* A's offset: P_A = r_A + A(phi_A) s_A */
-    TURN_SB = 2,        /* B's offset */
-    TURN_AXIS = 4,      /* A's axis: n_A = A(phi_A) (-uy, ux) */
-    TURN_P = 8,         /* spatial: both sides' A(p) */
+/* The planar family's formulas and what each rotates. */
+static const Formula formula_REVOLUTE = {revolute_joint, TURN_SA | TURN_SB};
+static const Formula formula_PRISMATIC = {prismatic_joint, TURN_SA | TURN_SB | TURN_AXIS};
+static const Formula formula_DISTANCE = {distance_row, TURN_SA | TURN_SB};
+static const Formula formula_POINTLINE = {pointline_joint, TURN_SA | TURN_SB | TURN_AXIS};
+static const Formula formula_WELD = {weld_joint, TURN_SA | TURN_SB};
+static const Formula formula_ROLLING = {rolling_row, 0};    /* phi' only, no rotation */
+static const Formula formula_KNIFE = {knife_row, TURN_SA | TURN_AXIS};
+/* constraint, driver, velocity: the row is interpreted (generic.c) */
+static const Formula formula_CONSTRAINT = {NULL, 0};
+#define formula_DRIVER formula_CONSTRAINT
+#define formula_VELOCITY formula_CONSTRAINT
+
+/* Every kind's formulas, by kind: a row of joints.def without its
+   formula_KIND (above, or the spatial family's in generic_impl.h) is an
+   undeclared identifier, so the build names it. */
+static const Formula *const formulas[JOINT_KIND_COUNT] = {
+#define X(e, ...) [JOINT_##e] = &formula_##e,
+#include "../parse/joints.def"
+#undef X
 };
-
-typedef struct Formula {
-    GenericRows *rows;  /* NULL: the row is interpreted (generic.c) */
-    int turns;          /* TURN_* */
-} Formula;
-
-/* A new kind adds its case here, beside its formulas above. */
-static Formula formula_of(JointKind kind)
-{
-    switch (kind) {
-    case JOINT_REVOLUTE:   return (Formula){revolute_joint, TURN_SA | TURN_SB};
-    case JOINT_PRISMATIC:  return (Formula){prismatic_joint, TURN_SA | TURN_SB | TURN_AXIS};
-    case JOINT_DISTANCE:   return (Formula){distance_row, TURN_SA | TURN_SB};
-    case JOINT_POINTLINE:  return (Formula){pointline_joint, TURN_SA | TURN_SB | TURN_AXIS};
-    case JOINT_WELD:       return (Formula){weld_joint, TURN_SA | TURN_SB};
-    case JOINT_ROLLING:    return (Formula){rolling_row, 0};   /* phi' only, no rotation */
-    case JOINT_KNIFE:      return (Formula){knife_row, TURN_SA | TURN_AXIS};
-    case JOINT_CONSTRAINT:
-    case JOINT_DRIVER:
-    case JOINT_VELOCITY:
-        break;
-    /* Spatial kinds (generic_spatial.c): dot-1, dot-2 and spherical over
-       Euler parameters; the body row .norm turns nothing. */
-    case JOINT_S_NORM:
-        return (Formula){generic_spatial_rows(kind), 0};
-    case JOINT_S_SPHERICAL:
-    case JOINT_S_UNIVERSAL:
-    case JOINT_S_REVOLUTE:
-    case JOINT_S_CYLINDRICAL:
-    case JOINT_S_TRANSLATIONAL:
-    case JOINT_S_WELD:
-    case JOINT_S_DISTANCE:
-    case JOINT_S_POINTPLANE:
-    case JOINT_S_PARALLEL:
-    case JOINT_S_PERPENDICULAR:
-    case JOINT_S_ROLLING:
-    case JOINT_S_CONTACT:
-        return (Formula){generic_spatial_rows(kind), TURN_P};
-    case JOINT_KIND_COUNT:
-        break;
-    }
-    return (Formula){NULL, 0};
-}
 
 /* need[phi] = 1 for velocity-level joints, 2 for position-level ones;
    an attachment without an angle, or an offset of zero, rotates nothing. */
@@ -334,7 +304,7 @@ static void need_angle(char *need, const Attach *at, bool axis, bool offset, boo
 
 GenericRows *generic_joint_formula(const Joint *j, char *need)
 {
-    Formula f = formula_of(j->kind);
+    Formula f = *formulas[j->kind];
     if (f.rows && (f.turns & TURN_P)) {
         if (j->a.has_p)
             need[j->a.q + 3] = NEED_ROT;

@@ -569,22 +569,18 @@ GenericRows *generic_measure_rows(const Joint *driver, const Joint *of, char *ne
     return driver->measures > 0 ? angle_driver : slide_driver;
 }
 
-GenericRows *generic_spatial_rows(JointKind kind)
-{
-    switch (kind) {
-    case JOINT_S_SPHERICAL:     return spherical_joint;
-    case JOINT_S_UNIVERSAL:     return universal_joint;
-    case JOINT_S_REVOLUTE:      return revolute_joint;
-    case JOINT_S_CYLINDRICAL:   return cylindrical_joint;
-    case JOINT_S_TRANSLATIONAL: return translational_joint;
-    case JOINT_S_WELD:          return weld_joint;
-    case JOINT_S_DISTANCE:      return distance_joint;
-    case JOINT_S_POINTPLANE:    return pointplane_joint;
-    case JOINT_S_PARALLEL:      return parallel_joint;
-    case JOINT_S_PERPENDICULAR: return perpendicular_joint;
-    case JOINT_S_NORM:          return norm_joint;
-    case JOINT_S_CONTACT:       return contact_joint;
-    case JOINT_S_ROLLING:       return rolling_joint;
-    default:                    return NULL;
-    }
-}
+/* Dot-1, dot-2 and spherical over Euler parameters turn both sides' A(p);
+   the body row .norm turns nothing. */
+const Formula formula_S_SPHERICAL = {spherical_joint, TURN_P};
+const Formula formula_S_UNIVERSAL = {universal_joint, TURN_P};
+const Formula formula_S_REVOLUTE = {revolute_joint, TURN_P};
+const Formula formula_S_CYLINDRICAL = {cylindrical_joint, TURN_P};
+const Formula formula_S_TRANSLATIONAL = {translational_joint, TURN_P};
+const Formula formula_S_WELD = {weld_joint, TURN_P};
+const Formula formula_S_DISTANCE = {distance_joint, TURN_P};
+const Formula formula_S_POINTPLANE = {pointplane_joint, TURN_P};
+const Formula formula_S_PARALLEL = {parallel_joint, TURN_P};
+const Formula formula_S_PERPENDICULAR = {perpendicular_joint, TURN_P};
+const Formula formula_S_NORM = {norm_joint, 0};
+const Formula formula_S_CONTACT = {contact_joint, TURN_P};
+const Formula formula_S_ROLLING = {rolling_joint, TURN_P};

@@ -12,6 +12,8 @@
  */
 #include "model.h"
 
+#include "joint_builders.h"
+
 #include <math.h>
 
 typedef struct Vec {
@@ -114,82 +116,81 @@ static NodeId relative_angle(Dag *d, Attach b, Attach a, NodeId theta)
     return dag_sub(d, dag_sub(d, pb, pa), theta);
 }
 
+/* revolute J: J.x, J.y = P_A - P_B */
+static void lower_REVOLUTE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec e = difference(d, j->a, j->b);
+    rows[0] = e.x;
+    rows[1] = e.y;
+}
+
+/* prismatic J: J.n = n_A . (P_B - P_A); J.phi = phi_B - phi_A - theta */
+static void lower_PRISMATIC(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec e = difference(d, j->b, j->a);
+    rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
+    rows[1] = relative_angle(d, j->b, j->a, j->option);
+}
+
+/* distance J: (P_B - P_A).(P_B - P_A) - L^2 */
+static void lower_DISTANCE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec e = difference(d, j->b, j->a);
+    NodeId l2 = dag_mul(d, j->option, j->option);
+    rows[0] = dag_sub(d, dot(d, e, e), l2);
+}
+
+/* pointline J: n_A . (P_B - P_A) */
+static void lower_POINTLINE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec e = difference(d, j->b, j->a);
+    rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
+}
+
+/* weld J: J.x, J.y = P_A - P_B; J.phi = phi_B - phi_A - theta */
+static void lower_WELD(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    lower_REVOLUTE(d, j, rows);
+    rows[2] = relative_angle(d, j->b, j->a, j->option);
+}
+
+/* constraint, driver, velocity J: lhs - rhs, which model.c lowered */
+static void lower_statement(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    (void)d;
+    rows[0] = j->expr;
+}
+#define lower_CONSTRAINT lower_statement
+#define lower_DRIVER lower_statement
+#define lower_VELOCITY lower_statement
+
+/* rolling J: der(B.x) + R der(B.phi) (no slip on the ground line) */
+static void lower_ROLLING(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    NodeId roll = dag_mul(d, j->option, dag_vard(d, j->a.q + 2));
+    rows[0] = dag_add(d, dag_vard(d, j->a.q), roll);
+}
+
+/* knife J: n_A . d/dt(P_A) (no velocity across the blade) */
+static void lower_KNIFE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec v = velocity(d, j->a);
+    Vec n = normal(d, j->a, j->ux, j->uy);
+    rows[0] = dot(d, n, v);
+}
+
+/* Every kind's builder, by kind: a row of joints.def without its
+   lower_KIND (here, or the spatial family's in joint_builders.h) is an
+   undeclared identifier, so the build names it. */
+static JointBuilder *const builders[JOINT_KIND_COUNT] = {
+#define X(e, ...) [JOINT_##e] = lower_##e,
+#include "../parse/joints.def"
+#undef X
+};
+
 void joints_lower(Model *model, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Dag *d = &model->dag;
-    switch (j->kind) {
-    /* revolute J: J.x, J.y = P_A - P_B */
-    case JOINT_REVOLUTE: {
-        Vec e = difference(d, j->a, j->b);
-        rows[0] = e.x;
-        rows[1] = e.y;
-        return;
-    }
-    /* prismatic J: J.n = n_A . (P_B - P_A); J.phi = phi_B - phi_A - theta */
-    case JOINT_PRISMATIC: {
-        Vec e = difference(d, j->b, j->a);
-        rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
-        rows[1] = relative_angle(d, j->b, j->a, j->option);
-        return;
-    }
-    /* distance J: (P_B - P_A).(P_B - P_A) - L^2 */
-    case JOINT_DISTANCE: {
-        Vec e = difference(d, j->b, j->a);
-        NodeId l2 = dag_mul(d, j->option, j->option);
-        rows[0] = dag_sub(d, dot(d, e, e), l2);
-        return;
-    }
-    /* pointline J: n_A . (P_B - P_A) */
-    case JOINT_POINTLINE: {
-        Vec e = difference(d, j->b, j->a);
-        rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
-        return;
-    }
-    /* weld J: J.x, J.y = P_A - P_B; J.phi = phi_B - phi_A - theta */
-    case JOINT_WELD: {
-        Vec e = difference(d, j->a, j->b);
-        rows[0] = e.x;
-        rows[1] = e.y;
-        rows[2] = relative_angle(d, j->b, j->a, j->option);
-        return;
-    }
-    /* constraint, driver, velocity J: lhs - rhs */
-    case JOINT_CONSTRAINT:
-    case JOINT_DRIVER:
-    case JOINT_VELOCITY:
-        rows[0] = j->expr;
-        return;
-    /* rolling J: der(B.x) + R der(B.phi) (no slip on the ground line) */
-    case JOINT_ROLLING: {
-        NodeId roll = dag_mul(d, j->option, dag_vard(d, j->a.q + 2));
-        rows[0] = dag_add(d, dag_vard(d, j->a.q), roll);
-        return;
-    }
-    /* knife J: n_A . d/dt(P_A) (no velocity across the blade) */
-    case JOINT_KNIFE: {
-        Vec v = velocity(d, j->a);
-        Vec n = normal(d, j->a, j->ux, j->uy);
-        rows[0] = dot(d, n, v);
-        return;
-    }
-    case JOINT_S_SPHERICAL:
-    case JOINT_S_UNIVERSAL:
-    case JOINT_S_REVOLUTE:
-    case JOINT_S_CYLINDRICAL:
-    case JOINT_S_TRANSLATIONAL:
-    case JOINT_S_WELD:
-    case JOINT_S_DISTANCE:
-    case JOINT_S_POINTPLANE:
-    case JOINT_S_PARALLEL:
-    case JOINT_S_PERPENDICULAR:
-    case JOINT_S_ROLLING:
-    case JOINT_S_NORM:
-    case JOINT_S_CONTACT:
-        joints_spatial_lower(model, j, rows);
-        return;
-    case JOINT_KIND_COUNT:
-        break;
-    }
+    builders[j->kind](&model->dag, j, rows);
 }
 
 void joints_point(Model *model, Attach at, NodeId xy[2])

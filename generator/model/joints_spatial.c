@@ -25,7 +25,7 @@
  * node ids (the generated C's temporaries) do not depend on the order a
  * compiler evaluates a call's arguments in.
  */
-#include "model.h"
+#include "joint_builders.h"
 
 #include <math.h>
 
@@ -269,9 +269,44 @@ static void cylindrical(Dag *d, const Joint *j, const Frame3 *a, const Frame3 *b
     rows[3] = v3_dot(d, ga, e);
 }
 
+void lower_S_SPHERICAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    spherical(d, j, rows);
+}
+
+/* universal: spherical; .dot dot-1 hA^T hB = 0 */
+void lower_S_UNIVERSAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    spherical(d, j, rows);
+    rows[3] = axis_dot(d, a.h, b.h);
+}
+
+/* revolute: spherical; .f, .g parallel axes */
+void lower_S_REVOLUTE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    spherical(d, j, rows);
+    parallel(d, &a, &b, rows + 3);
+}
+
+void lower_S_CYLINDRICAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    cylindrical(d, j, &a, &b, rows);
+}
+
+/* translational: cylindrical; .rot dot-1 gA^T fB = 0 (no turning about h) */
+void lower_S_TRANSLATIONAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    cylindrical(d, j, &a, &b, rows);
+    rows[4] = axis_dot(d, a.g, b.f);
+}
+
 /* weld: .x .y .z spherical; .xy, .yz, .zx dot-1 xA^T yB, yA^T zB, zA^T xB
    (B's axes stay those of A: the relative orientation is the identity) */
-static void weld(Dag *d, const Joint *j, NodeId rows[6])
+void lower_S_WELD(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     spherical(d, j, rows);
     Axis3 xa = {j->a, {1, 0, 0}}, ya = {j->a, {0, 1, 0}}, za = {j->a, {0, 0, 1}};
@@ -279,6 +314,41 @@ static void weld(Dag *d, const Joint *j, NodeId rows[6])
     rows[3] = axis_dot(d, xa, yb);
     rows[4] = axis_dot(d, ya, zb);
     rows[5] = axis_dot(d, za, xb);
+}
+
+/* distance: d^T d - L^2 = 0, d = P_B - P_A; a length written as sqrt(u)
+   gives L^2 = u, without the square root and the divisions its
+   derivatives would bring into nu and gamma (a leg length from
+   closed-form inverse kinematics is one). */
+void lower_S_DISTANCE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Vec3 e = difference3(d, j->b, j->a);
+    const DagNode *len = dag_node(d, j->option);
+    NodeId l2 = len->op == OP_SQRT ? len->a : dag_mul(d, j->option, j->option);
+    NodeId ee = v3_dot(d, e, e);
+    rows[0] = dag_sub(d, ee, l2);
+}
+
+/* pointplane: dot-2 hA^T (P_B - P_A) = 0 */
+void lower_S_POINTPLANE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false);
+    Vec3 e = difference3(d, j->b, j->a);
+    Vec3 ha = axis_global(d, a.h);
+    rows[0] = v3_dot(d, ha, e);
+}
+
+void lower_S_PARALLEL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    parallel(d, &a, &b, rows);
+}
+
+/* perpendicular: dot-1 hA^T hB = 0 */
+void lower_S_PERPENDICULAR(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
+{
+    Frame3 a = frame3(j, false), b = frame3(j, true);
+    rows[0] = axis_dot(d, a.h, b.h);
 }
 
 /* omega = 2 E(p) p', E = [-e, e~ + e0 I]: a spatial body's angular velocity, global */
@@ -328,7 +398,7 @@ static Vec3 contact_offset(Dag *d, const Joint *j, NodeId *s_out)
 /* rolling (no slip on the plane z = 0), velocity level: the disk's material
    point at the contact, r' + omega x (R k), has no x and no y velocity:
    .x: x' + R (omega x k)_x = 0,  .y: y' + R (omega x k)_y = 0 */
-static void rolling(Dag *d, const Joint *j, NodeId rows[2])
+void lower_S_ROLLING(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     NodeId s;
     Vec3 ks = contact_offset(d, j, &s);
@@ -344,105 +414,25 @@ static void rolling(Dag *d, const Joint *j, NodeId rows[2])
 
 /* contact (the rolling disk's holonomic row) .h: the lowest rim point is on
    the plane, z + R k_z = z - R s = 0 */
-static NodeId contact(Dag *d, const Joint *j)
+void lower_S_CONTACT(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     NodeId s;
     contact_offset(d, j, &s);
     NodeId z = dag_var(d, j->a.q + 2);
     NodeId rs = dag_mul(d, j->option, s);
-    return dag_sub(d, z, rs);
+    rows[0] = dag_sub(d, z, rs);
 }
 
 /* body B .norm: e0^2 + e1^2 + e2^2 + e3^2 - 1 = 0 */
-static NodeId norm(Dag *d, Attach at)
+void lower_S_NORM(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     NodeId sum = DAG_ZERO;
     for (int i = 0; i < 4; i++) {
-        NodeId e = dag_var(d, at.q + 3 + i);
+        NodeId e = dag_var(d, j->a.q + 3 + i);
         NodeId ee = dag_mul(d, e, e);
         sum = dag_add(d, sum, ee);
     }
-    return dag_sub(d, sum, DAG_ONE);
-}
-
-/* The position-level kinds built on a frame pair. */
-static void framed(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
-{
-    Frame3 a = frame3(j, false);
-    Frame3 b = frame3(j, true);
-    switch (j->kind) {
-    /* universal: spherical; .dot dot-1 hA^T hB = 0 */
-    case JOINT_S_UNIVERSAL:
-        spherical(d, j, rows);
-        rows[3] = axis_dot(d, a.h, b.h);
-        return;
-    /* revolute: spherical; .f, .g parallel axes */
-    case JOINT_S_REVOLUTE:
-        spherical(d, j, rows);
-        parallel(d, &a, &b, rows + 3);
-        return;
-    case JOINT_S_CYLINDRICAL:
-        cylindrical(d, j, &a, &b, rows);
-        return;
-    /* translational: cylindrical; .rot dot-1 gA^T fB = 0 (no turning about h) */
-    case JOINT_S_TRANSLATIONAL:
-        cylindrical(d, j, &a, &b, rows);
-        rows[4] = axis_dot(d, a.g, b.f);
-        return;
-    /* pointplane: dot-2 hA^T (P_B - P_A) = 0 */
-    case JOINT_S_POINTPLANE: {
-        Vec3 e = difference3(d, j->b, j->a);
-        Vec3 ha = axis_global(d, a.h);
-        rows[0] = v3_dot(d, ha, e);
-        return;
-    }
-    case JOINT_S_PARALLEL:
-        parallel(d, &a, &b, rows);
-        return;
-    /* perpendicular: dot-1 hA^T hB = 0 */
-    case JOINT_S_PERPENDICULAR:
-        rows[0] = axis_dot(d, a.h, b.h);
-        return;
-    default:
-        return;
-    }
-}
-
-void joints_spatial_lower(Model *model, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
-{
-    Dag *d = &model->dag;
-    switch (j->kind) {
-    case JOINT_S_SPHERICAL:
-        spherical(d, j, rows);
-        return;
-    case JOINT_S_WELD:
-        weld(d, j, rows);
-        return;
-    /* distance: d^T d - L^2 = 0, d = P_B - P_A; a length written as
-       sqrt(u) gives L^2 = u, without the square root and the divisions
-       its derivatives would bring into nu and gamma (a leg length from
-       closed-form inverse kinematics is one). */
-    case JOINT_S_DISTANCE: {
-        Vec3 e = difference3(d, j->b, j->a);
-        const DagNode *len = dag_node(d, j->option);
-        NodeId l2 = len->op == OP_SQRT ? len->a : dag_mul(d, j->option, j->option);
-        NodeId ee = v3_dot(d, e, e);
-        rows[0] = dag_sub(d, ee, l2);
-        return;
-    }
-    case JOINT_S_ROLLING:
-        rolling(d, j, rows);
-        return;
-    case JOINT_S_CONTACT:
-        rows[0] = contact(d, j);
-        return;
-    case JOINT_S_NORM:
-        rows[0] = norm(d, j->a);
-        return;
-    default:
-        framed(d, j, rows);
-        return;
-    }
+    rows[0] = dag_sub(d, sum, DAG_ONE);
 }
 
 void joints_spatial_point(Model *model, Attach at, NodeId xyz[3])

@@ -47,9 +47,10 @@ typedef struct Row {
 } Row;
 
 /* A body or a point: the owner of the consecutive coordinates q .. q + nq - 1,
-   named NAME.x, NAME.y, then NAME.phi for a body that turns. Scalar coords
-   own no Body. Another kind of body (spatial) would add a kind and own more
-   coordinates; code that walks a body's coordinates uses nq. */
+   named NAME.x, NAME.y, then NAME.phi for a body that turns; in a spatial
+   file NAME.x, NAME.y, NAME.z, then a body's Euler parameters NAME.e0 ..
+   NAME.e3. Scalar coords own no Body. Code that walks a body's coordinates
+   uses nq. */
 typedef struct Body {
     const char *name;
     int q;              /* index of its x coordinate */
@@ -71,7 +72,7 @@ typedef struct ModelOutput {
     Attach at;
 } ModelOutput;
 
-/* A mass element (DYN.md): mass m at the point p = (px, py), expressions of
+/* A mass element: mass m at the point p = (px, py), expressions of
    q (a body's centre of mass r + A(phi) s, a particle's position, or an
    element's at(x, y)), and moment of inertia J about p for the angle theta.
    Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2.
@@ -94,16 +95,8 @@ typedef struct MassElement {
     double inertia[6];  /* J' in body axes: xx, yy, zz, xy, xz, yz */
 } MassElement;
 
-typedef enum ForceKind {
-    FORCE_POINT,        /* Q += p_q^T (fx, fy) */
-    FORCE_TORQUE,       /* Q += theta_q^T tau, theta = a, tau = fx */
-    FORCE_SPRING,       /* l = |B - A|, f = k (l - L0) + c ldot + fx, Q += -f l_q */
-    FORCE_RSPRING,      /* a = theta_B - theta_A, tau = k (a - a0) + c adot + fx, Q += -tau a_q */
-    FORCE_GENERAL,      /* Q[coord] += fx */
-    FORCE_BODY_TORQUE,  /* spatial: Q[e0..e3] += 2 E(e)^T (fx, fy, fz), e at coord */
-} ForceKind;
-
-/* An applied force, every kind by virtual work. Expressions (fx, fy) may
+/* An applied force, every kind by virtual work (its kind's maths:
+   generator/parse/forces.def). Expressions (fx, fy) may
    use q, der(q) and t. In a spatial file points and forces have z
    components too (az, bz, fz; DAG_ZERO in a planar file). */
 typedef struct AppliedForce {
@@ -165,10 +158,9 @@ char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag
 /* The file stem of a path: "dir/slider_crank.mech" -> "slider_crank". */
 char *model_file_stem(Arena *arena, const char *path);
 
-/* Lowers one joint's rows into the graph (generator/model/joints.c). */
+/* Lowers one joint's rows into the graph, by its kind's builder
+   (generator/model/joints.c, joints_spatial.c). */
 void joints_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
-/* The same for the spatial kinds (generator/model/joints_spatial.c). */
-void joints_spatial_lower(Model *model, const Joint *joint, NodeId rows_out[JOINT_MAX_ROWS]);
 /* A spatial axis (ux, uy, uz) made unit, h, and its perpendiculars f and g
    (the generic evaluator's formulas use the builder's very frame). */
 void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3]);

@@ -1,4 +1,4 @@
-/* ast.c - the joint vocabulary expanded from joints.def, and names for AST kinds. */
+/* ast.c - the joint and force vocabularies expanded from joints.def and forces.def, and names for AST kinds. */
 #include "ast.h"
 
 #include <string.h>
@@ -10,10 +10,12 @@ const JointInfo joint_info[JOINT_KIND_COUNT] = {
 #undef X
 };
 
-const char *const dyn_keywords[DYN_KIND_COUNT] = {
-    [DYN_MASS] = "mass", [DYN_FORCE] = "force", [DYN_TORQUE] = "torque",
-    [DYN_SPRING] = "spring", [DYN_RSPRING] = "rspring", [DYN_GFORCE] = "gforce",
-    [DYN_GRAVITY] = "gravity",
+const ForceInfo force_info[FORCE_KIND_COUNT] = {
+#define KEY(k) (1u << DKEY_##k)
+#define X(e, kw, own, na, frame, keys) [FORCE_##e] = {kw, own, na, frame, keys},
+#include "forces.def"
+#undef X
+#undef KEY
 };
 
 const char *const dyn_key_names[DKEY_COUNT] = {
@@ -37,6 +39,23 @@ int joint_kind_lookup(const char *word, int len, bool spatial)
             return k;
     }
     return -1;
+}
+
+int force_kind_lookup(const char *word, int len)
+{
+    for (int k = 0; k < FORCE_KIND_COUNT; k++) {
+        const char *kw = force_info[k].keyword;
+        if (force_info[k].own && (int)strlen(kw) == len && memcmp(kw, word, (size_t)len) == 0)
+            return k;
+    }
+    return -1;
+}
+
+const char *dyn_keyword(const Stmt *s)
+{
+    if (s->kind == STMT_FORCE)
+        return force_info[s->force].keyword;
+    return s->kind == STMT_MASS ? "mass" : "gravity";
 }
 
 int joint_kind_from_keyword(const char *word, int len)

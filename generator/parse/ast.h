@@ -91,21 +91,12 @@ typedef enum StmtKind {
     STMT_COORD,         /* coord NAME [= value] */
     STMT_JOINT,         /* KIND NAME: operands [axis(ux, uy)] [option = e] */
     STMT_OUTPUT,        /* output NAME = e  |  output NAME: attachment */
-    STMT_DYNAMICS,      /* a mass, force or gravity statement (DynKind) */
+    STMT_MASS,          /* mass BODY m = .. [J = ..] [com(sx, sy)]  |  mass NAME: at(X, Y) m = .. [J = .. angle = ..] */
+    STMT_GRAVITY,       /* gravity (gx, gy) */
+    STMT_FORCE,         /* an applied force element (ForceKind) */
 } StmtKind;
 
-/* ---- dynamics statements: masses and applied forces (no rows) ---- */
-
-typedef enum DynKind {
-    DYN_MASS,       /* mass BODY m = .. [J = ..] [com(sx, sy)]  |  mass NAME: at(X, Y) m = .. [J = .. angle = ..] */
-    DYN_FORCE,      /* force NAME: ATTACHMENT (fx, fy) */
-    DYN_TORQUE,     /* torque NAME: BODY = e  |  torque NAME: angle(e) = e */
-    DYN_SPRING,     /* spring NAME: A B [k = ..] [c = ..] [length = ..] [force = ..] */
-    DYN_RSPRING,    /* rspring NAME: A B [k = ..] [c = ..] [angle = ..] [torque = ..] */
-    DYN_GFORCE,     /* gforce NAME: COORDINATE = e */
-    DYN_GRAVITY,    /* gravity (gx, gy) */
-    DYN_KIND_COUNT
-} DynKind;
+/* ---- dynamics statements: masses, gravity and applied forces (no rows) ---- */
 
 /* The `key = value` options of the dynamics statements. */
 typedef enum DynKey {
@@ -114,7 +105,26 @@ typedef enum DynKey {
     DKEY_COUNT
 } DynKey;
 
-extern const char *const dyn_keywords[DYN_KIND_COUNT];
+typedef enum ForceKind {
+#define X(e, kw, own, na, frame, keys) FORCE_##e,
+#include "forces.def"
+#undef X
+    FORCE_KIND_COUNT
+} ForceKind;
+
+typedef struct ForceInfo {
+    const char *keyword;
+    bool own;           /* the keyword names this kind (not a form of another's) */
+    int attachments;
+    bool frame;         /* its attachments are bodies' angles */
+    unsigned keys;      /* 1 << DynKey for each key it takes */
+} ForceInfo;
+
+extern const ForceInfo force_info[FORCE_KIND_COUNT];
+
+/* The force kind a statement keyword names, or -1. */
+int force_kind_lookup(const char *word, int len);
+
 extern const char *const dyn_key_names[DKEY_COUNT];
 
 /* A spatial body's initial orientation, as written. */
@@ -155,11 +165,11 @@ typedef struct Stmt {
     Ast *lhs, *rhs;         /* JOINT with attachments == 0 */
     SrcPos eq_pos;
 
-    DynKind dyn;            /* DYNAMICS; attach[] its attachments, value its
+    ForceKind force;        /* FORCE; attach[] its attachments, value its
                                torque or generalised force, lhs a torque's
                                angle(e) or gforce's coordinate */
-    bool declares;          /* DYNAMICS: name is declared (mass NAME: ...) */
-    Ast *key[DKEY_COUNT];   /* DYNAMICS: key = value (NULL: absent) */
+    bool declares;          /* MASS, FORCE: name is declared (mass NAME: ...) */
+    Ast *key[DKEY_COUNT];   /* MASS, FORCE: key = value (NULL: absent) */
     SrcPos key_pos[DKEY_COUNT];
     Ast *vec[3];            /* force (fx, fy), gravity (gx, gy), com(sx, sy);
                                spatial: three components, and a body's torque */
@@ -178,5 +188,7 @@ typedef struct Program {
 
 /* A readable name for an AST kind, for messages. */
 const char *ast_describe(const Ast *ast);
+/* The keyword of a mass, gravity or force statement, for messages. */
+const char *dyn_keyword(const Stmt *s);
 
 #endif
