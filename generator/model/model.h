@@ -47,9 +47,9 @@ typedef struct Row {
 } Row;
 
 /* A body or a point: the owner of the consecutive coordinates q .. q + nq - 1,
-   named NAME.x, NAME.y, then NAME.phi for a body that turns. Scalar coords
-   own no Body. Another kind of body (spatial) would add a kind and own more
-   coordinates; code that walks a body's coordinates uses nq. */
+   named NAME.x, NAME.y, then NAME.phi for a body that turns (a spatial
+   one: NAME.x, NAME.y, NAME.z, then its Euler parameters NAME.e0 .. e3).
+   Scalar coords own no Body; code that walks a body's coordinates uses nq. */
 typedef struct Body {
     const char *name;
     int q;              /* index of its x coordinate */
@@ -71,7 +71,7 @@ typedef struct ModelOutput {
     Attach at;
 } ModelOutput;
 
-/* A mass element (DYN.md): mass m at the point p = (px, py), expressions of
+/* A mass element (doc/dynamics.md): mass m at the point p = (px, py), expressions of
    q (a body's centre of mass r + A(phi) s, a particle's position, or an
    element's at(x, y)), and moment of inertia J about p for the angle theta.
    Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2.
