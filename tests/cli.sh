@@ -297,7 +297,7 @@ check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
 check "gen --prefix int (a C keyword) exits 2" status_is 2
 
-# ---- gen --roll: loops for joints of one shape (README "Loop-rolled code")
+# ---- gen --roll: loops for joints of one shape (doc/figures.md, "Loop-rolled code")
 sh "$ex/chain.sh" 90 "$tmp/chain90.mech"
 run gen "$tmp/chain90.mech" -o "$tmp/ch_auto.c"
 check "gen --roll auto (default) rolls a chain of 543 rows" grep -q "one shape: one loop" "$tmp/ch_auto.c"

@@ -1,11 +1,12 @@
 #!/bin/sh
 # tests/doc_links.sh MECHC - the documentation cites only what exists: in
-# README.md, doc/*.md and examples/README.md every relative link (and
+# README.md, doc/*.md and the other Markdown pages every relative link (and
 # image) names a file of the repository, every #anchor a heading of its
 # target (GitHub's slugs), and every backticked repository path (a span
 # with no blank whose first part is a top-level entry, say
-# `generator/emit/emit.c` or `runtime/*.c`) exists. Fenced code blocks
-# are not read. MECHC is not run; it is taken for the harness only.
+# `generator/emit/emit.c` or `runtime/*.c`) exists, or is a program built
+# from its .c (`tests/browser/pngdiff`). Fenced code blocks are not
+# read. MECHC is not run; it is taken for the harness only.
 #
 #   sh tests/doc_links.sh build/mechc
 set -u
@@ -14,7 +15,7 @@ set -u
 suite_begin doc_links "${1:-build/mechc}"
 cd "$root" || exit 2
 
-docs="README.md examples/README.md"
+docs="README.md examples/README.md examples/RENDERING.md examples/firmware/README.md tests/fuzz/README.md"
 for f in doc/*.md; do [ -f "$f" ] && docs="$docs $f"; done
 
 # Every heading's slug, as "FILE#slug", for every Markdown file cited.
@@ -67,7 +68,7 @@ function normal(p,    n, part, out, i, k) {   # a/b/../c -> a/c
     return p
 }
 function exists(p,    re, f) {
-    if (p in have) return 1
+    if (p in have || (p ".c") in have) return 1    # or a program built from p.c
     if (p !~ /[*?]/) return 0
     re = p
     gsub(/\./, "\\.", re); gsub(/\*/, "[^/]*", re); gsub(/\?/, "[^/]", re)
