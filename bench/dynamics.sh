@@ -24,7 +24,7 @@
 # 3. `mechc bench` on Andrews, the double pendulum, A02 and two spatial
 #    files (heavy_top, slider_crank_spatial_torque): ns per call of
 #    mass, force, m+q (both) and eom for generic, jit and aot, and the
-#    speed-ups generated / generic against the targets (3x jit,
+#    speed-ups generated / generic against the targets (3x jit,
 #    5x aot).
 # POSIX sh and awk only.
 set -u

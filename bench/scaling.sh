@@ -2,7 +2,7 @@
 # bench/scaling.sh MECHC - how `mechc run` grows with the mechanism: chains
 # of N four-bar loops (examples/chain.sh N, 6N + 3 coordinates), run with
 # the dense LU and with the sparse one (KLU) for N = 10, 100, 1000 and
-# 10 000, then the issue-15 target run.
+# 10 000, then the target run (doc/figures.md, Loop-rolled code).
 #
 #   sh bench/scaling.sh build/mechc                    (part of `make bench`)
 #   SIZES="10 100 1000 3000" STEPS=100 sh bench/scaling.sh build/mechc
@@ -114,7 +114,7 @@ for n in $sizes; do
 done
 
 echo
-echo "target (issue 15): chain N = $target_n, mechc run --steps 1000 (auto), whole command"
+echo "target: chain N = $target_n, mechc run --steps 1000 (auto), whole command"
 sh "$here/../examples/chain.sh" "$target_n" "$tmp/target.mech" || exit 2
 timed "$tmp/s" "$tmp/target.mech" --steps 0 --csv /dev/null
 read -r wall user sys rss < "$tmp/s.time"

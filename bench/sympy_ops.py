@@ -38,7 +38,7 @@ def main():
     print("%-8s %8s %8s" % ("function", "mechc", "sympy"))
     for k in ("phi", "jac", "nu", "gamma", "all"):
         print("%-8s %8s %8d" % (k, ours.get(k, "?"), counts[k]))
-    # issue 17's yardstick: the Jacobian's nonzeros and gamma together
+    # the yardstick: the Jacobian's nonzeros and gamma together
     if "jac" in ours and "gamma" in ours:
         mine = int(ours["jac"]) + int(ours["gamma"])
         theirs = counts["jac"] + counts["gamma"]

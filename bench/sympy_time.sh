@@ -11,7 +11,7 @@
 # built with gcc -O2 -fPIC -shared; bench/sympy_time.c checks they agree to
 # 1e-12 and times phi, jac_nz and gamma of both, interleaved, in thread CPU
 # time (medians of REPEAT rounds). Printed per kernel: ns per call of
-# mechc and of SymPy, their ratio (issue 18's target: at most 0.8), and the
+# mechc and of SymPy, their ratio (the target: at most 0.8), and the
 # ratio of what lies above the trig floor (sin and cos of every angle, the
 # time that both must spend), and what the target leaves for everything
 # but the trig: 0.8 SymPy - trig (negative: 0.8 is out of reach however

@@ -180,7 +180,7 @@ bad_input unknown_function  2 15 'point m x = 1\nconstraint c: foo(m.x) = 0\n' "
 bad_input missing_colon     2 14 'point m x = 1\ndistance rod ground m length = 2\n' "':'"
 bad_input no_coordinates    1 1  'param a = 1\n' "no coordinates"
 bad_input tab_indent        2 22 'point m x = 1\n\tconstraint c: m.x = q\n' "unknown name 'q'"
-# masses and forces (issue 16)
+# masses and forces (doc/dynamics.md)
 pin='body a x = 1\npoint p\nrevolute O: ground a\n'
 bad_input negative_mass     4 8  "${pin}mass a m = -2\n" "the mass m of mass 'a' is negative"
 bad_input negative_inertia  4 14 "${pin}mass a m = 1 J = -1\n" "moment of inertia J of mass 'a' is negative"
@@ -199,7 +199,7 @@ check "gen on bad input writes no file" [ ! -e "$tmp/genbad.c" ]
 run gen "$tmp/genbad.mech"
 check "gen on bad input: nothing on stdout" out_empty
 
-# ---- dynamics (issue 16): eval's M and Q, gen's kernels only with masses ----
+# ---- dynamics (doc/dynamics.md): eval's M and Q, gen's kernels only with masses ----
 run eval examples/pendulum_dynamics.mech --qd 0,0,2 --json
 check "eval dynamics: exit 0" status_is 0
 check "eval dynamics: M's last row" grep -q '\[0.8660254037844386, 0.5000000000000001, 0.6666666666666666\]' "$tmp/out"
@@ -297,7 +297,7 @@ check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
 check "gen --prefix int (a C keyword) exits 2" status_is 2
 
-# ---- gen --roll: loops for joints of one shape (README "Loop-rolled code")
+# ---- gen --roll: loops for joints of one shape (doc/figures.md, "Loop-rolled code")
 sh "$ex/chain.sh" 90 "$tmp/chain90.mech"
 run gen "$tmp/chain90.mech" -o "$tmp/ch_auto.c"
 check "gen --roll auto (default) rolls a chain of 543 rows" grep -q "one shape: one loop" "$tmp/ch_auto.c"
@@ -314,7 +314,7 @@ if have gcc; then
     check "gcc compiles gen --roll auto output" gcc $cflags -c "$tmp/ch_auto.c" -o "$tmp/ch_auto.o"
 fi
 
-# ---- spatial mechanisms (issue 14): gen, eval, check and bench work on them
+# ---- spatial mechanisms (doc/spatial.md): gen, eval, check and bench work on them
 for f in rssr all_spatial slider_crank_spatial rolling_disk; do
     run check "$ex/$f.mech" --samples 4
     check "check $f (spatial): derivatives, engines agree (exit 0)" status_is 0

@@ -149,7 +149,7 @@ else
     skip "python3 not found: JSON parse checks"
 fi
 
-# ---- spatial mechanisms (issue 14) ----------------------------------------
+# ---- spatial mechanisms (doc/spatial.md) ---------------------------------
 # Bricard: the count says it cannot move, the rank finds one redundant row
 # and 1 DOF (examples/bricard.mech's header)
 run info "$ex/bricard.mech"
@@ -181,7 +181,7 @@ check "rssr: 1 DOF without its driver" out_has "without its 1 driver: 1 DOF by t
 sed -E 's/^(body +[A-Za-z_0-9]+).*/\1/' "$ex/four_bar.mech" > "$tmp/fb0.mech"
 run info "$tmp/fb0.mech" --json
 check "info from every guess 0: assembled" out_has '"assembled": true'
-# ---- info at a given state (issue 19): --at T, --state FILE.csv ----------
+# ---- info at a given state: --at T, --state FILE.csv ----------------------
 # The A02 chain of 40 parallelograms driven flat at t = 0.25: every loop
 # folds at once, the holonomic rows lose 40 ranks and 40 rows turn
 # dependent (beyond 100 coordinates: SuiteSparseQR).
@@ -289,7 +289,7 @@ check "--state with velocity-level rows: the integrated state (cart.y = 1, not 0
 check "--state with velocity-level rows: the knife is free in 3 directions" \
     out_has "directions the rows leave free (3;"
 
-# ---- --linear: SuiteSparseQR gives the dense SVD's verdicts (issue 15) ----
+# ---- --linear: SuiteSparseQR gives the dense SVD's verdicts (doc/large.md) --
 for f in "$ex"/*.mech; do
     n=$(basename "$f" .mech)
     "$mechc" info "$f" --json --linear dense > "$tmp/$n.dense.json" 2>/dev/null

@@ -35,7 +35,7 @@ near() {
     awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= tol) }'
 }
 
-# ---- spatial mechanisms (issue 14) ----------------------------------------
+# ---- spatial mechanisms (doc/spatial.md) ---------------------------------
 # slider_crank_spatial.mech equals slider_crank.mech: x, y of every body,
 # phi = 2 atan2(e3, e0) (mod 2 pi), d(phi) = 2 (e0 e3' - e3 e0') = wz and
 # dd(phi) = 2 (e0 e3'' - e3 e0''), every step, to 1e-12
@@ -325,7 +325,7 @@ else
     skip "python3 missing: JSON checks"
 fi
 
-# ---- through singular positions (issue 19) ----------------------------------
+# ---- through singular positions (doc/singular.md) -------------------------
 # The toggle slider-crank (r = l) meets the branch x = 0 at t = 0.25 and
 # 0.75 and goes on along the smooth one it came on, x = 2 r cos(2 pi t).
 run "$ex/slider_crank_toggle.mech" --stats
@@ -338,7 +338,7 @@ check "toggle: d(slider.x) = -2 r omega at t = 0.25" \
 check "toggle --stats: the two steps by the rank-revealing corrector" \
     err_has "2 steps through singular positions by the rank-revealing corrector"
 
-# IFToMM A02, the issue's reproduction: a chain of 40 parallelograms
+# IFToMM A02, the reproduction of the singular-position failure: a chain of 40 parallelograms
 # turned through a full turn, flat at t = 0.25 and 0.75 (on the grid).
 sh "$ex/chain.sh" 40 "$tmp/c40.mech"
 sed -e 's/^driver drive: rod0.phi = .*/driver drive: rod0.phi = pi\/2 - 2*pi*t/' "$tmp/c40.mech" \
@@ -646,7 +646,7 @@ else
     skip "cc missing: firmware build"
 fi
 
-# ---- inverse dynamics: run --forces (issue 16) -----------------------------
+# ---- inverse dynamics: run --forces (doc/dynamics.md) ----------------------
 # slider_crank_torque.mech: effort(D) = -lambda(D) at theta = 30 k degrees
 # (t = k/12) is the crank torque of its header's reference table (REFS.md
 # section 3), with gravity and, with g set to 0, without; to 1e-9 relative

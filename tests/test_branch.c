@@ -333,7 +333,7 @@ static void expect_ok(const Collected *c, int steps)
     assert_int_equal((int)c->trace.rows, steps + 1);
 }
 
-/* The targets of issue 19: angles 1e-8, rates 1e-6, accelerations 1e-4
+/* The targets (doc/singular.md): angles 1e-8, rates 1e-6, accelerations 1e-4
    at every one of 400 steps, t = 0.25 and 0.75 (flat) on the grid; the
    two flat states by the corrector, rank-deficient by N = 40. */
 static void test_a02_chain(void **state)

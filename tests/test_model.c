@@ -32,7 +32,7 @@ static const BadInput bad_inputs[] = {
     {"coord c\nrolling R: c radius = 1\n", 2, 12, "rolling attaches to a body"},
     {"coord c\nbody b\nprismatic P: c b axis(1,0)\n", 3, 14, "prismatic attaches to bodies or ground"},
     {"param k = 1\nbody b\nrevolute R: k b\n", 3, 13, "revolute attaches to bodies, points or ground"},
-    /* spatial files (issue 14): the `spatial` statement, the dimension of
+    /* spatial files (doc/spatial.md): the `spatial` statement, the dimension of
        every statement, axes and orientations */
     {"body b\nspatial\n", 2, 1, "'spatial' must be the first statement"},
     {"mechanism m\nspatial\nspatial\n", 3, 1, "a second 'spatial' statement (the first is on line 2)"},

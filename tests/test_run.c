@@ -633,7 +633,7 @@ static void test_assembly_from_zero_guesses(void **state)
     }
     assert_true(assembled >= 60);
     assert_true(refused >= 4);
-    /* issue 21's target: at most twice the 2 iterations of the example's
+    /* the target: at most twice the 2 iterations of the example's
        own guesses (the answer to four decimals) */
     print_message("worst assembly: %d Newton iterations\n", worst_iterations);
     assert_true(worst_iterations <= 4);

@@ -1094,7 +1094,7 @@ static void test_kernel_wrappers(void **state)
 /* ---- pattern LU -----------------------------------------------------------
  * mechrt_lup_* against lu.c on the same matrices: by design the same
  * operations in the same order, so the comparisons are exact (==), which
- * is stronger than the 1e-12 of issue 17. */
+ * is stronger than the 1e-12 first asked of it. */
 
 /* A random n x n pattern (density about d, the diagonal always in) with
    values; row-major entries, as the generated kernels list them. */

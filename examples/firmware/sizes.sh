@@ -7,7 +7,7 @@
 # values, the name tables, the sparsity pattern); then the runtime core
 # (runtime/lu.c, newton.c, analysis.c) built the same way; then the two
 # images of this folder's Makefile, whole (newlib's printf and semihosting
-# included). Prints Markdown tables (pasted into README.md). The workspace
+# included). Prints Markdown tables (pasted into this folder's README.md). The workspace
 # column is the static array a program reserves for mechrt_step:
 # MECHRT_WORKSPACE_LEN(NQ, NR) reals, in bytes.
 #

@@ -27,7 +27,7 @@ typedef enum RunLinear { RUN_LINEAR_AUTO, RUN_LINEAR_DENSE, RUN_LINEAR_SPARSE } 
 extern const char *const run_linear_names[];
 
 /* auto stays dense up to this many coordinates, sparse above: near the
-   crossover measured on examples/chain.sh chains (README, Performance),
+   crossover measured on examples/chain.sh chains (doc/figures.md, "Size: dense against sparse"),
    where the dense LU's O(n^3) starts to cost more than KLU's overhead. */
 #define RUN_DENSE_MAX_NQ 100
 #define RUN_DENSE_MAX_NQ_TEXT "100"     /* the same, for --help */

@@ -6,9 +6,10 @@
 static const char usage[] =
     "usage: mechc COMMAND FILE.mech [options]\n"
     "\n"
-    "mechc compiles a planar mechanism, written as a joint list, into C for its\n"
-    "constraints Phi, Jacobian Phi_q and the velocity and acceleration right sides\n"
-    "nu and gamma, and runs kinematic analysis with it.\n"
+    "mechc compiles a planar or spatial mechanism, written as a joint list, into C\n"
+    "for its constraints Phi, Jacobian Phi_q and the velocity and acceleration right\n"
+    "sides nu and gamma (with masses also M(q) and Q(q, qd, t)), and runs kinematics\n"
+    "and dynamics, forward and inverse, with it.\n"
     "\n"
     "commands:\n"
     "  gen     write the generated C (and header)\n"

@@ -434,7 +434,7 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
            1.04-1.05x its --trig libm twin under gcc -O0 rather than
            1.11-1.12x, and 3-5% faster under gcc -O2; the other functions
            lost up to 3% so, and one-part gammas up to 10% (Andrews',
-           gcc -O2) (README, "Written files") */
+           gcc -O2) (doc/figures.md, "Written files") */
         if (sched_function(&e->sched, outs, n, &fn)) {
             e->fused = 0;
             e->trig.place_as_calls = f == EMIT_GAMMA && e->trig.sin_name && fn.nchunks > 1;

@@ -27,7 +27,7 @@ typedef struct Kernels {
     KernelGamma gamma;
     KernelAll all, all_nz;
     const int *jac_row, *jac_col;
-    /* Dynamics (DYN.md), NULL unless the file has masses: M (nq*nq dense),
+    /* Dynamics (doc/dynamics.md), NULL unless the file has masses: M (nq*nq dense),
        its nonzeros and their pattern, Q, and the fused M, Q, jac, gamma. */
     KernelMass mass, mass_nz;
     KernelGamma force;

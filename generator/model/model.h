@@ -72,7 +72,7 @@ typedef struct ModelOutput {
     Attach at;
 } ModelOutput;
 
-/* A mass element: mass m at the point p = (px, py), expressions of
+/* A mass element (doc/dynamics.md): mass m at the point p = (px, py), expressions of
    q (a body's centre of mass r + A(phi) s, a particle's position, or an
    element's at(x, y)), and moment of inertia J about p for the angle theta.
    Its kinetic energy is 1/2 m |p_q qd|^2 + 1/2 J (theta_q qd)^2.
