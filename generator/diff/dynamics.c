@@ -1,11 +1,7 @@
 /* dynamics.c - the mass matrix M(q) and the force vector Q(q, qd, t) as graph nodes, by symbolic differentiation.
  *
  * Every mass statement is a mass element: mass m at p(q), moment of inertia
-<<<<<<< HEAD
- * J about it for the angle theta(q). With T = 1/2 m |p_q qd|^2 +
-=======
  * J about it for the angle theta(q) (doc/dynamics.md). With T = 1/2 m |p_q qd|^2 +
->>>>>>> docs
  * 1/2 J (theta_q qd)^2, Lagrange's equations give
  *
  *   M += m p_q^T p_q + J theta_q^T theta_q
@@ -96,11 +92,7 @@ static NodeId dot2(Dag *d, NodeId a, NodeId b, NodeId c, NodeId e)
     return dag_add(d, ab, ce);
 }
 
-<<<<<<< HEAD
-/* A planar body's own mass, the formula worked out (the above with
-=======
 /* A planar body's own mass, the formula worked out (doc/dynamics.md's with
->>>>>>> docs
    p = r + A(phi) s, u = A(phi) s, p_phi = B s = (-u_y, u_x), w = phi'):
    M(x, x) = M(y, y) = m, M(x, phi) = -m u_y, M(y, phi) = m u_x,
    M(phi, phi) = J + m s.s; velocity terms m u w^2 on (x, y), none on phi

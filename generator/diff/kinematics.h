@@ -10,11 +10,7 @@ typedef struct JacEntry {
 } JacEntry;
 
 /* The equations of motion M(q) qdd + Phi_q^T lambda = Q(q, qd, t) of a
-<<<<<<< HEAD
-   model with masses (generator/diff/dynamics.c). */
-=======
    model with masses (generator/diff/dynamics.c, doc/dynamics.md). */
->>>>>>> docs
 typedef struct Dynamics {
     bool present;       /* the model has masses; nothing below otherwise */
     JacEntry *mass;     /* M's structural nonzeros, row-major, both triangles
