@@ -11,7 +11,7 @@
 #include "cli.h"
 
 #include "../analysis/run.h"
-#include "../analysis/sim.h"
+#include "../dyn/sim.h"
 #include "../base/arena.h"
 #include "run_output.h"
 
