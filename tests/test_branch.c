@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../generator/analysis/run.h"
+#include "../generator/kin/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"

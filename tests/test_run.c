@@ -19,8 +19,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../generator/analysis/outputs.h"
-#include "../generator/analysis/run.h"
+#include "../generator/kin/outputs.h"
+#include "../generator/kin/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"

@@ -2,7 +2,7 @@
 #include "cli.h"
 
 #include "../analysis/info.h"
-#include "../analysis/run.h"
+#include "../kin/run.h"
 #include "../base/arena.h"
 #include "state_csv.h"
 

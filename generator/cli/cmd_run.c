@@ -8,8 +8,8 @@
  */
 #include "cli.h"
 
-#include "../analysis/outputs.h"
-#include "../analysis/run.h"
+#include "../kin/outputs.h"
+#include "../kin/run.h"
 #include "../base/arena.h"
 #include "run_output.h"
 #include "run_table.h"

@@ -10,7 +10,7 @@
  */
 #include "cli.h"
 
-#include "../analysis/run.h"
+#include "../kin/run.h"
 #include "../dyn/sim.h"
 #include "../base/arena.h"
 #include "run_output.h"

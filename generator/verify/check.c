@@ -69,7 +69,7 @@
 #include "../analysis/assemble.h"
 #include "../analysis/construct.h"
 #include "../base/rng.h"
-#include "../analysis/run.h"
+#include "../kin/run.h"
 
 #include <math.h>
 #include <stdint.h>
