@@ -1,4 +1,4 @@
-/* test_run.c - kinematic analysis over time (generator/analysis/run.c, runtime/host/).
+/* test_run.c - kinematic analysis over time (generator/kin/, runtime/host/).
  *
  * Drives run_analysis on the examples and checks the states it delivers
  * against closed forms: the slider-crank's slider position, velocity and

@@ -1,4 +1,4 @@
-/* test_sim.c - forward and inverse dynamics (runtime/dynamics.c) and the simulation (sim.c) on hand-written kernels. */
+/* test_sim.c - forward and inverse dynamics (runtime/dynamics.c) and the simulation (generator/dyn/) on hand-written kernels. */
 #include "testutil.h"
 
 #include "../generator/dyn/sim.h"

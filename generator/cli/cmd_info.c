@@ -1,7 +1,7 @@
 /* cmd_info.c - mechc info: coordinates, rows, mobility, rank, redundant rows, singularity, integrability. */
 #include "cli.h"
 
-#include "../analysis/info.h"
+#include "../structure/info.h"
 #include "../kin/run.h"
 #include "../base/arena.h"
 #include "state_csv.h"
