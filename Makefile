@@ -22,7 +22,7 @@ KLU_CFLAGS := $(shell pkg-config --cflags klu 2>/dev/null || echo -I/usr/include
 KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig)
 CFLAGS_TOOL += $(KLU_CFLAGS)
 # SuiteSparseQR, the sparse rank-revealing QR of `info` at scale
-# (generator/analysis/spqr_rank.c): C++ inside, hence libstdc++. It goes
+# (generator/structure/spqr_rank.c): C++ inside, hence libstdc++. It goes
 # after -lgslcblas: CHOLMOD pulls in the system BLAS, whose cblas_* would
 # otherwise be found before GSL's and change the SVD's last digits.
 SPQR_LIBS  := $(shell pkg-config --libs spqr cholmod 2>/dev/null || echo -lspqr -lcholmod) -lstdc++

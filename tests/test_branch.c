@@ -1,4 +1,4 @@
-/* test_branch.c - kinematic analysis through change points and dead centres (runtime/rank.c, runtime/qr.c, run.c).
+/* test_branch.c - kinematic analysis through change points and dead centres (runtime/rank.c, runtime/qr.c, generator/kin/).
  *
  * The rank-revealing QR against known minimum-norm solutions, and the
  * corrector on a hand-written parallelogram at its fold (double and, at
@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../generator/analysis/run.h"
+#include "../generator/kin/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"

@@ -9,7 +9,7 @@
 #include "testutil.h"
 #include "testcache.h"
 
-#include "../generator/analysis/check.h"
+#include "../generator/verify/check.h"
 #include "../generator/base/arena.h"
 #include "../generator/engine/aot.h"
 

@@ -16,7 +16,7 @@
 #include "testdyn.h"
 #include "testload.h"
 
-#include "../generator/analysis/check.h"
+#include "../generator/verify/check.h"
 #include "../generator/base/arena.h"
 #include "../generator/base/rng.h"
 #include "../generator/engine/aot.h"

@@ -2,9 +2,9 @@
    minimum-norm assembly, singular positions, integrability and the laws. */
 #include "testutil.h"
 
-#include "../generator/analysis/info.h"
+#include "../generator/structure/info.h"
 #include "../generator/analysis/mech_eval.h"
-#include "../generator/analysis/spqr_rank.h"
+#include "../generator/structure/spqr_rank.h"
 #include "../generator/analysis/svd.h"
 #include "../generator/base/limits.h"
 

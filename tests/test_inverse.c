@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../generator/analysis/run.h"
+#include "../generator/kin/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/engine/engine.h"
 #include "../generator/render/reactions.h"

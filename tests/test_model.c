@@ -1,7 +1,7 @@
 /* test_model.c - the model builder's input errors (names, attachments, joint sanity, row levels), its body table, and option parsing. */
 #include "testutil.h"
 
-#include "../generator/analysis/outputs.h"
+#include "../generator/kin/outputs.h"
 #include "../generator/cli/cli.h"
 #include "../generator/model/orient.h"
 #include "../generator/pipeline/pipeline.h"

@@ -1,4 +1,4 @@
-/* test_run.c - kinematic analysis over time (generator/analysis/run.c, runtime/host/).
+/* test_run.c - kinematic analysis over time (generator/kin/, runtime/host/).
  *
  * Drives run_analysis on the examples and checks the states it delivers
  * against closed forms: the slider-crank's slider position, velocity and
@@ -19,8 +19,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../generator/analysis/outputs.h"
-#include "../generator/analysis/run.h"
+#include "../generator/kin/outputs.h"
+#include "../generator/kin/run.h"
 #include "../generator/base/arena.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"

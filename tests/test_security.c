@@ -25,7 +25,7 @@
 #include "../generator/base/arena.h"
 #include "../generator/base/diag.h"
 #include "../generator/base/limits.h"
-#include "../generator/analysis/info.h"
+#include "../generator/structure/info.h"
 #include "../generator/base/strbuf.h"
 #include "../generator/emit/emit.h"
 #include "../generator/pipeline/pipeline.h"

@@ -1,7 +1,7 @@
-/* test_sim.c - forward and inverse dynamics (runtime/dynamics.c) and the simulation (sim.c) on hand-written kernels. */
+/* test_sim.c - forward and inverse dynamics (runtime/dynamics.c) and the simulation (generator/dyn/) on hand-written kernels. */
 #include "testutil.h"
 
-#include "../generator/analysis/sim.h"
+#include "../generator/dyn/sim.h"
 #include "../runtime/mechrt.h"
 
 #include <gsl/gsl_linalg.h>

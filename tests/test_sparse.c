@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../generator/analysis/run.h"
+#include "../generator/kin/run.h"
 #include "../generator/jit/jit.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"

@@ -1,7 +1,7 @@
 /* cmd_check.c - mechc check: derivatives against finite differences, engines against each other. */
 #include "cli.h"
 
-#include "../analysis/check.h"
+#include "../verify/check.h"
 
 #include <limits.h>
 #include <math.h>

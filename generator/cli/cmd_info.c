@@ -1,8 +1,8 @@
 /* cmd_info.c - mechc info: coordinates, rows, mobility, rank, redundant rows, singularity, integrability. */
 #include "cli.h"
 
-#include "../analysis/info.h"
-#include "../analysis/run.h"
+#include "../structure/info.h"
+#include "../kin/run.h"
 #include "../base/arena.h"
 #include "state_csv.h"
 

@@ -1,15 +1,15 @@
 /* cmd_run.c - mechc run: assembly, then position, velocity and acceleration analysis over time.
  *
  * Parses the options, loads the mechanism, opens the engine and hands the
- * rest to run_analysis (generator/analysis/run.c), whose states stream to
+ * rest to run_analysis (generator/kin/run.c), whose states stream to
  * the CSV writer or are collected for JSON (runtime/host/output.c). On a
  * failure the states computed before it are still written, JSON included
  * ("ok": false and the error), and the message goes to stderr.
  */
 #include "cli.h"
 
-#include "../analysis/outputs.h"
-#include "../analysis/run.h"
+#include "../kin/outputs.h"
+#include "../kin/run.h"
 #include "../base/arena.h"
 #include "run_output.h"
 #include "run_table.h"

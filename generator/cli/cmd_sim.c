@@ -1,7 +1,7 @@
 /* cmd_sim.c - mechc sim: forward dynamics over time of a mechanism with masses.
  *
  * Parses the options, loads the mechanism, opens the engine and hands the
- * rest to sim_run (generator/analysis/sim.c). The states go out as run's
+ * rest to sim_run (generator/dyn/sim.c). The states go out as run's
  * do, through run's output module (run_output.c): the same CSV columns and
  * JSON keys, the file's outputs beside the coordinates, the same animation
  * and chart writers; JSON adds the multipliers ("rows", "lambda"). On a
@@ -10,8 +10,8 @@
  */
 #include "cli.h"
 
-#include "../analysis/run.h"
-#include "../analysis/sim.h"
+#include "../kin/run.h"
+#include "../dyn/sim.h"
 #include "../base/arena.h"
 #include "run_output.h"
 

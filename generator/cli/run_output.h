@@ -5,7 +5,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
-#include "../analysis/outputs.h"
+#include "../kin/outputs.h"
 #include "../model/model.h"
 #include "../render/progress.h"
 #include "../render/svg_anim.h"

@@ -63,7 +63,7 @@ typedef struct Body {
 
 /* A value reported beside the coordinates (an `output` statement): an
    expression of q and t; its velocity and acceleration come from its
-   derivatives along the motion (generator/analysis/outputs.h). */
+   derivatives along the motion (generator/kin/outputs.h). */
 typedef struct ModelOutput {
     const char *name;   /* NAME, or NAME.x and NAME.y for a point */
     NodeId expr;

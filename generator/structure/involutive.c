@@ -24,7 +24,7 @@
 #include "../dag/support.h"
 #include "../diff/diff.h"
 #include "../eval/interp.h"
-#include "svd.h"
+#include "../analysis/svd.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -3,7 +3,7 @@
 #define MECHC_INTEGRABILITY_H
 
 #include "../model/model.h"
-#include "options.h"
+#include "../analysis/options.h"
 
 #include <stdbool.h>
 

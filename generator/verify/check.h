@@ -3,7 +3,7 @@
 #define MECHC_CHECK_H
 
 #include "../engine/engine.h"
-#include "run.h"
+#include "../kin/run.h"
 
 /* A deliberate mistake planted in the engine under test (the JIT kernels),
    so tests can prove that check catches what it is meant to catch. */

@@ -2,7 +2,7 @@
 #ifndef MECHC_INFO_STATE_H
 #define MECHC_INFO_STATE_H
 
-#include "assemble.h"
+#include "../analysis/assemble.h"
 #include "info.h"
 
 /* Follows the motion of the holonomic rows (hrows, nh of them) from q,

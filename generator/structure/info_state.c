@@ -17,7 +17,7 @@
 
 #include "../base/arena.h"
 #include "spqr_rank.h"
-#include "sparse.h"
+#include "../analysis/sparse.h"
 
 #include <float.h>
 #include <math.h>

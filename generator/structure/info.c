@@ -25,9 +25,9 @@
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../base/strbuf.h"
-#include "construct.h"
+#include "../analysis/construct.h"
 #include "info_state.h"
-#include "sparse.h"
+#include "../analysis/sparse.h"
 #include "spqr_rank.h"
 
 #include <math.h>

@@ -3,10 +3,10 @@
 #define MECHC_INFO_H
 
 #include "../pipeline/pipeline.h"
-#include "assemble.h"
+#include "../analysis/assemble.h"
 #include "integrability.h"
 #include "involutive.h"
-#include "options.h"
+#include "../analysis/options.h"
 
 #include <stdbool.h>
 

@@ -1,0 +1,500 @@
+/* run.c - kinematic analysis over time: assembly, predictor-corrector steps, integration.
+ *
+ * A mechanism with holonomic rows only (nh == nq) is stepped by the
+ * freestanding runtime (mechrt_step): second-order Taylor predictor from
+ * the last q, qd, qdd, Newton corrector on Phi(q, t) = 0 with one call of
+ * the fused `all` kernel per iteration, then velocity and acceleration
+ * from one LU of the converged Jacobian (Haug 1989, section 6.1).
+ * A mechanism with velocity-level rows (nh + nv == nq, nv > 0) has no
+ * position equations for nv of its directions: its positions are
+ * integrated (runtime/host: GSL odeiv2, projection onto Phi = 0 after every
+ * step) and its velocities and accelerations solved at each output time.
+ *
+ * A coarse step can leave the branch it should follow: the predictor
+ * lands nearer another assembly (the crossed four-bar) or another turn of
+ * an angle, and Newton converges there without complaint. So every step is
+ * checked (step_quiet): Newton must have needed few iterations and
+ * corrected no coordinate by more than a small share of the motion the
+ * predictor gave it. An interval whose step fails the check, or fails, is
+ * redone from its start in 2, 4, 8 ... substeps (RunOptions.max_substeps at
+ * most), each a predictor and a corrector, until every substep of a level
+ * passes the check, or a level whose substeps all took few Newton
+ * iterations ends where the previous level did (a fully driven mechanism's
+ * position at a time depends only on its branch and turns, so two levels
+ * that agree followed the same one; this accepts a start from rest, where
+ * the predicted motion is nil at any step size). Only the grid's states are
+ * reported. Past the limit the run fails: "the motion is too fast for the
+ * step", or the error of the finest level. A fine step, one Newton
+ * iteration, passes the check for the price of saving the state it started
+ * from.
+ *
+ * The linear algebra is chosen once per run (RunOptions.linear): the
+ * runtime's dense LU (mechrt_step), or KLU on the Jacobian's nonzeros
+ * (mechrt_host_sparse_step, runtime/host/sparse_step.c: the same predictor,
+ * Newton and analysis); run_step is the one place the two differ, so the
+ * stepping, its checks and substeps are shared. The sparse path never forms
+ * an nr x nq matrix: its diagnostics name the failing pivot's row and
+ * coordinate instead of an SVD's, and the nearly singular test at t0 is
+ * KLU's condition estimate. With velocity-level rows the sparse path's
+ * host (mechrt_host_new_sparse) solves the velocities by KLU and projects
+ * by SuiteSparseQR's minimum-norm steps.
+ *
+ * Failures stop the run and say when, why and where: the time as
+ * `t = VALUE`, the runtime's cause, the row with the largest residual or
+ * the coordinate where elimination found no pivot, and, from an SVD of the
+ * Jacobian at the failing state, the rows and coordinates of the
+ * dependency (a toggle, a dead centre, redundant rows). Stretches where the
+ * condition estimate exceeds MechrtOptions.cond_warn are warned about once,
+ * when they begin, with a note when they end.
+ *
+ * run_analysis_forces adds inverse dynamics (`run --forces`): at every
+ * state, lambda from Phi_q^T lambda = Q - M qdd by the runtime's
+ * mechrt_inverse_dynamics, inside the step's timing so that --stats
+ * measures what the reactions cost (dyn/inverse.c).
+ *
+ * The pieces: step.c (the checked step, the rank corrector), subdivide.c,
+ * diagnose.c (failures and warnings), start.c (the assembly at t0),
+ * kernels.c (timing, the sparse bundle).
+ */
+#include "run.h"
+
+#include "diagnose.h"
+#include "run_state.h"
+#include "start.h"
+#include "step.h"
+#include "subdivide.h"
+
+#include "../base/arena.h"
+#include "../pipeline/pipeline.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
+
+RunOptions run_default_options(void)
+{
+    RunOptions o;
+    o.t0 = 0;
+    o.t1 = 1;
+    o.steps = 100;
+    o.max_substeps = 64;
+    o.mechrt = mechrt_default_options();
+    o.ode = mechrt_ode_default_options();
+    o.move_note = 1e-3;
+    o.assembly_max_iter = 100;
+    o.notes = NULL;
+    o.linear = RUN_LINEAR_AUTO;
+    o.jac_nz = NULL;
+    o.max_dense_entries = 0;
+    return o;
+}
+
+/* A state computed at t (in r->q, r->qd, r->qdd): the condition watch,
+   then out to the caller. */
+static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
+{
+    run_watch_condition(r, t, rep);
+    if (r->fstate)
+        r->fstate(ctx, t, r->q, r->qd, r->qdd, r->inv.lambda);
+    else
+        state(ctx, t, r->q, r->qd, r->qdd);
+    r->res->states++;
+}
+
+/* Inverse dynamics at the state just computed (t, r->q, r->qd, r->qdd),
+   into r->lambda; nothing without run_analysis_forces. False, with the
+   failure in r->res, when the solve fails. */
+static bool inverse_at(Run *r, double t)
+{
+    if (!r->fstate)
+        return true;
+    MechrtStatus st = inverse_solve(&r->inv, r->k, r->q, r->qd, r->qdd, t);
+    r->res->force_residual = r->inv.residual;
+    r->res->force_redundant = r->inv.redundant;
+    if (st == MECHRT_OK)
+        return true;
+    r->res->status = RUN_FAILED;
+    r->res->cause = st;
+    r->res->t_fail = t;
+    r->res->message[0] = '\0';
+    msgf(r, "t = %.10g: inverse dynamics failed: %s", t,
+         st == MECHRT_ENOTFINITE ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
+                                 : mechrt_strerror(st));
+    return false;
+}
+
+static double time_at(const RunOptions *o, int i)
+{
+    if (i == o->steps)
+        return o->t1;
+    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
+}
+
+/* Holonomic rows only: the runtime's predictor-corrector step, checked and
+   subdivided when needed (see the top of this file). */
+static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
+{
+    const RunOptions *o = r->o;
+    MechrtReport rep;
+    RunStatus status = RUN_OK;
+    size_t nq = (size_t)r->nq;
+    double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
+    double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
+    r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
+    r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
+    r->hist_qdd = keep + 9 * nq;
+    r->hist_n = 0;
+    run_place_at_t0(r, q0, start);
+    MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
+    r->res->assembly_iterations = rep.iterations;
+    if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
+        /* a guess Newton cannot start from: assemble robustly, then
+           Newton again for the velocities and accelerations there */
+        memcpy(r->q, start, nq * sizeof *start);
+        if (!run_assemble_robustly(r)) {
+            status = RUN_FAILED;
+            goto out;
+        }
+        st = run_step(r, o->t0, 0.0, &rep);
+        r->res->assembly_iterations += rep.iterations;
+    }
+    if (st == MECHRT_OK && run_nearly_singular(r, o->t0)) {
+        st = MECHRT_ESING;
+        rep.sing_index = -1;
+    }
+    if (st != MECHRT_OK) {
+        run_fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
+        status = RUN_FAILED;
+        goto out;
+    }
+    run_note_move(r, q0);
+    if (!inverse_at(r, o->t0)) {
+        status = RUN_FAILED;
+        goto out;
+    }
+    put_state(r, o->t0, &rep, state, ctx);
+
+    double t = o->t0;
+    for (int i = 1; i <= o->steps; i++) {
+        double tn = time_at(o, i);
+        clock_t cpu0 = clock();     /* before the wall clock: clock() is a system call */
+        double c0 = pipeline_now(); /* of about 0.65 us here, not the step's cost */
+        bool quiet;
+        StepCheck chk = {-1, 0, 0, 0};
+        r->res->rank_failed = false;
+        st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
+        bool ok = quiet || run_subdivide(r, t, tn, st, &rep, &chk);
+        if (!ok && r->res->rank_failed)
+            run_note_rank_failure(r);
+        if (ok && !inverse_at(r, tn))
+            ok = false;
+        r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
+        if (!ok) {
+            status = RUN_FAILED;
+            goto out;
+        }
+        r->res->steps_done++;
+        t = tn;
+        put_state(r, t, &rep, state, ctx);
+    }
+out:
+    free(q0);
+    free(keep);
+    r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = r->rq = r->hist_qdd = NULL;
+    free(r->rk_work);
+    r->rk_work = NULL;
+    return status;
+}
+
+/* Velocity-level rows, at t0: the positions projected onto the holonomic
+   rows (assembled robustly when that fails), the velocities and
+   accelerations solved there, the inverse dynamics asked for. False with
+   the failure in r->res. */
+static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
+{
+    const RunOptions *o = r->o;
+    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
+    bool ok = false;
+    run_place_at_t0(r, q0, start);
+    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
+    r->res->assembly_iterations = rep->iterations;
+    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
+        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
+        if (!run_assemble_robustly(r))
+            goto out;
+        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
+        r->res->assembly_iterations += rep->iterations;
+    }
+    if (st != MECHRT_OK) {
+        run_fail(r, st, o->t0, r->q, rep, "assembly (minimum-norm Newton)");
+        goto out;
+    }
+    run_note_move(r, q0);
+    st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd, r->qdd, rep);
+    if (st != MECHRT_OK) {
+        run_fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
+        goto out;
+    }
+    ok = inverse_at(r, o->t0);
+out:
+    free(q0);
+    return ok;
+}
+
+/* Velocity-level rows: integrate the positions between output times. */
+static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
+{
+    const RunOptions *o = r->o;
+    MechrtReport rep;
+    RunStatus status = RUN_OK;
+    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
+    r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
+    if (!host) {
+        snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
+        r->res->status = RUN_FAILED;
+        r->res->cause = MECHRT_EINVAL;
+        r->res->t_fail = o->t0;
+        return RUN_FAILED;
+    }
+    r->res->integrated = true;
+    if (!integrated_start(r, host, &rep)) {
+        status = RUN_FAILED;
+        goto out;
+    }
+    put_state(r, o->t0, &rep, state, ctx);
+
+    double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
+    for (int i = 1; i <= o->steps; i++) {
+        double tn = time_at(o, i);
+        clock_t cpu0 = clock();     /* outside the wall-clock span, as in run_holonomic */
+        double c0 = pipeline_now();
+        long it0 = mechrt_host_stats(host)->project_iterations;
+        MechrtStatus st = mechrt_host_integrate(host, &o->mechrt, &o->ode, r->q, &t, tn, &hstep,
+                                                &rep);
+        r->res->newton_iterations += mechrt_host_stats(host)->project_iterations - it0;
+        if (st != MECHRT_OK) {
+            double tf;
+            const double *qf = mechrt_host_failure(host, &tf);
+            bool proj = st == MECHRT_EMAXITER
+                        || (st == MECHRT_ENOTFINITE && rep.worst_row >= 0);
+            run_fail(r, st, tf, qf, &rep, proj ? "projection" : "integration (velocity analysis)");
+            status = RUN_FAILED;
+            goto out;
+        }
+        st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, tn, r->qd, r->qdd, &rep);
+        bool forces_ok = st != MECHRT_OK || inverse_at(r, tn);
+        r->res->step_seconds += pipeline_now() - c0;
+        r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
+        if (st != MECHRT_OK)
+            run_fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
+        if (st != MECHRT_OK || !forces_ok) {
+            status = RUN_FAILED;
+            goto out;
+        }
+        r->res->steps_done++;
+        t = tn;
+        put_state(r, t, &rep, state, ctx);
+    }
+out:
+    r->res->host = *mechrt_host_stats(host);
+    if (r->sp)
+        mechrt_host_sparse_counts(r->sp, &r->res->fresh_factorisations,
+                                  &r->res->refactorisations);
+    r->sp = NULL;
+    mechrt_host_free(host);
+    return status;
+}
+
+static RunStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static RunStatus bad_input(RunResult *res, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(res->message, sizeof res->message, fmt, ap);
+    va_end(ap);
+    res->status = RUN_BAD_INPUT;
+    res->cause = MECHRT_EINVAL;
+    return RUN_BAD_INPUT;
+}
+
+
+/* Dense or sparse for this run (RunOptions.linear); false with why when
+   the choice cannot be honoured. */
+static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
+                          size_t size)
+{
+    bool can = o->jac_nz != NULL;
+    *sparse = o->linear == RUN_LINEAR_SPARSE
+              || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
+    if (*sparse && !o->jac_nz) {
+        snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
+                 "which the generic engine does not have: use --engine jit or aot");
+        return false;
+    }
+    if (!*sparse && run_dense_too_large(m, o)) {
+        snprintf(why, size, "the dense Jacobian would have %d rows x %d coordinates = %lld "
+                 "entries, more than the limit of %lld (--max-jac-entries)%s", m->nr, m->nq,
+                 (long long)m->nr * m->nq, o->max_dense_entries,
+                 can ? ": use --linear sparse" : "; the sparse path cannot serve this run");
+        return false;
+    }
+    return true;
+}
+
+/* The dense path's factorisation: the pattern LU on the kernels' sparse
+   Jacobian (same results as lu.c's, replayed over the nonzeros), when
+   there is one, the mechanism is stepped (no velocity rows) and its
+   worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
+   One block: the state, then its reals, then its ints. */
+static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
+                              MechrtLuGen *gen)
+{
+    if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+        return NULL;
+    size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
+    MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
+    double *w = (double *)(f + 1);
+    *jnz = (MechrtJacNz){o->jac_nz->nnz, o->jac_nz->row, o->jac_nz->col, o->jac_nz->ctx,
+                         o->jac_nz->jac_nz};
+    if (mechrt_lup_init(f, m->nq, jnz->nnz, jnz->row, jnz->col, w, lw, (int *)(w + lw), liw)
+        != MECHRT_OK) {
+        free(f);
+        return NULL;
+    }
+    if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
+        *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
+                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
+        mechrt_lup_use(f, gen);
+    }
+    return f;
+}
+
+bool run_rows_match(const Model *m, char *why, size_t size)
+{
+    if (m->nr < m->nq) {
+        int dof = m->nq - m->nr;
+        snprintf(why, size, "%d degree%s of freedom %s not driven (%d coordinates, %d %s): "
+                 "add %s%s", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are", m->nq,
+                 m->nr, run_plural(m->nr, "row", "rows"), dof == 1 ? "a driver" : "drivers",
+                 dof == 1 ? "" : " (one per degree of freedom)");
+        return false;
+    }
+    if (m->nr > m->nq) {
+        int extra = m->nr - m->nq;
+        snprintf(why, size, "the mechanism has %d more %s than coordinates (%d rows, %d "
+                 "coordinates): run needs exactly one row per coordinate; remove "
+                 "redundant rows or drivers", extra, run_plural(extra, "row", "rows"),
+                 m->nr, m->nq);
+        return false;
+    }
+    return true;
+}
+
+/* run_analysis and run_analysis_forces: one of state and fstate. */
+static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                         RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    if (o->steps < 0)
+        return bad_input(res, "the number of steps must be at least 0, not %d", o->steps);
+    /* steps = 0 is the analysis at one instant, t0: t1 plays no part */
+    if (!(isfinite(o->t0) && (o->steps == 0 || isfinite(o->t1)))
+        || (o->steps > 0 && o->t0 == o->t1))
+        return bad_input(res, "the time interval must be finite and not empty (t0 = %g, t1 = %g)",
+                         o->t0, o->t1);
+    if (o->max_substeps < 1)
+        return bad_input(res, "the number of substeps must be at least 1, not %d",
+                         o->max_substeps);
+    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
+        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
+                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
+    char why[sizeof res->message];
+    if (!run_rows_match(m, why, sizeof why))
+        return bad_input(res, "%s", why);
+    bool sparse;
+    if (!choose_linear(m, o, &sparse, why, sizeof why))
+        return bad_input(res, "%s", why);
+
+    Run r = {0};
+    r.m = m;
+    r.k = k;
+    r.o = o;
+    r.res = res;
+    r.nq = m->nq;
+    r.nr = m->nr;
+    size_t nq = (size_t)m->nq;
+    /* one block, q | qd | qdd, so that a step's start is saved in one copy */
+    r.q = xcalloc(3 * nq, sizeof *r.q);
+    r.qd = r.q + nq;
+    r.qdd = r.q + 2 * nq;
+    r.sparse = sparse;
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+        free(r.q);
+        return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
+                         "entries) is not a valid %d x %d pattern, or out of memory",
+                         o->jac_nz->nnz, m->nq, m->nq);
+    }
+    res->sparse = sparse;
+    if (!sparse)
+        r.lup = run_lup_new(m, o, &r.lup_jnz, &r.lup_gen);
+    r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
+    r.work = xcalloc(r.lwork, sizeof *r.work);
+    memcpy(r.q, m->q0, nq * sizeof *r.q);
+    if (fstate) {
+        r.fstate = fstate;
+        inverse_init(&r.inv, m->nq, m->nr);
+    }
+
+    RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
+                                  : run_integrated(&r, state, state_ctx);
+    if (r.sp) {
+        mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
+        mechrt_host_sparse_free(r.sp);
+    }
+    if (r.lup) {
+        res->fresh_factorisations = r.lup->analyses;
+        res->refactorisations = r.lup->replays;
+        res->generated_factorisations = r.lup->gen_factors;
+        free(r.lup);
+    }
+    if (status == RUN_OK && r.episode)
+        run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
+              "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
+    res->status = status;
+    free(r.q), free(r.work);
+    inverse_free(&r.inv);
+    return status;
+}
+
+RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                       RunStateFn state, void *state_ctx, RunResult *res)
+{
+    return analyse(m, k, o, state, NULL, state_ctx, res);
+}
+
+RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                              RunForcesFn state, void *state_ctx, RunResult *res)
+{
+    if (!k->mass || !k->force) {
+        memset(res, 0, sizeof *res);
+        res->t_fail = NAN;
+        return bad_input(res, "inverse dynamics needs masses: the mechanism has no `mass` "
+                         "statements (run --forces reports the reactions of a file with "
+                         "masses)");
+    }
+    if (o->max_dense_entries > 0 && (long long)m->nq * m->nq > o->max_dense_entries) {
+        memset(res, 0, sizeof *res);
+        res->t_fail = NAN;
+        return bad_input(res, "inverse dynamics is dense (M and Phi_q as %d x %d matrices, "
+                         "%lld entries), more than the limit of %lld (--max-jac-entries)",
+                         m->nq, m->nq, (long long)m->nq * m->nq, o->max_dense_entries);
+    }
+    return analyse(m, k, o, NULL, state, state_ctx, res);
+}
