@@ -406,6 +406,7 @@ static void apply_TORQUE(GenericDyn *d, const AppliedForce *f, const Tape *p, co
     add_gradient(d, p, q, qd, t, 0, -1, d->vreg[p->out[4]], Q);
 }
 
+/* spring and rspring: the pull along the length or the angle (add_spring) */
 #define apply_SPRING add_spring
 #define apply_RSPRING add_spring
 
