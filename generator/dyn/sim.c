@@ -30,7 +30,7 @@
  * inconsistent by the error over its small pivot. The projection restores
  * the rows left out.
  *
- * Large mechanisms (SimOptions.linear; auto above SIM_DENSE_MAX_NQ
+ * Large mechanisms (SimOptions.linear; auto above ANALYSIS_DENSE_MAX_NQ
  * coordinates) take the sparse path instead: the generated kernels'
  * nonzeros (all_nz, jac_nz, mass_nz) into the augmented matrix [W Phi_A^T;
  * Phi_A 0] on KLU (runtime/host/sparse_kkt.c), W = M for the right side
@@ -86,7 +86,6 @@
 #include <gsl/gsl_errno.h>
 
 const char *const sim_method_names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf", NULL};
-const char *const sim_linear_names[] = {"auto", "dense", "sparse", NULL};
 
 SimOptions sim_default_options(void)
 {
@@ -107,7 +106,7 @@ SimOptions sim_default_options(void)
     o.assembly_max_iter = 100;
     o.max_steps = 10000000;
     o.notes = NULL;
-    o.linear = SIM_LINEAR_AUTO;
+    o.linear = ANALYSIS_LINEAR_AUTO;
     o.jac_nz = NULL;
     o.mass_nz = NULL;
     return o;
@@ -163,7 +162,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
 
 /* --interpolate: steps towards t1 across the output times, settling
    after each; the output states in a step from sim_hermite(). */
-static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, void *ctx)
+static AnalysisStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, void *ctx)
 {
     const SimOptions *o = s->o;
     size_t bytes = (size_t)s->dim * sizeof *y;
@@ -173,12 +172,12 @@ static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, voi
     int nk = 1;
     sim_watch_energy(s, y, true);
     if (!put_state(s, y, t, state, ctx, false) || !sim_end_rhs(s, y, t, s->fa))
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     memcpy(s->ya, y, bytes);
     for (int i = 1; i <= o->steps;) {
         if (!sim_one_step(s, y, &t, o->t1, &h) || !sim_settle(s, y, t, o->project)
             || !sim_end_rhs(s, y, t, s->fb))
-            return SIM_FAILED;
+            return ANALYSIS_FAILED;
         sim_watch_energy(s, y, false);
         tk[2] = t;
         nk = nk < 3 ? nk + 1 : 3;
@@ -189,7 +188,7 @@ static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, voi
             else
                 sim_hermite(s, nk, tk + 3 - nk, tn, yk + 3 - nk, fk + 3 - nk, s->yi);
             if (!put_state(s, s->yi, tn, state, ctx, false))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
         }
         /* shift the nodes: c <- a, a <- the end */
         double *ty = s->yc, *tf = s->fc;
@@ -200,11 +199,11 @@ static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, voi
         yk[0] = s->yc, fk[0] = s->fc, yk[1] = s->ya, fk[1] = s->fa;
         tk[0] = tk[1], tk[1] = t;
     }
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
 /* From the consistent state in y: the output times, stepping and projecting. */
-static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
+static AnalysisStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
 {
     const SimOptions *o = s->o;
     if (o->interpolate && o->method != SIM_MSBDF)
@@ -213,43 +212,43 @@ static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
     double t = o->t0, h = s->drv->h;
     sim_watch_energy(s, y, true);
     if (!put_state(s, y, t, state, ctx, true))
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     for (int i = 1; i <= o->steps; i++) {
         double tn = time_at(o, i);
         while (t != tn) {
             if (!sim_one_step(s, y, &t, tn, &h) || (per_step && !sim_settle(s, y, t, true)))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
             sim_watch_energy(s, y, false);
         }
         if (!per_step) {
             if (!sim_settle(s, y, t, o->project))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
             if (o->project)
                 gsl_odeiv2_driver_reset(s->drv);    /* the multistep history is stale */
             sim_watch_energy(s, y, false);
         }
         if (!put_state(s, y, t, state, ctx, true))
-            return SIM_FAILED;
+            return ANALYSIS_FAILED;
     }
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
-static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(SimResult *res, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
-static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(SimResult *res, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(res->message, sizeof res->message, fmt, ap);
     va_end(ap);
-    res->status = SIM_BAD_INPUT;
+    res->status = ANALYSIS_BAD_INPUT;
     res->cause = MECHRT_EINVAL;
-    return SIM_BAD_INPUT;
+    return ANALYSIS_BAD_INPUT;
 }
 
-/* Options and kernels usable; SIM_OK or SIM_BAD_INPUT with the message. */
-static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
+/* Options and kernels usable; ANALYSIS_OK or ANALYSIS_BAD_INPUT with the message. */
+static AnalysisStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
 {
     if (!sim_has_masses(k))
         return bad_input(res, "the mechanism has no masses: forward dynamics needs `mass` "
@@ -264,30 +263,30 @@ static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimRes
     if (k->nh > k->nq)
         return bad_input(res, "%d holonomic rows for %d coordinates: the position "
                          "projection needs at most one row per coordinate", k->nh, k->nq);
-    if (o->linear == SIM_LINEAR_SPARSE && !sim_sparse_can(k, o))
+    if (o->linear == ANALYSIS_LINEAR_SPARSE && !sim_sparse_can(k, o))
         return bad_input(res, "--linear sparse needs the generated kernels' nonzeros (--engine "
                          "jit or aot) and at least one constraint row");
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
-SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
-                        SimStateFn state, void *state_ctx, SimResult *res)
+AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+                             SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     res->min_pivot_ratio = 1;
-    if (check_input(k, o, res) != SIM_OK)
-        return SIM_BAD_INPUT;
+    if (check_input(k, o, res) != ANALYSIS_OK)
+        return ANALYSIS_BAD_INPUT;
     Sim s;
     memset(&s, 0, sizeof s);
-    SimStatus status = SIM_FAILED;
+    AnalysisStatus status = ANALYSIS_FAILED;
     if (!sim_open(&s, k, o, res)) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
-        res->status = SIM_FAILED;
+        res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EINVAL;
         res->t_fail = o->t0;
         sim_close(&s);
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     }
     double *y = xcalloc((size_t)s.dim, sizeof *y);
     memcpy(y, q0, (size_t)s.nq * sizeof *y);
@@ -326,7 +325,7 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
     mechrt_host_free(host);
     bool ok = st == MECHRT_OK;
-    if (!ok && sim_sparse_wanted(k, o) && m->nq > SIM_DENSE_MAX_NQ) {
+    if (!ok && sim_sparse_wanted(k, o) && m->nq > ANALYSIS_DENSE_MAX_NQ) {
         /* the restarts' dense SVDs would take hours here: the sparse
            Newton's own failure, in the same words */
         snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
@@ -354,26 +353,26 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
     return ok;
 }
 
-SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                  SimStateFn state, void *state_ctx, SimResult *res)
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                       SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (check_input(k, o, res) != SIM_OK)
-        return SIM_BAD_INPUT;
+    if (check_input(k, o, res) != ANALYSIS_OK)
+        return ANALYSIS_BAD_INPUT;
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
     if (!assemble_at_t0(m, k, o, q, &pre)) {
         *res = pre;
-        res->status = SIM_FAILED;
+        res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EMAXITER;
         res->t_fail = o->t0;
         free(q);
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     }
     double move = 0;
     for (int i = 0; i < m->nq; i++)
@@ -381,7 +380,7 @@ SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
     if (pre.assembled_robustly && o->notes)
         fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
                 "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
-    SimStatus st = sim_integrate(k, o, q, state, state_ctx, res);
+    AnalysisStatus st = sim_integrate(k, o, q, state, state_ctx, res);
     res->constructed = pre.constructed;
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;

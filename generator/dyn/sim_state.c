@@ -16,7 +16,7 @@
 void sim_fail(Sim *s, MechrtStatus st, double t, const char *what)
 {
     SimResult *res = s->res;
-    res->status = SIM_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = st;
     res->t_fail = t;
     res->message[0] = '\0';
@@ -85,8 +85,8 @@ bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o)
 bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o)
 {
     return sim_sparse_can(k, o)
-           && (o->linear == SIM_LINEAR_SPARSE
-               || (o->linear == SIM_LINEAR_AUTO && k->nq > SIM_DENSE_MAX_NQ));
+           && (o->linear == ANALYSIS_LINEAR_SPARSE
+               || (o->linear == ANALYSIS_LINEAR_AUTO && k->nq > ANALYSIS_DENSE_MAX_NQ));
 }
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */

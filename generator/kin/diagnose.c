@@ -160,14 +160,14 @@ static bool find_nonfinite(Run *r, const double *q, double t)
     return what != NULL;
 }
 
-/* Fills res with RUN_FAILED and the message for status st at time t, the
+/* Fills res with ANALYSIS_FAILED and the message for status st at time t, the
  * state q the runtime stopped at and its report. what: the phase. */
 void run_fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep,
                  const char *what)
 {
     RunResult *res = r->res;
     const Model *m = r->m;
-    res->status = RUN_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = st;
     res->t_fail = t;
     res->message[0] = '\0';
@@ -235,7 +235,7 @@ void run_fail_assembly(Run *r, const AssembleResult *ar)
 {
     const RunOptions *o = r->o;
     RunResult *res = r->res;
-    res->status = RUN_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = MECHRT_EMAXITER;
     res->t_fail = o->t0;
     res->message[0] = '\0';

@@ -6,7 +6,7 @@
 
 #include "../analysis/assemble.h"
 
-/* Fills res with RUN_FAILED and the message for status st at time t, the
+/* Fills res with ANALYSIS_FAILED and the message for status st at time t, the
    state q the runtime stopped at and its report. what: the phase. */
 void run_fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep,
               const char *what);

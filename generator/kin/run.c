@@ -73,8 +73,6 @@
 #include <string.h>
 #include <time.h>
 
-const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
-
 RunOptions run_default_options(void)
 {
     RunOptions o;
@@ -87,7 +85,7 @@ RunOptions run_default_options(void)
     o.move_note = 1e-3;
     o.assembly_max_iter = 100;
     o.notes = NULL;
-    o.linear = RUN_LINEAR_AUTO;
+    o.linear = ANALYSIS_LINEAR_AUTO;
     o.jac_nz = NULL;
     o.max_dense_entries = 0;
     return o;
@@ -117,7 +115,7 @@ static bool inverse_at(Run *r, double t)
     r->res->force_redundant = r->inv.redundant;
     if (st == MECHRT_OK)
         return true;
-    r->res->status = RUN_FAILED;
+    r->res->status = ANALYSIS_FAILED;
     r->res->cause = st;
     r->res->t_fail = t;
     r->res->message[0] = '\0';
@@ -136,11 +134,11 @@ static double time_at(const RunOptions *o, int i)
 
 /* Holonomic rows only: the runtime's predictor-corrector step, checked and
    subdivided when needed (see the top of this file). */
-static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
+static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 {
     const RunOptions *o = r->o;
     MechrtReport rep;
-    RunStatus status = RUN_OK;
+    AnalysisStatus status = ANALYSIS_OK;
     size_t nq = (size_t)r->nq;
     double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
     double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
@@ -156,7 +154,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
            Newton again for the velocities and accelerations there */
         memcpy(r->q, start, nq * sizeof *start);
         if (!run_assemble_robustly(r)) {
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         st = run_step(r, o->t0, 0.0, &rep);
@@ -168,12 +166,12 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     }
     if (st != MECHRT_OK) {
         run_fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
-        status = RUN_FAILED;
+        status = ANALYSIS_FAILED;
         goto out;
     }
     run_note_move(r, q0);
     if (!inverse_at(r, o->t0)) {
-        status = RUN_FAILED;
+        status = ANALYSIS_FAILED;
         goto out;
     }
     put_state(r, o->t0, &rep, state, ctx);
@@ -195,7 +193,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         r->res->steps_done++;
@@ -247,23 +245,23 @@ out:
 }
 
 /* Velocity-level rows: integrate the positions between output times. */
-static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
+static AnalysisStatus run_integrated(Run *r, RunStateFn state, void *ctx)
 {
     const RunOptions *o = r->o;
     MechrtReport rep;
-    RunStatus status = RUN_OK;
+    AnalysisStatus status = ANALYSIS_OK;
     MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
     r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
-        r->res->status = RUN_FAILED;
+        r->res->status = ANALYSIS_FAILED;
         r->res->cause = MECHRT_EINVAL;
         r->res->t_fail = o->t0;
-        return RUN_FAILED;
+        return ANALYSIS_FAILED;
     }
     r->res->integrated = true;
     if (!integrated_start(r, host, &rep)) {
-        status = RUN_FAILED;
+        status = ANALYSIS_FAILED;
         goto out;
     }
     put_state(r, o->t0, &rep, state, ctx);
@@ -283,7 +281,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
             bool proj = st == MECHRT_EMAXITER
                         || (st == MECHRT_ENOTFINITE && rep.worst_row >= 0);
             run_fail(r, st, tf, qf, &rep, proj ? "projection" : "integration (velocity analysis)");
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, tn, r->qd, r->qdd, &rep);
@@ -293,7 +291,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         if (st != MECHRT_OK)
             run_fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
         if (st != MECHRT_OK || !forces_ok) {
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         r->res->steps_done++;
@@ -310,17 +308,17 @@ out:
     return status;
 }
 
-static RunStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
-static RunStatus bad_input(RunResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(res->message, sizeof res->message, fmt, ap);
     va_end(ap);
-    res->status = RUN_BAD_INPUT;
+    res->status = ANALYSIS_BAD_INPUT;
     res->cause = MECHRT_EINVAL;
-    return RUN_BAD_INPUT;
+    return ANALYSIS_BAD_INPUT;
 }
 
 
@@ -330,8 +328,8 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
                           size_t size)
 {
     bool can = o->jac_nz != NULL;
-    *sparse = o->linear == RUN_LINEAR_SPARSE
-              || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
+    *sparse = o->linear == ANALYSIS_LINEAR_SPARSE
+              || (o->linear == ANALYSIS_LINEAR_AUTO && can && m->nq > ANALYSIS_DENSE_MAX_NQ);
     if (*sparse && !o->jac_nz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -350,12 +348,12 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
 /* The dense path's factorisation: the pattern LU on the kernels' sparse
    Jacobian (same results as lu.c's, replayed over the nonzeros), when
    there is one, the mechanism is stepped (no velocity rows) and its
-   worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
+   worst-case index lists stay small (ANALYSIS_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
 static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
                               MechrtLuGen *gen)
 {
-    if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+    if (!o->jac_nz || m->nv > 0 || m->nq > ANALYSIS_DENSE_MAX_NQ)
         return NULL;
     size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
     MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
@@ -397,8 +395,8 @@ bool run_rows_match(const Model *m, char *why, size_t size)
 }
 
 /* run_analysis and run_analysis_forces: one of state and fstate. */
-static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                         RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
+static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                              RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
@@ -452,7 +450,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
         inverse_init(&r.inv, m->nq, m->nr);
     }
 
-    RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
+    AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
                                   : run_integrated(&r, state, state_ctx);
     if (r.sp) {
         mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
@@ -464,7 +462,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
         res->generated_factorisations = r.lup->gen_factors;
         free(r.lup);
     }
-    if (status == RUN_OK && r.episode)
+    if (status == ANALYSIS_OK && r.episode)
         run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
@@ -473,14 +471,14 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     return status;
 }
 
-RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                       RunStateFn state, void *state_ctx, RunResult *res)
+AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                            RunStateFn state, void *state_ctx, RunResult *res)
 {
     return analyse(m, k, o, state, NULL, state_ctx, res);
 }
 
-RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                              RunForcesFn state, void *state_ctx, RunResult *res)
+AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                                   RunForcesFn state, void *state_ctx, RunResult *res)
 {
     if (!k->mass || !k->force) {
         memset(res, 0, sizeof *res);

@@ -43,7 +43,7 @@ bool run_assemble_robustly(Run *r)
     ao.stall_iter = ASSEMBLE_ROUGH_STALL;
     AssembleResult ar;
     if (run_dense_too_large(r->m, o)) {     /* it works on the dense Jacobian */
-        r->res->status = RUN_FAILED;
+        r->res->status = ANALYSIS_FAILED;
         r->res->cause = MECHRT_EMAXITER;
         r->res->t_fail = o->t0;
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: Newton found no "

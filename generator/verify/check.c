@@ -39,7 +39,7 @@
  * When no run of steps agrees, the differences cannot tell: the comparison
  * is counted as unsettled, neither passed nor failed, and reported.
  *
- * Large mechanisms (CheckOptions.linear, auto: above RUN_DENSE_MAX_NQ
+ * Large mechanisms (CheckOptions.linear, auto: above ANALYSIS_DENSE_MAX_NQ
  * coordinates) are checked on the Jacobian's nonzeros: the engines' jac_nz
  * (the generic interpreter's Jacobian is dense, so its jac is not
  * compared there), the assembly by KLU's Newton step, and the Jacobian's
@@ -177,8 +177,8 @@ static void init_items(CheckReport *rep, const CheckOptions *opt)
    jit's always, aot's when it has the same pattern. */
 static void choose_linear(Checker *c)
 {
-    RunLinear lin = c->opt->linear;
-    c->sparse = (lin == RUN_LINEAR_SPARSE || (lin == RUN_LINEAR_AUTO && c->nq > RUN_DENSE_MAX_NQ))
+    AnalysisLinear lin = c->opt->linear;
+    c->sparse = (lin == ANALYSIS_LINEAR_SPARSE || (lin == ANALYSIS_LINEAR_AUTO && c->nq > ANALYSIS_DENSE_MAX_NQ))
                 && run_jac_nz_of(&c->eng[ENGINE_JIT], &c->jnz[ENGINE_JIT]);
     if (!c->sparse)
         return;
