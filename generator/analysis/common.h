@@ -34,4 +34,10 @@ typedef enum AnalysisStatus {
    truncating quietly at its size: a failure's message is built in parts. */
 void analysis_msgf(char *msg, size_t size, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
+/* Appends to msg the names of the largest components of w (n >= 0, at
+   least a fifth of the largest, six at most), largest first, separated by
+   ", " and " and ". */
+void analysis_name_list(char *msg, size_t size, const char *const *names, const double *w,
+                        int n);
+
 #endif

@@ -72,8 +72,7 @@
 #include "sim_state.h"
 #include "step.h"
 
-#include "../analysis/assemble.h"
-#include "../analysis/construct.h"
+#include "../analysis/assemble_t0.h"
 #include "../base/arena.h"
 #include "../pipeline/pipeline.h"
 
@@ -307,49 +306,27 @@ AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const 
 }
 
 /* Construction, then Newton onto the rows from the file's values (as run
-   does at t0); q holds the result. False with the message set. */
-static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                           double *q, SimResult *res)
+   does at t0: assemble_at_t0, its default projection); q holds the
+   result. False with the message set. */
+static bool start_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                        double *q, SimResult *res)
 {
-    res->constructed = construct_with_kernels(m, k, o->t0, q);
-    /* the sparse path's Newton by SuiteSparseQR: the dense SVD is O(nq^3) */
-    MechrtHost *host = sim_sparse_wanted(k, o) ? mechrt_host_new_projector(k, o->jac_nz)
-                                               : mechrt_host_new(k);
-    if (!host) {
+    bool sparse = sim_sparse_wanted(k, o);
+    /* the robust restarts' dense SVDs would take hours on a large sparse mechanism */
+    AssembleT0Options ao = {.t0 = o->t0, .mechrt = &o->mechrt,
+                            .robust = !(sparse && m->nq > ANALYSIS_DENSE_MAX_NQ),
+                            .rough = analysis_default_options()};
+    ao.rough.tol_phi = o->mechrt.tol_phi;
+    ao.rough.tol_dq = o->mechrt.tol_dq;
+    ao.rough.max_iter = o->assembly_max_iter;
+    AssembleT0Report rep;
+    bool ok = assemble_at_t0(m, k, sparse ? o->jac_nz : NULL, &ao, q, &rep);
+    res->constructed = rep.constructed;
+    res->assembled_robustly = rep.robust;
+    if (rep.out_of_memory)
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
-        return false;
-    }
-    double *start = xmalloc((size_t)m->nq * sizeof *start);
-    memcpy(start, q, (size_t)m->nq * sizeof *q);
-    MechrtReport rep;
-    MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
-    mechrt_host_free(host);
-    bool ok = st == MECHRT_OK;
-    if (!ok && sim_sparse_wanted(k, o) && m->nq > ANALYSIS_DENSE_MAX_NQ) {
-        /* the restarts' dense SVDs would take hours here: the sparse
-           Newton's own failure, in the same words */
-        snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
-                 "these initial values: after %d iterations of minimum-norm Newton the "
-                 "largest residual is %.3g in row %s (%s)", o->t0, rep.iterations,
-                 rep.residual, rep.worst_row >= 0 ? m->rows[rep.worst_row].name : "?",
-                 mechrt_strerror(st));
-    } else if (!ok) {
-        AnalysisOptions ao = analysis_default_options();
-        AssembleResult ar;
-        ao.tol_phi = o->mechrt.tol_phi;
-        ao.tol_dq = o->mechrt.tol_dq;
-        ao.max_iter = o->assembly_max_iter;
-        ao.stall_iter = ASSEMBLE_ROUGH_STALL;
-        memcpy(q, start, (size_t)m->nq * sizeof *q);
-        ok = assemble_restarting(k, o->t0, q, &ao, &ar);
-        res->assembled_robustly = true;
-        if (!ok)
-            snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
-                     "these initial values: after %d iterations of minimum-norm Newton the "
-                     "largest residual is %.3g in row %s", o->t0, ar.iterations, ar.residual,
-                     ar.worst_row >= 0 ? m->rows[ar.worst_row].name : "?");
-    }
-    free(start);
+    else if (!ok)
+        assemble_t0_describe(m, k, &rep, q, res->message, sizeof res->message);
     return ok;
 }
 
@@ -366,7 +343,7 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions 
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
-    if (!assemble_at_t0(m, k, o, q, &pre)) {
+    if (!start_at_t0(m, k, o, q, &pre)) {
         *res = pre;
         res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EMAXITER;

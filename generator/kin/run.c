@@ -132,6 +132,15 @@ static double time_at(const RunOptions *o, int i)
     return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
 }
 
+/* Newton at t0 for run_assemble: the step of length 0 (q is r->q), which
+   also solves the velocities and accelerations there. */
+static MechrtStatus step_at_t0(void *ctx, double *q, MechrtReport *rep)
+{
+    Run *r = ctx;
+    (void)q;
+    return run_step(r, r->o->t0, 0.0, rep);
+}
+
 /* Holonomic rows only: the runtime's predictor-corrector step, checked and
    subdivided when needed (see the top of this file). */
 static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
@@ -140,36 +149,15 @@ static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
     MechrtReport rep;
     AnalysisStatus status = ANALYSIS_OK;
     size_t nq = (size_t)r->nq;
-    double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
     double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
     r->hist_qdd = keep + 9 * nq;
     r->hist_n = 0;
-    run_place_at_t0(r, q0, start);
-    MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
-    r->res->assembly_iterations = rep.iterations;
-    if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
-        /* a guess Newton cannot start from: assemble robustly, then
-           Newton again for the velocities and accelerations there */
-        memcpy(r->q, start, nq * sizeof *start);
-        if (!run_assemble_robustly(r)) {
-            status = ANALYSIS_FAILED;
-            goto out;
-        }
-        st = run_step(r, o->t0, 0.0, &rep);
-        r->res->assembly_iterations += rep.iterations;
-    }
-    if (st == MECHRT_OK && run_nearly_singular(r, o->t0)) {
-        st = MECHRT_ESING;
-        rep.sing_index = -1;
-    }
-    if (st != MECHRT_OK) {
-        run_fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
+    if (!run_assemble(r, step_at_t0, r, true, &rep, "assembly from the file's initial values")) {
         status = ANALYSIS_FAILED;
         goto out;
     }
-    run_note_move(r, q0);
     if (!inverse_at(r, o->t0)) {
         status = ANALYSIS_FAILED;
         goto out;
@@ -184,7 +172,7 @@ static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
         r->res->rank_failed = false;
-        st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
+        MechrtStatus st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || run_subdivide(r, t, tn, st, &rep, &chk);
         if (!ok && r->res->rank_failed)
             run_note_rank_failure(r);
@@ -201,12 +189,25 @@ static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         put_state(r, t, &rep, state, ctx);
     }
 out:
-    free(q0);
     free(keep);
     r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = r->rq = r->hist_qdd = NULL;
     free(r->rk_work);
     r->rk_work = NULL;
     return status;
+}
+
+/* Newton at t0 for run_assemble with velocity-level rows: the host's
+   minimum-norm projection onto the holonomic rows. */
+typedef struct ProjectAtT0 {
+    MechrtHost *host;
+    const MechrtOptions *mechrt;
+    double t0;
+} ProjectAtT0;
+
+static MechrtStatus project_at_t0(void *ctx, double *q, MechrtReport *rep)
+{
+    const ProjectAtT0 *p = ctx;
+    return mechrt_host_project(p->host, p->mechrt, q, p->t0, rep);
 }
 
 /* Velocity-level rows, at t0: the positions projected onto the holonomic
@@ -216,32 +217,16 @@ out:
 static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
 {
     const RunOptions *o = r->o;
-    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
-    bool ok = false;
-    run_place_at_t0(r, q0, start);
-    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
-    r->res->assembly_iterations = rep->iterations;
-    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
-        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
-        if (!run_assemble_robustly(r))
-            goto out;
-        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
-        r->res->assembly_iterations += rep->iterations;
-    }
-    if (st != MECHRT_OK) {
-        run_fail(r, st, o->t0, r->q, rep, "assembly (minimum-norm Newton)");
-        goto out;
-    }
-    run_note_move(r, q0);
-    st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd, r->qdd, rep);
+    ProjectAtT0 p = {host, &o->mechrt, o->t0};
+    if (!run_assemble(r, project_at_t0, &p, false, rep, "assembly (minimum-norm Newton)"))
+        return false;
+    MechrtStatus st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd,
+                                                        r->qdd, rep);
     if (st != MECHRT_OK) {
         run_fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
-        goto out;
+        return false;
     }
-    ok = inverse_at(r, o->t0);
-out:
-    free(q0);
-    return ok;
+    return inverse_at(r, o->t0);
 }
 
 /* Velocity-level rows: integrate the positions between output times. */
