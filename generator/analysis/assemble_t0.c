@@ -38,6 +38,7 @@ static MechrtStatus project(const MechrtKernels *k, const MechrtHostJacNz *jnz,
     return st;
 }
 
+/* The caller's Newton, or the default projection; its iterations counted. */
 static MechrtStatus newton(const MechrtKernels *k, const MechrtHostJacNz *jnz,
                            const AssembleT0Options *o, double *q, AssembleT0Report *rep)
 {

@@ -12,6 +12,13 @@
 
 const char *const analysis_linear_names[] = {"auto", "dense", "sparse", NULL};
 
+double analysis_time_at(double t0, double t1, int steps, int i)
+{
+    if (i == steps)
+        return t1;
+    return t0 + (t1 - t0) * (double)i / (double)steps;
+}
+
 void analysis_msgf(char *msg, size_t size, const char *fmt, ...)
 {
     size_t len = strlen(msg);

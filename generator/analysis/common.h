@@ -30,6 +30,9 @@ typedef enum AnalysisStatus {
     ANALYSIS_BAD_INPUT = 2 /* not runnable as given (row count, options): exit 2 */
 } AnalysisStatus;
 
+/* Output time i of steps equal intervals from t0 to t1: t1 itself at i = steps. */
+double analysis_time_at(double t0, double t1, int steps, int i);
+
 /* Appends printf-style text to the message msg (size bytes, NUL-terminated),
    truncating quietly at its size: a failure's message is built in parts. */
 void analysis_msgf(char *msg, size_t size, const char *fmt, ...) __attribute__((format(printf, 3, 4)));

@@ -116,13 +116,6 @@ bool sim_has_masses(const MechrtKernels *k)
     return k && k->mass && k->force;
 }
 
-static double time_at(const SimOptions *o, int i)
-{
-    if (i == o->steps)
-        return o->t1;
-    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
-}
-
 /* The state y at t out: its accelerations and multipliers, then the
    callback; with cache, the right side there is kept for the next step. */
 static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void *ctx,
@@ -180,8 +173,10 @@ static AnalysisStatus integrate_interpolated(Sim *s, double *y, SimStateFn state
         sim_watch_energy(s, y, false);
         tk[2] = t;
         nk = nk < 3 ? nk + 1 : 3;
-        for (; i <= o->steps && dir * (time_at(o, i) - t) <= 0; i++) {
-            double tn = time_at(o, i);
+        for (; i <= o->steps; i++) {
+            double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
+            if (!(dir * (tn - t) <= 0))
+                break;      /* beyond this step: the next one's */
             if (tn == t)
                 memcpy(s->yi, y, bytes);
             else
@@ -213,7 +208,7 @@ static AnalysisStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
     if (!put_state(s, y, t, state, ctx, true))
         return ANALYSIS_FAILED;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         while (t != tn) {
             if (!sim_one_step(s, y, &t, tn, &h) || (per_step && !sim_settle(s, y, t, true)))
                 return ANALYSIS_FAILED;

@@ -63,6 +63,7 @@ bool sim_dense_ready(Sim *s)
     return m == 0 || s->svd;
 }
 
+/* GSL's stepper of each --method. */
 static const gsl_odeiv2_step_type *step_type(SimMethod m)
 {
     switch (m) {
@@ -152,6 +153,7 @@ bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *re
     return s->drv != NULL;
 }
 
+/* Frees what sim_open made, the sparse path's counts kept in res. */
 void sim_close(Sim *s)
 {
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);

@@ -125,13 +125,6 @@ static bool inverse_at(Run *r, double t)
     return false;
 }
 
-static double time_at(const RunOptions *o, int i)
-{
-    if (i == o->steps)
-        return o->t1;
-    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
-}
-
 /* Newton at t0 for run_assemble: the step of length 0 (q is r->q), which
    also solves the velocities and accelerations there. */
 static MechrtStatus step_at_t0(void *ctx, double *q, MechrtReport *rep)
@@ -166,7 +159,7 @@ static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 
     double t = o->t0;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         clock_t cpu0 = clock();     /* before the wall clock: clock() is a system call */
         double c0 = pipeline_now(); /* of about 0.65 us here, not the step's cost */
         bool quiet;
@@ -253,7 +246,7 @@ static AnalysisStatus run_integrated(Run *r, RunStateFn state, void *ctx)
 
     double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         clock_t cpu0 = clock();     /* outside the wall-clock span, as in run_holonomic */
         double c0 = pipeline_now();
         long it0 = mechrt_host_stats(host)->project_iterations;
