@@ -203,7 +203,7 @@ static void test_rank_correct_fold(void **state)
 typedef struct Collected {
     MechrtTrace trace;
     RunResult res;
-    RunStatus status;
+    AnalysisStatus status;
     char notes[8192];
 } Collected;
 
@@ -328,7 +328,7 @@ static bool pfb_link(const char *body, Link *out)
 
 static void expect_ok(const Collected *c, int steps)
 {
-    if (c->status != RUN_OK)
+    if (c->status != ANALYSIS_OK)
         fail_msg("run failed: %s", c->res.message);
     assert_int_equal((int)c->trace.rows, steps + 1);
 }
@@ -389,7 +389,7 @@ static void test_chain_dense_near(void **state)
     Mech *mech = load_text(text, "chain5.mech");
     RunOptions o = run_default_options();
     o.steps = 400;
-    o.linear = RUN_LINEAR_DENSE;
+    o.linear = ANALYSIS_LINEAR_DENSE;
     Collected c;
     run_with(mech, o, &c);
     expect_ok(&c, 400);
@@ -513,7 +513,7 @@ static void test_dead_centre_passed(void **state)
     o.steps = 20;
     Collected c;
     run_with(mech, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_near(c.res.t_fail, 1, 0, 1e-15);
     assert_int_equal((int)c.trace.rows, 10);
     assert_non_null(strstr(c.res.message, "t = 1:"));
@@ -550,7 +550,7 @@ static void test_examples_never_switch(void **state)
             run_with(mech, run_default_options(), &c);
             if (c.res.rank_steps != 0)
                 fail_msg("%s: %d steps by the rank corrector", path, c.res.rank_steps);
-            ran += c.status == RUN_OK;
+            ran += c.status == ANALYSIS_OK;
             mechrt_trace_free(&c.trace);
         }
         pipeline_free(mech);

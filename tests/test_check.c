@@ -93,12 +93,12 @@ static void test_examples_pass(void **state)
         opt.samples = 6;
         CheckReport rep;
         /* the sparse comparisons first (fewer samples), then the dense */
-        opt.linear = RUN_LINEAR_SPARSE;
+        opt.linear = ANALYSIS_LINEAR_SPARSE;
         opt.samples = 3;
         assert_true(check_mechanism(mech, &opt, &rep, &diag));
         if (!rep.ok || !rep.sparse)
             fail_msg("%s: --linear sparse: %s", path, rep.ok ? "not sparse" : "fails");
-        opt.linear = RUN_LINEAR_DENSE;
+        opt.linear = ANALYSIS_LINEAR_DENSE;
         opt.samples = 6;
         assert_true(check_mechanism(mech, &opt, &rep, &diag));
         for (int w = 0; w < CHECK_WHAT_COUNT; w++) {
@@ -160,7 +160,7 @@ static void test_aot_left_out(void **state)
 
 /* Runs check (dense or sparse) on an example with one fault; returns the report. */
 static void run_fault_linear(const char *file, CheckFaultKind kind, const char *row,
-                             const char *col, double factor, RunLinear linear, CheckReport *rep)
+                             const char *col, double factor, AnalysisLinear linear, CheckReport *rep)
 {
     Diag diag;
     Mech *mech = load_example(file, &diag);
@@ -173,14 +173,14 @@ static void run_fault_linear(const char *file, CheckFaultKind kind, const char *
     assert_true(check_mechanism(mech, &opt, rep, &diag));
     /* the item's row index is checked against the fault's by the caller */
     assert_false(rep->ok);
-    assert_int_equal(rep->sparse, linear == RUN_LINEAR_SPARSE);
+    assert_int_equal(rep->sparse, linear == ANALYSIS_LINEAR_SPARSE);
     pipeline_free(mech);
 }
 
 static void run_fault(const char *file, CheckFaultKind kind, const char *row, const char *col,
                       double factor, CheckReport *rep)
 {
-    run_fault_linear(file, kind, row, col, factor, RUN_LINEAR_AUTO, rep);
+    run_fault_linear(file, kind, row, col, factor, ANALYSIS_LINEAR_AUTO, rep);
 }
 
 static void expect(const CheckReport *rep, CheckWhat what, int row, const char *hint_part)
@@ -261,7 +261,7 @@ static void test_sparse_jacobian_faults(void **state)
     for (size_t i = 0; i < sizeof f / sizeof *f; i++) {
         CheckReport rep;
         run_fault_linear(f[i].file, CHECK_FAULT_JAC_SCALE, f[i].row, f[i].col, f[i].factor,
-                         RUN_LINEAR_SPARSE, &rep);
+                         ANALYSIS_LINEAR_SPARSE, &rep);
         expect(&rep, CHECK_JAC_FD, row_of(f[i].file, f[i].row), f[i].hint);
         Diag diag;
         Mech *mech = load_example(f[i].file, &diag);
@@ -292,7 +292,7 @@ static void test_sparse_chain_agrees(void **state)
         assert_non_null(mech);
         CheckOptions opt = check_default_options();
         opt.samples = 4;
-        opt.linear = k ? RUN_LINEAR_SPARSE : RUN_LINEAR_DENSE;
+        opt.linear = k ? ANALYSIS_LINEAR_SPARSE : ANALYSIS_LINEAR_DENSE;
         assert_true(check_mechanism(mech, &opt, &rep[k], &diag));
         pipeline_free(mech);
         assert_true(rep[k].ok);

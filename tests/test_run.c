@@ -31,7 +31,7 @@
 typedef struct Collected {
     MechrtTrace trace;
     RunResult res;
-    RunStatus status;
+    AnalysisStatus status;
     char notes[8192];
 } Collected;
 
@@ -87,7 +87,7 @@ static void collected_free(Collected *c)
 
 static void expect_ok(const Collected *c, int steps)
 {
-    if (c->status != RUN_OK)
+    if (c->status != ANALYSIS_OK)
         fail_msg("run failed: %s", c->res.message);
     assert_int_equal((int)c->trace.rows, steps + 1);
     assert_int_equal(c->res.states, steps + 1);
@@ -274,7 +274,7 @@ static void test_examples_run(void **state)
         Mech *mech = load_file(files[f]);
         Collected c;
         run_with(mech, ENGINE_JIT, run_default_options(), &c);
-        if (c.status != RUN_OK)
+        if (c.status != ANALYSIS_OK)
             fail_msg("%s: %s", files[f], c.res.message);
         expect_ok(&c, 100);
         collected_free(&c);
@@ -341,7 +341,7 @@ static void test_coarse_steps_keep_branch(void **state)
             Collected c;
             o.steps = steps;
             run_with(mech, ENGINE_JIT, o, &c);
-            if (c.status != RUN_OK)
+            if (c.status != ANALYSIS_OK)
                 fail_msg("%s: %s", what, c.res.message);
             expect_ok(&c, steps);
             expect_same_states(&c, &ref, what);
@@ -383,7 +383,7 @@ static void test_coarse_steps_from_rest(void **state)
         Collected c;
         o.steps = steps;
         run_with(mech, ENGINE_JIT, o, &c);
-        if (c.status != RUN_OK)
+        if (c.status != ANALYSIS_OK)
             fail_msg("%d steps: %s", steps, c.res.message);
         expect_ok(&c, steps);
         expect_same_states(&c, &ref, "four-bar from rest");
@@ -404,7 +404,7 @@ static void test_substep_limit(void **state)
     o.max_substeps = 2;
     Collected c;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.cause, MECHRT_ESTEP);
     assert_int_equal(c.res.states, 1);   /* t = 0 only */
     assert_int_equal((int)c.trace.rows, 1);
@@ -419,7 +419,7 @@ static void test_substep_limit(void **state)
     /* no subdivision at all: the unchecked step itself fails */
     o.max_substeps = 1;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.cause, MECHRT_ESTEP);
     assert_near(c.res.t_fail, 0.5, 0, 0);
     assert_int_equal(c.res.states, 1);
@@ -434,7 +434,7 @@ static void test_substep_limit(void **state)
     o.t1 = 10;
     o.steps = 1;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.states, 1);
     assert_true(c.res.t_fail > 0 && c.res.t_fail <= 10);
     assert_non_null(strstr(c.res.message, "the motion is too fast for the step"));
@@ -444,7 +444,7 @@ static void test_substep_limit(void **state)
        fine run */
     o.max_substeps = 1024;
     run_with(mech, ENGINE_JIT, o, &c);
-    if (c.status != RUN_OK)
+    if (c.status != ANALYSIS_OK)
         fail_msg("10 turns, 1 step, 1024 substeps: %s", c.res.message);
     expect_ok(&c, 1);
     Collected ref;
@@ -462,7 +462,7 @@ static void test_substep_limit(void **state)
     o = run_default_options();
     o.max_substeps = 0;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     collected_free(&c);
     pipeline_free(mech);
 }
@@ -506,7 +506,7 @@ static void test_out_of_reach(void **state)
     o.steps = 10;
     Collected c;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_near(c.res.t_fail, 0.5, 0, 1e-15);
     assert_int_equal(c.res.states, 5);
     assert_non_null(strstr(c.res.message, "t = 0.5:"));
@@ -532,7 +532,7 @@ static void test_assembly_and_nan(void **state)
     o.t0 = 0.125;
     Collected c;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.states, 0);
     assert_non_null(strstr(c.res.message, "t = 0.125: could not assemble"));
     collected_free(&c);
@@ -545,7 +545,7 @@ static void test_assembly_and_nan(void **state)
     o = run_default_options();
     o.steps = 4;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     /* at t = 0.5 the position is still defined, its time derivative not */
     assert_near(c.res.t_fail, 0.5, 0, 0);
     assert_int_equal(c.res.cause, MECHRT_ENOTFINITE);
@@ -607,12 +607,12 @@ static void test_assembly_from_zero_guesses(void **state)
                 Collected col;
                 run_with(mech, ENGINE_JIT, o, &col);
                 if (!exists) {
-                    assert_int_equal(col.status, RUN_FAILED);
+                    assert_int_equal(col.status, ANALYSIS_FAILED);
                     assert_non_null(strstr(col.res.message, "could not assemble"));
                     assert_null(strstr(col.res.message, "toggle"));
                     refused++;
                 } else {
-                    if (col.status != RUN_OK)
+                    if (col.status != ANALYSIS_OK)
                         fail_msg("shape %zu, th2 = %g, positions %d: %s", g, th2, given,
                                  col.res.message);
                     assert_int_equal(col.res.states, 1);
@@ -772,7 +772,7 @@ static void test_one_instant(void **state)
     collected_free(&c);
     o.steps = -1;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "at least 0"));
     collected_free(&c);
     pipeline_free(mech);
@@ -874,7 +874,7 @@ static void test_cannot_assemble(void **state)
     o.steps = 4;
     Collected c;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.states, 0);
     assert_non_null(strstr(c.res.message, "t = 0: could not assemble from these initial values"));
     assert_non_null(strstr(c.res.message, "largest residual"));
@@ -883,7 +883,7 @@ static void test_cannot_assemble(void **state)
     pipeline_free(mech);
 }
 
-/* Not as many rows as coordinates: RUN_BAD_INPUT, nothing run, the count
+/* Not as many rows as coordinates: ANALYSIS_BAD_INPUT, nothing run, the count
    in plain words. */
 static void test_row_count(void **state)
 {
@@ -891,7 +891,7 @@ static void test_row_count(void **state)
     Mech *mech = load_file("examples/pendulum_distance.mech");
     Collected c;
     run_with(mech, ENGINE_JIT, run_default_options(), &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_int_equal(c.res.states, 0);
     assert_string_equal(c.res.message, "1 degree of freedom is not driven (2 coordinates, 1 row): "
                                        "add a driver");
@@ -900,7 +900,7 @@ static void test_row_count(void **state)
 
     mech = load_text("body b x = 0 y = 0 phi = 0\nconstraint c: b.x = 0\n", "free.mech");
     run_with(mech, ENGINE_JIT, run_default_options(), &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "2 degrees of freedom are not driven"));
     collected_free(&c);
     pipeline_free(mech);
@@ -908,7 +908,7 @@ static void test_row_count(void **state)
     mech = load_text("point p x = 0 y = 0\nconstraint a: p.x = 0\nconstraint b: p.y = 0\n"
                      "driver c: p.x = t\ndriver d: p.y = t\n", "over.mech");
     run_with(mech, ENGINE_JIT, run_default_options(), &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "the mechanism has 2 more rows than coordinates"));
     collected_free(&c);
 
@@ -916,7 +916,7 @@ static void test_row_count(void **state)
     RunOptions o = run_default_options();
     o.steps = 0;
     run_with(mech, ENGINE_JIT, o, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     collected_free(&c);
     pipeline_free(mech);
 }

@@ -327,7 +327,7 @@ static void test_klu_bad_pattern(void **state)
 typedef struct Collected {
     MechrtTrace trace;
     RunResult res;
-    RunStatus status;
+    AnalysisStatus status;
 } Collected;
 
 static void collect(void *ctx, double t, const double *q, const double *qd, const double *qdd)
@@ -360,7 +360,7 @@ static Mech *load_chain(int n)
 }
 
 /* Runs mech with the jit engine and linear algebra lin. */
-static void run_linear(Mech *mech, RunLinear lin, RunOptions o, EngineKind kind, Collected *c)
+static void run_linear(Mech *mech, AnalysisLinear lin, RunOptions o, EngineKind kind, Collected *c)
 {
     Engine e;
     Diag diag;
@@ -393,11 +393,11 @@ static void expect_same(const Collected *a, const Collected *b, const char *what
 static void compare(Mech *mech, RunOptions o, const char *what)
 {
     Collected d, s;
-    run_linear(mech, RUN_LINEAR_DENSE, o, ENGINE_JIT, &d);
-    run_linear(mech, RUN_LINEAR_SPARSE, o, ENGINE_JIT, &s);
-    if (d.status != RUN_OK)
+    run_linear(mech, ANALYSIS_LINEAR_DENSE, o, ENGINE_JIT, &d);
+    run_linear(mech, ANALYSIS_LINEAR_SPARSE, o, ENGINE_JIT, &s);
+    if (d.status != ANALYSIS_OK)
         fail_msg("%s dense: %s", what, d.res.message);
-    if (s.status != RUN_OK)
+    if (s.status != ANALYSIS_OK)
         fail_msg("%s sparse: %s", what, s.res.message);
     assert_false(d.res.sparse);
     assert_true(s.res.sparse);
@@ -439,8 +439,8 @@ static void test_chain_agrees(void **state)
     compare(mech, o, "chain 50");
     /* auto goes sparse at this size */
     Collected c;
-    run_linear(mech, RUN_LINEAR_AUTO, o, ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_AUTO, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_OK);
     assert_true(c.res.sparse);
     mechrt_trace_free(&c.trace);
     pipeline_free(mech);
@@ -455,20 +455,20 @@ static void test_toggle_sparse(void **state)
     (void)state;
     Mech *mech = load_file("examples/slider_crank_toggle.mech");
     Collected c, d;
-    run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_OK);
     assert_true(c.res.sparse);
     assert_int_equal(c.res.rank_deficient_steps, 2);
-    run_linear(mech, RUN_LINEAR_DENSE, run_default_options(), ENGINE_JIT, &d);
-    assert_int_equal(d.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_DENSE, run_default_options(), ENGINE_JIT, &d);
+    assert_int_equal(d.status, ANALYSIS_OK);
     expect_same(&d, &c, "toggle");
     mechrt_trace_free(&c.trace);
     mechrt_trace_free(&d.trace);
     pipeline_free(mech);
 
     mech = load_file("examples/parallelogram_redundant.mech");
-    run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_FAILED);
+    run_linear(mech, ANALYSIS_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_FAILED);
     assert_int_equal(c.res.cause, MECHRT_ESING);
     assert_near(c.res.t_fail, 0, 0, 0);
     assert_non_null(strstr(c.res.message, "t = 0: assembly from the file's initial values "
@@ -489,12 +489,12 @@ static void test_refusals(void **state)
     Collected c, d;
     for (size_t f = 0; f < sizeof vel / sizeof *vel; f++) {
         Mech *vm = load_file(vel[f]);
-        run_linear(vm, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
-        assert_int_equal(c.status, RUN_OK);
+        run_linear(vm, ANALYSIS_LINEAR_SPARSE, run_default_options(), ENGINE_JIT, &c);
+        assert_int_equal(c.status, ANALYSIS_OK);
         assert_true(c.res.sparse);
         assert_true(c.res.refactorisations + c.res.fresh_factorisations > 0);
-        run_linear(vm, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &d);
-        assert_int_equal(d.status, RUN_OK);
+        run_linear(vm, ANALYSIS_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &d);
+        assert_int_equal(d.status, ANALYSIS_OK);
         assert_false(d.res.sparse);     /* small: dense */
         expect_same(&d, &c, vel[f]);
         mechrt_trace_free(&c.trace);
@@ -503,12 +503,12 @@ static void test_refusals(void **state)
     }
 
     Mech *mech = load_file("examples/slider_crank.mech");
-    run_linear(mech, RUN_LINEAR_SPARSE, run_default_options(), ENGINE_GENERIC, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    run_linear(mech, ANALYSIS_LINEAR_SPARSE, run_default_options(), ENGINE_GENERIC, &c);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "generic engine"));
     mechrt_trace_free(&c.trace);
-    run_linear(mech, RUN_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_AUTO, run_default_options(), ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_OK);
     assert_false(c.res.sparse);     /* small: dense */
     mechrt_trace_free(&c.trace);
     pipeline_free(mech);
@@ -592,14 +592,14 @@ static void test_all_nz_run(void **state)
         mechrt_trace_init(&c[fused].trace, mech->model->nq);
         assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
         MechrtKernels k = e.k;
-        o.linear = RUN_LINEAR_SPARSE;
+        o.linear = ANALYSIS_LINEAR_SPARSE;
         assert_true(run_jac_nz_of(&e, &jnz));
         assert_non_null(jnz.all_nz);
         if (!fused)
             jnz.all_nz = NULL;
         o.jac_nz = &jnz;
         c[fused].status = run_analysis(mech->model, &k, &o, collect, &c[fused], &c[fused].res);
-        assert_int_equal(c[fused].status, RUN_OK);
+        assert_int_equal(c[fused].status, ANALYSIS_OK);
         engine_close(&e);
     }
     expect_same(&c[0], &c[1], "chain 20, all_nz");
@@ -620,23 +620,23 @@ static void test_dense_limit(void **state)
     o.steps = 4;
     o.max_dense_entries = 15000;
     Collected c;
-    run_linear(mech, RUN_LINEAR_AUTO, o, ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_AUTO, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_OK);
     assert_true(c.res.sparse);
     mechrt_trace_free(&c.trace);
-    run_linear(mech, RUN_LINEAR_DENSE, o, ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    run_linear(mech, ANALYSIS_LINEAR_DENSE, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "123 rows x 123 coordinates = 15129 entries, more "
                                           "than the limit of 15000 (--max-jac-entries): use "
                                           "--linear sparse"));
     mechrt_trace_free(&c.trace);
-    run_linear(mech, RUN_LINEAR_AUTO, o, ENGINE_GENERIC, &c);     /* no jac_nz: dense */
-    assert_int_equal(c.status, RUN_BAD_INPUT);
+    run_linear(mech, ANALYSIS_LINEAR_AUTO, o, ENGINE_GENERIC, &c); /* no jac_nz: dense */
+    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(c.res.message, "the sparse path cannot serve this run"));
     mechrt_trace_free(&c.trace);
     o.max_dense_entries = 15129;    /* at the limit: allowed */
-    run_linear(mech, RUN_LINEAR_DENSE, o, ENGINE_JIT, &c);
-    assert_int_equal(c.status, RUN_OK);
+    run_linear(mech, ANALYSIS_LINEAR_DENSE, o, ENGINE_JIT, &c);
+    assert_int_equal(c.status, ANALYSIS_OK);
     mechrt_trace_free(&c.trace);
     pipeline_free(mech);
 }

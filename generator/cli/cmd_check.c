@@ -12,7 +12,7 @@ typedef struct CheckCli {
     CheckOptions opt;
     MechLimits limits;
     int seed;               /* opt.seed, read as an int */
-    int linear;             /* --linear, a RunLinear */
+    int linear;             /* --linear, an AnalysisLinear */
     bool json;
     long long max_dense;    /* limits.max_jac_entries, checked by check_file */
 } CheckCli;
@@ -53,10 +53,10 @@ static const CliOption options[] = {
     {"--spread-qd", CLI_REAL_AT(CheckCli, opt.spread_qd), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "S", .help = "sampled qd = uniform(-S, S) (default 1)"},
     {"--no-aot", CLI_CLEAR_AT(CheckCli, opt.use_aot), .help = "do not build and compare the aot engine"},
-    {"--linear", CLI_CHOICE_AT(CheckCli, linear, run_linear_names), .metavar = "L",
+    {"--linear", CLI_CHOICE_AT(CheckCli, linear, analysis_linear_names), .metavar = "L",
      .help = "dense Jacobians, or sparse: the Jacobian's nonzeros,\n"
              "assembly by KLU, finite differences by column groups;\n"
-             "auto (default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates)"},
+             "auto (default: sparse above " ANALYSIS_DENSE_MAX_NQ_TEXT " coordinates)"},
     {"--json", CLI_FLAG_AT(CheckCli, json),
      .help = "print JSON: ok, samples, worst[{what, error, row, ...}]"},
 };
@@ -245,10 +245,10 @@ static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     CheckCli *c = opts;
     CheckReport rep;
     c->opt.seed = (unsigned long)c->seed;
-    c->opt.linear = (RunLinear)c->linear;
+    c->opt.linear = (AnalysisLinear)c->linear;
     const Model *m = mech->model;
-    bool sparse = c->linear == RUN_LINEAR_SPARSE
-                  || (c->linear == RUN_LINEAR_AUTO && m->nq > RUN_DENSE_MAX_NQ);
+    bool sparse = c->linear == ANALYSIS_LINEAR_SPARSE
+                  || (c->linear == ANALYSIS_LINEAR_AUTO && m->nq > ANALYSIS_DENSE_MAX_NQ);
     long long dense = (long long)m->nr * m->nq, mass = m->nmasses > 0 ? (long long)m->nq * m->nq : 0;
     if ((!sparse && dense > c->max_dense) || mass > c->max_dense) {
         fprintf(stderr, "mechc check: error: %s: the dense %s would have %lld entries, more than "

@@ -18,7 +18,7 @@ typedef struct InfoCli {
     double t;
     double at;              /* --at T: NAN when absent */
     const char *state;      /* --state FILE.csv, or NULL */
-    int linear;             /* --linear, a RunLinear */
+    int linear;             /* --linear, an AnalysisLinear */
     bool json;
 } InfoCli;
 
@@ -54,10 +54,10 @@ static const CliOption options[] = {
      .help = "analyse at time T instead of 0 (drivers move with t)"},
     {"--samples", CLI_INT_AT(InfoCli, analysis.samples, 1, 1000), .metavar = "N",
      .help = "random states for the numerical integrability check (default 8)"},
-    {"--linear", CLI_CHOICE_AT(InfoCli, linear, run_linear_names), .metavar = "L",
+    {"--linear", CLI_CHOICE_AT(InfoCli, linear, analysis_linear_names), .metavar = "L",
      .help = "rank by dense SVD, or by sparse QR (SuiteSparseQR: the rank,\n"
              "the redundant rows and mobility, no condition number), or\n"
-             "auto (default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates)"},
+             "auto (default: sparse above " ANALYSIS_DENSE_MAX_NQ_TEXT " coordinates)"},
     {"--max-dense", CLI_REAL_AT(InfoCli, analysis.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "N",
      .help = "rows x coordinates up to which a dense SVD is allowed\n"
@@ -488,8 +488,8 @@ static void print_text(const InfoReport *rep)
 static bool choose_linear(const InfoCli *c, const Model *m, AnalysisOptions *o)
 {
     bool fits = (double)m->nr * (double)m->nq <= o->max_dense;
-    switch ((RunLinear)c->linear) {
-    case RUN_LINEAR_DENSE:
+    switch ((AnalysisLinear)c->linear) {
+    case ANALYSIS_LINEAR_DENSE:
         if (!fits) {
             fprintf(stderr, "mechc info: error: --linear dense: the Jacobian is %d x %d, beyond "
                     "--max-dense %.0f (a dense SVD of it would take long): use --linear sparse "
@@ -497,11 +497,11 @@ static bool choose_linear(const InfoCli *c, const Model *m, AnalysisOptions *o)
             return false;
         }
         break;
-    case RUN_LINEAR_SPARSE:
+    case ANALYSIS_LINEAR_SPARSE:
         o->max_dense = -1;
         break;
-    case RUN_LINEAR_AUTO:
-        if (m->nq > RUN_DENSE_MAX_NQ)
+    case ANALYSIS_LINEAR_AUTO:
+        if (m->nq > ANALYSIS_DENSE_MAX_NQ)
             o->max_dense = -1;
         break;
     }
@@ -581,7 +581,7 @@ static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 static bool finish(Args *a, void *opts)
 {
     InfoCli *c = opts;
-    if (c->linear != RUN_LINEAR_DENSE)
+    if (c->linear != ANALYSIS_LINEAR_DENSE)
         c->limits.max_jac_entries = 0;
     return args_need_file(a);
 }

@@ -31,7 +31,7 @@ typedef struct RunCli {
     double at;              /* --at: one instant, t0 = at and no steps; NaN: not given */
     int engine, ode, digits;
     int view;               /* --view: an SvgView; -1: not given (iso) */
-    int linear;             /* --linear, a RunLinear */
+    int linear;             /* --linear, an AnalysisLinear */
     bool json, stats, forces;
     bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
@@ -70,11 +70,11 @@ static const CliOption options[] = {
      .help = "the instant T alone: --t0 T --steps 0"},
     {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
-    {"--linear", CLI_CHOICE_AT(RunCli, linear, run_linear_names), .metavar = "L",
+    {"--linear", CLI_CHOICE_AT(RunCli, linear, analysis_linear_names), .metavar = "L",
      .help = "linear algebra: dense (LU), sparse (KLU on the Jacobian's\n"
              "nonzeros; jit and aot; velocity-level rows integrated,\n"
              "KLU for the velocities) or auto\n"
-             "(default: sparse above " RUN_DENSE_MAX_NQ_TEXT " coordinates when it can)"},
+             "(default: sparse above " ANALYSIS_DENSE_MAX_NQ_TEXT " coordinates when it can)"},
     {"--csv", CLI_STRING_AT(RunCli, csv_path), .metavar = "FILE",
      .help = "write the CSV to FILE ('-': stdout; the default when\n"
              "there is no --json)"},
@@ -310,7 +310,7 @@ static bool finish(Args *a, void *opts)
         c->ro.t0 = c->at;
         c->ro.steps = 0;
     }
-    if (c->linear != RUN_LINEAR_DENSE) {    /* checked by the run, where a dense one is formed */
+    if (c->linear != ANALYSIS_LINEAR_DENSE) { /* checked by the run, where a dense one is formed */
         c->ro.max_dense_entries = c->limits.max_jac_entries;
         c->limits.max_jac_entries = 0;
     }
@@ -381,21 +381,21 @@ static bool prepare(const Args *a, const RunCli *c, const Mech *mech, RunPicture
 
 /* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
 static int report(const RunCli *c, const Model *m, const RunOutput *out, const RunPictures *pics,
-                  RunStatus rs, const RunResult *res, const MechrtKernels *k,
+                  AnalysisStatus rs, const RunResult *res, const MechrtKernels *k,
                   const MechrtHostJacNz *jnz, const LastState *last)
 {
     int status = EXIT_OK;
-    if (rs == RUN_BAD_INPUT) {
+    if (rs == ANALYSIS_BAD_INPUT) {
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         return EXIT_USAGE;
     }
     if (c->pictures && !run_output_pictures(out, pics))
         status = EXIT_USAGE;
     if (c->json)
-        run_output_json(stdout, out, rs == RUN_FAILED ? res->message : NULL, res->t_fail);
-    if (c->table && rs == RUN_OK && out->trace.rows == 1)
+        run_output_json(stdout, out, rs == ANALYSIS_FAILED ? res->message : NULL, res->t_fail);
+    if (c->table && rs == ANALYSIS_OK && out->trace.rows == 1)
         print_table(m, out, res, c->digits);
-    if (run_output_report_failure(out, m, rs == RUN_FAILED ? res->message : NULL, res->states,
+    if (run_output_report_failure(out, m, rs == ANALYSIS_FAILED ? res->message : NULL, res->states,
                                   res->t_fail))
         status = EXIT_ANALYSIS;
     if (c->stats)
@@ -436,14 +436,14 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
     MechrtHostJacNz jnz;
     RunResult res;
     c->ro.notes = stderr;
-    c->ro.linear = (RunLinear)c->linear;
+    c->ro.linear = (AnalysisLinear)c->linear;
     c->ro.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
     progress_start(&out.progress, "run", 1000);
     MechrtKernels newton = engine_newton_kernels(e);
-    RunStatus rs = c->forces
+    AnalysisStatus rs = c->forces
                    ? run_analysis_forces(m, &newton, &c->ro, on_state_keep, &last, &res)
                    : run_analysis(m, &newton, &c->ro, on_state_kinematic, &last, &res);
     progress_finish(&out.progress);

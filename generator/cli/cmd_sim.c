@@ -60,7 +60,7 @@ static const CliOption options[] = {
      .help = "integrator: rk8pd (default), rkf45 (explicit Runge-Kutta\n"
              "pairs), rk4imp or msbdf (implicit, for stiff springs and\n"
              "dampers; finite-difference Jacobian)"},
-    {"--linear", CLI_CHOICE_AT(SimCli, linear, sim_linear_names), .metavar = "L",
+    {"--linear", CLI_CHOICE_AT(SimCli, linear, analysis_linear_names), .metavar = "L",
      .help = "linear algebra: dense (null-space method, QR/SVD\n"
              "projections) or sparse (KLU on the augmented matrix from\n"
              "the generated kernels' nonzeros; jit, aot); default auto:\n"
@@ -215,18 +215,18 @@ static bool finish(Args *a, void *opts)
 
 /* After the simulation: pictures, JSON, the failure, --stats; the exit status. */
 static int report(const SimCli *c, const Model *m, const RunOutput *out, const RunPictures *p,
-                  SimStatus st, const SimResult *res)
+                  AnalysisStatus st, const SimResult *res)
 {
     int status = EXIT_OK;
-    if (st == SIM_BAD_INPUT) {
+    if (st == ANALYSIS_BAD_INPUT) {
         fprintf(stderr, "%s: error: %s\n", m->file, res->message);
         return EXIT_USAGE;
     }
     if (c->pictures && !run_output_pictures(out, p))
         status = EXIT_USAGE;        /* as run: a file that cannot be written */
     if (c->json)
-        run_output_json(stdout, out, st == SIM_FAILED ? res->message : NULL, res->t_fail);
-    if (run_output_report_failure(out, m, st == SIM_FAILED ? res->message : NULL, res->states,
+        run_output_json(stdout, out, st == ANALYSIS_FAILED ? res->message : NULL, res->t_fail);
+    if (run_output_report_failure(out, m, st == ANALYSIS_FAILED ? res->message : NULL, res->states,
                                   res->t_fail))
         status = EXIT_ANALYSIS;
     if (c->stats)
@@ -254,7 +254,7 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     }
     run_output_open(&out, m);
     c->so.notes = stderr;
-    c->so.linear = (SimLinear)c->linear;
+    c->so.linear = (AnalysisLinear)c->linear;
     MechrtHostJacNz jnz;
     MechrtHostMassNz mnz = {e->mech->kin.dyn.nnz, e->kernels.mass_row, e->kernels.mass_col,
                             (void *)&e->kernels, code_mass_nz};
@@ -262,7 +262,7 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     c->so.mass_nz = e->kernels.mass_nz && e->kernels.mass_row ? &mnz : NULL;
     SimResult res;
     progress_start(&out.progress, "sim", 1000);
-    SimStatus st = sim_run(m, &e->k, &c->so, run_output_state, &out, &res);
+    AnalysisStatus st = sim_run(m, &e->k, &c->so, run_output_state, &out, &res);
     progress_finish(&out.progress);
     int status = report(c, m, &out, p, st, &res);
     if (out.csv && out.csv != stdout && fclose(out.csv) != 0) {

@@ -30,7 +30,7 @@
  * inconsistent by the error over its small pivot. The projection restores
  * the rows left out.
  *
- * Large mechanisms (SimOptions.linear; auto above SIM_DENSE_MAX_NQ
+ * Large mechanisms (SimOptions.linear; auto above ANALYSIS_DENSE_MAX_NQ
  * coordinates) take the sparse path instead: the generated kernels'
  * nonzeros (all_nz, jac_nz, mass_nz) into the augmented matrix [W Phi_A^T;
  * Phi_A 0] on KLU (runtime/host/sparse_kkt.c), W = M for the right side
@@ -72,8 +72,7 @@
 #include "sim_state.h"
 #include "step.h"
 
-#include "../analysis/assemble.h"
-#include "../analysis/construct.h"
+#include "../analysis/assemble_t0.h"
 #include "../base/arena.h"
 #include "../pipeline/pipeline.h"
 
@@ -86,7 +85,6 @@
 #include <gsl/gsl_errno.h>
 
 const char *const sim_method_names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf", NULL};
-const char *const sim_linear_names[] = {"auto", "dense", "sparse", NULL};
 
 SimOptions sim_default_options(void)
 {
@@ -107,7 +105,7 @@ SimOptions sim_default_options(void)
     o.assembly_max_iter = 100;
     o.max_steps = 10000000;
     o.notes = NULL;
-    o.linear = SIM_LINEAR_AUTO;
+    o.linear = ANALYSIS_LINEAR_AUTO;
     o.jac_nz = NULL;
     o.mass_nz = NULL;
     return o;
@@ -116,13 +114,6 @@ SimOptions sim_default_options(void)
 bool sim_has_masses(const MechrtKernels *k)
 {
     return k && k->mass && k->force;
-}
-
-static double time_at(const SimOptions *o, int i)
-{
-    if (i == o->steps)
-        return o->t1;
-    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
 }
 
 /* The state y at t out: its accelerations and multipliers, then the
@@ -163,7 +154,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
 
 /* --interpolate: steps towards t1 across the output times, settling
    after each; the output states in a step from sim_hermite(). */
-static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, void *ctx)
+static AnalysisStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, void *ctx)
 {
     const SimOptions *o = s->o;
     size_t bytes = (size_t)s->dim * sizeof *y;
@@ -173,23 +164,25 @@ static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, voi
     int nk = 1;
     sim_watch_energy(s, y, true);
     if (!put_state(s, y, t, state, ctx, false) || !sim_end_rhs(s, y, t, s->fa))
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     memcpy(s->ya, y, bytes);
     for (int i = 1; i <= o->steps;) {
         if (!sim_one_step(s, y, &t, o->t1, &h) || !sim_settle(s, y, t, o->project)
             || !sim_end_rhs(s, y, t, s->fb))
-            return SIM_FAILED;
+            return ANALYSIS_FAILED;
         sim_watch_energy(s, y, false);
         tk[2] = t;
         nk = nk < 3 ? nk + 1 : 3;
-        for (; i <= o->steps && dir * (time_at(o, i) - t) <= 0; i++) {
-            double tn = time_at(o, i);
+        for (; i <= o->steps; i++) {
+            double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
+            if (!(dir * (tn - t) <= 0))
+                break;      /* beyond this step: the next one's */
             if (tn == t)
                 memcpy(s->yi, y, bytes);
             else
                 sim_hermite(s, nk, tk + 3 - nk, tn, yk + 3 - nk, fk + 3 - nk, s->yi);
             if (!put_state(s, s->yi, tn, state, ctx, false))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
         }
         /* shift the nodes: c <- a, a <- the end */
         double *ty = s->yc, *tf = s->fc;
@@ -200,11 +193,11 @@ static SimStatus integrate_interpolated(Sim *s, double *y, SimStateFn state, voi
         yk[0] = s->yc, fk[0] = s->fc, yk[1] = s->ya, fk[1] = s->fa;
         tk[0] = tk[1], tk[1] = t;
     }
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
 /* From the consistent state in y: the output times, stepping and projecting. */
-static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
+static AnalysisStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
 {
     const SimOptions *o = s->o;
     if (o->interpolate && o->method != SIM_MSBDF)
@@ -213,43 +206,43 @@ static SimStatus integrate(Sim *s, double *y, SimStateFn state, void *ctx)
     double t = o->t0, h = s->drv->h;
     sim_watch_energy(s, y, true);
     if (!put_state(s, y, t, state, ctx, true))
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         while (t != tn) {
             if (!sim_one_step(s, y, &t, tn, &h) || (per_step && !sim_settle(s, y, t, true)))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
             sim_watch_energy(s, y, false);
         }
         if (!per_step) {
             if (!sim_settle(s, y, t, o->project))
-                return SIM_FAILED;
+                return ANALYSIS_FAILED;
             if (o->project)
                 gsl_odeiv2_driver_reset(s->drv);    /* the multistep history is stale */
             sim_watch_energy(s, y, false);
         }
         if (!put_state(s, y, t, state, ctx, true))
-            return SIM_FAILED;
+            return ANALYSIS_FAILED;
     }
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
-static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(SimResult *res, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
-static SimStatus bad_input(SimResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(SimResult *res, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(res->message, sizeof res->message, fmt, ap);
     va_end(ap);
-    res->status = SIM_BAD_INPUT;
+    res->status = ANALYSIS_BAD_INPUT;
     res->cause = MECHRT_EINVAL;
-    return SIM_BAD_INPUT;
+    return ANALYSIS_BAD_INPUT;
 }
 
-/* Options and kernels usable; SIM_OK or SIM_BAD_INPUT with the message. */
-static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
+/* Options and kernels usable; ANALYSIS_OK or ANALYSIS_BAD_INPUT with the message. */
+static AnalysisStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
 {
     if (!sim_has_masses(k))
         return bad_input(res, "the mechanism has no masses: forward dynamics needs `mass` "
@@ -264,30 +257,30 @@ static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimRes
     if (k->nh > k->nq)
         return bad_input(res, "%d holonomic rows for %d coordinates: the position "
                          "projection needs at most one row per coordinate", k->nh, k->nq);
-    if (o->linear == SIM_LINEAR_SPARSE && !sim_sparse_can(k, o))
+    if (o->linear == ANALYSIS_LINEAR_SPARSE && !sim_sparse_can(k, o))
         return bad_input(res, "--linear sparse needs the generated kernels' nonzeros (--engine "
                          "jit or aot) and at least one constraint row");
-    return SIM_OK;
+    return ANALYSIS_OK;
 }
 
-SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
-                        SimStateFn state, void *state_ctx, SimResult *res)
+AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+                             SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     res->min_pivot_ratio = 1;
-    if (check_input(k, o, res) != SIM_OK)
-        return SIM_BAD_INPUT;
+    if (check_input(k, o, res) != ANALYSIS_OK)
+        return ANALYSIS_BAD_INPUT;
     Sim s;
     memset(&s, 0, sizeof s);
-    SimStatus status = SIM_FAILED;
+    AnalysisStatus status = ANALYSIS_FAILED;
     if (!sim_open(&s, k, o, res)) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
-        res->status = SIM_FAILED;
+        res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EINVAL;
         res->t_fail = o->t0;
         sim_close(&s);
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     }
     double *y = xcalloc((size_t)s.dim, sizeof *y);
     memcpy(y, q0, (size_t)s.nq * sizeof *y);
@@ -308,72 +301,50 @@ SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const doubl
 }
 
 /* Construction, then Newton onto the rows from the file's values (as run
-   does at t0); q holds the result. False with the message set. */
-static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                           double *q, SimResult *res)
+   does at t0: assemble_at_t0, its default projection); q holds the
+   result. False with the message set. */
+static bool start_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                        double *q, SimResult *res)
 {
-    res->constructed = construct_with_kernels(m, k, o->t0, q);
-    /* the sparse path's Newton by SuiteSparseQR: the dense SVD is O(nq^3) */
-    MechrtHost *host = sim_sparse_wanted(k, o) ? mechrt_host_new_projector(k, o->jac_nz)
-                                               : mechrt_host_new(k);
-    if (!host) {
+    bool sparse = sim_sparse_wanted(k, o);
+    /* the robust restarts' dense SVDs would take hours on a large sparse mechanism */
+    AssembleT0Options ao = {.t0 = o->t0, .mechrt = &o->mechrt,
+                            .robust = !(sparse && m->nq > ANALYSIS_DENSE_MAX_NQ),
+                            .rough = analysis_default_options()};
+    ao.rough.tol_phi = o->mechrt.tol_phi;
+    ao.rough.tol_dq = o->mechrt.tol_dq;
+    ao.rough.max_iter = o->assembly_max_iter;
+    AssembleT0Report rep;
+    bool ok = assemble_at_t0(m, k, sparse ? o->jac_nz : NULL, &ao, q, &rep);
+    res->constructed = rep.constructed;
+    res->assembled_robustly = rep.robust;
+    if (rep.out_of_memory)
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
-        return false;
-    }
-    double *start = xmalloc((size_t)m->nq * sizeof *start);
-    memcpy(start, q, (size_t)m->nq * sizeof *q);
-    MechrtReport rep;
-    MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
-    mechrt_host_free(host);
-    bool ok = st == MECHRT_OK;
-    if (!ok && sim_sparse_wanted(k, o) && m->nq > SIM_DENSE_MAX_NQ) {
-        /* the restarts' dense SVDs would take hours here: the sparse
-           Newton's own failure, in the same words */
-        snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
-                 "these initial values: after %d iterations of minimum-norm Newton the "
-                 "largest residual is %.3g in row %s (%s)", o->t0, rep.iterations,
-                 rep.residual, rep.worst_row >= 0 ? m->rows[rep.worst_row].name : "?",
-                 mechrt_strerror(st));
-    } else if (!ok) {
-        AnalysisOptions ao = analysis_default_options();
-        AssembleResult ar;
-        ao.tol_phi = o->mechrt.tol_phi;
-        ao.tol_dq = o->mechrt.tol_dq;
-        ao.max_iter = o->assembly_max_iter;
-        ao.stall_iter = ASSEMBLE_ROUGH_STALL;
-        memcpy(q, start, (size_t)m->nq * sizeof *q);
-        ok = assemble_restarting(k, o->t0, q, &ao, &ar);
-        res->assembled_robustly = true;
-        if (!ok)
-            snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
-                     "these initial values: after %d iterations of minimum-norm Newton the "
-                     "largest residual is %.3g in row %s", o->t0, ar.iterations, ar.residual,
-                     ar.worst_row >= 0 ? m->rows[ar.worst_row].name : "?");
-    }
-    free(start);
+    else if (!ok)
+        assemble_t0_describe(m, k, &rep, q, res->message, sizeof res->message);
     return ok;
 }
 
-SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                  SimStateFn state, void *state_ctx, SimResult *res)
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                       SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (check_input(k, o, res) != SIM_OK)
-        return SIM_BAD_INPUT;
+    if (check_input(k, o, res) != ANALYSIS_OK)
+        return ANALYSIS_BAD_INPUT;
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
-    if (!assemble_at_t0(m, k, o, q, &pre)) {
+    if (!start_at_t0(m, k, o, q, &pre)) {
         *res = pre;
-        res->status = SIM_FAILED;
+        res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EMAXITER;
         res->t_fail = o->t0;
         free(q);
-        return SIM_FAILED;
+        return ANALYSIS_FAILED;
     }
     double move = 0;
     for (int i = 0; i < m->nq; i++)
@@ -381,7 +352,7 @@ SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
     if (pre.assembled_robustly && o->notes)
         fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
                 "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
-    SimStatus st = sim_integrate(k, o, q, state, state_ctx, res);
+    AnalysisStatus st = sim_integrate(k, o, q, state, state_ctx, res);
     res->constructed = pre.constructed;
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;

@@ -6,7 +6,7 @@
  * odeiv2 (state (q, qd), accelerations from mechrt_forward_dynamics),
  * projecting positions and velocities back onto the constraints, and hands
  * the state at `steps` equal intervals to a callback. Like run.h: no
- * printing, no exit; a failure is a SimStatus with a one-line message
+ * printing, no exit; a failure is an AnalysisStatus with a one-line message
  * naming `t = VALUE` and the cause.
  */
 #ifndef MECHC_SIM_H
@@ -18,6 +18,7 @@
 #include "../../runtime/mechrt.h"
 #include "../../runtime/host/mechrt_host.h"
 #include "../model/model.h"
+#include "../analysis/common.h"
 
 /* The integrators: explicit embedded Runge-Kutta pairs, and two implicit
    methods for stiff mechanisms (stiff springs, large damping) that take
@@ -26,18 +27,6 @@ typedef enum SimMethod { SIM_RK8PD, SIM_RKF45, SIM_RK4IMP, SIM_MSBDF } SimMethod
 
 /* "rk8pd", "rkf45", "rk4imp", "msbdf", NULL: the --method names, in order. */
 extern const char *const sim_method_names[];
-
-/* The linear algebra of the right side and the projections: the dense
-   null-space method and QR/SVD, or the sparse augmented matrix on KLU
-   (runtime/host/sparse_kkt.c; needs the generated kernels' patterns);
-   auto: sparse above SIM_DENSE_MAX_NQ coordinates when it can. */
-typedef enum SimLinear { SIM_LINEAR_AUTO, SIM_LINEAR_DENSE, SIM_LINEAR_SPARSE } SimLinear;
-
-/* "auto", "dense", "sparse", NULL: the --linear names, in order. */
-extern const char *const sim_linear_names[];
-
-/* auto's size limit of the dense path: run's (RUN_DENSE_MAX_NQ). */
-#define SIM_DENSE_MAX_NQ 100
 
 /* What a simulation does; fill with sim_default_options(). */
 typedef struct SimOptions {
@@ -72,7 +61,7 @@ typedef struct SimOptions {
     int assembly_max_iter;  /* minimum-norm Newton at t0 when projection fails; 100 */
     long max_steps;         /* integrator steps allowed in all; 10 000 000 */
     FILE *notes;            /* notes ("FILE: note: ..."); NULL: none */
-    SimLinear linear;       /* SIM_LINEAR_AUTO */
+    AnalysisLinear linear;  /* ANALYSIS_LINEAR_AUTO */
     /* the generated kernels' nonzeros (jit, aot), NULL without: the
        sparse path needs both and jac_nz->all_nz */
     const MechrtHostJacNz *jac_nz;
@@ -80,9 +69,6 @@ typedef struct SimOptions {
 } SimOptions;
 
 SimOptions sim_default_options(void);
-
-/* Statuses double as exit codes, as RunStatus does. */
-typedef enum SimStatus { SIM_OK = 0, SIM_FAILED = 1, SIM_BAD_INPUT = 2 } SimStatus;
 
 enum { SIM_MESSAGE_MAX = 1024 };
 
@@ -93,8 +79,8 @@ typedef struct SimKernelCalls {
 } SimKernelCalls;
 
 typedef struct SimResult {
-    SimStatus status;
-    MechrtStatus cause;          /* behind SIM_FAILED */
+    AnalysisStatus status;
+    MechrtStatus cause;          /* behind ANALYSIS_FAILED */
     double t_fail;
     char message[SIM_MESSAGE_MAX];
     int states;                  /* states handed to the callback */
@@ -138,11 +124,11 @@ bool sim_has_masses(const MechrtKernels *k);
 
 /* From the file's initial values: construction and assembly at t0 (as
    run), then sim_integrate. */
-SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                  SimStateFn state, void *state_ctx, SimResult *res);
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
+                       SimStateFn state, void *state_ctx, SimResult *res);
 
 /* From positions q0 (nq; projected onto Phi = 0 first) and o->qd0. */
-SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
-                        SimStateFn state, void *state_ctx, SimResult *res);
+AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+                             SimStateFn state, void *state_ctx, SimResult *res);
 
 #endif

@@ -16,7 +16,7 @@
 void sim_fail(Sim *s, MechrtStatus st, double t, const char *what)
 {
     SimResult *res = s->res;
-    res->status = SIM_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = st;
     res->t_fail = t;
     res->message[0] = '\0';
@@ -63,6 +63,7 @@ bool sim_dense_ready(Sim *s)
     return m == 0 || s->svd;
 }
 
+/* GSL's stepper of each --method. */
 static const gsl_odeiv2_step_type *step_type(SimMethod m)
 {
     switch (m) {
@@ -85,8 +86,8 @@ bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o)
 bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o)
 {
     return sim_sparse_can(k, o)
-           && (o->linear == SIM_LINEAR_SPARSE
-               || (o->linear == SIM_LINEAR_AUTO && k->nq > SIM_DENSE_MAX_NQ));
+           && (o->linear == ANALYSIS_LINEAR_SPARSE
+               || (o->linear == ANALYSIS_LINEAR_AUTO && k->nq > ANALYSIS_DENSE_MAX_NQ));
 }
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */
@@ -152,6 +153,7 @@ bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *re
     return s->drv != NULL;
 }
 
+/* Frees what sim_open made, the sparse path's counts kept in res. */
 void sim_close(Sim *s)
 {
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);

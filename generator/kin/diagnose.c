@@ -9,37 +9,9 @@
 
 /* A singular value ratio below this names the dependency in a failure message. */
 #define RUN_NEAR_SINGULAR 1e-7
-/* Components of a singular vector at least this fraction of its largest are named. */
-#define RUN_NAME_SHARE 0.2
-#define RUN_NAME_MAX 6
 /* Above this many coordinates the dense SVD of a failure message (O(n^3))
    would take longer than the user should wait for an error: left out. */
 #define RUN_SVD_MAX_NQ 400
-
-/* " and " / ", " separated names of the largest components of w, largest first. */
-static void name_list(Run *r, const char *const *names, const double *w, int n)
-{
-    int picked[RUN_NAME_MAX], count = 0;
-    double wmax = 0;
-    for (int i = 0; i < n; i++)
-        if (w[i] > wmax)
-            wmax = w[i];
-    while (count < RUN_NAME_MAX) {
-        int best = -1;
-        for (int i = 0; i < n; i++) {
-            bool taken = false;
-            for (int c = 0; c < count; c++)
-                taken = taken || picked[c] == i;
-            if (!taken && w[i] >= RUN_NAME_SHARE * wmax && (best < 0 || w[i] > w[best]))
-                best = i;
-        }
-        if (best < 0)
-            break;
-        picked[count++] = best;
-    }
-    for (int c = 0; c < count; c++)
-        msgf(r, "%s%s", c == 0 ? "" : c + 1 == count ? " and " : ", ", names[picked[c]]);
-}
 
 /* The sparse path's account of a singular factorisation: the row and the
    coordinate of the pivot that failed (KLU's permutations undone). */
@@ -71,9 +43,9 @@ static double describe_dense_dependency(Run *r, const double *q, double t, int r
     double ratio = mechrt_host_singular_direction(rows, r->nq, jac, roww, colw);
     if (ratio >= 0 && (always || ratio < RUN_NEAR_SINGULAR)) {
         msgf(r, "; the Jacobian there is %s along rows ", always ? "singular" : "nearly singular");
-        name_list(r, row_names, roww, rows);
+        analysis_name_list(r->res->message, sizeof r->res->message, row_names, roww, rows);
         msgf(r, " and coordinates ");
-        name_list(r, r->m->coord_names, colw, r->nq);
+        analysis_name_list(r->res->message, sizeof r->res->message, r->m->coord_names, colw, r->nq);
         msgf(r, " (smallest singular value %.2g of the largest)", ratio);
     }
     free(jac), free(roww), free(colw), free(row_names);
@@ -160,14 +132,14 @@ static bool find_nonfinite(Run *r, const double *q, double t)
     return what != NULL;
 }
 
-/* Fills res with RUN_FAILED and the message for status st at time t, the
+/* Fills res with ANALYSIS_FAILED and the message for status st at time t, the
  * state q the runtime stopped at and its report. what: the phase. */
 void run_fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep,
                  const char *what)
 {
     RunResult *res = r->res;
     const Model *m = r->m;
-    res->status = RUN_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = st;
     res->t_fail = t;
     res->message[0] = '\0';
@@ -230,39 +202,14 @@ void run_fail_step(Run *r, MechrtStatus st, double t, const double *q,
 }
 
 /* The message of an assembly that found no configuration: the rows left
-   unsatisfied at the attempt that came closest. */
-void run_fail_assembly(Run *r, const AssembleResult *ar)
+   unsatisfied at the attempt that came closest (assemble_t0_describe). */
+void run_fail_assembly(Run *r, const AssembleT0Report *ar)
 {
-    const RunOptions *o = r->o;
     RunResult *res = r->res;
-    res->status = RUN_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = MECHRT_EMAXITER;
-    res->t_fail = o->t0;
-    res->message[0] = '\0';
-    msgf(r, "t = %.10g: could not assemble from these initial values: ", o->t0);
-    size_t nh = (size_t)r->k->nh;
-    double *phi = xcalloc(nh + 1, sizeof *phi);
-    const char **names = xcalloc(nh + 1, sizeof *names);
-    r->k->phi(r->k->ctx, r->q, o->t0, phi);
-    bool finite = true;
-    for (size_t i = 0; i < nh; i++) {
-        finite = finite && isfinite(phi[i]);
-        phi[i] = fabs(phi[i]);
-        names[i] = r->m->rows[i].name;
-    }
-    if (!finite) {
-        msgf(r, "minimum-norm Newton reached NaN or infinity after %d %s", ar->iterations,
-             run_plural(ar->iterations, "iteration", "iterations"));
-    } else {
-        msgf(r, "after %d %s of minimum-norm Newton the largest residual is %.3g in row %s; "
-             "rows left unsatisfied: ", ar->iterations,
-             run_plural(ar->iterations, "iteration", "iterations"), ar->residual,
-             ar->worst_row >= 0 ? names[ar->worst_row] : "?");
-        name_list(r, names, phi, (int)nh);
-    }
-    msgf(r, " (the mechanism may not close with these lengths, or the guess is nearer "
-         "a configuration that does not exist; try other initial values, or more --assembly-iter)");
-    free(phi), free(names);
+    res->t_fail = ar->t0;
+    assemble_t0_describe(r->m, r->k, ar, r->q, res->message, sizeof res->message);
 }
 
 /* A failed step after which the rank-revealing corrector could not go on

@@ -4,9 +4,9 @@
 
 #include "run_state.h"
 
-#include "../analysis/assemble.h"
+#include "../analysis/assemble_t0.h"
 
-/* Fills res with RUN_FAILED and the message for status st at time t, the
+/* Fills res with ANALYSIS_FAILED and the message for status st at time t, the
    state q the runtime stopped at and its report. what: the phase. */
 void run_fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep,
               const char *what);
@@ -16,8 +16,8 @@ void run_fail(Run *r, MechrtStatus st, double t, const double *q, const MechrtRe
 void run_fail_step(Run *r, MechrtStatus st, double t, const double *q, const MechrtReport *rep);
 
 /* The message of an assembly that found no configuration: the rows left
-   unsatisfied at the attempt that came closest. */
-void run_fail_assembly(Run *r, const AssembleResult *ar);
+   unsatisfied at the attempt that came closest (assemble_t0_describe). */
+void run_fail_assembly(Run *r, const AssembleT0Report *ar);
 
 /* A failed step after which the rank-revealing corrector could not go on
    either: what it found, after the LU's message. */

@@ -73,8 +73,6 @@
 #include <string.h>
 #include <time.h>
 
-const char *const run_linear_names[] = {"auto", "dense", "sparse", NULL};
-
 RunOptions run_default_options(void)
 {
     RunOptions o;
@@ -87,7 +85,7 @@ RunOptions run_default_options(void)
     o.move_note = 1e-3;
     o.assembly_max_iter = 100;
     o.notes = NULL;
-    o.linear = RUN_LINEAR_AUTO;
+    o.linear = ANALYSIS_LINEAR_AUTO;
     o.jac_nz = NULL;
     o.max_dense_entries = 0;
     return o;
@@ -117,7 +115,7 @@ static bool inverse_at(Run *r, double t)
     r->res->force_redundant = r->inv.redundant;
     if (st == MECHRT_OK)
         return true;
-    r->res->status = RUN_FAILED;
+    r->res->status = ANALYSIS_FAILED;
     r->res->cause = st;
     r->res->t_fail = t;
     r->res->message[0] = '\0';
@@ -127,66 +125,47 @@ static bool inverse_at(Run *r, double t)
     return false;
 }
 
-static double time_at(const RunOptions *o, int i)
+/* Newton at t0 for run_assemble: the step of length 0 (q is r->q), which
+   also solves the velocities and accelerations there. */
+static MechrtStatus step_at_t0(void *ctx, double *q, MechrtReport *rep)
 {
-    if (i == o->steps)
-        return o->t1;
-    return o->t0 + (o->t1 - o->t0) * (double)i / (double)o->steps;
+    Run *r = ctx;
+    (void)q;
+    return run_step(r, r->o->t0, 0.0, rep);
 }
 
 /* Holonomic rows only: the runtime's predictor-corrector step, checked and
    subdivided when needed (see the top of this file). */
-static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
+static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
 {
     const RunOptions *o = r->o;
     MechrtReport rep;
-    RunStatus status = RUN_OK;
+    AnalysisStatus status = ANALYSIS_OK;
     size_t nq = (size_t)r->nq;
-    double *q0 = xmalloc(2 * nq * sizeof *q0), *start = q0 + nq;
     double *keep = xmalloc((9 + RUN_HISTORY) * nq * sizeof *keep);
     r->sq = keep, r->sqd = keep + nq, r->sqdd = keep + 2 * nq;
     r->iq = keep + 3 * nq, r->lq = keep + 6 * nq, r->fq = keep + 7 * nq, r->rq = keep + 8 * nq;
     r->hist_qdd = keep + 9 * nq;
     r->hist_n = 0;
-    run_place_at_t0(r, q0, start);
-    MechrtStatus st = run_step(r, o->t0, 0.0, &rep);
-    r->res->assembly_iterations = rep.iterations;
-    if (st != MECHRT_OK && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
-        /* a guess Newton cannot start from: assemble robustly, then
-           Newton again for the velocities and accelerations there */
-        memcpy(r->q, start, nq * sizeof *start);
-        if (!run_assemble_robustly(r)) {
-            status = RUN_FAILED;
-            goto out;
-        }
-        st = run_step(r, o->t0, 0.0, &rep);
-        r->res->assembly_iterations += rep.iterations;
-    }
-    if (st == MECHRT_OK && run_nearly_singular(r, o->t0)) {
-        st = MECHRT_ESING;
-        rep.sing_index = -1;
-    }
-    if (st != MECHRT_OK) {
-        run_fail(r, st, o->t0, r->q, &rep, "assembly from the file's initial values");
-        status = RUN_FAILED;
+    if (!run_assemble(r, step_at_t0, r, true, &rep, "assembly from the file's initial values")) {
+        status = ANALYSIS_FAILED;
         goto out;
     }
-    run_note_move(r, q0);
     if (!inverse_at(r, o->t0)) {
-        status = RUN_FAILED;
+        status = ANALYSIS_FAILED;
         goto out;
     }
     put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         clock_t cpu0 = clock();     /* before the wall clock: clock() is a system call */
         double c0 = pipeline_now(); /* of about 0.65 us here, not the step's cost */
         bool quiet;
         StepCheck chk = {-1, 0, 0, 0};
         r->res->rank_failed = false;
-        st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
+        MechrtStatus st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || run_subdivide(r, t, tn, st, &rep, &chk);
         if (!ok && r->res->rank_failed)
             run_note_rank_failure(r);
@@ -195,7 +174,7 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         r->res->step_seconds += pipeline_now() - c0;
         r->res->step_cpu_seconds += (double)(clock() - cpu0) / CLOCKS_PER_SEC;
         if (!ok) {
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         r->res->steps_done++;
@@ -203,12 +182,25 @@ static RunStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         put_state(r, t, &rep, state, ctx);
     }
 out:
-    free(q0);
     free(keep);
     r->sq = r->sqd = r->sqdd = r->iq = r->lq = r->fq = r->rq = r->hist_qdd = NULL;
     free(r->rk_work);
     r->rk_work = NULL;
     return status;
+}
+
+/* Newton at t0 for run_assemble with velocity-level rows: the host's
+   minimum-norm projection onto the holonomic rows. */
+typedef struct ProjectAtT0 {
+    MechrtHost *host;
+    const MechrtOptions *mechrt;
+    double t0;
+} ProjectAtT0;
+
+static MechrtStatus project_at_t0(void *ctx, double *q, MechrtReport *rep)
+{
+    const ProjectAtT0 *p = ctx;
+    return mechrt_host_project(p->host, p->mechrt, q, p->t0, rep);
 }
 
 /* Velocity-level rows, at t0: the positions projected onto the holonomic
@@ -218,59 +210,43 @@ out:
 static bool integrated_start(Run *r, MechrtHost *host, MechrtReport *rep)
 {
     const RunOptions *o = r->o;
-    double *q0 = xmalloc(2 * (size_t)r->nq * sizeof *q0), *start = q0 + r->nq;
-    bool ok = false;
-    run_place_at_t0(r, q0, start);
-    MechrtStatus st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
-    r->res->assembly_iterations = rep->iterations;
-    if (st != MECHRT_OK && st != MECHRT_EINVAL) {
-        memcpy(r->q, start, (size_t)r->nq * sizeof *start);
-        if (!run_assemble_robustly(r))
-            goto out;
-        st = mechrt_host_project(host, &o->mechrt, r->q, o->t0, rep);
-        r->res->assembly_iterations += rep->iterations;
-    }
-    if (st != MECHRT_OK) {
-        run_fail(r, st, o->t0, r->q, rep, "assembly (minimum-norm Newton)");
-        goto out;
-    }
-    run_note_move(r, q0);
-    st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd, r->qdd, rep);
+    ProjectAtT0 p = {host, &o->mechrt, o->t0};
+    if (!run_assemble(r, project_at_t0, &p, false, rep, "assembly (minimum-norm Newton)"))
+        return false;
+    MechrtStatus st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, o->t0, r->qd,
+                                                        r->qdd, rep);
     if (st != MECHRT_OK) {
         run_fail(r, st, o->t0, r->q, rep, "velocity and acceleration analysis");
-        goto out;
+        return false;
     }
-    ok = inverse_at(r, o->t0);
-out:
-    free(q0);
-    return ok;
+    return inverse_at(r, o->t0);
 }
 
 /* Velocity-level rows: integrate the positions between output times. */
-static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
+static AnalysisStatus run_integrated(Run *r, RunStateFn state, void *ctx)
 {
     const RunOptions *o = r->o;
     MechrtReport rep;
-    RunStatus status = RUN_OK;
+    AnalysisStatus status = ANALYSIS_OK;
     MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
     r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
-        r->res->status = RUN_FAILED;
+        r->res->status = ANALYSIS_FAILED;
         r->res->cause = MECHRT_EINVAL;
         r->res->t_fail = o->t0;
-        return RUN_FAILED;
+        return ANALYSIS_FAILED;
     }
     r->res->integrated = true;
     if (!integrated_start(r, host, &rep)) {
-        status = RUN_FAILED;
+        status = ANALYSIS_FAILED;
         goto out;
     }
     put_state(r, o->t0, &rep, state, ctx);
 
     double t = o->t0, hstep = o->steps > 0 ? (o->t1 - o->t0) / o->steps : 0;
     for (int i = 1; i <= o->steps; i++) {
-        double tn = time_at(o, i);
+        double tn = analysis_time_at(o->t0, o->t1, o->steps, i);
         clock_t cpu0 = clock();     /* outside the wall-clock span, as in run_holonomic */
         double c0 = pipeline_now();
         long it0 = mechrt_host_stats(host)->project_iterations;
@@ -283,7 +259,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
             bool proj = st == MECHRT_EMAXITER
                         || (st == MECHRT_ENOTFINITE && rep.worst_row >= 0);
             run_fail(r, st, tf, qf, &rep, proj ? "projection" : "integration (velocity analysis)");
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         st = mechrt_host_velocity_acceleration(host, &o->mechrt, r->q, tn, r->qd, r->qdd, &rep);
@@ -293,7 +269,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
         if (st != MECHRT_OK)
             run_fail(r, st, tn, r->q, &rep, "velocity and acceleration analysis");
         if (st != MECHRT_OK || !forces_ok) {
-            status = RUN_FAILED;
+            status = ANALYSIS_FAILED;
             goto out;
         }
         r->res->steps_done++;
@@ -310,17 +286,17 @@ out:
     return status;
 }
 
-static RunStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
-static RunStatus bad_input(RunResult *res, const char *fmt, ...)
+static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(res->message, sizeof res->message, fmt, ap);
     va_end(ap);
-    res->status = RUN_BAD_INPUT;
+    res->status = ANALYSIS_BAD_INPUT;
     res->cause = MECHRT_EINVAL;
-    return RUN_BAD_INPUT;
+    return ANALYSIS_BAD_INPUT;
 }
 
 
@@ -330,8 +306,8 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
                           size_t size)
 {
     bool can = o->jac_nz != NULL;
-    *sparse = o->linear == RUN_LINEAR_SPARSE
-              || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
+    *sparse = o->linear == ANALYSIS_LINEAR_SPARSE
+              || (o->linear == ANALYSIS_LINEAR_AUTO && can && m->nq > ANALYSIS_DENSE_MAX_NQ);
     if (*sparse && !o->jac_nz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -350,12 +326,12 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
 /* The dense path's factorisation: the pattern LU on the kernels' sparse
    Jacobian (same results as lu.c's, replayed over the nonzeros), when
    there is one, the mechanism is stepped (no velocity rows) and its
-   worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
+   worst-case index lists stay small (ANALYSIS_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
 static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
                               MechrtLuGen *gen)
 {
-    if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+    if (!o->jac_nz || m->nv > 0 || m->nq > ANALYSIS_DENSE_MAX_NQ)
         return NULL;
     size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
     MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
@@ -397,8 +373,8 @@ bool run_rows_match(const Model *m, char *why, size_t size)
 }
 
 /* run_analysis and run_analysis_forces: one of state and fstate. */
-static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                         RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
+static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                              RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
@@ -452,7 +428,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
         inverse_init(&r.inv, m->nq, m->nr);
     }
 
-    RunStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
+    AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
                                   : run_integrated(&r, state, state_ctx);
     if (r.sp) {
         mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
@@ -464,7 +440,7 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
         res->generated_factorisations = r.lup->gen_factors;
         free(r.lup);
     }
-    if (status == RUN_OK && r.episode)
+    if (status == ANALYSIS_OK && r.episode)
         run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
@@ -473,14 +449,14 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     return status;
 }
 
-RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                       RunStateFn state, void *state_ctx, RunResult *res)
+AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                            RunStateFn state, void *state_ctx, RunResult *res)
 {
     return analyse(m, k, o, state, NULL, state_ctx, res);
 }
 
-RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                              RunForcesFn state, void *state_ctx, RunResult *res)
+AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                                   RunForcesFn state, void *state_ctx, RunResult *res)
 {
     if (!k->mass || !k->force) {
         memset(res, 0, sizeof *res);

@@ -3,7 +3,7 @@
  * run_analysis assembles a mechanism at t0 from its file's initial values
  * and walks it over `steps` equal intervals to t1, handing every state
  * (t, q, qd, qdd) to a callback as soon as it is known. It never prints
- * an error and never exits: a failure is a RunStatus with a one-line
+ * an error and never exits: a failure is an AnalysisStatus with a one-line
  * message naming `t = VALUE`, the cause and the rows and coordinates
  * involved; notes and warnings (assembly moved q, nearly singular
  * stretches) go to RunOptions.notes when that is not NULL.
@@ -17,20 +17,7 @@
 #include "../../runtime/host/mechrt_host.h"
 #include "../engine/engine.h"
 #include "../model/model.h"
-
-/* The linear algebra of a holonomic run: the freestanding runtime's dense
-   LU, or KLU on the Jacobian's nonzeros (runtime/host/sparse_klu.c), or
-   whichever suits the size (RUN_DENSE_MAX_NQ). */
-typedef enum RunLinear { RUN_LINEAR_AUTO, RUN_LINEAR_DENSE, RUN_LINEAR_SPARSE } RunLinear;
-
-/* "auto", "dense", "sparse", NULL: the --linear names, in RunLinear order. */
-extern const char *const run_linear_names[];
-
-/* auto stays dense up to this many coordinates, sparse above: near the
-   crossover measured on examples/chain.sh chains (doc/figures.md, "Size: dense against sparse"),
-   where the dense LU's O(n^3) starts to cost more than KLU's overhead. */
-#define RUN_DENSE_MAX_NQ 100
-#define RUN_DENSE_MAX_NQ_TEXT "100"     /* the same, for --help */
+#include "../analysis/common.h"
 
 /* What a run does; fill with run_default_options(), then change fields. */
 typedef struct RunOptions {
@@ -53,7 +40,7 @@ typedef struct RunOptions {
        guess, no convergence); default 100 */
     int assembly_max_iter;
     FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
-    RunLinear linear;        /* RUN_LINEAR_AUTO */
+    AnalysisLinear linear;   /* ANALYSIS_LINEAR_AUTO */
     /* the kernels' sparse Jacobian (run_jac_nz_of); NULL: none, dense only
        (the generic engine has none); default NULL */
     const MechrtHostJacNz *jac_nz;
@@ -66,22 +53,15 @@ typedef struct RunOptions {
 
 RunOptions run_default_options(void);
 
-/* Statuses double as mechc's exit codes (spec section 3). */
-typedef enum RunStatus {
-    RUN_OK = 0,              /* every state computed */
-    RUN_FAILED = 1,          /* the analysis failed at t_fail: exit 1 */
-    RUN_BAD_INPUT = 2        /* not runnable as given (row count, options): exit 2 */
-} RunStatus;
-
 enum { RUN_MESSAGE_MAX = 1024 };
 
 typedef struct RunResult {
-    RunStatus status;
-    MechrtStatus cause;          /* the runtime's status behind RUN_FAILED;
+    AnalysisStatus status;
+    MechrtStatus cause;          /* the runtime's status behind ANALYSIS_FAILED;
                                     MECHRT_ESTEP also when an interval still
                                     looked unreliable with max_substeps substeps */
-    double t_fail;               /* when RUN_FAILED: the time that failed */
-    char message[RUN_MESSAGE_MAX]; /* RUN_FAILED, RUN_BAD_INPUT: "t = 0.25: ..." */
+    double t_fail;               /* when ANALYSIS_FAILED: the time that failed */
+    char message[RUN_MESSAGE_MAX]; /* ANALYSIS_FAILED, ANALYSIS_BAD_INPUT: "t = 0.25: ..." */
     int states;                  /* states handed to the callback */
     int warnings;                /* nearly singular episodes warned about */
     double assembly_move;        /* ||q(t0) - q0||_inf */
@@ -149,19 +129,19 @@ typedef void (*RunForcesFn)(void *ctx, double t, const double *q, const double *
 bool run_rows_match(const Model *m, char *why, size_t size);
 
 /* The run. m gives sizes, names and initial values; k evaluates m's rows.
-   Needs k->nh + k->nv == k->nq, otherwise RUN_BAD_INPUT saying how many
+   Needs k->nh + k->nv == k->nq, otherwise ANALYSIS_BAD_INPUT saying how many
    degrees of freedom are not driven (or how many rows are too many). */
-RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                       RunStateFn state, void *state_ctx, RunResult *res);
+AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                            RunStateFn state, void *state_ctx, RunResult *res);
 
 /* run_analysis with inverse dynamics at every state: lambda from
    Phi_q^T lambda = Q(q, qd, t) - M(q) qdd (mechrt_inverse_dynamics,
    minimum-norm where rows are dependent), computed inside each step's
    timing, handed to state with the state. Needs k->mass and k->force (a
-   file with masses): RUN_BAD_INPUT otherwise. A failed solve (NaN in M or
+   file with masses): ANALYSIS_BAD_INPUT otherwise. A failed solve (NaN in M or
    Q) fails the run at that time. */
-RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                              RunForcesFn state, void *state_ctx, RunResult *res);
+AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+                                   RunForcesFn state, void *state_ctx, RunResult *res);
 
 /* Nanoseconds per call of the fused `all` kernel (or phi + jac + nu + gamma
    when there is none; with jnz, phi + jac_nz + nu + gamma, the sparse

@@ -1,25 +1,15 @@
-/* start.c - a run's start at t0: construction, Newton, the robust assembly, the note on how far it moved. */
+/* start.c - a run's start at t0: the assembly with the run's Newton, its failures, the note on how far it moved. */
 #include "start.h"
 
 #include "diagnose.h"
 
-#include "../analysis/assemble.h"
-#include "../analysis/construct.h"
+#include "../analysis/assemble_t0.h"
+#include "../base/arena.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
-
-/* The start of the assembly at t0: the file's values into q0 (the note on
-   how far assembly moved them compares with these), then r->q as the
-   construction places it (construct.h), also into start, where a robust
-   assembly begins again when Newton cannot start. q0, start: nq each. */
-void run_place_at_t0(Run *r, double *q0, double *start)
-{
-    size_t nq = (size_t)r->nq;
-    memcpy(q0, r->q, nq * sizeof *q0);
-    r->res->constructed = construct_with_kernels(r->m, r->k, r->o->t0, r->q);
-    memcpy(start, r->q, nq * sizeof *start);
-}
 
 /* Whether a dense nr x nq Jacobian would be beyond RunOptions.max_dense_entries. */
 bool run_dense_too_large(const Model *m, const RunOptions *o)
@@ -27,41 +17,8 @@ bool run_dense_too_large(const Model *m, const RunOptions *o)
     return o->max_dense_entries > 0 && (long long)m->nr * m->nq > o->max_dense_entries;
 }
 
-/* Minimum-norm Newton with step halving over the holonomic rows, from the
- * start in r->q (assemble_kernels, what `info` uses):
- * unlike Newton with LU it starts from any guess, including one where the
- * Jacobian is singular because two links are merely parallel (all angles
- * 0). False, with the message filled, when even it finds no configuration
- * near the initial values: the rows it could not satisfy are named. */
-bool run_assemble_robustly(Run *r)
-{
-    const RunOptions *o = r->o;
-    AnalysisOptions ao = analysis_default_options();
-    ao.tol_phi = o->mechrt.tol_phi;
-    ao.tol_dq = o->mechrt.tol_dq;
-    ao.max_iter = o->assembly_max_iter;
-    ao.stall_iter = ASSEMBLE_ROUGH_STALL;
-    AssembleResult ar;
-    if (run_dense_too_large(r->m, o)) {     /* it works on the dense Jacobian */
-        r->res->status = RUN_FAILED;
-        r->res->cause = MECHRT_EMAXITER;
-        r->res->t_fail = o->t0;
-        snprintf(r->res->message, sizeof r->res->message, "t = %.10g: Newton found no "
-                 "configuration from these initial values, and the robust assembly's dense "
-                 "Jacobian would have more than %lld entries (--max-jac-entries)", o->t0,
-                 o->max_dense_entries);
-        return false;
-    }
-    bool ok = assemble_restarting(r->k, o->t0, r->q, &ao, &ar);
-    r->res->assembly_iterations += ar.iterations;
-    r->res->assembled_robustly = true;
-    if (!ok)
-        run_fail_assembly(r, &ar);
-    return ok;
-}
-
 /* A note when assembly moved the initial values much. */
-void run_note_move(Run *r, const double *q0)
+static void note_move(Run *r, const double *q0)
 {
     double moved = 0, scale = 0;
     int at = 0;
@@ -98,3 +55,55 @@ void run_note_move(Run *r, const double *q0)
               r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at]);
 }
 
+/* The assembly at t0 (assemble_at_t0) with the run's Newton, from the
+   file's values in r->q: the construction, Newton, and where Newton cannot
+   start the robust minimum-norm Newton with restarts (dense: not beyond
+   RunOptions.max_dense_entries), then Newton again for the velocities and
+   accelerations there. With singular, a configuration where the Jacobian
+   is nearly singular fails as the toggle it is. res's assembly fields
+   filled, *rep Newton's last report; false with the failure in res
+   (what: the phase Newton's failure names). */
+bool run_assemble(Run *r, AssembleNewtonFn newton, void *ctx, bool singular, MechrtReport *rep,
+                  const char *what)
+{
+    const RunOptions *o = r->o;
+    RunResult *res = r->res;
+    size_t bytes = (size_t)r->nq * sizeof *r->q;
+    AssembleT0Options ao = {.t0 = o->t0, .newton = newton, .newton_ctx = ctx,
+                            .robust = !run_dense_too_large(r->m, o), .again = true,
+                            .rough = analysis_default_options(), .more_option = "--assembly-iter"};
+    ao.rough.tol_phi = o->mechrt.tol_phi;
+    ao.rough.tol_dq = o->mechrt.tol_dq;
+    ao.rough.max_iter = o->assembly_max_iter;
+    double *q0 = xmalloc(bytes + 1);
+    memcpy(q0, r->q, bytes);
+    AssembleT0Report ar;
+    bool ok = assemble_at_t0(r->m, r->k, NULL, &ao, r->q, &ar);
+    *rep = ar.newton;
+    res->constructed = ar.constructed;
+    res->assembly_iterations = ar.iterations;
+    res->assembled_robustly = ar.robust;
+    MechrtStatus st = ar.status;
+    if (ar.robust && !ar.robust_ok) {
+        run_fail_assembly(r, &ar);
+    } else if (!ok && !ao.robust && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
+        res->status = ANALYSIS_FAILED;     /* the robust assembly works on the dense Jacobian */
+        res->cause = MECHRT_EMAXITER;
+        res->t_fail = o->t0;
+        snprintf(res->message, sizeof res->message, "t = %.10g: Newton found no "
+                 "configuration from these initial values, and the robust assembly's dense "
+                 "Jacobian would have more than %lld entries (--max-jac-entries)", o->t0,
+                 o->max_dense_entries);
+    } else {
+        if (st == MECHRT_OK && singular && run_nearly_singular(r, o->t0)) {
+            st = MECHRT_ESING;
+            rep->sing_index = -1;
+        }
+        if (st != MECHRT_OK)
+            run_fail(r, st, o->t0, r->q, rep, what);
+        else
+            note_move(r, q0);
+    }
+    free(q0);
+    return st == MECHRT_OK && !(ar.robust && !ar.robust_ok);
+}

@@ -25,7 +25,7 @@ static void run_fail_too_fast(Run *r, double t_start, double t_end, double t_bad
                           const StepCheck *chk)
 {
     RunResult *res = r->res;
-    res->status = RUN_FAILED;
+    res->status = ANALYSIS_FAILED;
     res->cause = MECHRT_ESTEP;
     res->t_fail = t_bad;
     res->message[0] = '\0';

@@ -39,7 +39,7 @@
  * When no run of steps agrees, the differences cannot tell: the comparison
  * is counted as unsettled, neither passed nor failed, and reported.
  *
- * Large mechanisms (CheckOptions.linear, auto: above RUN_DENSE_MAX_NQ
+ * Large mechanisms (CheckOptions.linear, auto: above ANALYSIS_DENSE_MAX_NQ
  * coordinates) are checked on the Jacobian's nonzeros: the engines' jac_nz
  * (the generic interpreter's Jacobian is dense, so its jac is not
  * compared there), the assembly by KLU's Newton step, and the Jacobian's
@@ -66,8 +66,8 @@
 #include "hints.h"
 
 #include "../../runtime/mechrt.h"
-#include "../analysis/assemble.h"
-#include "../analysis/construct.h"
+#include "../analysis/assemble_t0.h"
+#include "../base/arena.h"
 #include "../base/rng.h"
 #include "../kin/run.h"
 
@@ -97,60 +97,57 @@ static const char *const dyn_names[CHECK_WHAT_COUNT - CHECK_DYN_FIRST] = {
     "M symmetric", "M semi-definite", "Q velocity fd",
 };
 
-/* The base state: Newton from the initial values at t = 0 when the
-   holonomic rows are square (minimum-norm Newton with restarts from rough
-   ones), else the initial values. */
+/* The base state's Newton (assemble_at_t0's, on the engine under test's
+   phi and jac, not its fused all): the runtime's dense Newton, or on the
+   sparse path a step of length 0 of run's sparse path (KLU). */
+typedef struct BaseNewton {
+    Checker *c;
+    const MechrtKernels *k;
+} BaseNewton;
 
-/* The sparse path's assembly: the construction, then Newton with KLU (a
-   step of length 0 of run's sparse path); no rough-guess fallback (it is
-   dense). */
-static bool assemble_klu(Checker *c, const MechrtKernels *k, double *q)
+static MechrtStatus base_newton(void *ctx, double *q, MechrtReport *rep)
 {
-    size_t nq = (size_t)c->nq;
-    MechrtHostSparse *s = mechrt_host_sparse_new(c->nq, &c->jnz[ENGINE_JIT]);
+    const BaseNewton *b = ctx;
+    size_t nq = (size_t)b->c->nq;
+    if (!b->c->sparse) {
+        size_t lwork = mechrt_workspace_size(b->c->nq, b->c->nr);
+        double *work = xmalloc(lwork * sizeof *work);
+        MechrtStatus st = mechrt_assemble(b->k, NULL, q, 0.0, work, lwork, rep);
+        free(work);
+        return st;
+    }
+    MechrtHostSparse *s = mechrt_host_sparse_new(b->c->nq, &b->c->jnz[ENGINE_JIT]);
     double *work = xcalloc(MECHRT_HOST_SPARSE_WORK_LEN(nq) + 2 * nq, sizeof *work);
     double *qd = work + MECHRT_HOST_SPARSE_WORK_LEN(nq), *qdd = qd + nq;
-    construct_with_kernels(c->m, k, 0.0, q);
-    bool ok = s && mechrt_host_sparse_step(s, k, NULL, q, qd, qdd, 0.0, 0.0, work,
-                                           MECHRT_HOST_SPARSE_WORK_LEN(nq), NULL) == MECHRT_OK;
+    MechrtStatus st = !s ? MECHRT_EINVAL
+                         : mechrt_host_sparse_step(s, b->k, NULL, q, qd, qdd, 0.0, 0.0, work,
+                                                   MECHRT_HOST_SPARSE_WORK_LEN(nq), rep);
     mechrt_host_sparse_free(s);
     free(work);
-    if (!ok)
-        memcpy(q, c->m->q0, nq * sizeof *q);
-    return ok;
+    return st;
 }
 
+/* The base state: assembled at t = 0 from the initial values when the
+   holonomic rows are square (dense: with the robust restarts from rough
+   initial values, as run; sparse: none, they are dense), else the initial
+   values. */
 static bool assemble(Checker *c, double *q)
 {
     memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
     if (c->nh != c->nq)
         return false;
-    if (c->sparse) {
-        MechrtKernels k = c->eng[ENGINE_JIT].k;
-        return assemble_klu(c, &k, q);
-    }
-    /* Newton on the engine under test's phi and jac, not its fused all */
     MechrtKernels k = c->eng[ENGINE_JIT].k;
-    k.all = NULL;
-    size_t lwork = mechrt_workspace_size(c->nq, c->nr);
-    double *work = xmalloc(lwork * sizeof *work);
-    construct_with_kernels(c->m, &k, 0.0, q);
-    MechrtStatus st = mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL);
-    if (st != MECHRT_OK) {
-        /* rough initial values: as run assembles them (run.c) */
-        AnalysisOptions ao = analysis_default_options();
-        ao.stall_iter = ASSEMBLE_ROUGH_STALL;
-        AssembleResult ar;
+    if (!c->sparse)
+        k.all = NULL;
+    BaseNewton b = {c, &k};
+    AssembleT0Options ao = {.t0 = 0.0, .newton = base_newton, .newton_ctx = &b,
+                            .robust = !c->sparse, .again = true,
+                            .rough = analysis_default_options()};
+    AssembleT0Report rep;
+    bool ok = assemble_at_t0(c->m, &k, NULL, &ao, q, &rep);
+    if (!ok)
         memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
-        construct_with_kernels(c->m, &k, 0.0, q);
-        if (assemble_restarting(&k, 0.0, q, &ao, &ar)
-            && mechrt_assemble(&k, NULL, q, 0.0, work, lwork, NULL) == MECHRT_OK)
-            st = MECHRT_OK;
-    }
-    free(work);
-    if (st != MECHRT_OK)
-        memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
-    return st == MECHRT_OK;
+    return ok;
 }
 
 /* Uniform in [lo, hi) from the shared deterministic generator. */
@@ -177,8 +174,8 @@ static void init_items(CheckReport *rep, const CheckOptions *opt)
    jit's always, aot's when it has the same pattern. */
 static void choose_linear(Checker *c)
 {
-    RunLinear lin = c->opt->linear;
-    c->sparse = (lin == RUN_LINEAR_SPARSE || (lin == RUN_LINEAR_AUTO && c->nq > RUN_DENSE_MAX_NQ))
+    AnalysisLinear lin = c->opt->linear;
+    c->sparse = (lin == ANALYSIS_LINEAR_SPARSE || (lin == ANALYSIS_LINEAR_AUTO && c->nq > ANALYSIS_DENSE_MAX_NQ))
                 && run_jac_nz_of(&c->eng[ENGINE_JIT], &c->jnz[ENGINE_JIT]);
     if (!c->sparse)
         return;

@@ -44,8 +44,8 @@ typedef struct CheckOptions {
     /* dense (nr x nq Jacobians), or sparse: the Jacobian's nonzeros
        (jac_nz), assembly by KLU, the Jacobian's finite differences by
        groups of columns that share no row; auto: sparse above
-       RUN_DENSE_MAX_NQ coordinates (default auto) */
-    RunLinear linear;
+       ANALYSIS_DENSE_MAX_NQ coordinates (default auto) */
+    AnalysisLinear linear;
     CheckFault fault;       /* tests only (default none) */
 } CheckOptions;
 
