@@ -323,8 +323,7 @@ static int put_roll_body(void *emitter, const Dag *dag, SchedOutput *outs, int n
     Emitter e = *(const Emitter *)emitter;
     e.dag = dag;
     e.roll = hooks;
-    e.trig.written = xcalloc((size_t)dag->count + 1, sizeof *e.trig.written);
-    e.trig.call_rank = xcalloc((size_t)dag->count + 1, sizeof *e.trig.call_rank);
+    trig_graph(&e.trig, dag->count);
     sched_init(&e.sched, dag, 1 << 28);     /* one chunk: a loop body is small */
     SchedFunction fn;
     sched_function(&e.sched, outs, n, &fn);

@@ -37,6 +37,11 @@ void trig_init(EmitTrig *t, const EmitOptions *opt, const char *prefix, int nnod
         t->sincos2_some_name = t->names[4];
     }
     t->calls = opt->declare_math || opt->libm_trig || opt->real_float;
+    trig_graph(t, nnodes);
+}
+
+void trig_graph(EmitTrig *t, int nnodes)
+{
     t->written = xcalloc((size_t)nnodes + 1, sizeof *t->written);
     t->call_rank = xcalloc((size_t)nnodes + 1, sizeof *t->call_rank);
 }

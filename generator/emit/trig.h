@@ -51,6 +51,9 @@ enum { TRIG_INLINE_MAX = 64 };
    per-node state for a graph of nnodes nodes (trig_free frees it; the
    names stay). */
 void trig_init(EmitTrig *t, const EmitOptions *opt, const char *prefix, int nnodes);
+/* Fresh per-node state for another graph of nnodes nodes (a loop body's):
+   the names and mode stay. */
+void trig_graph(EmitTrig *t, int nnodes);
 void trig_free(EmitTrig *t);
 
 /* Whether the file's calls of its own pair are inlined: only then does
