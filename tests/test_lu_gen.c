@@ -105,7 +105,7 @@ static void gen_solve(void *ctx, const double *lu, const double *b, double *x)
 static int gen_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
                     const double *tol, int max_iter, double *out, int *iout)
 {
-    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+    return ((const Kernels *)ctx)->step(q, qd, qdd, t, h, tol, max_iter, out, iout);
 }
 
 static void gen_jac_nz(void *ctx, const double *q, double t, double *vals)
@@ -189,14 +189,14 @@ static void test_declines(void **s)
     memcpy(st, mech->model->q0, 9 * sizeof *st);
     for (int i = 9; i < 27; i++)
         st[i] = 0;
-    assert_int_equal(e.kernels.lu_step(st, st + 9, st + 18, 0, 0, tol, 25, out, iout), 0);
+    assert_int_equal(e.kernels.step(st, st + 9, st + 18, 0, 0, tol, 25, out, iout), 0);
     st[9] = NAN;
     memcpy(before, st, sizeof st);
-    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 25, out, iout) != 0);
+    assert_true(e.kernels.step(st, st + 9, st + 18, 0, 0.01, tol, 25, out, iout) != 0);
     assert_memory_equal(st, before, sizeof st);
     st[9] = 0;
     memcpy(before, st, sizeof st);
-    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 0, out, iout) != 0);
+    assert_true(e.kernels.step(st, st + 9, st + 18, 0, 0.01, tol, 0, out, iout) != 0);
     assert_memory_equal(st, before, sizeof st);
     free(f);
     engine_close(&e);

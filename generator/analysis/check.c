@@ -86,7 +86,7 @@ CheckOptions check_default_options(void)
     };
 }
 
-enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT, PAIR_COUNT = 3 };
+enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT = CHECK_QTY_COUNT, PAIR_COUNT = CHECK_PAIR_COUNT };
 
 /* The ladder of finite-difference steps: index i is the step
    h * pi^(FD_COARSE - i), the default h at FD_COARSE, pi^2 h first, h/pi^8

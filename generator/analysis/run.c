@@ -1387,7 +1387,7 @@ static void code_lu_solve(void *ctx, const double *lu, const double *b, double *
 static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
                         const double *tol, int max_iter, double *out, int *iout)
 {
-    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+    return ((const Kernels *)ctx)->step(q, qd, qdd, t, h, tol, max_iter, out, iout);
 }
 
 bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
@@ -1400,6 +1400,6 @@ bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
                              code_jac_nz, code->all_nz ? code_all_nz : NULL,
                              code->lu_factor ? code_lu_factor : NULL,
                              code->lu_factor ? code_lu_solve : NULL,
-                             code->lu_step ? code_lu_step : NULL};
+                             code->step ? code_lu_step : NULL};
     return true;
 }

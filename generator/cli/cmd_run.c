@@ -68,7 +68,7 @@ static const CliOption options[] = {
              "as a table unless --csv or --json is given"},
     {"--at", CLI_REAL_AT(RunCli, at), .metavar = "T",
      .help = "the instant T alone: --t0 T --steps 0"},
-    {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
+    {"--engine", CLI_CHOICE_AT(RunCli, engine, engine_names), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--linear", CLI_CHOICE_AT(RunCli, linear, run_linear_names), .metavar = "L",
      .help = "linear algebra: dense (LU), sparse (KLU on the Jacobian's\n"

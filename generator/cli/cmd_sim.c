@@ -54,7 +54,7 @@ static const CliOption options[] = {
     {"--steps", CLI_INT_AT(SimCli, so.steps, 1, 100000000), .metavar = "N",
      .help = "output intervals (default 100); the integrator chooses\n"
              "its own steps in between"},
-    {"--engine", CLI_CHOICE_AT(SimCli, engine, cli_engine_choices), .metavar = "E",
+    {"--engine", CLI_CHOICE_AT(SimCli, engine, engine_names), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--method", CLI_CHOICE_AT(SimCli, method, sim_method_names), .metavar = "M",
      .help = "integrator: rk8pd (default), rkf45 (explicit Runge-Kutta\n"

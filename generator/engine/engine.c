@@ -17,15 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const engine_names[ENGINE_KIND_COUNT] = {"jit", "generic", "aot"};
-
-int engine_from_name(const char *name)
-{
-    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-        if (strcmp(name, engine_names[k]) == 0)
-            return k;
-    return -1;
-}
+const char *const engine_names[ENGINE_KIND_COUNT + 1] = {
+#define X(E, name) [ENGINE_##E] = name,
+    ENGINE_KINDS(X)
+#undef X
+};
 
 EngineOptions engine_default_options(void)
 {
@@ -143,17 +139,7 @@ static void bind_generic_pattern(Engine *e, const Dynamics *dyn)
 
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
 {
-    EmitOptions eo = emit_default_options();
-    eo.declare_math = false;
-    eo.real_float = false;
-    eo.prefix = "mechc_aot";
-    /* Stores in place are faster than the spread from jac_nz; only large
-       mechanisms keep the compact form, for the compiler's sake. */
-    eo.direct_jac = mech->kin.nnz <= 4000;
-    eo.all_nz = true;       /* run's sparse path */
-    eo.sparse_only = pipeline_sparse_only(mech);
-    eo.lu = true;           /* run's dense path: the unrolled LU */
-    eo.source_name = mech->model->file;
+    EmitOptions eo = engine_emit_options(mech, ENGINE_AOT);
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))
         return false;
@@ -182,7 +168,7 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
     e->nr = mech->model->nr;
     switch (kind) {
     case ENGINE_JIT:
-        e->jit = pipeline_jit(mech, &e->emitted, &e->gen_seconds, &e->compile_seconds, diag);
+        e->jit = engine_jit(mech, &e->emitted, &e->gen_seconds, &e->compile_seconds, diag);
         if (!e->jit) {
             emit_result_free(&e->emitted);
             return false;

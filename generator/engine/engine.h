@@ -3,14 +3,28 @@
 #define MECHC_ENGINE_H
 
 #include "../../runtime/mechrt.h"
+#include "../emit/emit.h"
 #include "../eval/generic.h"
 #include "../jit/jit.h"
 #include "../pipeline/pipeline.h"
 #include "aot.h"
 
-typedef enum EngineKind { ENGINE_JIT, ENGINE_GENERIC, ENGINE_AOT, ENGINE_KIND_COUNT } EngineKind;
+/* The engines, one row each: X(ENUM, name); the name is --engine's
+   value and the report's. */
+#define ENGINE_KINDS(X) \
+    X(JIT, "jit")         /* generated C compiled in memory by libtcc */ \
+    X(GENERIC, "generic") /* formulas interpreted over the joint list */ \
+    X(AOT, "aot")         /* generated C built by cc, cached, dlopen'ed */
 
-extern const char *const engine_names[ENGINE_KIND_COUNT];
+typedef enum EngineKind {
+#define X(E, name) ENGINE_##E,
+    ENGINE_KINDS(X)
+#undef X
+    ENGINE_KIND_COUNT
+} EngineKind;
+
+/* The names, by kind, NULL after the last (an option's choices). */
+extern const char *const engine_names[ENGINE_KIND_COUNT + 1];
 
 typedef struct Engine {
     EngineKind kind;
@@ -45,15 +59,28 @@ typedef struct EngineOptions {
 
 EngineOptions engine_default_options(void);
 
-/* Parses an --engine value; -1 when unknown. */
-int engine_from_name(const char *name);
-
 /* Prepares an engine for mech. Returns false with diag filled when it
    cannot (no compiler for aot, a bug for jit). */
 bool engine_open(Engine *engine, EngineKind kind, const Mech *mech, Diag *diag);
 bool engine_open_with(Engine *engine, EngineKind kind, const Mech *mech,
                       const EngineOptions *options, Diag *diag);
 void engine_close(Engine *engine);
+
+/* The options the engine of kind emits mech's kernels with (generic,
+   which compiles nothing: the defaults). The one place that decides what
+   the engines compile: jit all_nz, the unrolled LU and the direct
+   Jacobian, with large parts for libtcc; aot the same with <math.h>, and
+   the compact Jacobian for large mechanisms (EMIT_DIRECT_JAC_NNZ). */
+EmitOptions engine_emit_options(const Mech *mech, EngineKind kind);
+
+/* Emits mech's kernels with eo (double, declare_math) and compiles them
+   with libtcc; NULL with diag filled on failure (emitted may hold the
+   source). emit_seconds and tcc_seconds may be NULL. engine_jit: with
+   engine_emit_options(mech, ENGINE_JIT). */
+Jit *engine_jit_compile(const Mech *mech, const EmitOptions *eo, EmitResult *emitted,
+                        double *emit_seconds, double *tcc_seconds, Diag *diag);
+Jit *engine_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
+                double *tcc_seconds, Diag *diag);
 
 /* The kernels Newton should see: e->k, without the fused `all` when gamma,
    which Newton does not need, has at least as many operations as phi and
