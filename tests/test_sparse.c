@@ -364,15 +364,13 @@ static void run_linear(Mech *mech, RunLinear lin, RunOptions o, EngineKind kind,
 {
     Engine e;
     Diag diag;
-    MechrtHostJacNz jnz;
     memset(c, 0, sizeof *c);
     mechrt_trace_init(&c->trace, mech->model->nq);
     if (!engine_open(&e, kind, mech, &diag))
         fail_msg("engine: %s", diag.message);
     MechrtKernels k = e.k;
     o.linear = lin;
-    o.jac_nz = run_jac_nz_of(&e, &jnz) ? &jnz : NULL;
-    c->status = run_analysis(mech->model, &k, &o, collect, c, &c->res);
+    c->status = run_analysis(mech->model, &k, engine_jac_nz(&e), &o, collect, c, &c->res);
     engine_close(&e);
 }
 
@@ -525,7 +523,7 @@ static void expect_all_nz_agrees(Mech *mech, EngineKind kind)
     Diag diag;
     if (!engine_open(&e, kind, mech, &diag))
         fail_msg("engine: %s", diag.message);
-    const Kernels *code = e.k.ctx;
+    const Kernels *code = &e.kernels;
     assert_non_null(code->all_nz);
     const Model *m = mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr, nnz = (size_t)mech->kin.nnz;
@@ -593,12 +591,12 @@ static void test_all_nz_run(void **state)
         assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
         MechrtKernels k = e.k;
         o.linear = RUN_LINEAR_SPARSE;
-        assert_true(run_jac_nz_of(&e, &jnz));
+        assert_non_null(engine_jac_nz(&e));
+        jnz = *engine_jac_nz(&e);
         assert_non_null(jnz.all_nz);
         if (!fused)
             jnz.all_nz = NULL;
-        o.jac_nz = &jnz;
-        c[fused].status = run_analysis(mech->model, &k, &o, collect, &c[fused], &c[fused].res);
+        c[fused].status = run_analysis(mech->model, &k, &jnz, &o, collect, &c[fused], &c[fused].res);
         assert_int_equal(c[fused].status, RUN_OK);
         engine_close(&e);
     }

@@ -147,7 +147,7 @@ typedef struct Checker {
     double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
     /* the sparse comparisons (CheckOptions.linear) */
     bool sparse;
-    MechrtHostJacNz jnz[ENGINE_KIND_COUNT];     /* jit's and aot's jac_nz */
+    const MechrtHostJacNz *jnz[ENGINE_KIND_COUNT];  /* jit's and aot's jac_nz */
     bool has_nz[ENGINE_KIND_COUNT];
     int nnz;
     int ngroups;
@@ -165,7 +165,7 @@ static void under_test(Checker *c)
     double **o = c->out[ENGINE_JIT];
     engine_phi(e, c->q, c->t, o[QTY_PHI]);
     if (c->sparse)
-        c->jnz[ENGINE_JIT].jac_nz(c->jnz[ENGINE_JIT].ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[ENGINE_JIT]->jac_nz(c->jnz[ENGINE_JIT]->ctx, c->q, c->t, o[QTY_JAC]);
     else
         engine_jac(e, c->q, c->t, o[QTY_JAC]);
     engine_nu(e, c->q, c->t, o[QTY_NU]);
@@ -173,7 +173,8 @@ static void under_test(Checker *c)
     if (c->dyn) {
         e->k.mass(e->k.ctx, c->q, c->mass[ENGINE_JIT]);
         e->k.force(e->k.ctx, c->q, c->qd, c->t, c->force[ENGINE_JIT]);
-        engine_mass_nz(e, c->q, c->mass_nz[ENGINE_JIT]);
+        const MechrtHostMassNz *mnz = engine_mass_nz(e);
+        mnz->mass_nz(mnz->ctx, c->q, c->mass_nz[ENGINE_JIT]);
     }
     const CheckFault *f = &c->opt->fault;
     if (f->kind == CHECK_FAULT_MASS_SCALE && c->dyn && f->row >= 0 && f->row < c->nq
@@ -187,7 +188,7 @@ static void under_test(Checker *c)
         break;
     case CHECK_FAULT_JAC_SCALE:
         for (int k = 0; c->sparse && k < c->nnz; k++)
-            if (c->jnz[ENGINE_JIT].row[k] == f->row && c->jnz[ENGINE_JIT].col[k] == f->col)
+            if (c->jnz[ENGINE_JIT]->row[k] == f->row && c->jnz[ENGINE_JIT]->col[k] == f->col)
                 o[QTY_JAC][k] *= f->factor;
         if (!c->sparse && f->col >= 0 && f->col < c->nq)
             o[QTY_JAC][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
@@ -494,7 +495,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
     for (int i = 0; i < n; i++) {
         int e = c->ent[first + i];
         p.comp = i;
-        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT].col[e] : -1,
+        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT]->col[e] : -1,
                    e >= 0 ? vals[e] : 0.0, c->ladder[FD_COARSE][i], &p, h);
     }
 }
@@ -503,7 +504,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
    Psi (velocity rows) along each column group. */
 static void check_fd_groups(Checker *c, double *scratch)
 {
-    const int *row = c->jnz[ENGINE_JIT].row;
+    const int *row = c->jnz[ENGINE_JIT]->row;
     VecFn f;
     for (int g = 0; g < c->ngroups; g++) {
         const int *cols = c->group_cols + c->group_start[g];
@@ -588,14 +589,15 @@ static void eval_engine(Checker *c, EngineKind k)
     if (!c->sparse)
         engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
     else if (c->has_nz[k])
-        c->jnz[k].jac_nz(c->jnz[k].ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[k]->jac_nz(c->jnz[k]->ctx, c->q, c->t, o[QTY_JAC]);
     engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
     engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
     if (c->dyn) {
         const MechrtKernels *mk = &c->eng[k].k;
         mk->mass(mk->ctx, c->q, c->mass[k]);
         mk->force(mk->ctx, c->q, c->qd, c->t, c->force[k]);
-        engine_mass_nz(&c->eng[k], c->q, c->mass_nz[k]);
+        const MechrtHostMassNz *mnz = engine_mass_nz(&c->eng[k]);
+        mnz->mass_nz(mnz->ctx, c->q, c->mass_nz[k]);
     }
 }
 
@@ -610,8 +612,8 @@ static void compare_pair(Checker *c, int pair)
             continue;   /* the generic interpreter's Jacobian is dense */
         int n = qty == QTY_PHI ? c->nh : nz ? c->nnz : qty == QTY_JAC ? c->nr * nq : c->nr;
         for (int i = 0; i < n; i++) {
-            int row = nz ? c->jnz[ENGINE_JIT].row[i] : qty == QTY_JAC ? i / nq : i;
-            int col = nz ? c->jnz[ENGINE_JIT].col[i] : qty == QTY_JAC ? i % nq : -1;
+            int row = nz ? c->jnz[ENGINE_JIT]->row[i] : qty == QTY_JAC ? i / nq : i;
+            int col = nz ? c->jnz[ENGINE_JIT]->col[i] : qty == QTY_JAC ? i % nq : -1;
             record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i], 0.0);
         }
         if (n == 0)
@@ -625,9 +627,9 @@ static void compare_pair(Checker *c, int pair)
     }
     /* M's nonzeros (what sim's sparse path calls) count under M: every
        engine writes them in the generated kernel's pattern. */
-    const Engine *ea = &c->eng[a];
-    for (int i = 0; c->dyn && i < ea->mass_nnz; i++)
-        record(c, CHECK_DYN_FIRST + 2 * pair, -1, ea->mass_col[i], c->mass_nz[a][i],
+    const MechrtHostMassNz *mnz = c->dyn ? engine_mass_nz(&c->eng[a]) : NULL;
+    for (int i = 0; mnz && i < mnz->nnz; i++)
+        record(c, CHECK_DYN_FIRST + 2 * pair, -1, mnz->col[i], c->mass_nz[a][i],
                c->mass_nz[b][i], 0.0);
 }
 
@@ -871,7 +873,7 @@ static void hint_pair(const Checker *c, CheckItem *it, int pair, int qty)
 static bool assemble_klu(Checker *c, const MechrtKernels *k, double *q)
 {
     size_t nq = (size_t)c->nq;
-    MechrtHostSparse *s = mechrt_host_sparse_new(c->nq, &c->jnz[ENGINE_JIT]);
+    MechrtHostSparse *s = mechrt_host_sparse_new(c->nq, c->jnz[ENGINE_JIT]);
     double *work = xcalloc(MECHRT_HOST_SPARSE_WORK_LEN(nq) + 2 * nq, sizeof *work);
     double *qd = work + MECHRT_HOST_SPARSE_WORK_LEN(nq), *qdd = qd + nq;
     construct_with_kernels(c->m, k, 0.0, q);
@@ -1001,7 +1003,7 @@ static void take_buffers(Checker *c)
     for (int k = 0; k < ENGINE_KIND_COUNT && c->dyn; k++) {
         c->mass[k] = take(c, nq * nq);
         c->force[k] = take(c, nq);
-        c->mass_nz[k] = take(c, (size_t)c->eng[ENGINE_JIT].mass_nnz + 1);
+        c->mass_nz[k] = take(c, (size_t)engine_mass_nz(&c->eng[ENGINE_JIT])->nnz + 1);
     }
     if (c->dyn) {
         c->mw = take(c, nq * nq);
@@ -1034,7 +1036,7 @@ static void entries_by(Checker *c, const int *key, int n, int **start, int **ent
    first group none of whose columns shares a row with it. */
 static void group_columns(Checker *c)
 {
-    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT];
+    const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
     int *row_start, *row_ent;
     entries_by(c, j->row, c->nr, &row_start, &row_ent);
     entries_by(c, j->col, c->nq, &c->col_start, &c->col_ent);
@@ -1079,15 +1081,17 @@ static void group_columns(Checker *c)
 static void choose_linear(Checker *c)
 {
     RunLinear lin = c->opt->linear;
+    c->jnz[ENGINE_JIT] = engine_jac_nz(&c->eng[ENGINE_JIT]);
     c->sparse = (lin == RUN_LINEAR_SPARSE || (lin == RUN_LINEAR_AUTO && c->nq > RUN_DENSE_MAX_NQ))
-                && run_jac_nz_of(&c->eng[ENGINE_JIT], &c->jnz[ENGINE_JIT]);
+                && c->jnz[ENGINE_JIT];
     if (!c->sparse)
         return;
     c->has_nz[ENGINE_JIT] = true;
-    c->nnz = c->jnz[ENGINE_JIT].nnz;
-    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT], *a = &c->jnz[ENGINE_AOT];
-    c->has_nz[ENGINE_AOT] = c->open[ENGINE_AOT] && run_jac_nz_of(&c->eng[ENGINE_AOT], &c->jnz[ENGINE_AOT])
-                            && a->nnz == j->nnz
+    c->nnz = c->jnz[ENGINE_JIT]->nnz;
+    const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
+    const MechrtHostJacNz *a = c->open[ENGINE_AOT] ? engine_jac_nz(&c->eng[ENGINE_AOT]) : NULL;
+    c->jnz[ENGINE_AOT] = a;
+    c->has_nz[ENGINE_AOT] = a && a->nnz == j->nnz
                             && memcmp(a->row, j->row, (size_t)j->nnz * sizeof *j->row) == 0
                             && memcmp(a->col, j->col, (size_t)j->nnz * sizeof *j->col) == 0;
     c->rep->sparse = true;

@@ -115,7 +115,6 @@ RunOptions run_default_options(void)
     o.assembly_max_iter = 100;
     o.notes = NULL;
     o.linear = RUN_LINEAR_AUTO;
-    o.jac_nz = NULL;
     o.max_dense_entries = 0;
     return o;
 }
@@ -125,6 +124,7 @@ RunOptions run_default_options(void)
 typedef struct Run {
     const Model *m;
     const MechrtKernels *k;
+    const MechrtHostJacNz *jnz;  /* the kernels' sparse Jacobian, or NULL */
     const RunOptions *o;
     RunResult *res;
     int nq, nr;
@@ -135,7 +135,7 @@ typedef struct Run {
                                 velocity-level rows: the sparse host's) */
     bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
-    MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
+    MechrtJacNz lup_jnz;     /* its kernel: jnz's */
     MechrtLuGen lup_gen;     /* the kernels' unrolled LU, when they have one */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
@@ -294,7 +294,7 @@ static int nonfinite_jac_row(Run *r, const double *q, double t)
 {
     int row = -1;
     if (r->sp) {
-        const MechrtHostJacNz *j = r->o->jac_nz;
+        const MechrtHostJacNz *j = r->jnz;
         double *vals = mechrt_host_sparse_values(r->sp);
         mechrt_host_sparse_eval(r->sp, q, t);
         for (int e = 0; e < j->nnz && row < 0; e++)
@@ -1079,7 +1079,7 @@ static RunStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     const RunOptions *o = r->o;
     MechrtReport rep;
     RunStatus status = RUN_OK;
-    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
+    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, r->jnz) : mechrt_host_new(r->k);
     r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
@@ -1152,13 +1152,13 @@ static RunStatus bad_input(RunResult *res, const char *fmt, ...)
 
 /* Dense or sparse for this run (RunOptions.linear); false with why when
    the choice cannot be honoured. */
-static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
-                          size_t size)
+static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o,
+                          bool *sparse, char *why, size_t size)
 {
-    bool can = o->jac_nz != NULL;
+    bool can = jnz != NULL;
     *sparse = o->linear == RUN_LINEAR_SPARSE
               || (o->linear == RUN_LINEAR_AUTO && can && m->nq > RUN_DENSE_MAX_NQ);
-    if (*sparse && !o->jac_nz) {
+    if (*sparse && !jnz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
         return false;
@@ -1178,24 +1178,22 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
    there is one, the mechanism is stepped (no velocity rows) and its
    worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
-static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
+static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *hj, MechrtJacNz *jnz,
                               MechrtLuGen *gen)
 {
-    if (!o->jac_nz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+    if (!hj || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
         return NULL;
     size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
     MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
     double *w = (double *)(f + 1);
-    *jnz = (MechrtJacNz){o->jac_nz->nnz, o->jac_nz->row, o->jac_nz->col, o->jac_nz->ctx,
-                         o->jac_nz->jac_nz};
+    *jnz = (MechrtJacNz){hj->nnz, hj->row, hj->col, hj->ctx, hj->jac_nz};
     if (mechrt_lup_init(f, m->nq, jnz->nnz, jnz->row, jnz->col, w, lw, (int *)(w + lw), liw)
         != MECHRT_OK) {
         free(f);
         return NULL;
     }
-    if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
-        *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
-                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
+    if (hj->lu_factor && hj->lu_solve) {
+        *gen = (MechrtLuGen){m->nq * m->nq, hj->ctx, hj->lu_factor, hj->lu_solve, hj->lu_step};
         mechrt_lup_use(f, gen);
     }
     return f;
@@ -1223,8 +1221,9 @@ bool run_rows_match(const Model *m, char *why, size_t size)
 }
 
 /* run_analysis and run_analysis_forces: one of state and fstate. */
-static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                         RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
+static RunStatus analyse(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                         const RunOptions *o, RunStateFn state, RunForcesFn fstate,
+                         void *state_ctx, RunResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
@@ -1245,12 +1244,13 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     if (!run_rows_match(m, why, sizeof why))
         return bad_input(res, "%s", why);
     bool sparse;
-    if (!choose_linear(m, o, &sparse, why, sizeof why))
+    if (!choose_linear(m, jnz, o, &sparse, why, sizeof why))
         return bad_input(res, "%s", why);
 
     Run r = {0};
     r.m = m;
     r.k = k;
+    r.jnz = jnz;
     r.o = o;
     r.res = res;
     r.nq = m->nq;
@@ -1261,15 +1261,15 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     r.qd = r.q + nq;
     r.qdd = r.q + 2 * nq;
     r.sparse = sparse;
-    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, jnz))) {
         free(r.q);
         return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
                          "entries) is not a valid %d x %d pattern, or out of memory",
-                         o->jac_nz->nnz, m->nq, m->nq);
+                         jnz->nnz, m->nq, m->nq);
     }
     res->sparse = sparse;
     if (!sparse)
-        r.lup = run_lup_new(m, o, &r.lup_jnz, &r.lup_gen);
+        r.lup = run_lup_new(m, jnz, &r.lup_jnz, &r.lup_gen);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -1301,13 +1301,14 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const RunOption
     return status;
 }
 
-RunStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                       RunStateFn state, void *state_ctx, RunResult *res)
+RunStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const RunOptions *o, RunStateFn state, void *state_ctx, RunResult *res)
 {
-    return analyse(m, k, o, state, NULL, state_ctx, res);
+    return analyse(m, k, jnz, o, state, NULL, state_ctx, res);
 }
 
-RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k,
+                              const MechrtHostJacNz *jnz, const RunOptions *o,
                               RunForcesFn state, void *state_ctx, RunResult *res)
 {
     if (!k->mass || !k->force) {
@@ -1324,82 +1325,5 @@ RunStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunO
                          "%lld entries), more than the limit of %lld (--max-jac-entries)",
                          m->nq, m->nq, (long long)m->nq * m->nq, o->max_dense_entries);
     }
-    return analyse(m, k, o, NULL, state, state_ctx, res);
-}
-
-double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const double *q,
-                    const double *qd, double t, double min_seconds)
-{
-    size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
-    size_t njac = jnz ? (size_t)jnz->nnz : nr * nq;
-    double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(njac + 1, sizeof *jac);
-    double *nu = xcalloc(nr + 1, sizeof *nu), *gamma = xcalloc(nr + 1, sizeof *gamma);
-    long calls = 0, batch = 64;
-    double t0 = pipeline_now(), elapsed;
-    do {
-        for (long i = 0; i < batch; i++) {
-            if (jnz && jnz->all_nz) {
-                jnz->all_nz(jnz->ctx, q, qd, t, phi, jac, nu, gamma);
-            } else if (jnz) {
-                k->phi(k->ctx, q, t, phi);
-                jnz->jac_nz(jnz->ctx, q, t, jac);
-                k->nu(k->ctx, q, t, nu);
-                k->gamma(k->ctx, q, qd, t, gamma);
-            } else if (k->all) {
-                k->all(k->ctx, q, qd, t, phi, jac, nu, gamma);
-            } else {
-                k->phi(k->ctx, q, t, phi);
-                k->jac(k->ctx, q, t, jac);
-                k->nu(k->ctx, q, t, nu);
-                k->gamma(k->ctx, q, qd, t, gamma);
-            }
-        }
-        calls += batch;
-        batch *= 2;
-        elapsed = pipeline_now() - t0;
-    } while (elapsed < min_seconds);
-    free(phi), free(jac), free(nu), free(gamma);
-    return 1e9 * elapsed / (double)calls;
-}
-
-static void code_jac_nz(void *ctx, const double *q, double t, double *vals)
-{
-    ((const Kernels *)ctx)->jac_nz(q, t, vals);
-}
-
-static void code_all_nz(void *ctx, const double *q, const double *qd, double t, double *phi,
-                        double *vals, double *nu, double *gamma)
-{
-    ((const Kernels *)ctx)->all_nz(q, qd, t, phi, vals, nu, gamma);
-}
-
-static int code_lu_factor(void *ctx, const double *a, double *lu, double pivot_tol,
-                          double *spread)
-{
-    return ((const Kernels *)ctx)->lu_factor(a, lu, pivot_tol, spread);
-}
-
-static void code_lu_solve(void *ctx, const double *lu, const double *b, double *x)
-{
-    ((const Kernels *)ctx)->lu_solve(lu, b, x);
-}
-
-static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
-                        const double *tol, int max_iter, double *out, int *iout)
-{
-    return ((const Kernels *)ctx)->step(q, qd, qdd, t, h, tol, max_iter, out, iout);
-}
-
-bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out)
-{
-    const Kernels *code = e->k.ctx;
-    if ((e->kind != ENGINE_JIT && e->kind != ENGINE_AOT) || !code || !code->jac_nz
-        || !code->jac_row || !code->jac_col)
-        return false;
-    *out = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, (void *)code,
-                             code_jac_nz, code->all_nz ? code_all_nz : NULL,
-                             code->lu_factor ? code_lu_factor : NULL,
-                             code->lu_factor ? code_lu_solve : NULL,
-                             code->step ? code_lu_step : NULL};
-    return true;
+    return analyse(m, k, jnz, o, NULL, state, state_ctx, res);
 }

@@ -122,8 +122,6 @@ SimOptions sim_default_options(void)
     o.max_steps = 10000000;
     o.notes = NULL;
     o.linear = SIM_LINEAR_AUTO;
-    o.jac_nz = NULL;
-    o.mass_nz = NULL;
     return o;
 }
 
@@ -136,7 +134,8 @@ bool sim_has_masses(const MechrtKernels *k)
 
 typedef struct Sim {
     const MechrtKernels *inner;  /* the caller's kernels */
-    MechrtKernels kc;            /* the same, counted (ctx: this Sim) */
+    EngineCounter counter;
+    MechrtKernels kc;            /* the same, counted (engine_counting) */
     const SimOptions *o;
     SimResult *res;
     int nq, nr, dim;             /* dim: 2 nq (+1 with energy) */
@@ -172,57 +171,6 @@ typedef struct Sim {
     double *yc, *fc, *ya, *fa;   /* --interpolate: the last two steps' starts, f there */
     double *fb, *yi;             /* f at the step's end, the output state */
 } Sim;
-
-/* Counting wrappers: every kernel call of the simulation goes through these. */
-static void c_phi(void *ctx, const double *q, double t, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.phi++;
-    s->inner->phi(s->inner->ctx, q, t, out);
-}
-
-static void c_jac(void *ctx, const double *q, double t, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.jac++;
-    s->inner->jac(s->inner->ctx, q, t, out);
-}
-
-static void c_nu(void *ctx, const double *q, double t, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.nu++;
-    s->inner->nu(s->inner->ctx, q, t, out);
-}
-
-static void c_gamma(void *ctx, const double *q, const double *qd, double t, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.gamma++;
-    s->inner->gamma(s->inner->ctx, q, qd, t, out);
-}
-
-static void c_all(void *ctx, const double *q, const double *qd, double t, double *phi,
-                  double *jac, double *nu, double *gamma)
-{
-    Sim *s = ctx;
-    s->res->calls.all++;
-    s->inner->all(s->inner->ctx, q, qd, t, phi, jac, nu, gamma);
-}
-
-static void c_mass(void *ctx, const double *q, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.mass++;
-    s->inner->mass(s->inner->ctx, q, out);
-}
-
-static void c_force(void *ctx, const double *q, const double *qd, double t, double *out)
-{
-    Sim *s = ctx;
-    s->res->calls.force++;
-    s->inner->force(s->inner->ctx, q, qd, t, out);
-}
 
 static void msgf(Sim *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
@@ -901,22 +849,24 @@ static const gsl_odeiv2_step_type *step_type(SimMethod m)
 }
 
 /* The sparse path's kernels are there (and rows to constrain). */
-static bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o)
+static bool sim_sparse_can(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                           const MechrtHostMassNz *mnz)
 {
-    return k->nh + k->nv > 0 && o->jac_nz && o->jac_nz->all_nz && o->jac_nz->jac_nz
-           && o->mass_nz && o->mass_nz->mass_nz;
+    return k->nh + k->nv > 0 && jnz && jnz->all_nz && jnz->jac_nz && mnz && mnz->mass_nz;
 }
 
 /* The sparse path is taken: asked for, or auto on a large mechanism. */
-static bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o)
+static bool sim_sparse_wanted(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                              const MechrtHostMassNz *mnz, const SimOptions *o)
 {
-    return sim_sparse_can(k, o)
+    return sim_sparse_can(k, jnz, mnz)
            && (o->linear == SIM_LINEAR_SPARSE
                || (o->linear == SIM_LINEAR_AUTO && k->nq > SIM_DENSE_MAX_NQ));
 }
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */
-static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *res)
+static bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                     const MechrtHostMassNz *mnz, const SimOptions *o, SimResult *res)
 {
     size_t n = (size_t)k->nq, m = (size_t)(k->nh + k->nv);
     s->inner = k;
@@ -925,8 +875,7 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     s->nq = k->nq;
     s->nr = (int)m;
     s->dim = 2 * k->nq + (o->energy ? 1 : 0);
-    s->kc = (MechrtKernels){k->nq, k->nh, k->nv, s, c_phi, c_jac, c_nu, c_gamma,
-                            k->all ? c_all : NULL, c_mass, c_force};
+    s->kc = engine_counting(&s->counter, k, &res->calls);
     s->nu = xcalloc(m + 1, sizeof *s->nu);
     s->resid = xcalloc(m + 1, sizeof *s->resid);
     s->lambda = xcalloc(m + 1, sizeof *s->lambda);
@@ -947,10 +896,10 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
     memset(s->active, 1, m + 1);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
-    if (sim_sparse_wanted(k, o)) {
-        s->jnz = o->jac_nz;
-        s->mnz = o->mass_nz;
-        s->kkt = mechrt_host_kkt_new(k->nq, (int)m, o->jac_nz, o->mass_nz);
+    if (sim_sparse_wanted(k, jnz, mnz, o)) {
+        s->jnz = jnz;
+        s->mnz = mnz;
+        s->kkt = mechrt_host_kkt_new(k->nq, (int)m, jnz, mnz);
         if (!s->kkt)
             return false;
         s->res->sparse = true;
@@ -960,7 +909,7 @@ static bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimRes
         s->sphi = xcalloc(m, sizeof *s->sphi);
         s->sg = xcalloc(m, sizeof *s->sg);
         s->sforce = xcalloc(n, sizeof *s->sforce);
-        s->smass = xcalloc((size_t)o->mass_nz->nnz + 1, sizeof *s->smass);
+        s->smass = xcalloc((size_t)mnz->nnz + 1, sizeof *s->smass);
     }
     if (!s->kkt && !dense_ready(s))
         return false;
@@ -1326,7 +1275,8 @@ static SimStatus bad_input(SimResult *res, const char *fmt, ...)
 }
 
 /* Options and kernels usable; SIM_OK or SIM_BAD_INPUT with the message. */
-static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
+static SimStatus check_input(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             const MechrtHostMassNz *mnz, const SimOptions *o, SimResult *res)
 {
     if (!sim_has_masses(k))
         return bad_input(res, "the mechanism has no masses: forward dynamics needs `mass` "
@@ -1341,24 +1291,25 @@ static SimStatus check_input(const MechrtKernels *k, const SimOptions *o, SimRes
     if (k->nh > k->nq)
         return bad_input(res, "%d holonomic rows for %d coordinates: the position "
                          "projection needs at most one row per coordinate", k->nh, k->nq);
-    if (o->linear == SIM_LINEAR_SPARSE && !sim_sparse_can(k, o))
+    if (o->linear == SIM_LINEAR_SPARSE && !sim_sparse_can(k, jnz, mnz))
         return bad_input(res, "--linear sparse needs the generated kernels' nonzeros (--engine "
                          "jit or aot) and at least one constraint row");
     return SIM_OK;
 }
 
-SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+SimStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                        const MechrtHostMassNz *mnz, const SimOptions *o, const double *q0,
                         SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     res->min_pivot_ratio = 1;
-    if (check_input(k, o, res) != SIM_OK)
+    if (check_input(k, jnz, mnz, o, res) != SIM_OK)
         return SIM_BAD_INPUT;
     Sim s;
     memset(&s, 0, sizeof s);
     SimStatus status = SIM_FAILED;
-    if (!sim_open(&s, k, o, res)) {
+    if (!sim_open(&s, k, jnz, mnz, o, res)) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
         res->status = SIM_FAILED;
         res->cause = MECHRT_EINVAL;
@@ -1386,13 +1337,14 @@ SimStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const doubl
 
 /* Construction, then Newton onto the rows from the file's values (as run
    does at t0); q holds the result. False with the message set. */
-static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                           double *q, SimResult *res)
+static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                           const MechrtHostMassNz *mnz, const SimOptions *o, double *q,
+                           SimResult *res)
 {
+    bool sparse = sim_sparse_wanted(k, jnz, mnz, o);
     res->constructed = construct_with_kernels(m, k, o->t0, q);
     /* the sparse path's Newton by SuiteSparseQR: the dense SVD is O(nq^3) */
-    MechrtHost *host = sim_sparse_wanted(k, o) ? mechrt_host_new_projector(k, o->jac_nz)
-                                               : mechrt_host_new(k);
+    MechrtHost *host = sparse ? mechrt_host_new_projector(k, jnz) : mechrt_host_new(k);
     if (!host) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
         return false;
@@ -1403,7 +1355,7 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
     MechrtStatus st = mechrt_host_project(host, &o->mechrt, q, o->t0, &rep);
     mechrt_host_free(host);
     bool ok = st == MECHRT_OK;
-    if (!ok && sim_sparse_wanted(k, o) && m->nq > SIM_DENSE_MAX_NQ) {
+    if (!ok && sparse && m->nq > SIM_DENSE_MAX_NQ) {
         /* the restarts' dense SVDs would take hours here: the sparse
            Newton's own failure, in the same words */
         snprintf(res->message, sizeof res->message, "t = %.10g: could not assemble from "
@@ -1431,20 +1383,21 @@ static bool assemble_at_t0(const Model *m, const MechrtKernels *k, const SimOpti
     return ok;
 }
 
-SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                  SimStateFn state, void *state_ctx, SimResult *res)
+SimStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                  const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
+                  void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (check_input(k, o, res) != SIM_OK)
+    if (check_input(k, jnz, mnz, o, res) != SIM_OK)
         return SIM_BAD_INPUT;
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
-    if (!assemble_at_t0(m, k, o, q, &pre)) {
+    if (!assemble_at_t0(m, k, jnz, mnz, o, q, &pre)) {
         *res = pre;
         res->status = SIM_FAILED;
         res->cause = MECHRT_EMAXITER;
@@ -1458,7 +1411,7 @@ SimStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
     if (pre.assembled_robustly && o->notes)
         fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
                 "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
-    SimStatus st = sim_integrate(k, o, q, state, state_ctx, res);
+    SimStatus st = sim_integrate(k, jnz, mnz, o, q, state, state_ctx, res);
     res->constructed = pre.constructed;
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;
