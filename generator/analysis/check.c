@@ -165,7 +165,7 @@ static void under_test(Checker *c)
     double **o = c->out[ENGINE_JIT];
     engine_phi(e, c->q, c->t, o[QTY_PHI]);
     if (c->sparse)
-        c->jnz[ENGINE_JIT]->jac_nz(c->jnz[ENGINE_JIT]->ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[ENGINE_JIT]->jac.jac_nz(c->jnz[ENGINE_JIT]->jac.ctx, c->q, c->t, o[QTY_JAC]);
     else
         engine_jac(e, c->q, c->t, o[QTY_JAC]);
     engine_nu(e, c->q, c->t, o[QTY_NU]);
@@ -188,7 +188,7 @@ static void under_test(Checker *c)
         break;
     case CHECK_FAULT_JAC_SCALE:
         for (int k = 0; c->sparse && k < c->nnz; k++)
-            if (c->jnz[ENGINE_JIT]->row[k] == f->row && c->jnz[ENGINE_JIT]->col[k] == f->col)
+            if (c->jnz[ENGINE_JIT]->jac.row[k] == f->row && c->jnz[ENGINE_JIT]->jac.col[k] == f->col)
                 o[QTY_JAC][k] *= f->factor;
         if (!c->sparse && f->col >= 0 && f->col < c->nq)
             o[QTY_JAC][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
@@ -495,7 +495,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
     for (int i = 0; i < n; i++) {
         int e = c->ent[first + i];
         p.comp = i;
-        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT]->col[e] : -1,
+        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT]->jac.col[e] : -1,
                    e >= 0 ? vals[e] : 0.0, c->ladder[FD_COARSE][i], &p, h);
     }
 }
@@ -504,7 +504,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
    Psi (velocity rows) along each column group. */
 static void check_fd_groups(Checker *c, double *scratch)
 {
-    const int *row = c->jnz[ENGINE_JIT]->row;
+    const int *row = c->jnz[ENGINE_JIT]->jac.row;
     VecFn f;
     for (int g = 0; g < c->ngroups; g++) {
         const int *cols = c->group_cols + c->group_start[g];
@@ -589,7 +589,7 @@ static void eval_engine(Checker *c, EngineKind k)
     if (!c->sparse)
         engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
     else if (c->has_nz[k])
-        c->jnz[k]->jac_nz(c->jnz[k]->ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[k]->jac.jac_nz(c->jnz[k]->jac.ctx, c->q, c->t, o[QTY_JAC]);
     engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
     engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
     if (c->dyn) {
@@ -612,8 +612,8 @@ static void compare_pair(Checker *c, int pair)
             continue;   /* the generic interpreter's Jacobian is dense */
         int n = qty == QTY_PHI ? c->nh : nz ? c->nnz : qty == QTY_JAC ? c->nr * nq : c->nr;
         for (int i = 0; i < n; i++) {
-            int row = nz ? c->jnz[ENGINE_JIT]->row[i] : qty == QTY_JAC ? i / nq : i;
-            int col = nz ? c->jnz[ENGINE_JIT]->col[i] : qty == QTY_JAC ? i % nq : -1;
+            int row = nz ? c->jnz[ENGINE_JIT]->jac.row[i] : qty == QTY_JAC ? i / nq : i;
+            int col = nz ? c->jnz[ENGINE_JIT]->jac.col[i] : qty == QTY_JAC ? i % nq : -1;
             record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i], 0.0);
         }
         if (n == 0)
@@ -1038,8 +1038,8 @@ static void group_columns(Checker *c)
 {
     const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
     int *row_start, *row_ent;
-    entries_by(c, j->row, c->nr, &row_start, &row_ent);
-    entries_by(c, j->col, c->nq, &c->col_start, &c->col_ent);
+    entries_by(c, j->jac.row, c->nr, &row_start, &row_ent);
+    entries_by(c, j->jac.col, c->nq, &c->col_start, &c->col_ent);
     int *color = xmalloc(((size_t)c->nq + 1) * sizeof *color);
     int *mark = xmalloc(((size_t)c->nq + 1) * sizeof *mark);
     for (int k = 0; k < c->nq; k++)
@@ -1047,9 +1047,9 @@ static void group_columns(Checker *c)
     c->ngroups = 0;
     for (int col = 0; col < c->nq; col++) {
         for (int a = c->col_start[col]; a < c->col_start[col + 1]; a++) {
-            int r = j->row[c->col_ent[a]];
+            int r = j->jac.row[c->col_ent[a]];
             for (int b = row_start[r]; b < row_start[r + 1]; b++) {
-                int other = j->col[row_ent[b]];
+                int other = j->jac.col[row_ent[b]];
                 if (color[other] >= 0)
                     mark[color[other]] = col;
             }
@@ -1087,13 +1087,13 @@ static void choose_linear(Checker *c)
     if (!c->sparse)
         return;
     c->has_nz[ENGINE_JIT] = true;
-    c->nnz = c->jnz[ENGINE_JIT]->nnz;
+    c->nnz = c->jnz[ENGINE_JIT]->jac.nnz;
     const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
     const MechrtHostJacNz *a = c->open[ENGINE_AOT] ? engine_jac_nz(&c->eng[ENGINE_AOT]) : NULL;
     c->jnz[ENGINE_AOT] = a;
-    c->has_nz[ENGINE_AOT] = a && a->nnz == j->nnz
-                            && memcmp(a->row, j->row, (size_t)j->nnz * sizeof *j->row) == 0
-                            && memcmp(a->col, j->col, (size_t)j->nnz * sizeof *j->col) == 0;
+    c->has_nz[ENGINE_AOT] = a && a->jac.nnz == j->jac.nnz
+                            && memcmp(a->jac.row, j->jac.row, (size_t)j->jac.nnz * sizeof *j->jac.row) == 0
+                            && memcmp(a->jac.col, j->jac.col, (size_t)j->jac.nnz * sizeof *j->jac.col) == 0;
     c->rep->sparse = true;
     size_t len = strlen(c->rep->note);
     snprintf(c->rep->note + len, sizeof c->rep->note - len, "%ssparse: the Jacobian's %d nonzeros "

@@ -135,8 +135,6 @@ typedef struct Run {
                                 velocity-level rows: the sparse host's) */
     bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
-    MechrtJacNz lup_jnz;     /* its kernel: jnz's */
-    MechrtLuGen lup_gen;     /* the kernels' unrolled LU, when they have one */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)
@@ -297,9 +295,9 @@ static int nonfinite_jac_row(Run *r, const double *q, double t)
         const MechrtHostJacNz *j = r->jnz;
         double *vals = mechrt_host_sparse_values(r->sp);
         mechrt_host_sparse_eval(r->sp, q, t);
-        for (int e = 0; e < j->nnz && row < 0; e++)
+        for (int e = 0; e < j->jac.nnz && row < 0; e++)
             if (!isfinite(vals[e]))
-                row = j->row[e];
+                row = j->jac.row[e];
         return row;
     }
     size_t nq = (size_t)r->nq, nr = (size_t)r->nr;
@@ -696,7 +694,7 @@ static MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
         return mechrt_host_sparse_step(r->sp, r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h,
                                        r->work, r->lwork, rep);
     if (r->lup)
-        return mechrt_step_lup(r->k, &r->lup_jnz, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
+        return mechrt_step_lup(r->k, &r->jnz->jac, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
                                t, h, r->work, r->lwork, rep);
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }
@@ -1174,28 +1172,25 @@ static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunO
 }
 
 /* The dense path's factorisation: the pattern LU on the kernels' sparse
-   Jacobian (same results as lu.c's, replayed over the nonzeros), when
-   there is one, the mechanism is stepped (no velocity rows) and its
-   worst-case index lists stay small (RUN_DENSE_MAX_NQ); NULL otherwise.
-   One block: the state, then its reals, then its ints. */
-static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *hj, MechrtJacNz *jnz,
-                              MechrtLuGen *gen)
+   Jacobian jnz (same results as lu.c's, replayed over the nonzeros), with
+   jnz's unrolled LU when it has one, when the mechanism is stepped (no
+   velocity rows) and its worst-case index lists stay small
+   (RUN_DENSE_MAX_NQ); NULL otherwise. One block: the state, then its
+   reals, then its ints. */
+static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *jnz)
 {
-    if (!hj || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
+    if (!jnz || m->nv > 0 || m->nq > RUN_DENSE_MAX_NQ)
         return NULL;
     size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
     MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
     double *w = (double *)(f + 1);
-    *jnz = (MechrtJacNz){hj->nnz, hj->row, hj->col, hj->ctx, hj->jac_nz};
-    if (mechrt_lup_init(f, m->nq, jnz->nnz, jnz->row, jnz->col, w, lw, (int *)(w + lw), liw)
-        != MECHRT_OK) {
+    if (mechrt_lup_init(f, m->nq, jnz->jac.nnz, jnz->jac.row, jnz->jac.col, w, lw,
+                        (int *)(w + lw), liw) != MECHRT_OK) {
         free(f);
         return NULL;
     }
-    if (hj->lu_factor && hj->lu_solve) {
-        *gen = (MechrtLuGen){m->nq * m->nq, hj->ctx, hj->lu_factor, hj->lu_solve, hj->lu_step};
-        mechrt_lup_use(f, gen);
-    }
+    if (jnz->lu.factor && jnz->lu.solve)
+        mechrt_lup_use(f, &jnz->lu);
     return f;
 }
 
@@ -1265,11 +1260,11 @@ static RunStatus analyse(const Model *m, const MechrtKernels *k, const MechrtHos
         free(r.q);
         return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
                          "entries) is not a valid %d x %d pattern, or out of memory",
-                         jnz->nnz, m->nq, m->nq);
+                         jnz->jac.nnz, m->nq, m->nq);
     }
     res->sparse = sparse;
     if (!sparse)
-        r.lup = run_lup_new(m, jnz, &r.lup_jnz, &r.lup_gen);
+        r.lup = run_lup_new(m, jnz);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);

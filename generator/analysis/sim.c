@@ -225,8 +225,8 @@ static void sparse_jac_times(const Sim *s, const double *x, double *y)
 {
     const double *v = mechrt_host_kkt_jac(s->kkt);
     memset(y, 0, (size_t)s->nr * sizeof *y);
-    for (int e = 0; e < s->jnz->nnz; e++)
-        y[s->jnz->row[e]] += v[e] * x[s->jnz->col[e]];
+    for (int e = 0; e < s->jnz->jac.nnz; e++)
+        y[s->jnz->jac.row[e]] += v[e] * x[s->jnz->jac.col[e]];
 }
 
 /* qd^T M x over M's nonzeros vals. */
@@ -261,8 +261,8 @@ static MechrtStatus sparse_eval(Sim *s, const double *q, const double *qd, doubl
 {
     double *jac = mechrt_host_kkt_jac(s->kkt);
     s->res->calls.all_nz++;
-    s->jnz->all_nz(s->jnz->ctx, q, qd, t, s->sphi, jac, s->nu, s->sg);
-    if (!all_finite(s->jnz->nnz, jac) || !all_finite(s->nr, s->nu) || !all_finite(s->nr, s->sg))
+    s->jnz->all_nz(s->jnz->jac.ctx, q, qd, t, s->sphi, jac, s->nu, s->sg);
+    if (!all_finite(s->jnz->jac.nnz, jac) || !all_finite(s->nr, s->nu) || !all_finite(s->nr, s->sg))
         return MECHRT_ENOTFINITE;
     if (!dynamics)
         return MECHRT_OK;
@@ -634,7 +634,7 @@ static MechrtStatus position_correction(Sim *s, const MechrtOptions *o, const do
     *zero = false;
     if (s->kkt) {
         s->res->calls.jac_nz++;
-        s->jnz->jac_nz(s->jnz->ctx, q, t, mechrt_host_kkt_jac(s->kkt));
+        s->jnz->jac.jac_nz(s->jnz->jac.ctx, q, t, mechrt_host_kkt_jac(s->kkt));
         if (mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_IDENTITY, s->active, nh,
                                    SIM_KKT_PIVOT_TOL) == MECHRT_OK) {
             memset(s->sx, 0, (size_t)n * sizeof *s->sx);
@@ -852,7 +852,7 @@ static const gsl_odeiv2_step_type *step_type(SimMethod m)
 static bool sim_sparse_can(const MechrtKernels *k, const MechrtHostJacNz *jnz,
                            const MechrtHostMassNz *mnz)
 {
-    return k->nh + k->nv > 0 && jnz && jnz->all_nz && jnz->jac_nz && mnz && mnz->mass_nz;
+    return k->nh + k->nv > 0 && jnz && jnz->all_nz && jnz->jac.jac_nz && mnz && mnz->mass_nz;
 }
 
 /* The sparse path is taken: asked for, or auto on a large mechanism. */

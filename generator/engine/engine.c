@@ -155,11 +155,12 @@ static void bind_code(Engine *e, const Kernels *code)
                            .phi = code_phi, .jac = code->jac ? code_jac : NULL,
                            .nu = code_nu, .gamma = code_gamma,
                            .all = code->all ? code_all : NULL};   /* NULL: sparse-only */
-    e->jac_nz = (MechrtHostJacNz){e->mech->kin.nnz, code->jac_row, code->jac_col, ctx,
-                                  code_jac_nz, code->all_nz ? code_all_nz : NULL,
-                                  code->lu_factor ? code_lu_factor : NULL,
-                                  code->lu_solve ? code_lu_solve : NULL,
-                                  code->step ? code_lu_step : NULL};
+    e->jac_nz = (MechrtHostJacNz){
+        .jac = {e->mech->kin.nnz, code->jac_row, code->jac_col, ctx, code_jac_nz},
+        .all_nz = code->all_nz ? code_all_nz : NULL};
+    if (code->lu_factor)    /* the LU's family, all or none (kernels_bind) */
+        e->jac_nz.lu = (MechrtLuGen){e->nq * e->nq, ctx, code_lu_factor, code_lu_solve,
+                                     code_lu_step};
     if (code->mass) {       /* the file has masses */
         e->k.mass = code_mass;
         e->k.force = code_force;

@@ -156,7 +156,7 @@ static inline const MechrtKernels *engine_kernels(const Engine *e)
 
 static inline const MechrtHostJacNz *engine_jac_nz(const Engine *e)
 {
-    return e->jac_nz.jac_nz ? &e->jac_nz : NULL;
+    return e->jac_nz.jac.jac_nz ? &e->jac_nz : NULL;
 }
 
 static inline const MechrtHostMassNz *engine_mass_nz(const Engine *e)

@@ -9,7 +9,7 @@ double engine_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const
                        const double *qd, double t, double min_seconds)
 {
     size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
-    size_t njac = jnz ? (size_t)jnz->nnz : nr * nq;
+    size_t njac = jnz ? (size_t)jnz->jac.nnz : nr * nq;
     double *phi = xcalloc(nr + 1, sizeof *phi), *jac = xcalloc(njac + 1, sizeof *jac);
     double *nu = xcalloc(nr + 1, sizeof *nu), *gamma = xcalloc(nr + 1, sizeof *gamma);
     long calls = 0, batch = 64;
@@ -17,10 +17,10 @@ double engine_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const
     do {
         for (long i = 0; i < batch; i++) {
             if (jnz && jnz->all_nz) {
-                jnz->all_nz(jnz->ctx, q, qd, t, phi, jac, nu, gamma);
+                jnz->all_nz(jnz->jac.ctx, q, qd, t, phi, jac, nu, gamma);
             } else if (jnz) {
                 k->phi(k->ctx, q, t, phi);
-                jnz->jac_nz(jnz->ctx, q, t, jac);
+                jnz->jac.jac_nz(jnz->jac.ctx, q, t, jac);
                 k->nu(k->ctx, q, t, nu);
                 k->gamma(k->ctx, q, qd, t, gamma);
             } else if (k->all) {
