@@ -91,7 +91,7 @@ count_file() {
         [ "$1" -gt 0 ] && echo "$k $1 $2"
     done)
     # the unit: one `all` call, from run --stats' timing loop
-    if ! valgrind --tool=callgrind --toggle-collect=run_time_all \
+    if ! valgrind --tool=callgrind --toggle-collect=engine_time_all \
             --callgrind-out-file="$tmp/cg2" "$mechc" run "$1" --steps 1 --engine aot --stats \
             --csv /dev/null > /dev/null 2>&1; then
         echo "instructions: skipped (the aot engine or valgrind failed)"

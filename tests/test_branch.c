@@ -228,13 +228,10 @@ static void run_with(Mech *mech, RunOptions o, Collected *c)
     mechrt_trace_init(&c->trace, mech->model->nq);
     if (!engine_open(&e, ENGINE_JIT, mech, &diag))
         fail_msg("jit engine: %s", diag.message);
-    MechrtHostJacNz jnz;
-    if (run_jac_nz_of(&e, &jnz))
-        o.jac_nz = &jnz;
     FILE *notes = fmemopen(c->notes, sizeof c->notes - 1, "w");
     assert_non_null(notes);
     o.notes = notes;
-    c->status = run_analysis(mech->model, &e.k, &o, collect, c, &c->res);
+    c->status = run_analysis(mech->model, &e.k, engine_jac_nz(&e), &o, collect, c, &c->res);
     fclose(notes);
     engine_close(&e);
 }

@@ -13,6 +13,7 @@
 #include "../generator/base/limits.h"
 #include "../generator/base/sincos.h"
 #include "../generator/emit/emit.h"
+#include "../generator/engine/engine.h"
 #include "../generator/emit/literal.h"
 #include "../generator/pipeline/pipeline.h"
 
@@ -507,7 +508,7 @@ static void compare_with_jit(const char *stem, bool real_float, int chunk, bool 
         fail_msg("%s: the gcc build of the generated C failed, or its fb_all disagreed with fb_jac", stem);
     }
     /* the JIT's values at the same state */
-    Jit *jit = pipeline_jit(mech, &res, NULL, NULL, &diag);
+    Jit *jit = engine_jit(mech, &res, NULL, NULL, &diag);
     assert_non_null(jit);
     const Kernels *k = jit_kernels(jit);
     double q[MAXQ], qd[MAXQ];

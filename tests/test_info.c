@@ -3,7 +3,7 @@
 #include "testutil.h"
 
 #include "../generator/structure/info.h"
-#include "../generator/analysis/mech_eval.h"
+#include "../generator/engine/mech_eval.h"
 #include "../generator/structure/spqr_rank.h"
 #include "../generator/analysis/svd.h"
 #include "../generator/base/limits.h"

@@ -79,7 +79,7 @@ static void run_forces(const Mech *mech, EngineKind kind, double t1, int steps, 
     k->nq = mech->model->nq;
     k->nr = mech->model->nr;
     assert_true(k->nq <= 16 && k->nr <= 16);
-    AnalysisStatus st = run_analysis_forces(mech->model, &e.k, &o, keep, k, &res);
+    AnalysisStatus st = run_analysis_forces(mech->model, &e.k, NULL, &o, keep, k, &res);
     if (st != ANALYSIS_OK)
         fail_msg("%s: %s", engine_names[kind], res.message);
     assert_int_equal(k->n, steps + 1);
@@ -290,7 +290,7 @@ static void test_through_singular(void **state)
     Kept k;
     memset(&k, 0, sizeof k);
     k.nq = mech->model->nq, k.nr = mech->model->nr;
-    assert_int_equal(run_analysis_forces(mech->model, &e.k, &o, keep, &k, &res), ANALYSIS_OK);
+    assert_int_equal(run_analysis_forces(mech->model, &e.k, NULL, &o, keep, &k, &res), ANALYSIS_OK);
     assert_int_equal(k.n, 101);
     assert_int_equal(res.force_redundant, 1);
     for (int i = 0; i <= 100; i++)
@@ -356,7 +356,7 @@ static void test_no_masses_refused(void **state)
     RunOptions o = run_default_options();
     RunResult res;
     Kept k = {.nq = mech->model->nq, .nr = mech->model->nr};
-    assert_int_equal(run_analysis_forces(mech->model, &e.k, &o, keep, &k, &res), ANALYSIS_BAD_INPUT);
+    assert_int_equal(run_analysis_forces(mech->model, &e.k, NULL, &o, keep, &k, &res), ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(res.message, "needs masses"));
     assert_int_equal(k.n, 0);
     engine_close(&e);

@@ -1,7 +1,7 @@
 /* test_kinematics.c - every joint's rows through the whole pipeline and the JIT, against textbook formulas.
  *
  * Each test loads a small mechanism from text (pipeline_load_text), compiles
- * its kernels with libtcc (pipeline_jit) and evaluates Phi, Phi_q, nu and
+ * its kernels with libtcc (engine_jit) and evaluates Phi, Phi_q, nu and
  * gamma at a high-entropy state. The expected values are written here by
  * hand from the planar multibody formulas (Haug, Computer-Aided Kinematics
  * and Dynamics of Mechanical Systems, ch. 3; Nikravesh, ch. 4):
@@ -20,6 +20,7 @@
 
 #include "../generator/base/diag.h"
 #include "../generator/base/limits.h"
+#include "../generator/engine/engine.h"
 #include "../generator/pipeline/pipeline.h"
 
 #include <stdlib.h>
@@ -54,7 +55,7 @@ static Loaded *load(const char *text)
         diag_print(&L->diag, stderr);
         fail_msg("the test mechanism did not load:\n%s", text);
     }
-    L->jit = pipeline_jit(L->mech, &L->emitted, NULL, NULL, &L->diag);
+    L->jit = engine_jit(L->mech, &L->emitted, NULL, NULL, &L->diag);
     if (!L->jit) {
         diag_print(&L->diag, stderr);
         fail_msg("the JIT failed");
@@ -799,7 +800,7 @@ static void test_spatial_rows(void **state)
     const Model *m = L->mech->model;
     assert_int_equal(L->nq, 24);
     assert_int_equal(L->nh, 24);
-    /* libtcc gets parts of up to 1000 operations and stores (pipeline_jit):
+    /* libtcc gets parts of up to 1000 operations and stores (engine_jit):
        this `all` (2 506 operations, 648 stores) is 4 of them; at the
        written file's 150 a part it would be 25 */
     assert_true(L->emitted.ops[EMIT_ALL] > 2000);

@@ -91,28 +91,6 @@ static void test_solves_match_dense(void **s)
     }
 }
 
-/* The engine's compiled functions as the runtime's context-taking ones. */
-static int gen_factor(void *ctx, const double *a, double *lu, double tol, double *spread)
-{
-    return ((const Kernels *)ctx)->lu_factor(a, lu, tol, spread);
-}
-
-static void gen_solve(void *ctx, const double *lu, const double *b, double *x)
-{
-    ((const Kernels *)ctx)->lu_solve(lu, b, x);
-}
-
-static int gen_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
-                    const double *tol, int max_iter, double *out, int *iout)
-{
-    return ((const Kernels *)ctx)->lu_step(q, qd, qdd, t, h, tol, max_iter, out, iout);
-}
-
-static void gen_jac_nz(void *ctx, const double *q, double t, double *vals)
-{
-    ((const Kernels *)ctx)->jac_nz(q, t, vals);
-}
-
 /* A pattern LU for e's Jacobian (one block: free it), with e's unrolled
    LU when gen > 0, and its step when gen > 1. */
 static MechrtLup *lup_new(const Engine *e, const Mech *mech, int gen, MechrtLuGen *g)
@@ -123,8 +101,9 @@ static MechrtLup *lup_new(const Engine *e, const Mech *mech, int gen, MechrtLuGe
     double *w = (double *)(f + 1);
     assert_int_equal(mechrt_lup_init(f, n, mech->kin.nnz, e->kernels.jac_row, e->kernels.jac_col,
                                      w, lw, (int *)(w + lw), liw), MECHRT_OK);
-    *g = (MechrtLuGen){n * n, (void *)&e->kernels, gen_factor, gen_solve,
-                       gen > 1 ? gen_step : NULL};
+    *g = engine_jac_nz(e)->lu;      /* the engine's unrolled LU and step */
+    if (gen < 2)
+        g->step = NULL;
     if (gen > 0)
         assert_int_equal(mechrt_lup_use(f, g), MECHRT_OK);
     return f;
@@ -189,14 +168,14 @@ static void test_declines(void **s)
     memcpy(st, mech->model->q0, 9 * sizeof *st);
     for (int i = 9; i < 27; i++)
         st[i] = 0;
-    assert_int_equal(e.kernels.lu_step(st, st + 9, st + 18, 0, 0, tol, 25, out, iout), 0);
+    assert_int_equal(e.kernels.step(st, st + 9, st + 18, 0, 0, tol, 25, out, iout), 0);
     st[9] = NAN;
     memcpy(before, st, sizeof st);
-    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 25, out, iout) != 0);
+    assert_true(e.kernels.step(st, st + 9, st + 18, 0, 0.01, tol, 25, out, iout) != 0);
     assert_memory_equal(st, before, sizeof st);
     st[9] = 0;
     memcpy(before, st, sizeof st);
-    assert_true(e.kernels.lu_step(st, st + 9, st + 18, 0, 0.01, tol, 0, out, iout) != 0);
+    assert_true(e.kernels.step(st, st + 9, st + 18, 0, 0.01, tol, 0, out, iout) != 0);
     assert_memory_equal(st, before, sizeof st);
     free(f);
     engine_close(&e);
@@ -218,8 +197,7 @@ static void test_step(void **s)
         int n = m->nq, steps = 400;
         MechrtLuGen g[3];
         MechrtLup *f[3];
-        MechrtJacNz jnz = {mech->kin.nnz, e.kernels.jac_row, e.kernels.jac_col,
-                           (void *)&e.kernels, gen_jac_nz};
+        const MechrtJacNz *jnz = &engine_jac_nz(&e)->jac;
         size_t lwork = mechrt_workspace_size(n, n);
         double *work = xcalloc(lwork, sizeof *work), *st[3];
         for (int v = 0; v < 3; v++) {
@@ -231,7 +209,7 @@ static void test_step(void **s)
             double t = k == 0 ? 0 : (k - 1) / (double)steps, h = k == 0 ? 0 : 1.0 / steps;
             MechrtReport r[3];
             for (int v = 0; v < 3; v++)
-                assert_int_equal(mechrt_step_lup(&e.k, &jnz, f[v], NULL, st[v], st[v] + n,
+                assert_int_equal(mechrt_step_lup(&e.k, jnz, f[v], NULL, st[v], st[v] + n,
                                                  st[v] + 2 * n, t, h, work, lwork, &r[v]),
                                  MECHRT_OK);
             assert_int_equal(r[0].iterations, r[1].iterations);

@@ -9,6 +9,7 @@
  */
 #include "testutil.h"
 
+#include "../generator/emit/emit.h"
 #include "../generator/engine/aot.h"
 #include "../generator/pipeline/pipeline.h"
 #include "testload.h"

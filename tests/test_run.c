@@ -73,7 +73,7 @@ static bool run_with(Mech *mech, EngineKind kind, RunOptions o, Collected *c)
     FILE *notes = fmemopen(c->notes, sizeof c->notes - 1, "w");
     assert_non_null(notes);
     o.notes = notes;
-    c->status = run_analysis(mech->model, &k, &o, collect, c, &c->res);
+    c->status = run_analysis(mech->model, &k, NULL, &o, collect, c, &c->res);
     fclose(notes);
     engine_close(&e);
     assert_int_equal(c->status, c->res.status);

@@ -28,6 +28,7 @@
 #include "../generator/structure/info.h"
 #include "../generator/base/strbuf.h"
 #include "../generator/emit/emit.h"
+#include "../generator/engine/engine.h"
 #include "../generator/pipeline/pipeline.h"
 
 #include <stdlib.h>
@@ -541,7 +542,7 @@ static void test_ieee_at_run_time(void **state)
     Diag diag;
     Mech *mech = load_ok(text, "ieee.mech", NULL, &diag);
     EmitResult res;
-    Jit *jit = pipeline_jit(mech, &res, NULL, NULL, &diag);
+    Jit *jit = engine_jit(mech, &res, NULL, NULL, &diag);
     if (!jit)
         fail_msg("jit: %s", diag.message);
     double q[2] = {-1, 0}, qd[2] = {0.5, -0.25}, phi[4], jac[8], nu[4], gamma[4];
@@ -658,7 +659,7 @@ static bool pipeline_bounded(const char *text, const MechLimits *limits, const c
     Mech *mech = load(text, "stress.mech", limits, &diag);
     if (mech) {
         EmitResult res;
-        Jit *jit = pipeline_jit(mech, &res, NULL, NULL, &diag);
+        Jit *jit = engine_jit(mech, &res, NULL, NULL, &diag);
         if (jit)
             jit_free(jit);
         else if (!strstr(diag.message, want))

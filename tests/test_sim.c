@@ -693,7 +693,7 @@ static void test_double_pendulum_energy(void **state)
     Collect *c = calloc(1, sizeof *c);
     c->tm = &tm;
     SimResult res;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, c, &res), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res), ANALYSIS_OK);
     assert_int_equal(c->n, 1001);
     assert_near(c->t[1000], 10, 0, 0);
     /* the energy exchanged: the largest kinetic energy is about the potential drop */
@@ -729,9 +729,9 @@ static void test_double_pendulum_interpolated(void **state)
     Collect *ref = calloc(1, sizeof *ref), *c = calloc(1, sizeof *c);
     ref->tm = c->tm = &tm;
     SimResult rres, res;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, ref, &rres), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, ref, &rres), ANALYSIS_OK);
     o.interpolate = true;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, c, &res), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res), ANALYSIS_OK);
     assert_int_equal(c->n, 401);
     assert_near(c->t[200], 1, 0, 1e-15);
     assert_true(res.steps < o.steps / 2 && res.steps < rres.steps / 2);
@@ -763,7 +763,7 @@ static void test_offset_pendulum(void **state)
     Collect *col = calloc(1, sizeof *col);
     col->tm = &tm;
     SimResult res;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, col, &res), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, col, &res), ANALYSIS_OK);
     /* a small swing returns after one period (to O(amplitude^3)) */
     assert_near(col->q_last[2], q[2], 0, 1e-5);
     assert_true(max_energy_change(col) < 1e-10);
@@ -775,7 +775,7 @@ static void test_offset_pendulum(void **state)
     col->tm = &tm;
     o.t1 = 3;
     o.steps = 30;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, col, &res), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, col, &res), ANALYSIS_OK);
     assert_true(res.energy_scale > 1);
     assert_true(res.energy_drift < 1e-8 * res.energy_scale);
     assert_true(max_energy_change(col) < 1e-8 * res.energy_scale);
@@ -802,7 +802,7 @@ static void test_redundant_simulation(void **state)
         Collect *c = calloc(1, sizeof *c);
         c->tm = &tm;
         SimResult res;
-        AnalysisStatus st = sim_integrate(&k, &o, q, on_state, c, &res);
+        AnalysisStatus st = sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res);
         if (st != ANALYSIS_OK)
             fail_msg("%s: %s", sim_method_names[method], res.message);
         assert_int_equal(c->n, 11);
@@ -833,12 +833,12 @@ static void test_sim_failure(void **state)
     Collect *c = calloc(1, sizeof *c);
     c->tm = &tm;
     SimResult res;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, c, &res), ANALYSIS_FAILED);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res), ANALYSIS_FAILED);
     assert_int_equal(res.cause, MECHRT_ESING);
     assert_non_null(strstr(res.message, "t = 0: "));
     assert_non_null(strstr(res.message, "singular"));
     k.mass = NULL;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, c, &res), ANALYSIS_BAD_INPUT);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res), ANALYSIS_BAD_INPUT);
     assert_non_null(strstr(res.message, "no masses"));
     free(c);
 }
@@ -860,7 +860,7 @@ static void test_initial_velocity_projection(void **state)
     Collect *c = calloc(1, sizeof *c);
     c->tm = &tm;
     SimResult res;
-    assert_int_equal(sim_integrate(&k, &o, q, on_state, c, &res), ANALYSIS_OK);
+    assert_int_equal(sim_integrate(&k, NULL, NULL, &o, q, on_state, c, &res), ANALYSIS_OK);
     /* zero given: the driver's rate, and the pin's velocities that follow */
     assert_near(c->qd_first[2], 2.0, 1e-14, 0);
     assert_near(c->qd_first[0], -0.5 * sin(0.3) * 2.0, 1e-12, 1e-14);

@@ -39,7 +39,8 @@ static void fill_vals(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostJacNz small_pattern(double *v)
 {
-    return (MechrtHostJacNz){.nnz = 6, .row = p_row, .col = p_col, .ctx = v, .jac_nz = fill_vals};
+    return (MechrtHostJacNz){.jac = {.nnz = 6, .row = p_row, .col = p_col,
+                                     .ctx = v, .jac_nz = fill_vals}};
 }
 
 static void test_klu_solve(void **state)
@@ -93,7 +94,8 @@ static void kkt_no_jac(void *ctx, const double *q, double t, double *vals)
 
 static MechrtHostKkt *small_kkt(void)
 {
-    MechrtHostJacNz j = {.nnz = 4, .row = j_row, .col = j_col, .ctx = NULL, .jac_nz = kkt_no_jac};
+    MechrtHostJacNz j = {.jac = {.nnz = 4, .row = j_row, .col = j_col,
+                                 .ctx = NULL, .jac_nz = kkt_no_jac}};
     MechrtHostMassNz m = {4, m_row, m_col, NULL, NULL};
     MechrtHostKkt *s = mechrt_host_kkt_new(3, 2, &j, &m);
     assert_non_null(s);
@@ -183,7 +185,8 @@ static void fill_mn(void *ctx, const double *q, double t, double *vals)
 static void test_minnorm_step(void **state)
 {
     (void)state;
-    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
+    MechrtHostJacNz j = {.jac = {.nnz = 7, .row = mn_row, .col = mn_col,
+                                 .ctx = NULL, .jac_nz = fill_mn}};
     double q[3] = {0, 0, 0}, dq[3];
     for (int nh = 2; nh <= 3; nh++) {
         MechrtHostMinNorm *m = mechrt_host_minnorm_new(nh, 3, &j);
@@ -197,8 +200,8 @@ static void test_minnorm_step(void **state)
     }
     assert_null(mechrt_host_minnorm_new(4, 3, &j));     /* more rows than coordinates */
     MechrtHostJacNz no_rows = j, no_cols = j;               /* entries but no pattern */
-    no_rows.row = NULL;
-    no_cols.col = NULL;
+    no_rows.jac.row = NULL;
+    no_cols.jac.col = NULL;
     assert_null(mechrt_host_minnorm_new(2, 3, &no_rows));
     assert_null(mechrt_host_minnorm_new(2, 3, &no_cols));
 }
@@ -220,7 +223,8 @@ static void pr_phi(void *ctx, const double *q, double t, double *phi)
 static void test_projector(void **state)
 {
     (void)state;
-    MechrtHostJacNz j = {.nnz = 7, .row = mn_row, .col = mn_col, .ctx = NULL, .jac_nz = fill_mn};
+    MechrtHostJacNz j = {.jac = {.nnz = 7, .row = mn_row, .col = mn_col,
+                                 .ctx = NULL, .jac_nz = fill_mn}};
     MechrtKernels k = {3, 2, 0, NULL, pr_phi, NULL, NULL, NULL, NULL, NULL, NULL};
     assert_null(mechrt_host_new_sparse(&k, &j));
     MechrtHost *h = mechrt_host_new_projector(&k, &j);
@@ -285,7 +289,8 @@ static void test_klu_repivots(void **state)
 {
     (void)state;
     double v[4] = {1, 1, 1e-3, 2};
-    MechrtHostJacNz j = {.nnz = 4, .row = full_row, .col = full_col, .ctx = v, .jac_nz = fill_full};
+    MechrtHostJacNz j = {.jac = {.nnz = 4, .row = full_row, .col = full_col,
+                                 .ctx = v, .jac_nz = fill_full}};
     MechrtHostSparse *s = mechrt_host_sparse_new(2, &j);
     assert_non_null(s);
     mechrt_host_sparse_eval(s, NULL, 0);
@@ -311,14 +316,15 @@ static void test_klu_bad_pattern(void **state)
     (void)state;
     double v[6] = {1, 1, 1, 1, 1, 1};
     static const int dup_col[] = {0, 0, 0, 1, 1, 2};    /* (0, 0) twice */
-    MechrtHostJacNz j = {.nnz = 6, .row = p_row, .col = dup_col, .ctx = v, .jac_nz = fill_vals};
+    MechrtHostJacNz j = {.jac = {.nnz = 6, .row = p_row, .col = dup_col,
+                                 .ctx = v, .jac_nz = fill_vals}};
     assert_null(mechrt_host_sparse_new(3, &j));
     static const int far_col[] = {0, 3, 0, 1, 1, 2};    /* column 3 of 3 */
-    j.col = far_col;
+    j.jac.col = far_col;
     assert_null(mechrt_host_sparse_new(3, &j));
-    j.col = p_col;
+    j.jac.col = p_col;
     assert_null(mechrt_host_sparse_new(0, &j));
-    j.jac_nz = NULL;
+    j.jac.jac_nz = NULL;
     assert_null(mechrt_host_sparse_new(3, &j));
 }
 
@@ -364,15 +370,13 @@ static void run_linear(Mech *mech, AnalysisLinear lin, RunOptions o, EngineKind 
 {
     Engine e;
     Diag diag;
-    MechrtHostJacNz jnz;
     memset(c, 0, sizeof *c);
     mechrt_trace_init(&c->trace, mech->model->nq);
     if (!engine_open(&e, kind, mech, &diag))
         fail_msg("engine: %s", diag.message);
     MechrtKernels k = e.k;
     o.linear = lin;
-    o.jac_nz = run_jac_nz_of(&e, &jnz) ? &jnz : NULL;
-    c->status = run_analysis(mech->model, &k, &o, collect, c, &c->res);
+    c->status = run_analysis(mech->model, &k, engine_jac_nz(&e), &o, collect, c, &c->res);
     engine_close(&e);
 }
 
@@ -525,7 +529,7 @@ static void expect_all_nz_agrees(Mech *mech, EngineKind kind)
     Diag diag;
     if (!engine_open(&e, kind, mech, &diag))
         fail_msg("engine: %s", diag.message);
-    const Kernels *code = e.k.ctx;
+    const Kernels *code = &e.kernels;
     assert_non_null(code->all_nz);
     const Model *m = mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr, nnz = (size_t)mech->kin.nnz;
@@ -593,12 +597,12 @@ static void test_all_nz_run(void **state)
         assert_true(engine_open(&e, ENGINE_JIT, mech, &diag));
         MechrtKernels k = e.k;
         o.linear = ANALYSIS_LINEAR_SPARSE;
-        assert_true(run_jac_nz_of(&e, &jnz));
+        assert_non_null(engine_jac_nz(&e));
+        jnz = *engine_jac_nz(&e);
         assert_non_null(jnz.all_nz);
         if (!fused)
             jnz.all_nz = NULL;
-        o.jac_nz = &jnz;
-        c[fused].status = run_analysis(mech->model, &k, &o, collect, &c[fused], &c[fused].res);
+        c[fused].status = run_analysis(mech->model, &k, &jnz, &o, collect, &c[fused], &c[fused].res);
         assert_int_equal(c[fused].status, ANALYSIS_OK);
         engine_close(&e);
     }

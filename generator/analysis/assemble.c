@@ -1,6 +1,7 @@
 /* assemble.c - minimum-norm Newton assembly on any set of holonomic rows.
  *
- * Phi and Phi_q come from the graph interpreter (mech_eval.c).
+ * Phi and Phi_q come from kernels: an engine's, or the graph interpreter's
+ * (mech_eval.c); the sparse path reads the graph's pattern.
  *
  * Minimum-norm Newton (Gauss-Newton through the pseudo-inverse; Ben-Israel
  * 1966, Deuflhard, Newton Methods for Nonlinear Problems, 4.4):
@@ -105,11 +106,15 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
     return ok;
 }
 
-/* ---- the dense direction: SVD of the selected rows ---- */
+/* ---- the dense direction: SVD of the selected rows ----
+ *
+ * The rows of any kernels: an engine's (run, sim and check assemble with
+ * jit, aot or generic) or the graph's (info, mech_eval_kernels).
+ */
 
 typedef struct DenseRows {
-    MechEval *me;
-    const int *rows;        /* model rows */
+    const MechrtKernels *k;
+    const int *rows;        /* kernel rows; NULL: the first nrows */
     int nrows;
     double t, rank_tol;
     MechrtSvd *w;
@@ -119,35 +124,45 @@ typedef struct DenseRows {
     double *ftrial;         /* Phi at a trial point */
 } DenseRows;
 
+static int dense_row(const DenseRows *d, int i)
+{
+    return d->rows ? d->rows[i] : i;
+}
+
 static double dense_eval(void *ctx, const double *q, bool iterate, double *inf, int *worst)
 {
     DenseRows *d = ctx;
-    int nq = d->me->nq;
+    const MechrtKernels *k = d->k;
+    size_t nq = (size_t)k->nq;
     double *f = iterate ? d->f : d->ftrial;
-    mech_eval(d->me, q, d->t, d->phi_all, iterate ? d->jac : NULL);
-    double sum = 0.0, big = 0.0;
+    k->phi(k->ctx, q, d->t, d->phi_all);
+    if (iterate)
+        k->jac(k->ctx, q, d->t, d->jac);
+    double sum = 0.0;
+    *inf = 0.0;
     *worst = -1;
     for (int i = 0; i < d->nrows; i++) {
-        f[i] = d->phi_all[d->rows[i]];
+        int r = dense_row(d, i);
+        f[i] = d->phi_all[r];
         if (iterate)
-            memcpy(d->J + (size_t)i * (size_t)nq, d->jac + (size_t)d->rows[i] * (size_t)nq,
-                   (size_t)nq * sizeof *d->J);
-        if (!isfinite(f[i]))
+            memcpy(d->J + (size_t)i * nq, d->jac + (size_t)r * nq, nq * sizeof *d->J);
+        if (!isfinite(f[i])) {
+            *worst = r;
             return NAN;
+        }
         sum += f[i] * f[i];
-        if (fabs(f[i]) > big || *worst < 0) {
-            big = fabs(f[i]);
-            *worst = d->rows[i];
+        if (fabs(f[i]) > *inf || *worst < 0) {
+            *inf = fabs(f[i]);
+            *worst = r;
         }
     }
-    *inf = big;
     return sqrt(sum);
 }
 
 static bool dense_direction(void *ctx, double *dq, int *rank)
 {
     DenseRows *d = ctx;
-    int nq = d->me->nq;
+    int nq = d->k->nq;
     MechrtSvdResult sv;
     if (!mechrt_svd(d->w, d->J, d->nrows, nq, nq, d->rank_tol, &sv))
         return false;
@@ -158,20 +173,23 @@ static bool dense_direction(void *ctx, double *dq, int *rank)
     return true;
 }
 
-bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, double *q,
+bool assemble_min_norm(const MechrtKernels *k, const int *rows, int nrows, double t, double *q,
                        const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res)
 {
-    size_t nq = (size_t)me->nq;
+    size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
+    MechrtSvd *own = !w && nrows > 0 ? mechrt_svd_new(nrows, k->nq) : NULL;
     DenseRows d = {
-        .me = me, .rows = rows, .nrows = nrows, .t = t, .rank_tol = opt->rank_tol, .w = w,
-        .phi_all = xcalloc((size_t)me->nh + 1, sizeof *d.phi_all),
-        .jac = xcalloc((size_t)me->nr * nq + 1, sizeof *d.jac),
+        .k = k, .rows = rows, .nrows = nrows, .t = t, .rank_tol = opt->rank_tol,
+        .w = w ? w : own,
+        .phi_all = xcalloc((size_t)k->nh + 1, sizeof *d.phi_all),
+        .jac = xcalloc(nr * nq + 1, sizeof *d.jac),
         .J = xcalloc((size_t)nrows * nq + 1, sizeof *d.J),
         .f = xcalloc((size_t)nrows + 1, sizeof *d.f),
         .ftrial = xcalloc((size_t)nrows + 1, sizeof *d.ftrial),
     };
     NewtonPath path = {dense_eval, dense_direction, &d};
-    bool ok = min_norm_newton(&path, nrows, me->nq, q, opt, res);
+    bool ok = (nrows == 0 || d.w) && min_norm_newton(&path, nrows, k->nq, q, opt, res);
+    mechrt_svd_free(own);
     free(d.phi_all), free(d.jac), free(d.J), free(d.f), free(d.ftrial);
     return ok;
 }
@@ -290,79 +308,6 @@ bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
     return ok;
 }
 
-/* ---- the direction from compiled kernels: SVD of Phi_q's holonomic rows ----
- *
- * What `run` and `check` assemble with: the same loop over the engine's
- * kernels (jit, aot or generic), so no graph interpreter is needed there.
- * The holonomic rows come first in the kernels' dense Jacobian, so they
- * are its first nh rows.
- */
-
-typedef struct KernelRows {
-    const MechrtKernels *k;
-    double t, rank_tol;
-    MechrtSvd *w;
-    double *f, *ftrial;     /* Phi at the iterate and at a trial point (nh) */
-    double *jac;            /* nr x nq at the iterate */
-} KernelRows;
-
-static double kernel_eval(void *ctx, const double *q, bool iterate, double *inf, int *worst)
-{
-    KernelRows *kr = ctx;
-    const MechrtKernels *k = kr->k;
-    double *f = iterate ? kr->f : kr->ftrial;
-    k->phi(k->ctx, q, kr->t, f);
-    if (iterate)
-        k->jac(k->ctx, q, kr->t, kr->jac);
-    double sum = 0.0;
-    *inf = 0.0;
-    *worst = -1;
-    for (int i = 0; i < k->nh; i++) {
-        if (!isfinite(f[i])) {
-            *worst = i;
-            return NAN;
-        }
-        sum += f[i] * f[i];
-        if (fabs(f[i]) > *inf || *worst < 0) {
-            *inf = fabs(f[i]);
-            *worst = i;
-        }
-    }
-    return sqrt(sum);
-}
-
-static bool kernel_direction(void *ctx, double *dq, int *rank)
-{
-    KernelRows *kr = ctx;
-    int nq = kr->k->nq;
-    MechrtSvdResult sv;
-    if (!mechrt_svd(kr->w, kr->jac, kr->k->nh, nq, nq, kr->rank_tol, &sv))
-        return false;
-    *rank = sv.rank;
-    mechrt_svd_pinv_solve(kr->w, kr->f, dq);
-    for (int j = 0; j < nq; j++)
-        dq[j] = -dq[j];
-    return true;
-}
-
-bool assemble_kernels(const MechrtKernels *k, double t, double *q,
-                      const AnalysisOptions *opt, AssembleResult *res)
-{
-    size_t nq = (size_t)k->nq, nr = (size_t)(k->nh + k->nv);
-    KernelRows kr = {
-        .k = k, .t = t, .rank_tol = opt->rank_tol,
-        .w = k->nh > 0 ? mechrt_svd_new(k->nh, k->nq) : NULL,
-        .f = xcalloc((size_t)k->nh + 1, sizeof *kr.f),
-        .ftrial = xcalloc((size_t)k->nh + 1, sizeof *kr.ftrial),
-        .jac = xcalloc(nr * nq + 1, sizeof *kr.jac),
-    };
-    NewtonPath path = {kernel_eval, kernel_direction, &kr};
-    bool ok = (k->nh == 0 || kr.w) && min_norm_newton(&path, k->nh, k->nq, q, opt, res);
-    mechrt_svd_free(kr.w);
-    free(kr.f), free(kr.ftrial), free(kr.jac);
-    return ok;
-}
-
 /* ---- restarts from jittered guesses ----
  *
  * A stall (opt->stall_iter) is a stationary point of ||Phi|| that is no
@@ -466,7 +411,7 @@ static void kernel_rough_eval(void *ctx, const double *q, double *phi, double *j
 static bool kernel_attempt(void *ctx, double *q, AssembleResult *res)
 {
     KernelAttempt *ka = ctx;
-    return assemble_kernels(ka->k, ka->t, q, ka->opt, res);
+    return assemble_min_norm(ka->k, NULL, ka->k->nh, ka->t, q, ka->opt, NULL, res);
 }
 
 bool assemble_restarting(const MechrtKernels *k, double t, double *q,
@@ -477,46 +422,5 @@ bool assemble_restarting(const MechrtKernels *k, double t, double *q,
     RoughRows rr = {k->nq, k->nh, kernel_rough_eval, kernel_attempt, &ka};
     bool ok = restart_loop(&rr, q, res);
     free(ka.jac);
-    return ok;
-}
-
-/* Chosen rows of a MechEval (what info assembles). */
-typedef struct EvalAttempt {
-    MechEval *me;
-    const int *rows;
-    int nrows;
-    double t;
-    const AnalysisOptions *opt;
-    MechrtSvd *w;
-    double *phi_all, *jac;  /* nh, nr x nq */
-} EvalAttempt;
-
-static void eval_rough_eval(void *ctx, const double *q, double *phi, double *jac)
-{
-    EvalAttempt *ea = ctx;
-    size_t nq = (size_t)ea->me->nq;
-    mech_eval(ea->me, q, ea->t, ea->phi_all, ea->jac);
-    for (int i = 0; i < ea->nrows; i++) {
-        phi[i] = ea->phi_all[ea->rows[i]];
-        memcpy(jac + (size_t)i * nq, ea->jac + (size_t)ea->rows[i] * nq, nq * sizeof *jac);
-    }
-}
-
-static bool eval_attempt(void *ctx, double *q, AssembleResult *res)
-{
-    EvalAttempt *ea = ctx;
-    return assemble_min_norm(ea->me, ea->rows, ea->nrows, ea->t, q, ea->opt, ea->w, res);
-}
-
-bool assemble_min_norm_restarting(MechEval *me, const int *rows, int nrows, double t, double *q,
-                                  const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res)
-{
-    size_t nq = (size_t)me->nq;
-    EvalAttempt ea = {me, rows, nrows, t, opt, w,
-                      xcalloc((size_t)me->nh + 1, sizeof *ea.phi_all),
-                      xcalloc((size_t)me->nr * nq + 1, sizeof *ea.jac)};
-    RoughRows rr = {me->nq, nrows, eval_rough_eval, eval_attempt, &ea};
-    bool ok = restart_loop(&rr, q, res);
-    free(ea.phi_all), free(ea.jac);
     return ok;
 }

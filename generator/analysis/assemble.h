@@ -2,7 +2,7 @@
 #ifndef MECHC_ASSEMBLE_H
 #define MECHC_ASSEMBLE_H
 
-#include "mech_eval.h"
+#include "../engine/mech_eval.h"
 #include "options.h"
 #include "svd.h"
 
@@ -17,13 +17,15 @@ typedef struct AssembleResult {
     int rank;               /* rank of the rows' Jacobian at the last step, -1 if none */
 } AssembleResult;
 
-/* Minimum-norm Newton on the holonomic rows listed in rows[] (model row
-   indices < nh), at time t, from q (updated in place):
-   dq = -pinv(Phi_q) Phi, with step halving when the residual grows. Works
-   for fewer rows than coordinates (the step nearest to q) and for
-   redundant rows (singular values at or below the rank tolerance are
-   dropped). w must hold nrows x nq. */
-bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, double *q,
+/* Minimum-norm Newton on the holonomic rows of kernels k listed in rows[]
+   (row indices < k->nh; NULL: the first nrows), at time t, from q
+   (updated in place): dq = -pinv(Phi_q) Phi, with step halving when the
+   residual grows. Works for fewer rows than coordinates (the step nearest
+   to q) and for redundant rows (singular values at or below the rank
+   tolerance are dropped). k: an engine's (run, sim, check) or the
+   graph's (info, mech_eval_kernels); needs phi and jac. w must hold
+   nrows x nq; NULL: one of its own. res->worst_row is a kernel row. */
+bool assemble_min_norm(const MechrtKernels *k, const int *rows, int nrows, double t, double *q,
                        const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res);
 
 /* The same beyond the dense limit, on the first nrows holonomic rows, with
@@ -33,26 +35,18 @@ bool assemble_min_norm(MechEval *me, const int *rows, int nrows, double t, doubl
 bool assemble_sparse(MechEval *me, int nrows, double t, double *q,
                      const AnalysisOptions *opt, AssembleResult *res);
 
-/* The same on the holonomic rows of compiled (or generic) kernels, dense:
-   what run and check assemble with. res->worst_row is a kernel row. */
-bool assemble_kernels(const MechrtKernels *k, double t, double *q,
-                      const AnalysisOptions *opt, AssembleResult *res);
-
 /* Iterations without 1 % progress after which an assembly from rough
    initial values gives up an attempt and restarts (AnalysisOptions.stall_iter
    for run, check and info). */
 #define ASSEMBLE_ROUGH_STALL 8
 
-/* assemble_kernels from q, restarted from jittered guesses (a fixed seed)
-   while it stalls (give opt->stall_iter > 0): what assembles a mechanism
-   from rough initial values, all angles 0 included. Coordinates the rows
+/* assemble_min_norm on all of k's holonomic rows from q, restarted from
+   jittered guesses (a fixed seed) while it stalls (give opt->stall_iter >
+   0): what assembles a mechanism from rough initial values, all angles 0
+   included. Coordinates the rows
    do not depend on keep their values. res->iterations counts every
    attempt's; on failure q is the attempt with the smallest residual. */
 bool assemble_restarting(const MechrtKernels *k, double t, double *q,
                          const AnalysisOptions *opt, AssembleResult *res);
-
-/* The same with assemble_min_norm on chosen rows of a MechEval (info). */
-bool assemble_min_norm_restarting(MechEval *me, const int *rows, int nrows, double t, double *q,
-                                  const AnalysisOptions *opt, MechrtSvd *w, AssembleResult *res);
 
 #endif

@@ -12,7 +12,6 @@
 
 #include "../base/arena.h"
 #include "../dag/support.h"
-#include "mech_eval.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -24,7 +23,8 @@
 
 typedef struct Place {
     const Model *m;
-    const ConstructRows *rows;
+    const MechrtKernels *k;     /* Phi: its holonomic rows at t */
+    double t;
     double *q;
     bool *known;            /* per coordinate: placed */
     double *phi;            /* nh */
@@ -95,7 +95,7 @@ static void mark(Place *p, int q)
 
 static double row_at(Place *p, int row)
 {
-    p->rows->phi(p->rows->ctx, p->q, p->phi);
+    p->k->phi(p->k->ctx, p->q, p->t, p->phi);
     return p->phi[row];
 }
 
@@ -423,13 +423,13 @@ static int *row_supports(const Model *m, int **start)
     return sup;
 }
 
-int construct_assembly(const Model *m, const ConstructRows *rows, double *q)
+int construct_with_kernels(const Model *m, const MechrtKernels *k, double t, double *q)
 {
     if (m->nh == 0)
         return 0;
     size_t nq = (size_t)m->nq, nh = (size_t)m->nh;
     Place p = {
-        .m = m, .rows = rows, .q = q,
+        .m = m, .k = k, .t = t, .q = q,
         .known = xcalloc(nq, sizeof *p.known),
         .phi = xcalloc(nh, sizeof *p.phi),
     };
@@ -440,40 +440,4 @@ int construct_assembly(const Model *m, const ConstructRows *rows, double *q)
     free(sup), free(start);
     free(p.known), free(p.phi), free(p.owner), free(p.at_start), free(p.at);
     return p.placed;
-}
-
-/* ---- the rows from compiled kernels or from the graph ---- */
-
-typedef struct KernelRowsAt {
-    const MechrtKernels *k;
-    double t;
-} KernelRowsAt;
-
-static void eval_kernel_rows(void *ctx, const double *q, double *phi)
-{
-    KernelRowsAt *kr = ctx;
-    kr->k->phi(kr->k->ctx, q, kr->t, phi);
-}
-
-int construct_with_kernels(const Model *m, const MechrtKernels *k, double t, double *q)
-{
-    KernelRowsAt kr = {k, t};
-    return construct_assembly(m, &(ConstructRows){eval_kernel_rows, &kr}, q);
-}
-
-typedef struct EvalRowsAt {
-    MechEval *me;
-    double t;
-} EvalRowsAt;
-
-static void eval_graph_rows(void *ctx, const double *q, double *phi)
-{
-    EvalRowsAt *er = ctx;
-    mech_eval(er->me, q, er->t, phi, NULL);
-}
-
-int construct_with_eval(const Model *m, MechEval *me, double t, double *q)
-{
-    EvalRowsAt er = {me, t};
-    return construct_assembly(m, &(ConstructRows){eval_graph_rows, &er}, q);
 }

@@ -4,15 +4,10 @@
 
 #include "../../runtime/mechrt.h"
 #include "../model/model.h"
-#include "mech_eval.h"
 
-/* The holonomic rows being assembled: Phi (m->nh values) at q. */
-typedef struct ConstructRows {
-    void (*phi)(void *ctx, const double *q, double *phi);
-    void *ctx;
-} ConstructRows;
-
-/* Places what the mechanism fixes without a guess, the way a textbook
+/* Places what the mechanism fixes without a guess, from the holonomic rows
+ * of kernels k at t (an engine's for run, sim and check; the graph's,
+ * mech_eval_kernels, for info), the way a textbook
  * solves a linkage at one instant: a row in which a single coordinate is
  * still unknown is solved for it (a driver gives its angle, a pin to ground
  * the position of the link, one scalar Newton per row); a body pinned at
@@ -26,11 +21,6 @@ typedef struct ConstructRows {
  * q is updated in place; coordinates nothing fixes keep their values.
  * Returns how many coordinates were placed. The rows themselves are not
  * trusted to be satisfied: Newton follows. */
-int construct_assembly(const Model *m, const ConstructRows *rows, double *q);
-
-/* The same on the holonomic rows of compiled (or generic) kernels at t
-   (run, check) or of the graph (info). */
 int construct_with_kernels(const Model *m, const MechrtKernels *k, double t, double *q);
-int construct_with_eval(const Model *m, MechEval *me, double t, double *q);
 
 #endif

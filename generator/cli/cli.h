@@ -124,9 +124,6 @@ typedef struct CliCommand {
 bool cli_parse(Args *a, const CliCommand *cmd, int argc, char **argv, void *opts);
 void cli_print_help(const CliCommand *cmd, FILE *out);
 
-/* The engine names as a CLI_CHOICE list, in EngineKind order. */
-extern const char *const cli_engine_choices[];
-
 /* ---- after the options (common.c) ---- */
 
 /* A whole command: reads the options into opts (holding the defaults),

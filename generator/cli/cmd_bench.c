@@ -84,13 +84,15 @@ static void call_dynamics(Bench *b, const Engine *e, int fn)
     const MechrtKernels *k = &e->k;
     if (fn == FN_MASS || fn == FN_MQ)
         k->mass(k->ctx, b->q, b->mass);
-    if (fn == FN_MASS_NZ || fn == FN_MQ_NZ)
-        engine_mass_nz(e, b->q, b->mass);
+    if (fn == FN_MASS_NZ || fn == FN_MQ_NZ) {
+        const MechrtHostMassNz *mnz = engine_mass_nz(e);
+        mnz->mass_nz(mnz->ctx, b->q, b->mass);
+    }
     if (fn == FN_FORCE || fn == FN_MQ || fn == FN_MQ_NZ)
         k->force(k->ctx, b->q, b->qd, b->t, b->force);
     if (fn != FN_EOM)
         return;
-    if (e->kind != ENGINE_GENERIC) {
+    if (e->compiled) {
         e->kernels.eom(b->q, b->qd, b->t, b->mass, b->force, b->jac, b->gamma);
         return;
     }
@@ -130,7 +132,7 @@ static int compare_doubles(const void *x, const void *y)
 
 static bool has_fn(const Bench *b, int k, int fn)
 {
-    return b->open[k] && (!generated_only(fn) || k != ENGINE_GENERIC)
+    return b->open[k] && (!generated_only(fn) || b->eng[k].compiled)
            && (fn < FN_MASS || b->dynamics);
 }
 

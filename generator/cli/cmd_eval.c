@@ -29,7 +29,7 @@ static const CliOption options[] = {
              "(default: the file's initial values)"},
     {"--qd", CLI_STRING_AT(EvalCli, qd_text), .metavar = "LIST", .help = "velocities (default: zeros)"},
     {"--t", CLI_REAL_AT(EvalCli, t), .metavar = "T", .help = "time (default 0)"},
-    {"--engine", CLI_CHOICE_AT(EvalCli, engine, cli_engine_choices), .metavar = "E",
+    {"--engine", CLI_CHOICE_AT(EvalCli, engine, engine_names), .metavar = "E",
      .help = "jit (default: generated C compiled in memory), generic\n"
              "(no code generation) or aot (system compiler)"},
     {"--json", CLI_FLAG_AT(EvalCli, json), .help = "print JSON: coords, rows, phi, jac, nu, gamma\n(and M, Q with masses)"},

@@ -185,8 +185,10 @@ static void print_stats(Mech *mech, const GenCli *c, const EmitResult *res, doub
             (int)mech->model->dag.count, mech->load_seconds, mech->diff_seconds, emit_seconds);
     EmitResult jit_src;
     double jit_emit = 0, jit_tcc = 0;
-    Jit *jit = pipeline_jit_roll(mech, c->emit.roll, c->emit.sparse_only, &jit_src, &jit_emit,
-                                 &jit_tcc, diag);
+    EmitOptions eo = engine_emit_options(mech, ENGINE_JIT);
+    eo.roll = c->emit.roll;
+    eo.sparse_only = eo.sparse_only || c->emit.sparse_only;
+    Jit *jit = engine_jit_compile(mech, &eo, &jit_src, &jit_emit, &jit_tcc, diag);
     if (jit)
         fprintf(stderr, "mechc gen: in-process: emission %.3f s + libtcc %.3f s; from the "
                 "file to machine code %.3f s\n", jit_emit, jit_tcc,

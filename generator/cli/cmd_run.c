@@ -68,7 +68,7 @@ static const CliOption options[] = {
              "as a table unless --csv or --json is given"},
     {"--at", CLI_REAL_AT(RunCli, at), .metavar = "T",
      .help = "the instant T alone: --t0 T --steps 0"},
-    {"--engine", CLI_CHOICE_AT(RunCli, engine, cli_engine_choices), .metavar = "E",
+    {"--engine", CLI_CHOICE_AT(RunCli, engine, engine_names), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--linear", CLI_CHOICE_AT(RunCli, linear, analysis_linear_names), .metavar = "L",
      .help = "linear algebra: dense (LU), sparse (KLU on the Jacobian's\n"
@@ -251,7 +251,7 @@ static void print_stats(const RunResult *res, const MechrtKernels *k,
         fprintf(stderr, "mechc run: stats: unrolled LU (the kernels' lu_factor): %ld "
                 "factorisations; its pivot checks sent the others to the pattern LU\n",
                 res->generated_factorisations);
-    double ns_all = run_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
+    double ns_all = engine_time_all(k, res->sparse ? jnz : NULL, q, qd, t, 0.05);
     fprintf(stderr, "mechc run: stats: one %s call (Phi, Phi_q, nu, gamma) takes "
             "%.1f ns: a step costs %.2f of them\n",
             !res->sparse ? "`all` kernel" : jnz->all_nz ? "`all_nz` kernel"
@@ -432,22 +432,21 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
         return EXIT_USAGE;
     }
     run_output_open(&out, m);
-    MechrtKernels k = e->k;
-    MechrtHostJacNz jnz;
+    const MechrtKernels *k = engine_kernels(e);
+    const MechrtHostJacNz *jnz = engine_jac_nz(e);
     RunResult res;
     c->ro.notes = stderr;
     c->ro.linear = (AnalysisLinear)c->linear;
-    c->ro.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
     progress_start(&out.progress, "run", 1000);
     MechrtKernels newton = engine_newton_kernels(e);
     AnalysisStatus rs = c->forces
-                   ? run_analysis_forces(m, &newton, &c->ro, on_state_keep, &last, &res)
-                   : run_analysis(m, &newton, &c->ro, on_state_kinematic, &last, &res);
+                   ? run_analysis_forces(m, &newton, jnz, &c->ro, on_state_keep, &last, &res)
+                   : run_analysis(m, &newton, jnz, &c->ro, on_state_kinematic, &last, &res);
     progress_finish(&out.progress);
-    int status = report(c, m, &out, pics, rs, &res, &k, &jnz, &last);
+    int status = report(c, m, &out, pics, rs, &res, k, jnz, &last);
     status = finish_output(c, out.csv, status);
     free(last.q), free(last.qd);
     run_output_close(&out);

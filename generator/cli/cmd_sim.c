@@ -54,7 +54,7 @@ static const CliOption options[] = {
     {"--steps", CLI_INT_AT(SimCli, so.steps, 1, 100000000), .metavar = "N",
      .help = "output intervals (default 100); the integrator chooses\n"
              "its own steps in between"},
-    {"--engine", CLI_CHOICE_AT(SimCli, engine, cli_engine_choices), .metavar = "E",
+    {"--engine", CLI_CHOICE_AT(SimCli, engine, engine_names), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--method", CLI_CHOICE_AT(SimCli, method, sim_method_names), .metavar = "M",
      .help = "integrator: rk8pd (default), rkf45 (explicit Runge-Kutta\n"
@@ -234,12 +234,6 @@ static int report(const SimCli *c, const Model *m, const RunOutput *out, const R
     return status;
 }
 
-/* M's nonzeros through the compiled unit's context-free kernel. */
-static void code_mass_nz(void *ctx, const double *q, double *vals)
-{
-    ((const Kernels *)ctx)->mass_nz(q, vals);
-}
-
 /* The simulation with the open engine, the states going where c says. */
 static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p)
 {
@@ -255,14 +249,10 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     run_output_open(&out, m);
     c->so.notes = stderr;
     c->so.linear = (AnalysisLinear)c->linear;
-    MechrtHostJacNz jnz;
-    MechrtHostMassNz mnz = {e->mech->kin.dyn.nnz, e->kernels.mass_row, e->kernels.mass_col,
-                            (void *)&e->kernels, code_mass_nz};
-    c->so.jac_nz = run_jac_nz_of(e, &jnz) ? &jnz : NULL;
-    c->so.mass_nz = e->kernels.mass_nz && e->kernels.mass_row ? &mnz : NULL;
     SimResult res;
     progress_start(&out.progress, "sim", 1000);
-    AnalysisStatus st = sim_run(m, &e->k, &c->so, run_output_state, &out, &res);
+    AnalysisStatus st = sim_run(m, engine_kernels(e), engine_jac_nz(e), engine_mass_nz(e),
+                                &c->so, run_output_state, &out, &res);
     progress_finish(&out.progress);
     int status = report(c, m, &out, p, st, &res);
     if (out.csv && out.csv != stdout && fclose(out.csv) != 0) {

@@ -4,8 +4,6 @@
 #include <limits.h>
 #include <string.h>
 
-const char *const cli_engine_choices[] = {"jit", "generic", "aot", NULL};
-
 /* The --max-... options of every command, into a MechLimits. The upper
    bounds keep what the limits protect: the parser's and differentiator's
    recursion stays far from the stack's end, and int indices (file

@@ -15,8 +15,8 @@ void sim_sparse_jac_times(const Sim *s, const double *x, double *y)
 {
     const double *v = mechrt_host_kkt_jac(s->kkt);
     memset(y, 0, (size_t)s->nr * sizeof *y);
-    for (int e = 0; e < s->jnz->nnz; e++)
-        y[s->jnz->row[e]] += v[e] * x[s->jnz->col[e]];
+    for (int e = 0; e < s->jnz->jac.nnz; e++)
+        y[s->jnz->jac.row[e]] += v[e] * x[s->jnz->jac.col[e]];
 }
 
 /* qd^T M x over M's nonzeros vals. */
@@ -51,8 +51,8 @@ MechrtStatus sim_sparse_eval(Sim *s, const double *q, const double *qd, double t
 {
     double *jac = mechrt_host_kkt_jac(s->kkt);
     s->res->calls.all_nz++;
-    s->jnz->all_nz(s->jnz->ctx, q, qd, t, s->sphi, jac, s->nu, s->sg);
-    if (!sim_all_finite(s->jnz->nnz, jac) || !sim_all_finite(s->nr, s->nu) || !sim_all_finite(s->nr, s->sg))
+    s->jnz->all_nz(s->jnz->jac.ctx, q, qd, t, s->sphi, jac, s->nu, s->sg);
+    if (!sim_all_finite(s->jnz->jac.nnz, jac) || !sim_all_finite(s->nr, s->nu) || !sim_all_finite(s->nr, s->sg))
         return MECHRT_ENOTFINITE;
     if (!dynamics)
         return MECHRT_OK;

@@ -124,7 +124,7 @@ static MechrtStatus position_correction(Sim *s, const MechrtOptions *o, const do
     *zero = false;
     if (s->kkt) {
         s->res->calls.jac_nz++;
-        s->jnz->jac_nz(s->jnz->ctx, q, t, mechrt_host_kkt_jac(s->kkt));
+        s->jnz->jac.jac_nz(s->jnz->jac.ctx, q, t, mechrt_host_kkt_jac(s->kkt));
         if (mechrt_host_kkt_factor(s->kkt, MECHRT_KKT_IDENTITY, s->active, nh,
                                    SIM_KKT_PIVOT_TOL) == MECHRT_OK) {
             memset(s->sx, 0, (size_t)n * sizeof *s->sx);

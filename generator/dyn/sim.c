@@ -106,8 +106,6 @@ SimOptions sim_default_options(void)
     o.max_steps = 10000000;
     o.notes = NULL;
     o.linear = ANALYSIS_LINEAR_AUTO;
-    o.jac_nz = NULL;
-    o.mass_nz = NULL;
     return o;
 }
 
@@ -242,7 +240,9 @@ static AnalysisStatus bad_input(SimResult *res, const char *fmt, ...)
 }
 
 /* Options and kernels usable; ANALYSIS_OK or ANALYSIS_BAD_INPUT with the message. */
-static AnalysisStatus check_input(const MechrtKernels *k, const SimOptions *o, SimResult *res)
+static AnalysisStatus check_input(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                                  const MechrtHostMassNz *mnz, const SimOptions *o,
+                                  SimResult *res)
 {
     if (!sim_has_masses(k))
         return bad_input(res, "the mechanism has no masses: forward dynamics needs `mass` "
@@ -257,24 +257,25 @@ static AnalysisStatus check_input(const MechrtKernels *k, const SimOptions *o, S
     if (k->nh > k->nq)
         return bad_input(res, "%d holonomic rows for %d coordinates: the position "
                          "projection needs at most one row per coordinate", k->nh, k->nq);
-    if (o->linear == ANALYSIS_LINEAR_SPARSE && !sim_sparse_can(k, o))
+    if (o->linear == ANALYSIS_LINEAR_SPARSE && !sim_sparse_can(k, jnz, mnz))
         return bad_input(res, "--linear sparse needs the generated kernels' nonzeros (--engine "
                          "jit or aot) and at least one constraint row");
     return ANALYSIS_OK;
 }
 
-AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+AnalysisStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             const MechrtHostMassNz *mnz, const SimOptions *o, const double *q0,
                              SimStateFn state, void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     res->min_pivot_ratio = 1;
-    if (check_input(k, o, res) != ANALYSIS_OK)
+    if (check_input(k, jnz, mnz, o, res) != ANALYSIS_OK)
         return ANALYSIS_BAD_INPUT;
     Sim s;
     memset(&s, 0, sizeof s);
     AnalysisStatus status = ANALYSIS_FAILED;
-    if (!sim_open(&s, k, o, res)) {
+    if (!sim_open(&s, k, jnz, mnz, o, res)) {
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
         res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EINVAL;
@@ -303,10 +304,11 @@ AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const 
 /* Construction, then Newton onto the rows from the file's values (as run
    does at t0: assemble_at_t0, its default projection); q holds the
    result. False with the message set. */
-static bool start_at_t0(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                        double *q, SimResult *res)
+static bool start_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                        const MechrtHostMassNz *mnz, const SimOptions *o, double *q,
+                        SimResult *res)
 {
-    bool sparse = sim_sparse_wanted(k, o);
+    bool sparse = sim_sparse_wanted(k, jnz, mnz, o);
     /* the robust restarts' dense SVDs would take hours on a large sparse mechanism */
     AssembleT0Options ao = {.t0 = o->t0, .mechrt = &o->mechrt,
                             .robust = !(sparse && m->nq > ANALYSIS_DENSE_MAX_NQ),
@@ -315,7 +317,7 @@ static bool start_at_t0(const Model *m, const MechrtKernels *k, const SimOptions
     ao.rough.tol_dq = o->mechrt.tol_dq;
     ao.rough.max_iter = o->assembly_max_iter;
     AssembleT0Report rep;
-    bool ok = assemble_at_t0(m, k, sparse ? o->jac_nz : NULL, &ao, q, &rep);
+    bool ok = assemble_at_t0(m, k, sparse ? jnz : NULL, &ao, q, &rep);
     res->constructed = rep.constructed;
     res->assembled_robustly = rep.robust;
     if (rep.out_of_memory)
@@ -325,20 +327,21 @@ static bool start_at_t0(const Model *m, const MechrtKernels *k, const SimOptions
     return ok;
 }
 
-AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                       SimStateFn state, void *state_ctx, SimResult *res)
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
+                       void *state_ctx, SimResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
     if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
         return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
                          "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (check_input(k, o, res) != ANALYSIS_OK)
+    if (check_input(k, jnz, mnz, o, res) != ANALYSIS_OK)
         return ANALYSIS_BAD_INPUT;
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
-    if (!start_at_t0(m, k, o, q, &pre)) {
+    if (!start_at_t0(m, k, jnz, mnz, o, q, &pre)) {
         *res = pre;
         res->status = ANALYSIS_FAILED;
         res->cause = MECHRT_EMAXITER;
@@ -352,7 +355,7 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions 
     if (pre.assembled_robustly && o->notes)
         fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
                 "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
-    AnalysisStatus st = sim_integrate(k, o, q, state, state_ctx, res);
+    AnalysisStatus st = sim_integrate(k, jnz, mnz, o, q, state, state_ctx, res);
     res->constructed = pre.constructed;
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;

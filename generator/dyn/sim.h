@@ -17,6 +17,7 @@
 
 #include "../../runtime/mechrt.h"
 #include "../../runtime/host/mechrt_host.h"
+#include "../engine/engine.h"
 #include "../model/model.h"
 #include "../analysis/common.h"
 
@@ -62,21 +63,14 @@ typedef struct SimOptions {
     long max_steps;         /* integrator steps allowed in all; 10 000 000 */
     FILE *notes;            /* notes ("FILE: note: ..."); NULL: none */
     AnalysisLinear linear;  /* ANALYSIS_LINEAR_AUTO */
-    /* the generated kernels' nonzeros (jit, aot), NULL without: the
-       sparse path needs both and jac_nz->all_nz */
-    const MechrtHostJacNz *jac_nz;
-    const MechrtHostMassNz *mass_nz;
 } SimOptions;
 
 SimOptions sim_default_options(void);
 
 enum { SIM_MESSAGE_MAX = 1024 };
 
-/* Kernel calls by kind, through the counting wrapper. */
-typedef struct SimKernelCalls {
-    long phi, jac, nu, gamma, all, mass, force;
-    long jac_nz, all_nz, mass_nz;    /* the sparse path's */
-} SimKernelCalls;
+/* Kernel calls by kind, through the counting wrapper (engine_counting). */
+typedef EngineCalls SimKernelCalls;
 
 typedef struct SimResult {
     AnalysisStatus status;
@@ -124,11 +118,16 @@ bool sim_has_masses(const MechrtKernels *k);
 
 /* From the file's initial values: construction and assembly at t0 (as
    run), then sim_integrate. */
-AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const SimOptions *o,
-                       SimStateFn state, void *state_ctx, SimResult *res);
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
+                       void *state_ctx, SimResult *res);
 
-/* From positions q0 (nq; projected onto Phi = 0 first) and o->qd0. */
-AnalysisStatus sim_integrate(const MechrtKernels *k, const SimOptions *o, const double *q0,
+/* From positions q0 (nq; projected onto Phi = 0 first) and o->qd0, with
+   kernels k and, for the sparse path, their nonzeros jnz and mnz
+   (engine_jac_nz, engine_mass_nz; NULL without: the sparse path needs
+   both and jnz->all_nz). */
+AnalysisStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             const MechrtHostMassNz *mnz, const SimOptions *o, const double *q0,
                              SimStateFn state, void *state_ctx, SimResult *res);
 
 #endif

@@ -1,7 +1,6 @@
 /* sim_state.c - the state of one simulation, its set-up and its failure messages. */
 #include "sim_state.h"
 
-#include "counting.h"
 #include "rhs.h"
 
 #include "../base/arena.h"
@@ -76,22 +75,24 @@ static const gsl_odeiv2_step_type *step_type(SimMethod m)
 }
 
 /* The sparse path's kernels are there (and rows to constrain). */
-bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o)
+bool sim_sparse_can(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                    const MechrtHostMassNz *mnz)
 {
-    return k->nh + k->nv > 0 && o->jac_nz && o->jac_nz->all_nz && o->jac_nz->jac_nz
-           && o->mass_nz && o->mass_nz->mass_nz;
+    return k->nh + k->nv > 0 && jnz && jnz->all_nz && jnz->jac.jac_nz && mnz && mnz->mass_nz;
 }
 
 /* The sparse path is taken: asked for, or auto on a large mechanism. */
-bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o)
+bool sim_sparse_wanted(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const MechrtHostMassNz *mnz, const SimOptions *o)
 {
-    return sim_sparse_can(k, o)
+    return sim_sparse_can(k, jnz, mnz)
            && (o->linear == ANALYSIS_LINEAR_SPARSE
                || (o->linear == ANALYSIS_LINEAR_AUTO && k->nq > ANALYSIS_DENSE_MAX_NQ));
 }
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */
-bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *res)
+bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+              const MechrtHostMassNz *mnz, const SimOptions *o, SimResult *res)
 {
     size_t n = (size_t)k->nq, m = (size_t)(k->nh + k->nv);
     s->inner = k;
@@ -100,7 +101,7 @@ bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *re
     s->nq = k->nq;
     s->nr = (int)m;
     s->dim = 2 * k->nq + (o->energy ? 1 : 0);
-    sim_counting(s);
+    s->kc = engine_counting(&s->counter, k, &res->calls);
     s->nu = xcalloc(m + 1, sizeof *s->nu);
     s->resid = xcalloc(m + 1, sizeof *s->resid);
     s->lambda = xcalloc(m + 1, sizeof *s->lambda);
@@ -121,10 +122,10 @@ bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *re
     memset(s->active, 1, m + 1);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
-    if (sim_sparse_wanted(k, o)) {
-        s->jnz = o->jac_nz;
-        s->mnz = o->mass_nz;
-        s->kkt = mechrt_host_kkt_new(k->nq, (int)m, o->jac_nz, o->mass_nz);
+    if (sim_sparse_wanted(k, jnz, mnz, o)) {
+        s->jnz = jnz;
+        s->mnz = mnz;
+        s->kkt = mechrt_host_kkt_new(k->nq, (int)m, jnz, mnz);
         if (!s->kkt)
             return false;
         s->res->sparse = true;
@@ -134,7 +135,7 @@ bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *re
         s->sphi = xcalloc(m, sizeof *s->sphi);
         s->sg = xcalloc(m, sizeof *s->sg);
         s->sforce = xcalloc(n, sizeof *s->sforce);
-        s->smass = xcalloc((size_t)o->mass_nz->nnz + 1, sizeof *s->smass);
+        s->smass = xcalloc((size_t)mnz->nnz + 1, sizeof *s->smass);
     }
     if (!s->kkt && !sim_dense_ready(s))
         return false;

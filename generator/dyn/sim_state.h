@@ -10,7 +10,8 @@
 
 typedef struct Sim {
     const MechrtKernels *inner;  /* the caller's kernels */
-    MechrtKernels kc;            /* the same, counted (ctx: this Sim) */
+    EngineCounter counter;
+    MechrtKernels kc;            /* the same, counted (engine_counting) */
     const SimOptions *o;
     SimResult *res;
     int nq, nr, dim;             /* dim: 2 nq (+1 with energy) */
@@ -51,13 +52,16 @@ typedef struct Sim {
 #define msgf(s, ...) analysis_msgf((s)->res->message, sizeof (s)->res->message, __VA_ARGS__)
 
 /* The sparse path's kernels are there (and rows to constrain). */
-bool sim_sparse_can(const MechrtKernels *k, const SimOptions *o);
+bool sim_sparse_can(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                    const MechrtHostMassNz *mnz);
 
 /* The sparse path is taken: asked for, or auto on a large mechanism. */
-bool sim_sparse_wanted(const MechrtKernels *k, const SimOptions *o);
+bool sim_sparse_wanted(const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const MechrtHostMassNz *mnz, const SimOptions *o);
 
 /* Buffers, projection objects and the GSL driver; false when out of memory. */
-bool sim_open(Sim *s, const MechrtKernels *k, const SimOptions *o, SimResult *res);
+bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+              const MechrtHostMassNz *mnz, const SimOptions *o, SimResult *res);
 void sim_close(Sim *s);
 
 /* The dense method's arrays, allocated at the first need; false when out of memory. */

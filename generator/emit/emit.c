@@ -20,10 +20,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const emit_function_names[EMIT_FUNCTION_COUNT] = {
-    "phi", "jac", "jac_nz", "nu", "gamma", "all", "all_nz", "mass", "mass_nz", "force", "eom",
-};
-
 int emit_function_count(const Kinematics *kin)
 {
     return kin->dyn.present ? EMIT_FUNCTION_COUNT : EMIT_KINEMATIC_COUNT;
@@ -36,28 +32,24 @@ typedef struct Param {
     bool scalar;        /* by value: P_real (t); else written: P_real * */
 } Param;
 
-#define IN(name) {name, true, false}
-#define VALUE(name) {name, false, true}
-#define OUT(name) {name, false, false}
-/* Parameters of each generated function, in order, up to a NULL name (all
-   are void-cast so no mechanism triggers an unused-parameter warning). */
-static const Param function_params[EMIT_FUNCTION_COUNT][8] = {
-    [EMIT_PHI] = {IN("q"), VALUE("t"), OUT("phi")},
-    [EMIT_JAC] = {IN("q"), VALUE("t"), OUT("jac")},
-    [EMIT_JAC_NZ] = {IN("q"), VALUE("t"), OUT("vals")},
-    [EMIT_NU] = {IN("q"), VALUE("t"), OUT("nu")},
-    [EMIT_GAMMA] = {IN("q"), IN("qd"), VALUE("t"), OUT("gamma")},
-    [EMIT_ALL] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac"), OUT("nu"), OUT("gamma")},
-    [EMIT_ALL_NZ] = {IN("q"), IN("qd"), VALUE("t"), OUT("phi"), OUT("jac_vals"), OUT("nu"),
-                     OUT("gamma")},
-    [EMIT_MASS] = {IN("q"), OUT("M")},
-    [EMIT_MASS_NZ] = {IN("q"), OUT("vals")},
-    [EMIT_FORCE] = {IN("q"), IN("qd"), VALUE("t"), OUT("Q")},
-    [EMIT_EOM] = {IN("q"), IN("qd"), VALUE("t"), OUT("M"), OUT("Q"), OUT("jac"), OUT("gamma")},
+#define IN(name) {#name, true, false}
+#define VALUE(name) {#name, false, true}
+#define OUT(name) {#name, false, false}
+#define NONE {NULL, false, false}
+#define P(...) {__VA_ARGS__}
+/* Parameters of each generated function (functions.def), in order, up to
+   a NULL name (all are void-cast so no mechanism triggers an
+   unused-parameter warning); none for the LU's, which emit_lu.c writes. */
+static const Param function_params[EMIT_GENERATED_COUNT][8] = {
+#define X(E, name, type, family, params) [EMIT_##E] = params,
+#include "functions.def"
+#undef X
 };
 #undef IN
 #undef VALUE
 #undef OUT
+#undef NONE
+#undef P
 
 EmitOptions emit_default_options(void)
 {
@@ -371,9 +363,13 @@ static long roll_outputs(Emitter *e, EmitFunction f, SchedOutput **outs, int *n,
 
 bool emit_function_written(const EmitOptions *opt, EmitFunction f)
 {
-    if (f == EMIT_ALL_NZ)
-        return opt->all_nz || opt->sparse_only;
-    return !(opt->sparse_only && (f == EMIT_JAC || f == EMIT_ALL));
+    switch (emit_function_family[f]) {
+    case EMIT_DENSE: return !opt->sparse_only;
+    case EMIT_SPARSE: return opt->all_nz || opt->sparse_only;
+    case EMIT_LU: return opt->lu;
+    case EMIT_KIN: case EMIT_DYN: case EMIT_FAMILY_COUNT: break;
+    }
+    return true;
 }
 
 bool emit_direct_jac_default(const Kinematics *kin, int roll)

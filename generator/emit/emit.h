@@ -7,6 +7,7 @@
 #include "../base/strbuf.h"
 #include "../diff/kinematics.h"
 #include "options.h"
+#include "functions.h"
 
 #include <stdbool.h>
 
@@ -22,26 +23,13 @@
 enum { EMIT_DIRECT_JAC_NNZ = 4000 };
 bool emit_direct_jac_default(const Kinematics *kin, int roll);
 
-/* The spec's function order, for op counts and reports (jac and all count
-   0 in a sparse-only file); then all_nz, an extension (written only with
-   EmitOptions.all_nz or sparse_only: its ops count 0 without),
-   and the dynamics functions, written only for a file with masses. */
-typedef enum EmitFunction {
-    EMIT_PHI, EMIT_JAC, EMIT_JAC_NZ, EMIT_NU, EMIT_GAMMA, EMIT_ALL, EMIT_ALL_NZ,
-    EMIT_MASS, EMIT_MASS_NZ, EMIT_FORCE, EMIT_EOM, EMIT_FUNCTION_COUNT
-} EmitFunction;
-
-enum { EMIT_KINEMATIC_COUNT = EMIT_MASS };
-
-extern const char *const emit_function_names[EMIT_FUNCTION_COUNT];
-
 /* The functions kin's file gets: the kinematic ones, and the dynamics
    ones when it has masses (EMIT_KINEMATIC_COUNT or EMIT_FUNCTION_COUNT). */
 int emit_function_count(const Kinematics *kin);
 
 /* Whether a file emitted with opt gets function f (kin with masses
-   permitting): all_nz with all_nz or sparse_only, jac and all unless
-   sparse_only. */
+   permitting; for the LU's, a mechanism emit_lu serves): by its family,
+   all_nz with all_nz or sparse_only, jac and all unless sparse_only. */
 bool emit_function_written(const EmitOptions *opt, EmitFunction f);
 
 typedef struct EmitResult {

@@ -5,9 +5,11 @@
  *          cached shared library and loaded with dlopen (generator/engine/aot.c).
  * generic: no code generation; formulas and an interpreter over the joint
  *          list (generator/eval/generic.c).
- * All three fill one MechrtKernels: jit and aot through thunks whose ctx is
- * the compiled unit's Kernels, generic through wrappers whose ctx is its
- * state. Everything downstream (engine_phi..., check, run) calls e->k.
+ * All three fill one MechrtKernels (and where they have them the Jacobian's
+ * and M's nonzeros): jit and aot through thunks whose ctx is the compiled
+ * unit's Kernels, generic through wrappers whose ctx is its state. These
+ * are the only kernel adapters; everything downstream (check, run, sim)
+ * asks engine_kernels, engine_jac_nz and engine_mass_nz.
  */
 #include "engine.h"
 
@@ -17,15 +19,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const engine_names[ENGINE_KIND_COUNT] = {"jit", "generic", "aot"};
-
-int engine_from_name(const char *name)
-{
-    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-        if (strcmp(name, engine_names[k]) == 0)
-            return k;
-    return -1;
-}
+const char *const engine_names[ENGINE_KIND_COUNT + 1] = {
+#define X(E, name) [ENGINE_##E] = name,
+    ENGINE_KINDS(X)
+#undef X
+};
 
 EngineOptions engine_default_options(void)
 {
@@ -70,6 +68,39 @@ static void code_force(void *ctx, const double *q, const double *qd, double t, d
     ((const Kernels *)ctx)->force(q, qd, t, Q);
 }
 
+static void code_mass_nz(void *ctx, const double *q, double *vals)
+{
+    ((const Kernels *)ctx)->mass_nz(q, vals);
+}
+
+static void code_jac_nz(void *ctx, const double *q, double t, double *vals)
+{
+    ((const Kernels *)ctx)->jac_nz(q, t, vals);
+}
+
+static void code_all_nz(void *ctx, const double *q, const double *qd, double t, double *phi,
+                        double *vals, double *nu, double *gamma)
+{
+    ((const Kernels *)ctx)->all_nz(q, qd, t, phi, vals, nu, gamma);
+}
+
+static int code_lu_factor(void *ctx, const double *a, double *lu, double pivot_tol,
+                          double *spread)
+{
+    return ((const Kernels *)ctx)->lu_factor(a, lu, pivot_tol, spread);
+}
+
+static void code_lu_solve(void *ctx, const double *lu, const double *b, double *x)
+{
+    ((const Kernels *)ctx)->lu_solve(lu, b, x);
+}
+
+static int code_lu_step(void *ctx, double *q, double *qd, double *qdd, double t, double h,
+                        const double *tol, int max_iter, double *out, int *iout)
+{
+    return ((const Kernels *)ctx)->step(q, qd, qdd, t, h, tol, max_iter, out, iout);
+}
+
 /* ---- generic: ctx is the evaluator's state ---- */
 
 static void gen_phi(void *ctx, const double *q, double t, double *out)
@@ -108,20 +139,33 @@ static void gen_force(void *ctx, const double *q, const double *qd, double t, do
     generic_force(ctx, q, qd, t, Q);
 }
 
-/* e->k for compiled code (jit, aot) whose functions code holds. */
+static void gen_mass_nz(void *ctx, const double *q, double *vals)
+{
+    generic_mass_nz(ctx, q, vals);
+}
+
+/* e->k, e->jac_nz and e->mass_nz for compiled code (jit, aot) whose
+   functions code holds. */
 static void bind_code(Engine *e, const Kernels *code)
 {
+    void *ctx = (void *)code;
+    e->compiled = true;
     e->kernels = *code;
-    e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = (void *)code,
+    e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = ctx,
                            .phi = code_phi, .jac = code->jac ? code_jac : NULL,
                            .nu = code_nu, .gamma = code_gamma,
                            .all = code->all ? code_all : NULL};   /* NULL: sparse-only */
+    e->jac_nz = (MechrtHostJacNz){
+        .jac = {e->mech->kin.nnz, code->jac_row, code->jac_col, ctx, code_jac_nz},
+        .all_nz = code->all_nz ? code_all_nz : NULL};
+    if (code->lu_factor)    /* the LU's family, all or none (kernels_bind) */
+        e->jac_nz.lu = (MechrtLuGen){e->nq * e->nq, ctx, code_lu_factor, code_lu_solve,
+                                     code_lu_step};
     if (code->mass) {       /* the file has masses */
         e->k.mass = code_mass;
         e->k.force = code_force;
-        e->mass_row = code->mass_row;
-        e->mass_col = code->mass_col;
-        e->mass_nnz = e->mech->kin.dyn.nnz;
+        e->mass_nz = (MechrtHostMassNz){e->mech->kin.dyn.nnz, code->mass_row, code->mass_col,
+                                        ctx, code_mass_nz};
     }
 }
 
@@ -135,25 +179,13 @@ static void bind_generic_pattern(Engine *e, const Dynamics *dyn)
         e->pattern[k] = dyn->mass[k].row;
         e->pattern[n + k] = dyn->mass[k].col;
     }
-    e->mass_row = e->pattern;
-    e->mass_col = e->pattern + n;
-    e->mass_nnz = n;
-    generic_mass_pattern(e->generic, e->mass_row, e->mass_col, n);
+    e->mass_nz = (MechrtHostMassNz){n, e->pattern, e->pattern + n, e->generic, gen_mass_nz};
+    generic_mass_pattern(e->generic, e->mass_nz.row, e->mass_nz.col, n);
 }
 
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
 {
-    EmitOptions eo = emit_default_options();
-    eo.declare_math = false;
-    eo.real_float = false;
-    eo.prefix = "mechc_aot";
-    /* Stores in place are faster than the spread from jac_nz; only large
-       mechanisms keep the compact form, for the compiler's sake. */
-    eo.direct_jac = mech->kin.nnz <= 4000;
-    eo.all_nz = true;       /* run's sparse path */
-    eo.sparse_only = pipeline_sparse_only(mech);
-    eo.lu = true;           /* run's dense path: the unrolled LU */
-    eo.source_name = mech->model->file;
+    EmitOptions eo = engine_emit_options(mech, ENGINE_AOT);
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))
         return false;
@@ -182,7 +214,7 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
     e->nr = mech->model->nr;
     switch (kind) {
     case ENGINE_JIT:
-        e->jit = pipeline_jit(mech, &e->emitted, &e->gen_seconds, &e->compile_seconds, diag);
+        e->jit = engine_jit(mech, &e->emitted, &e->gen_seconds, &e->compile_seconds, diag);
         if (!e->jit) {
             emit_result_free(&e->emitted);
             return false;
@@ -225,8 +257,7 @@ MechrtKernels engine_newton_kernels(const Engine *e)
 {
     MechrtKernels k = e->k;
     const int *ops = e->emitted.ops;
-    bool compiled = e->kind == ENGINE_JIT || e->kind == ENGINE_AOT;
-    if (compiled && k.phi && k.jac
+    if (e->compiled && k.phi && k.jac
         && ops[EMIT_GAMMA] >= ops[EMIT_PHI] + ops[EMIT_JAC])
         k.all = NULL;
     return k;

@@ -10,6 +10,7 @@
 #include "../base/arena.h"
 #include "../base/sincos.h"
 #include "../base/strbuf.h"
+#include "../emit/functions.h"
 
 #include <libtcc.h>
 #include <math.h>
@@ -74,32 +75,32 @@ static void *kernel(KernelFind find, void *handle, const char *prefix, const cha
 
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
 {
+    int found[EMIT_FAMILY_COUNT] = {0}, rows[EMIT_FAMILY_COUNT] = {0};
     memset(k, 0, sizeof *k);
-    k->phi = (KernelPhi)kernel(find, handle, prefix, "phi");
-    k->jac = (KernelPhi)kernel(find, handle, prefix, "jac");
-    k->jac_nz = (KernelPhi)kernel(find, handle, prefix, "jac_nz");
-    k->nu = (KernelPhi)kernel(find, handle, prefix, "nu");
-    k->gamma = (KernelGamma)kernel(find, handle, prefix, "gamma");
-    k->all = (KernelAll)kernel(find, handle, prefix, "all");
-    k->all_nz = (KernelAll)kernel(find, handle, prefix, "all_nz");
+#define X(E, name, type, family, params) \
+    k->name = (Kernel##type)kernel(find, handle, prefix, #name); \
+    found[family] += k->name != NULL; \
+    rows[family]++;
+#include "../emit/functions.def"
+#undef X
+    if (found[EMIT_LU] < rows[EMIT_LU]) {
+#define X(E, name, type, family, params) \
+        if (family == EMIT_LU) \
+            k->name = NULL;
+#include "../emit/functions.def"
+#undef X
+    }
     k->jac_row = kernel(find, handle, prefix, "jac_row");
     k->jac_col = kernel(find, handle, prefix, "jac_col");
-    k->mass = (KernelMass)kernel(find, handle, prefix, "mass");
-    k->mass_nz = (KernelMass)kernel(find, handle, prefix, "mass_nz");
-    k->force = (KernelGamma)kernel(find, handle, prefix, "force");
-    k->eom = (KernelEom)kernel(find, handle, prefix, "eom");
     k->mass_row = kernel(find, handle, prefix, "mass_row");
     k->mass_col = kernel(find, handle, prefix, "mass_col");
-    k->lu_factor = (KernelLuFactor)kernel(find, handle, prefix, "lu_factor");
-    k->lu_solve = (KernelLuSolve)kernel(find, handle, prefix, "lu_solve");
-    k->lu_step = (KernelLuStep)kernel(find, handle, prefix, "step");
-    if (!k->lu_factor || !k->lu_solve || !k->lu_step)
-        k->lu_factor = NULL, k->lu_solve = NULL, k->lu_step = NULL;
-    bool dynamics = k->mass && k->mass_nz && k->force && k->eom && k->mass_row && k->mass_col;
-    bool none = !k->mass && !k->mass_nz && !k->force && !k->eom && !k->mass_row && !k->mass_col;
-    /* a sparse-only unit has neither dense function, and all_nz instead */
-    bool dense = k->jac && k->all, sparse_only = !k->jac && !k->all && k->all_nz;
-    return k->phi && k->jac_nz && k->nu && k->gamma && k->jac_row && k->jac_col
+    bool mass_pattern = k->mass_row && k->mass_col;
+    bool dynamics = found[EMIT_DYN] == rows[EMIT_DYN] && mass_pattern;
+    bool none = found[EMIT_DYN] == 0 && !k->mass_row && !k->mass_col;
+    /* a sparse-only unit has no dense function, and all_nz instead */
+    bool dense = found[EMIT_DENSE] == rows[EMIT_DENSE];
+    bool sparse_only = found[EMIT_DENSE] == 0 && k->all_nz;
+    return found[EMIT_KIN] == rows[EMIT_KIN] && k->jac_row && k->jac_col
            && (dense || sparse_only) && (dynamics || none);
 }
 

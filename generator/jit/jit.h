@@ -17,37 +17,30 @@ typedef void (*KernelEom)(const double *q, const double *qd, double t,
                           double *M, double *Q, double *jac, double *gamma);
 
 /* The generated functions of one mechanism as the compiled unit exports
-   them (libtcc, dlopen of a cc-built library): context-free, with jac_nz
-   and its pattern. Engines evaluate through a MechrtKernels whose ctx is
-   this struct (engine.c). all_nz (the fused kernel with the Jacobian's
-   nonzeros, EmitOptions.all_nz) is NULL in a unit written without it;
-   jac and all are NULL in a sparse-only one (EmitOptions.sparse_only). */
+   them (libtcc, dlopen of a cc-built library), one field per row of
+   functions.def: context-free, with the patterns of jac_nz and mass_nz.
+   Engines evaluate through a MechrtKernels whose ctx is this struct
+   (engine.c). A family a unit was written without is NULL (EmitFamily):
+   all_nz without EmitOptions.all_nz, jac and all in a sparse-only unit,
+   the dynamics without masses (mass_row and mass_col with them), the
+   unrolled LU (lu_factor, lu_solve and step, the kinematic step over
+   them; above 24 coordinates one that declines) where it was not written. */
 typedef struct Kernels {
-    KernelPhi phi, jac, jac_nz, nu;
-    KernelGamma gamma;
-    KernelAll all, all_nz;
+#define X(E, name, type, family, params) Kernel##type name;
+#include "../emit/functions.def"
+#undef X
     const int *jac_row, *jac_col;
-    /* Dynamics (doc/dynamics.md), NULL unless the file has masses: M (nq*nq dense),
-       its nonzeros and their pattern, Q, and the fused M, Q, jac, gamma. */
-    KernelMass mass, mass_nz;
-    KernelGamma force;
-    KernelEom eom;
     const int *mass_row, *mass_col;
-    /* The Jacobian's LU unrolled for its pattern (emit_lu.c); NULL in a
-       unit written without it or for a mechanism it does not serve. */
-    KernelLuFactor lu_factor;
-    KernelLuSolve lu_solve;
-    KernelLuStep lu_step;   /* PREFIX_step: the kinematic step over them
-                               (above 24 coordinates one that declines) */
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
 typedef void *(*KernelFind)(void *handle, const char *symbol);
 
 /* Fills k with the generated functions PREFIX_phi, PREFIX_jac, ... of
-   handle; false when one is missing (PREFIX_all_nz may be, or PREFIX_jac
-   and PREFIX_all together when PREFIX_all_nz is there). The dynamics
-   functions are bound when the unit has them (all or none), NULL otherwise. */
+   handle, by family (functions.h); false when one is missing: a
+   kinematic one, a dense one unless the unit is sparse-only (PREFIX_all_nz
+   there and no dense one), some of the dynamics but not all. An LU
+   family found in part is left out (NULL). */
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix);
 
 typedef struct Jit Jit;

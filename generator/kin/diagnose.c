@@ -89,12 +89,12 @@ static int nonfinite_jac_row(Run *r, const double *q, double t)
 {
     int row = -1;
     if (r->sp) {
-        const MechrtHostJacNz *j = r->o->jac_nz;
+        const MechrtHostJacNz *j = r->jnz;
         double *vals = mechrt_host_sparse_values(r->sp);
         mechrt_host_sparse_eval(r->sp, q, t);
-        for (int e = 0; e < j->nnz && row < 0; e++)
+        for (int e = 0; e < j->jac.nnz && row < 0; e++)
             if (!isfinite(vals[e]))
-                row = j->row[e];
+                row = j->jac.row[e];
         return row;
     }
     size_t nq = (size_t)r->nq, nr = (size_t)r->nr;

@@ -86,7 +86,6 @@ RunOptions run_default_options(void)
     o.assembly_max_iter = 100;
     o.notes = NULL;
     o.linear = ANALYSIS_LINEAR_AUTO;
-    o.jac_nz = NULL;
     o.max_dense_entries = 0;
     return o;
 }
@@ -228,7 +227,7 @@ static AnalysisStatus run_integrated(Run *r, RunStateFn state, void *ctx)
     const RunOptions *o = r->o;
     MechrtReport rep;
     AnalysisStatus status = ANALYSIS_OK;
-    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, o->jac_nz) : mechrt_host_new(r->k);
+    MechrtHost *host = r->sparse ? mechrt_host_new_sparse(r->k, r->jnz) : mechrt_host_new(r->k);
     r->sp = mechrt_host_sparse_of(host);    /* a failure names its pivot */
     if (!host) {
         snprintf(r->res->message, sizeof r->res->message, "t = %.10g: out of memory", o->t0);
@@ -302,13 +301,13 @@ static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...)
 
 /* Dense or sparse for this run (RunOptions.linear); false with why when
    the choice cannot be honoured. */
-static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, char *why,
-                          size_t size)
+static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o,
+                          bool *sparse, char *why, size_t size)
 {
-    bool can = o->jac_nz != NULL;
+    bool can = jnz != NULL;
     *sparse = o->linear == ANALYSIS_LINEAR_SPARSE
               || (o->linear == ANALYSIS_LINEAR_AUTO && can && m->nq > ANALYSIS_DENSE_MAX_NQ);
-    if (*sparse && !o->jac_nz) {
+    if (*sparse && !jnz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
         return false;
@@ -328,26 +327,20 @@ static bool choose_linear(const Model *m, const RunOptions *o, bool *sparse, cha
    there is one, the mechanism is stepped (no velocity rows) and its
    worst-case index lists stay small (ANALYSIS_DENSE_MAX_NQ); NULL otherwise.
    One block: the state, then its reals, then its ints. */
-static MechrtLup *run_lup_new(const Model *m, const RunOptions *o, MechrtJacNz *jnz,
-                              MechrtLuGen *gen)
+static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *jnz)
 {
-    if (!o->jac_nz || m->nv > 0 || m->nq > ANALYSIS_DENSE_MAX_NQ)
+    if (!jnz || m->nv > 0 || m->nq > ANALYSIS_DENSE_MAX_NQ)
         return NULL;
     size_t lw = mechrt_lup_work_size(m->nq), liw = mechrt_lup_iwork_size(m->nq);
     MechrtLup *f = xcalloc(1, sizeof *f + lw * sizeof(double) + liw * sizeof(int));
     double *w = (double *)(f + 1);
-    *jnz = (MechrtJacNz){o->jac_nz->nnz, o->jac_nz->row, o->jac_nz->col, o->jac_nz->ctx,
-                         o->jac_nz->jac_nz};
-    if (mechrt_lup_init(f, m->nq, jnz->nnz, jnz->row, jnz->col, w, lw, (int *)(w + lw), liw)
-        != MECHRT_OK) {
+    if (mechrt_lup_init(f, m->nq, jnz->jac.nnz, jnz->jac.row, jnz->jac.col, w, lw,
+                        (int *)(w + lw), liw) != MECHRT_OK) {
         free(f);
         return NULL;
     }
-    if (o->jac_nz->lu_factor && o->jac_nz->lu_solve) {
-        *gen = (MechrtLuGen){m->nq * m->nq, o->jac_nz->ctx, o->jac_nz->lu_factor,
-                             o->jac_nz->lu_solve, o->jac_nz->lu_step};
-        mechrt_lup_use(f, gen);
-    }
+    if (jnz->lu.factor && jnz->lu.solve)
+        mechrt_lup_use(f, &jnz->lu);
     return f;
 }
 
@@ -373,8 +366,9 @@ bool run_rows_match(const Model *m, char *why, size_t size)
 }
 
 /* run_analysis and run_analysis_forces: one of state and fstate. */
-static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                              RunStateFn state, RunForcesFn fstate, void *state_ctx, RunResult *res)
+static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                              const RunOptions *o, RunStateFn state, RunForcesFn fstate,
+                              void *state_ctx, RunResult *res)
 {
     memset(res, 0, sizeof *res);
     res->t_fail = NAN;
@@ -395,12 +389,13 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunO
     if (!run_rows_match(m, why, sizeof why))
         return bad_input(res, "%s", why);
     bool sparse;
-    if (!choose_linear(m, o, &sparse, why, sizeof why))
+    if (!choose_linear(m, jnz, o, &sparse, why, sizeof why))
         return bad_input(res, "%s", why);
 
     Run r = {0};
     r.m = m;
     r.k = k;
+    r.jnz = jnz;
     r.o = o;
     r.res = res;
     r.nq = m->nq;
@@ -411,15 +406,15 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunO
     r.qd = r.q + nq;
     r.qdd = r.q + 2 * nq;
     r.sparse = sparse;
-    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, o->jac_nz))) {
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, jnz))) {
         free(r.q);
         return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
                          "entries) is not a valid %d x %d pattern, or out of memory",
-                         o->jac_nz->nnz, m->nq, m->nq);
+                         jnz->jac.nnz, m->nq, m->nq);
     }
     res->sparse = sparse;
     if (!sparse)
-        r.lup = run_lup_new(m, o, &r.lup_jnz, &r.lup_gen);
+        r.lup = run_lup_new(m, jnz);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -449,13 +444,15 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const RunO
     return status;
 }
 
-AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                            RunStateFn state, void *state_ctx, RunResult *res)
+AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                            const RunOptions *o, RunStateFn state, void *state_ctx,
+                            RunResult *res)
 {
-    return analyse(m, k, o, state, NULL, state_ctx, res);
+    return analyse(m, k, jnz, o, state, NULL, state_ctx, res);
 }
 
-AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k,
+                                   const MechrtHostJacNz *jnz, const RunOptions *o,
                                    RunForcesFn state, void *state_ctx, RunResult *res)
 {
     if (!k->mass || !k->force) {
@@ -472,5 +469,5 @@ AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const
                          "%lld entries), more than the limit of %lld (--max-jac-entries)",
                          m->nq, m->nq, (long long)m->nq * m->nq, o->max_dense_entries);
     }
-    return analyse(m, k, o, NULL, state, state_ctx, res);
+    return analyse(m, k, jnz, o, NULL, state, state_ctx, res);
 }

@@ -41,9 +41,6 @@ typedef struct RunOptions {
     int assembly_max_iter;
     FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
     AnalysisLinear linear;   /* ANALYSIS_LINEAR_AUTO */
-    /* the kernels' sparse Jacobian (run_jac_nz_of); NULL: none, dense only
-       (the generic engine has none); default NULL */
-    const MechrtHostJacNz *jac_nz;
     /* most rows x coordinates of a dense Jacobian, checked when the run
        would form one (dense linear algebra, the robust assembly at t0);
        0: no limit (default; mechc run passes --max-jac-entries here when
@@ -128,11 +125,13 @@ typedef void (*RunForcesFn)(void *ctx, double t, const double *q, const double *
    or how many rows are too many. */
 bool run_rows_match(const Model *m, char *why, size_t size);
 
-/* The run. m gives sizes, names and initial values; k evaluates m's rows.
+/* The run. m gives sizes, names and initial values; k evaluates m's rows;
+   jnz is their sparse Jacobian (engine_jac_nz), or NULL: dense only.
    Needs k->nh + k->nv == k->nq, otherwise ANALYSIS_BAD_INPUT saying how many
    degrees of freedom are not driven (or how many rows are too many). */
-AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOptions *o,
-                            RunStateFn state, void *state_ctx, RunResult *res);
+AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                            const RunOptions *o, RunStateFn state, void *state_ctx,
+                            RunResult *res);
 
 /* run_analysis with inverse dynamics at every state: lambda from
    Phi_q^T lambda = Q(q, qd, t) - M(q) qdd (mechrt_inverse_dynamics,
@@ -140,17 +139,8 @@ AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const RunOpt
    timing, handed to state with the state. Needs k->mass and k->force (a
    file with masses): ANALYSIS_BAD_INPUT otherwise. A failed solve (NaN in M or
    Q) fails the run at that time. */
-AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k, const RunOptions *o,
+AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k,
+                                   const MechrtHostJacNz *jnz, const RunOptions *o,
                                    RunForcesFn state, void *state_ctx, RunResult *res);
-
-/* Nanoseconds per call of the fused `all` kernel (or phi + jac + nu + gamma
-   when there is none; with jnz, phi + jac_nz + nu + gamma, the sparse
-   path's) at (q, qd, t), timed over at least min_seconds. */
-double run_time_all(const MechrtKernels *k, const MechrtHostJacNz *jnz, const double *q,
-                    const double *qd, double t, double min_seconds);
-
-/* The sparse Jacobian of compiled kernels (jit, aot) into *out, whose
-   ctx is e's; false for the generic engine, which has none. */
-bool run_jac_nz_of(const Engine *e, MechrtHostJacNz *out);
 
 #endif

@@ -14,6 +14,7 @@
 typedef struct Run {
     const Model *m;
     const MechrtKernels *k;
+    const MechrtHostJacNz *jnz;  /* the kernels' sparse Jacobian, or NULL */
     const RunOptions *o;
     RunResult *res;
     int nq, nr;
@@ -24,8 +25,6 @@ typedef struct Run {
                                 velocity-level rows: the sparse host's) */
     bool sparse;             /* the sparse path (RunOptions.linear) */
     MechrtLup *lup;          /* the dense path's pattern LU (run_lup_new); NULL: lu.c's */
-    MechrtJacNz lup_jnz;     /* its kernel: o->jac_nz */
-    MechrtLuGen lup_gen;     /* the kernels' unrolled LU, when they have one */
     /* holonomic stepping: the start of the last step (sq | sqd | sqdd, laid
        out like q | qd | qdd), the start of the interval being subdivided
        (iq, the same layout), the end of the previous subdivision level (lq)

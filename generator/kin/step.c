@@ -65,7 +65,7 @@ MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
         return mechrt_host_sparse_step(r->sp, r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h,
                                        r->work, r->lwork, rep);
     if (r->lup)
-        return mechrt_step_lup(r->k, &r->lup_jnz, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
+        return mechrt_step_lup(r->k, &r->jnz->jac, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
                                t, h, r->work, r->lwork, rep);
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }

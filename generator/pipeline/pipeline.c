@@ -1,4 +1,4 @@
-/* pipeline.c - runs the stages in order and times them; every command starts here. */
+/* pipeline.c - loads: runs the stages up to the derivatives in order and times them; every command starts here. */
 #include "pipeline.h"
 
 #include "../base/arena.h"
@@ -87,48 +87,4 @@ void pipeline_free(Mech *mech)
     model_free(mech->model);
     free(mech->text);
     free(mech);
-}
-
-bool pipeline_sparse_only(const Mech *mech)
-{
-    return (long long)mech->model->nr * mech->model->nq > EMIT_DENSE_MAX_ENTRIES;
-}
-
-Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
-                  double *tcc_seconds, Diag *diag)
-{
-    return pipeline_jit_roll(mech, EMIT_ROLL_AUTO, false, emitted, emit_seconds, tcc_seconds,
-                             diag);
-}
-
-Jit *pipeline_jit_roll(const Mech *mech, int roll, bool sparse_only, EmitResult *emitted,
-                       double *emit_seconds, double *tcc_seconds, Diag *diag)
-{
-    EmitOptions opt = emit_default_options();
-    opt.roll = roll;
-    opt.sparse_only = sparse_only || pipeline_sparse_only(mech);
-    opt.declare_math = true;
-    opt.direct_jac = true;
-    opt.all_nz = true;      /* run's sparse path */
-    opt.lu = true;           /* run's dense path: the unrolled LU */
-    opt.prefix = "mechc_jit";
-    /* Chunks exist for optimizing compilers, whose passes grow faster than
-       the function; libtcc's time is linear, and a part boundary costs it a
-       call and the workspace stores and loads of what crosses it (the
-       RSSR's all: 165 -> 134 ns). 1000 keeps a function's temporaries
-       (one stack slot each under libtcc) to a few kilobytes. */
-    opt.chunk_nodes = 1000;
-    opt.source_name = mech->model->file;
-    opt.max_ops = mech->limits.max_code_ops;
-    double t0 = pipeline_now();
-    if (!emit_mechanism(&mech->kin, &opt, emitted, diag))
-        return NULL;
-    double t1 = pipeline_now();
-    Jit *jit = jit_compile(emitted->c_text, emitted->prefix, diag);
-    double t2 = pipeline_now();
-    if (emit_seconds)
-        *emit_seconds = t1 - t0;
-    if (tcc_seconds)
-        *tcc_seconds = t2 - t1;
-    return jit;
 }

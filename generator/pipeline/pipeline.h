@@ -1,11 +1,9 @@
-/* pipeline.h - the whole front to back: file -> model -> derivatives -> C -> machine code. */
+/* pipeline.h - the front half: file -> model -> derivatives (the engines compile, engine.h). */
 #ifndef MECHC_PIPELINE_H
 #define MECHC_PIPELINE_H
 
 #include "../base/limits.h"
 #include "../diff/kinematics.h"
-#include "../emit/emit.h"
-#include "../jit/jit.h"
 
 #include <stddef.h>
 
@@ -29,20 +27,6 @@ Mech *pipeline_load_text(const char *text, const char *name, const MechLimits *l
 Mech *pipeline_load_bytes(const char *data, size_t len, const char *name, const MechLimits *limits,
                           Diag *diag);
 void pipeline_free(Mech *mech);
-
-/* Whether the engines' kernels of mech are sparse-only (no dense jac and
-   all): where its dense Jacobian has more entries than a generated file
-   indexes (EMIT_DENSE_MAX_ENTRIES), which only run's sparse path admits,
-   and it calls neither. */
-bool pipeline_sparse_only(const Mech *mech);
-
-/* Emits double kernels for the JIT and compiles them with libtcc. */
-Jit *pipeline_jit(const Mech *mech, EmitResult *emitted, double *emit_seconds,
-                  double *tcc_seconds, Diag *diag);
-/* The same with EmitOptions.roll = roll (an EmitRoll) and sparse_only (or
-   pipeline_sparse_only): gen --stats --roll --sparse-only. */
-Jit *pipeline_jit_roll(const Mech *mech, int roll, bool sparse_only, EmitResult *emitted,
-                       double *emit_seconds, double *tcc_seconds, Diag *diag);
 
 double pipeline_now(void);
 

@@ -90,7 +90,8 @@ static int generic_rank(MechEval *me, const int *rows, int nrows, const double *
     for (int s = 0; s < opt->generic_samples; s++) {
         perturb(q, nq, &state, qs);
         AssembleResult ar;
-        if (!assemble_min_norm(me, rows, nrows, t, qs, opt, w, &ar))
+        MechrtKernels k = mech_eval_kernels(me);
+        if (!assemble_min_norm(&k, rows, nrows, t, qs, opt, w, &ar))
             continue;
         mech_eval(me, qs, t, NULL, jac);
         pick_rows(jac, nq, rows, nrows, sub);
@@ -126,7 +127,8 @@ static bool system_test(Model *m, MechEval *me, InfoReport *rep, const int *undr
         perturb(rep->q, nq, &state, qs);
         double ts = rep->t + 0.5 * rng_symmetric(&state);
         AssembleResult ar;
-        if (assemble_min_norm(me, undriven, nuh, ts, qs, opt, w, &ar))
+        MechrtKernels k = mech_eval_kernels(me);
+        if (assemble_min_norm(&k, undriven, nuh, ts, qs, opt, w, &ar))
             times[np++] = ts;
     }
     bool ok = involutivity_analyse(m, undriven, nu, points, times, np, &rep->system, diag);
@@ -381,15 +383,15 @@ static void assemble_at(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
     } else if (w) {
-        rep->constructed = construct_with_eval(m, me, t, rep->q);
-        rep->assembled = assemble_min_norm(me, hrows, nh, t, rep->q, opt, w, &rep->assembly);
+        MechrtKernels k = mech_eval_kernels(me);
+        rep->constructed = construct_with_kernels(m, &k, t, rep->q);
+        rep->assembled = assemble_min_norm(&k, hrows, nh, t, rep->q, opt, w, &rep->assembly);
         if (!rep->assembled) {      /* rough initial values: restarts, as run does */
             AnalysisOptions rough = *opt;
             rough.stall_iter = ASSEMBLE_ROUGH_STALL;
             memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
-            construct_with_eval(m, me, t, rep->q);
-            rep->assembled = assemble_min_norm_restarting(me, hrows, nh, t, rep->q, &rough, w,
-                                                          &rep->assembly);
+            construct_with_kernels(m, &k, t, rep->q);
+            rep->assembled = assemble_restarting(&k, t, rep->q, &rough, &rep->assembly);
         }
     } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
         rep->assembled = assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);

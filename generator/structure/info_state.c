@@ -100,7 +100,8 @@ static bool follow_step(MechEval *me, MechrtSvd *w, const int *hrows, int nh, do
     const double *q = hist->q[hist->n - 1];
     predict(hist, t, nq, pred);
     memcpy(trial, pred, (size_t)nq * sizeof *trial);
-    bool ok = w ? assemble_min_norm(me, hrows, nh, t, trial, opt, w, res)
+    MechrtKernels k = mech_eval_kernels(me);
+    bool ok = w ? assemble_min_norm(&k, hrows, nh, t, trial, opt, w, res)
                 : assemble_sparse(me, nh, t, trial, opt, res);
     if (!ok)
         return false;

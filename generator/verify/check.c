@@ -116,7 +116,7 @@ static MechrtStatus base_newton(void *ctx, double *q, MechrtReport *rep)
         free(work);
         return st;
     }
-    MechrtHostSparse *s = mechrt_host_sparse_new(b->c->nq, &b->c->jnz[ENGINE_JIT]);
+    MechrtHostSparse *s = mechrt_host_sparse_new(b->c->nq, b->c->jnz[ENGINE_JIT]);
     double *work = xcalloc(MECHRT_HOST_SPARSE_WORK_LEN(nq) + 2 * nq, sizeof *work);
     double *qd = work + MECHRT_HOST_SPARSE_WORK_LEN(nq), *qdd = qd + nq;
     MechrtStatus st = !s ? MECHRT_EINVAL
@@ -175,17 +175,21 @@ static void init_items(CheckReport *rep, const CheckOptions *opt)
 static void choose_linear(Checker *c)
 {
     AnalysisLinear lin = c->opt->linear;
-    c->sparse = (lin == ANALYSIS_LINEAR_SPARSE || (lin == ANALYSIS_LINEAR_AUTO && c->nq > ANALYSIS_DENSE_MAX_NQ))
-                && run_jac_nz_of(&c->eng[ENGINE_JIT], &c->jnz[ENGINE_JIT]);
+    c->jnz[ENGINE_JIT] = engine_jac_nz(&c->eng[ENGINE_JIT]);
+    c->sparse = (lin == ANALYSIS_LINEAR_SPARSE
+                 || (lin == ANALYSIS_LINEAR_AUTO && c->nq > ANALYSIS_DENSE_MAX_NQ))
+                && c->jnz[ENGINE_JIT];
     if (!c->sparse)
         return;
     c->has_nz[ENGINE_JIT] = true;
-    c->nnz = c->jnz[ENGINE_JIT].nnz;
-    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT], *a = &c->jnz[ENGINE_AOT];
-    c->has_nz[ENGINE_AOT] = c->open[ENGINE_AOT] && run_jac_nz_of(&c->eng[ENGINE_AOT], &c->jnz[ENGINE_AOT])
-                            && a->nnz == j->nnz
-                            && memcmp(a->row, j->row, (size_t)j->nnz * sizeof *j->row) == 0
-                            && memcmp(a->col, j->col, (size_t)j->nnz * sizeof *j->col) == 0;
+    c->nnz = c->jnz[ENGINE_JIT]->jac.nnz;
+    const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
+    const MechrtHostJacNz *a = c->open[ENGINE_AOT] ? engine_jac_nz(&c->eng[ENGINE_AOT]) : NULL;
+    c->jnz[ENGINE_AOT] = a;
+    size_t len_pat = (size_t)j->jac.nnz * sizeof *j->jac.row;
+    c->has_nz[ENGINE_AOT] = a && a->jac.nnz == j->jac.nnz
+                            && memcmp(a->jac.row, j->jac.row, len_pat) == 0
+                            && memcmp(a->jac.col, j->jac.col, len_pat) == 0;
     c->rep->sparse = true;
     size_t len = strlen(c->rep->note);
     snprintf(c->rep->note + len, sizeof c->rep->note - len, "%ssparse: the Jacobian's %d nonzeros "

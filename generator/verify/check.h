@@ -56,11 +56,16 @@ CheckOptions check_default_options(void);
    for a file with masses only, every pair on M and Q, M's symmetry and
    positive semi-definiteness, and Q's velocity terms against finite
    differences of the kinetic energy (M from the jit). */
+enum {
+    CHECK_PAIR_COUNT = ENGINE_KIND_COUNT * (ENGINE_KIND_COUNT - 1) / 2,   /* pairs of engines */
+    CHECK_QTY_COUNT = 4,                                                /* phi, jac, nu, gamma */
+};
+
 typedef enum CheckWhat {
     CHECK_JAC_FD, CHECK_NU_FD, CHECK_GAMMA_FD,
     CHECK_PAIR_FIRST,
-    CHECK_DYN_FIRST = CHECK_PAIR_FIRST + 12,    /* M and Q of each pair */
-    CHECK_M_SYMMETRIC = CHECK_DYN_FIRST + 6,
+    CHECK_DYN_FIRST = CHECK_PAIR_FIRST + CHECK_QTY_COUNT * CHECK_PAIR_COUNT, /* M, Q of each pair */
+    CHECK_M_SYMMETRIC = CHECK_DYN_FIRST + 2 * CHECK_PAIR_COUNT,
     CHECK_M_PSD,
     CHECK_QV_FD,
     CHECK_WHAT_COUNT

@@ -72,7 +72,7 @@ void check_take_buffers(Checker *c)
     for (int k = 0; k < ENGINE_KIND_COUNT && c->dyn; k++) {
         c->mass[k] = take(c, nq * nq);
         c->force[k] = take(c, nq);
-        c->mass_nz[k] = take(c, (size_t)c->eng[ENGINE_JIT].mass_nnz + 1);
+        c->mass_nz[k] = take(c, (size_t)engine_mass_nz(&c->eng[ENGINE_JIT])->nnz + 1);
     }
     if (c->dyn) {
         c->mw = take(c, nq * nq);

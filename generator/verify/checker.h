@@ -9,7 +9,7 @@
 
 #include <gsl/gsl_eigen.h>
 
-enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT, PAIR_COUNT = 3 };
+enum { QTY_PHI, QTY_JAC, QTY_NU, QTY_GAMMA, QTY_COUNT = CHECK_QTY_COUNT, PAIR_COUNT = CHECK_PAIR_COUNT };
 
 /* The ladder of finite-difference steps: index i is the step
    h * pi^(FD_COARSE - i), the default h at FD_COARSE, pi^2 h first, h/pi^8
@@ -58,7 +58,7 @@ typedef struct Checker {
     double *scratch;                            /* a VecFn's cache (FD_CACHE vectors) */
     /* the sparse comparisons (CheckOptions.linear) */
     bool sparse;
-    MechrtHostJacNz jnz[ENGINE_KIND_COUNT];     /* jit's and aot's jac_nz */
+    const MechrtHostJacNz *jnz[ENGINE_KIND_COUNT];  /* jit's and aot's jac_nz */
     bool has_nz[ENGINE_KIND_COUNT];
     int nnz;
     int ngroups;

@@ -12,7 +12,7 @@ void check_under_test(Checker *c)
     double **o = c->out[ENGINE_JIT];
     engine_phi(e, c->q, c->t, o[QTY_PHI]);
     if (c->sparse)
-        c->jnz[ENGINE_JIT].jac_nz(c->jnz[ENGINE_JIT].ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[ENGINE_JIT]->jac.jac_nz(c->jnz[ENGINE_JIT]->jac.ctx, c->q, c->t, o[QTY_JAC]);
     else
         engine_jac(e, c->q, c->t, o[QTY_JAC]);
     engine_nu(e, c->q, c->t, o[QTY_NU]);
@@ -20,7 +20,8 @@ void check_under_test(Checker *c)
     if (c->dyn) {
         e->k.mass(e->k.ctx, c->q, c->mass[ENGINE_JIT]);
         e->k.force(e->k.ctx, c->q, c->qd, c->t, c->force[ENGINE_JIT]);
-        engine_mass_nz(e, c->q, c->mass_nz[ENGINE_JIT]);
+        const MechrtHostMassNz *mnz = engine_mass_nz(e);
+        mnz->mass_nz(mnz->ctx, c->q, c->mass_nz[ENGINE_JIT]);
     }
     const CheckFault *f = &c->opt->fault;
     if (f->kind == CHECK_FAULT_MASS_SCALE && c->dyn && f->row >= 0 && f->row < c->nq
@@ -34,7 +35,7 @@ void check_under_test(Checker *c)
         break;
     case CHECK_FAULT_JAC_SCALE:
         for (int k = 0; c->sparse && k < c->nnz; k++)
-            if (c->jnz[ENGINE_JIT].row[k] == f->row && c->jnz[ENGINE_JIT].col[k] == f->col)
+            if (c->jnz[ENGINE_JIT]->jac.row[k] == f->row && c->jnz[ENGINE_JIT]->jac.col[k] == f->col)
                 o[QTY_JAC][k] *= f->factor;
         if (!c->sparse && f->col >= 0 && f->col < c->nq)
             o[QTY_JAC][(size_t)f->row * (size_t)c->nq + (size_t)f->col] *= f->factor;
@@ -65,14 +66,15 @@ void check_eval_engine(Checker *c, EngineKind k)
     if (!c->sparse)
         engine_jac(&c->eng[k], c->q, c->t, o[QTY_JAC]);
     else if (c->has_nz[k])
-        c->jnz[k].jac_nz(c->jnz[k].ctx, c->q, c->t, o[QTY_JAC]);
+        c->jnz[k]->jac.jac_nz(c->jnz[k]->jac.ctx, c->q, c->t, o[QTY_JAC]);
     engine_nu(&c->eng[k], c->q, c->t, o[QTY_NU]);
     engine_gamma(&c->eng[k], c->q, c->qd, c->t, o[QTY_GAMMA]);
     if (c->dyn) {
         const MechrtKernels *mk = &c->eng[k].k;
         mk->mass(mk->ctx, c->q, c->mass[k]);
         mk->force(mk->ctx, c->q, c->qd, c->t, c->force[k]);
-        engine_mass_nz(&c->eng[k], c->q, c->mass_nz[k]);
+        const MechrtHostMassNz *mnz = engine_mass_nz(&c->eng[k]);
+        mnz->mass_nz(mnz->ctx, c->q, c->mass_nz[k]);
     }
 }
 
@@ -87,8 +89,8 @@ void check_compare_pair(Checker *c, int pair)
             continue;   /* the generic interpreter's Jacobian is dense */
         int n = qty == QTY_PHI ? c->nh : nz ? c->nnz : qty == QTY_JAC ? c->nr * nq : c->nr;
         for (int i = 0; i < n; i++) {
-            int row = nz ? c->jnz[ENGINE_JIT].row[i] : qty == QTY_JAC ? i / nq : i;
-            int col = nz ? c->jnz[ENGINE_JIT].col[i] : qty == QTY_JAC ? i % nq : -1;
+            int row = nz ? c->jnz[ENGINE_JIT]->jac.row[i] : qty == QTY_JAC ? i / nq : i;
+            int col = nz ? c->jnz[ENGINE_JIT]->jac.col[i] : qty == QTY_JAC ? i % nq : -1;
             check_record(c, what, row, col, c->out[a][qty][i], c->out[b][qty][i], 0.0);
         }
         if (n == 0)
@@ -102,10 +104,10 @@ void check_compare_pair(Checker *c, int pair)
     }
     /* M's nonzeros (what sim's sparse path calls) count under M: every
        engine writes them in the generated kernel's pattern. */
-    const Engine *ea = &c->eng[a];
-    for (int i = 0; c->dyn && i < ea->mass_nnz; i++)
-        check_record(c, CHECK_DYN_FIRST + 2 * pair, -1, ea->mass_col[i], c->mass_nz[a][i],
-               c->mass_nz[b][i], 0.0);
+    const MechrtHostMassNz *mnz = c->dyn ? engine_mass_nz(&c->eng[a]) : NULL;
+    for (int i = 0; mnz && i < mnz->nnz; i++)
+        check_record(c, CHECK_DYN_FIRST + 2 * pair, -1, mnz->col[i], c->mass_nz[a][i],
+                     c->mass_nz[b][i], 0.0);
 }
 
 /* ---- dynamics: M's symmetry and definiteness, Q's velocity terms ---- */

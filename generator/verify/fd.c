@@ -268,7 +268,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
     for (int i = 0; i < n; i++) {
         int e = c->ent[first + i];
         p.comp = i;
-        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT].col[e] : -1,
+        compare_fd(c, CHECK_JAC_FD, first + i, e >= 0 ? c->jnz[ENGINE_JIT]->jac.col[e] : -1,
                    e >= 0 ? vals[e] : 0.0, c->ladder[FD_COARSE][i], &p, h);
     }
 }
@@ -277,7 +277,7 @@ static void compare_group(Checker *c, VecFn *f, int first, int n)
    Psi (velocity rows) along each column group. */
 static void check_fd_groups(Checker *c, double *scratch)
 {
-    const int *row = c->jnz[ENGINE_JIT].row;
+    const int *row = c->jnz[ENGINE_JIT]->jac.row;
     VecFn f;
     for (int g = 0; g < c->ngroups; g++) {
         const int *cols = c->group_cols + c->group_start[g];

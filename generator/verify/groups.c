@@ -30,10 +30,10 @@ static void entries_by(Checker *c, const int *key, int n, int **start, int **ent
    first group none of whose columns shares a row with it. */
 void check_group_columns(Checker *c)
 {
-    const MechrtHostJacNz *j = &c->jnz[ENGINE_JIT];
+    const MechrtHostJacNz *j = c->jnz[ENGINE_JIT];
     int *row_start, *row_ent;
-    entries_by(c, j->row, c->nr, &row_start, &row_ent);
-    entries_by(c, j->col, c->nq, &c->col_start, &c->col_ent);
+    entries_by(c, j->jac.row, c->nr, &row_start, &row_ent);
+    entries_by(c, j->jac.col, c->nq, &c->col_start, &c->col_ent);
     int *color = xmalloc(((size_t)c->nq + 1) * sizeof *color);
     int *mark = xmalloc(((size_t)c->nq + 1) * sizeof *mark);
     for (int k = 0; k < c->nq; k++)
@@ -41,9 +41,9 @@ void check_group_columns(Checker *c)
     c->ngroups = 0;
     for (int col = 0; col < c->nq; col++) {
         for (int a = c->col_start[col]; a < c->col_start[col + 1]; a++) {
-            int r = j->row[c->col_ent[a]];
+            int r = j->jac.row[c->col_ent[a]];
             for (int b = row_start[r]; b < row_start[r + 1]; b++) {
-                int other = j->col[row_ent[b]];
+                int other = j->jac.col[row_ent[b]];
                 if (color[other] >= 0)
                     mark[color[other]] = col;
             }

@@ -177,24 +177,20 @@ double mechrt_host_singular_direction(int m, int n, const double *a, double *row
    per call). Nothing of size nr x nq is allocated. */
 
 /* The Jacobian's nonzeros as generated code gives them (spec section 4:
-   PREFIX_jac_nz with its fixed pattern PREFIX_jac_row, PREFIX_jac_col):
-   entry e sits at (row[e], col[e]); jac_nz writes the nnz values in that
-   order. The arrays must outlive every user. */
+   PREFIX_jac_nz with its fixed pattern PREFIX_jac_row, PREFIX_jac_col),
+   the runtime's MechrtJacNz: entry e sits at (jac.row[e], jac.col[e]);
+   jac.jac_nz writes the jac.nnz values in that order. The arrays must
+   outlive every user. With what the host adds: */
 struct MechrtHostJacNz {
-    int nnz;
-    const int *row, *col;
-    void *ctx;              /* passed unchanged to jac_nz and all_nz */
-    void (*jac_nz)(void *ctx, const double *q, double t, double *vals);
+    MechrtJacNz jac;
     /* Phi, the nnz values, nu and gamma in one call, sharing their work
-       (PREFIX_all_nz); may be NULL */
+       (PREFIX_all_nz), passed jac.ctx; may be NULL */
     void (*all_nz)(void *ctx, const double *q, const double *qd, double t, double *phi,
                    double *vals, double *nu, double *gamma);
-    /* The pattern's unrolled LU (PREFIX_lu_factor, PREFIX_lu_solve, as
-       MechrtLuGen's: factors in at most nq*nq reals); both may be NULL */
-    int (*lu_factor)(void *ctx, const double *a, double *lu, double pivot_tol, double *spread);
-    void (*lu_solve)(void *ctx, const double *lu, const double *b, double *x);
-    int (*lu_step)(void *ctx, double *q, double *qd, double *qdd, double t, double h,
-                   const double *tol, int max_iter, double *out, int *iout);
+    /* The pattern's unrolled LU (PREFIX_lu_factor, PREFIX_lu_solve,
+       PREFIX_step: factors in at most nq*nq reals); lu.factor and
+       lu.solve NULL without */
+    MechrtLuGen lu;
 };
 
 /* The n x n matrix of pattern jnz (copied; its arrays are kept by

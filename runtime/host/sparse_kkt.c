@@ -65,9 +65,9 @@ static bool kkt_pattern(MechrtHostKkt *s, const MechrtHostJacNz *jnz, const Mech
     for (int k = 0; k < s->nxd; k++, e++)
         s->row[e] = s->col[e] = s->xdiag[k];
     for (int k = 0; k < s->jnz; k++, e++)
-        s->row[e] = s->nq + jnz->row[k], s->col[e] = jnz->col[k];
+        s->row[e] = s->nq + jnz->jac.row[k], s->col[e] = jnz->jac.col[k];
     for (int k = 0; k < s->jnz; k++, e++)
-        s->row[e] = jnz->col[k], s->col[e] = s->nq + jnz->row[k];
+        s->row[e] = jnz->jac.col[k], s->col[e] = s->nq + jnz->jac.row[k];
     for (int k = 0; k < s->nr; k++, e++)
         s->row[e] = s->col[e] = s->nq + k;
     return true;
@@ -76,8 +76,9 @@ static bool kkt_pattern(MechrtHostKkt *s, const MechrtHostJacNz *jnz, const Mech
 MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
                                    const MechrtHostMassNz *mnz)
 {
-    if (nq < 1 || nr < 0 || !jnz || !mnz || jnz->nnz < 0 || mnz->nnz < 0
-        || (jnz->nnz > 0 && (!jnz->row || !jnz->col)) || (mnz->nnz > 0 && (!mnz->row || !mnz->col)))
+    if (nq < 1 || nr < 0 || !jnz || !mnz || jnz->jac.nnz < 0 || mnz->nnz < 0
+        || (jnz->jac.nnz > 0 && (!jnz->jac.row || !jnz->jac.col))
+        || (mnz->nnz > 0 && (!mnz->row || !mnz->col)))
         return NULL;
     MechrtHostKkt *s = calloc(1, sizeof *s);
     if (!s)
@@ -85,7 +86,7 @@ MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
     s->nq = nq;
     s->nr = nr;
     s->mnz = mnz->nnz;
-    s->jnz = jnz->nnz;
+    s->jnz = jnz->jac.nnz;
     size_t total = (size_t)s->mnz + (size_t)nq + 2u * (size_t)s->jnz + (size_t)nr + 1u;
     s->xdiag = malloc((size_t)nq * sizeof *s->xdiag);
     s->mdiag = calloc((size_t)s->mnz + 1u, 1);
@@ -98,8 +99,8 @@ MechrtHostKkt *mechrt_host_kkt_new(int nq, int nr, const MechrtHostJacNz *jnz,
         mechrt_host_kkt_free(s);
         return NULL;
     }
-    MechrtHostJacNz pat = {.nnz = s->mnz + s->nxd + 2 * s->jnz + nr, .row = s->row,
-                           .col = s->col, .jac_nz = kkt_no_eval};
+    MechrtHostJacNz pat = {.jac = {.nnz = s->mnz + s->nxd + 2 * s->jnz + nr, .row = s->row,
+                                   .col = s->col, .jac_nz = kkt_no_eval}};
     for (int w = 0; w < 3; w++) {
         s->lu[w] = mechrt_host_sparse_new(nq + nr, &pat);
         if (!s->lu[w]) {

@@ -55,9 +55,9 @@ static bool sparse_layout(MechrtHostSparse *s)
     int *seen = malloc(((size_t)s->n + 1) * sizeof *seen);
     bool ok = next && seen;
     for (int e = 0; ok && e < s->nnz; e++) {
-        ok = j->row[e] >= 0 && j->row[e] < s->n && j->col[e] >= 0 && j->col[e] < s->n;
+        ok = j->jac.row[e] >= 0 && j->jac.row[e] < s->n && j->jac.col[e] >= 0 && j->jac.col[e] < s->n;
         if (ok)
-            s->ap[j->col[e] + 1]++;
+            s->ap[j->jac.col[e] + 1]++;
     }
     for (int c = 0; ok && c < s->n; c++) {
         s->ap[c + 1] += s->ap[c];
@@ -65,8 +65,8 @@ static bool sparse_layout(MechrtHostSparse *s)
         seen[c] = -1;
     }
     for (int e = 0; ok && e < s->nnz; e++) {
-        int slot = next[j->col[e]]++;
-        s->ai[slot] = j->row[e];
+        int slot = next[j->jac.col[e]]++;
+        s->ai[slot] = j->jac.row[e];
         s->map[e] = slot;
     }
     /* duplicates: a row met twice in one column */
@@ -82,14 +82,15 @@ static bool sparse_layout(MechrtHostSparse *s)
 
 MechrtHostSparse *mechrt_host_sparse_new(int n, const MechrtHostJacNz *jnz)
 {
-    if (n < 1 || !jnz || jnz->nnz < 0 || !jnz->jac_nz || (jnz->nnz > 0 && (!jnz->row || !jnz->col)))
+    if (n < 1 || !jnz || jnz->jac.nnz < 0 || !jnz->jac.jac_nz
+        || (jnz->jac.nnz > 0 && (!jnz->jac.row || !jnz->jac.col)))
         return NULL;
     MechrtHostSparse *s = calloc(1, sizeof *s);
     if (!s)
         return NULL;
-    size_t nnz = (size_t)jnz->nnz + 1;
+    size_t nnz = (size_t)jnz->jac.nnz + 1;
     s->n = n;
-    s->nnz = jnz->nnz;
+    s->nnz = jnz->jac.nnz;
     s->jnz = *jnz;
     s->sing_row = s->sing_col = -1;
     s->ap = calloc((size_t)n + 1, sizeof *s->ap);
@@ -138,7 +139,7 @@ double *mechrt_host_sparse_values(MechrtHostSparse *s)
 
 void mechrt_host_sparse_eval(MechrtHostSparse *s, const double *q, double t)
 {
-    s->jnz.jac_nz(s->jnz.ctx, q, t, s->vals);
+    s->jnz.jac.jac_nz(s->jnz.jac.ctx, q, t, s->vals);
 }
 
 bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const double *qd,
@@ -146,7 +147,7 @@ bool mechrt_host_sparse_eval_all(MechrtHostSparse *s, const double *q, const dou
 {
     if (!s->jnz.all_nz)
         return false;
-    s->jnz.all_nz(s->jnz.ctx, q, qd, t, phi, s->vals, nu, gamma);
+    s->jnz.all_nz(s->jnz.jac.ctx, q, qd, t, phi, s->vals, nu, gamma);
     return true;
 }
 
@@ -177,7 +178,7 @@ MechrtStatus mechrt_host_sparse_factor(MechrtHostSparse *s, double pivot_tol)
     for (int e = 0; e < s->nnz; e++) {
         double a = fabs(s->vals[e]);
         if (!(a <= DBL_MAX)) {      /* NaN too */
-            s->sing_row = s->jnz.row[e];
+            s->sing_row = s->jnz.jac.row[e];
             s->sing_col = -1;
             return MECHRT_ENOTFINITE;
         }

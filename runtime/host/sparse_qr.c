@@ -65,16 +65,16 @@ static bool minnorm_layout(MechrtHostMinNorm *m)
     Long *next = malloc(((size_t)m->nh + 1) * sizeof *next);
     bool ok = cstart && order && next;
     for (int e = 0; ok && e < m->nnz; e++) {
-        ok = j->row[e] >= 0 && j->col[e] >= 0 && j->col[e] < m->nq;
-        if (ok && j->row[e] < m->nh)
-            p[j->row[e] + 1]++;
+        ok = j->jac.row[e] >= 0 && j->jac.col[e] >= 0 && j->jac.col[e] < m->nq;
+        if (ok && j->jac.row[e] < m->nh)
+            p[j->jac.row[e] + 1]++;
         if (ok)
-            cstart[j->col[e] + 2]++;
+            cstart[j->jac.col[e] + 2]++;
     }
     for (int c = 0; ok && c < m->nq; c++)
         cstart[c + 2] += cstart[c + 1];
     for (int e = 0; ok && e < m->nnz; e++)
-        order[cstart[j->col[e] + 1]++] = e;
+        order[cstart[j->jac.col[e] + 1]++] = e;
     for (int i = 0; ok && i < m->nh; i++) {
         p[i + 1] += p[i];
         next[i] = p[i];
@@ -82,10 +82,10 @@ static bool minnorm_layout(MechrtHostMinNorm *m)
     for (int k = 0; ok && k < m->nnz; k++) {
         int e = order[k];
         m->map[e] = -1;
-        if (j->row[e] >= m->nh)
+        if (j->jac.row[e] >= m->nh)
             continue;
-        Long slot = next[j->row[e]]++;
-        ix[slot] = j->col[e];
+        Long slot = next[j->jac.row[e]]++;
+        ix[slot] = j->jac.col[e];
         m->map[e] = (int)slot;
     }
     free(cstart), free(order), free(next);
@@ -94,22 +94,22 @@ static bool minnorm_layout(MechrtHostMinNorm *m)
 
 MechrtHostMinNorm *mechrt_host_minnorm_new(int nh, int nq, const MechrtHostJacNz *jnz)
 {
-    if (nh < 1 || nq < nh || !jnz || jnz->nnz < 0 || !jnz->jac_nz
-        || (jnz->nnz > 0 && (!jnz->row || !jnz->col)))
+    if (nh < 1 || nq < nh || !jnz || jnz->jac.nnz < 0 || !jnz->jac.jac_nz
+        || (jnz->jac.nnz > 0 && (!jnz->jac.row || !jnz->jac.col)))
         return NULL;
     MechrtHostMinNorm *m = calloc(1, sizeof *m);
     if (!m)
         return NULL;
     m->nh = nh;
     m->nq = nq;
-    m->nnz = jnz->nnz;
+    m->nnz = jnz->jac.nnz;
     m->jnz = *jnz;
     cholmod_l_start(&m->cc);
     m->cc.print = 0;
     m->cc.error_handler = NULL;
-    m->vals = calloc((size_t)jnz->nnz + 1, sizeof *m->vals);
-    m->map = malloc(((size_t)jnz->nnz + 1) * sizeof *m->map);
-    m->at = cholmod_l_allocate_sparse((size_t)nq, (size_t)nh, (size_t)jnz->nnz + 1, 1, 1, 0,
+    m->vals = calloc((size_t)jnz->jac.nnz + 1, sizeof *m->vals);
+    m->map = malloc(((size_t)jnz->jac.nnz + 1) * sizeof *m->map);
+    m->at = cholmod_l_allocate_sparse((size_t)nq, (size_t)nh, (size_t)jnz->jac.nnz + 1, 1, 1, 0,
                                       CHOLMOD_REAL, &m->cc);
     m->b = cholmod_l_allocate_dense((size_t)nh, 1, (size_t)nh, CHOLMOD_REAL, &m->cc);
     if (!m->vals || !m->map || !m->at || !m->b || !minnorm_layout(m)) {
@@ -127,7 +127,7 @@ MechrtHostMinNorm *mechrt_host_minnorm_new(int nh, int nq, const MechrtHostJacNz
 MechrtStatus mechrt_host_minnorm_step(MechrtHostMinNorm *m, const double *q, double t,
                                       const double *phi, double pivot_tol, double *dq)
 {
-    m->jnz.jac_nz(m->jnz.ctx, q, t, m->vals);
+    m->jnz.jac.jac_nz(m->jnz.jac.ctx, q, t, m->vals);
     double *x = m->at->x, *rownorm2 = m->b->x, big = 0;
     memset(rownorm2, 0, (size_t)m->nh * sizeof *rownorm2);
     for (int e = 0; e < m->nnz; e++) {
@@ -137,7 +137,7 @@ MechrtStatus mechrt_host_minnorm_step(MechrtHostMinNorm *m, const double *q, dou
         if (!isfinite(v))
             return MECHRT_ENOTFINITE;
         x[m->map[e]] = v;
-        rownorm2[m->jnz.row[e]] += v * v;
+        rownorm2[m->jnz.jac.row[e]] += v * v;
     }
     for (int i = 0; i < m->nh; i++)
         big = rownorm2[i] > big ? rownorm2[i] : big;

@@ -19,6 +19,7 @@
  */
 #include "../../generator/base/arena.h"
 #include "../../generator/base/strbuf.h"
+#include "../../generator/engine/engine.h"
 #include "../../generator/pipeline/pipeline.h"
 
 #include <math.h>
@@ -203,7 +204,7 @@ int fuzz_frontend(const uint8_t *data, size_t size)
     dump_rows(mech->model);
     emit_float(mech);
     EmitResult emitted;
-    Jit *jit = pipeline_jit(mech, &emitted, NULL, NULL, &diag);
+    Jit *jit = engine_jit(mech, &emitted, NULL, NULL, &diag);
     if (jit) {
         run_kernels(mech, jit_kernels(jit));
         jit_free(jit);

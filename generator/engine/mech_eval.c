@@ -63,3 +63,19 @@ void mech_eval_nz(MechEval *me, const double *q, double t, double *phi, double *
         for (int e = 0; e < me->kin->nnz; e++)
             vals[e] = node_values_get(&me->values, me->nh + e);
 }
+
+static void kernel_phi(void *ctx, const double *q, double t, double *phi)
+{
+    mech_eval(ctx, q, t, phi, NULL);
+}
+
+static void kernel_jac(void *ctx, const double *q, double t, double *jac)
+{
+    mech_eval(ctx, q, t, NULL, jac);
+}
+
+MechrtKernels mech_eval_kernels(MechEval *me)
+{
+    return (MechrtKernels){.nq = me->nq, .nh = me->nh, .nv = me->nr - me->nh, .ctx = me,
+                           .phi = kernel_phi, .jac = kernel_jac};
+}
