@@ -53,7 +53,8 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
 {
     size_t bytes = (size_t)m->nq * sizeof *q;
     *rep = (AssembleT0Report){.t0 = o->t0, .more_option = o->more_option};
-    rep->constructed = construct_with_kernels(m, k, o->t0, q);
+    if (!o->no_construction)
+        rep->constructed = construct_with_kernels(m, k, o->t0, q);
     double *start = xmalloc(bytes + 1);
     memcpy(start, q, bytes);
     rep->status = newton(k, jnz, o, q, rep);

@@ -18,6 +18,8 @@ typedef MechrtStatus (*AssembleNewtonFn)(void *ctx, double *q, MechrtReport *rep
 /* How to assemble; the fields the caller does not set are 0. */
 typedef struct AssembleT0Options {
     double t0;
+    bool no_construction;   /* Newton from q as given (info beyond the dense
+                               limit keeps the file's values as they are) */
     /* Newton from the construction's q; NULL: minimum-norm projection onto
        the holonomic rows (mechrt_host_project) with mechrt's tolerances,
        on the sparse bundle's projector (SuiteSparseQR) when one is given */

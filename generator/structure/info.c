@@ -25,7 +25,7 @@
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../base/strbuf.h"
-#include "../analysis/construct.h"
+#include "../analysis/assemble_t0.h"
 #include "info_state.h"
 #include "../analysis/sparse.h"
 #include "spqr_rank.h"
@@ -370,32 +370,52 @@ static int count_rows(const Model *m, InfoReport *rep, int *undriven, int *hrows
     return nu;
 }
 
-/* Assembly at t from the file's initial values: construction, then
-   minimum-norm Newton (restarting from jittered guesses when it stalls),
-   or beyond the dense limit (w NULL) minimum-norm Newton by sparse QR. */
+/* info's Newton for assemble_at_t0: minimum-norm Newton on the holonomic
+   rows (dense SVD), or beyond the dense limit (w NULL) by sparse QR; its
+   AssembleResult kept for the report. */
+typedef struct InfoNewton {
+    MechEval *me;
+    MechrtKernels k;
+    MechrtSvd *w;
+    const int *hrows;
+    int nh;
+    double t;
+    const AnalysisOptions *opt;
+    AssembleResult res;
+} InfoNewton;
+
+static MechrtStatus info_newton(void *ctx, double *q, MechrtReport *rep)
+{
+    InfoNewton *n = ctx;
+    bool ok = n->w ? assemble_min_norm(&n->k, n->hrows, n->nh, n->t, q, n->opt, n->w, &n->res)
+                   : assemble_sparse(n->me, n->nh, n->t, q, n->opt, &n->res);
+    *rep = (MechrtReport){.iterations = n->res.iterations, .residual = n->res.residual,
+                          .step = n->res.step, .worst_row = n->res.worst_row, .sing_index = -1};
+    return ok ? MECHRT_OK : MECHRT_EMAXITER;
+}
+
+/* Assembly at t from the file's initial values, as run, sim and check
+   assemble (assemble_at_t0): construction, then minimum-norm Newton, and
+   where it stalls the restarts from jittered guesses (dense only: beyond
+   the dense limit, w NULL, Newton is the sparse QR's and restarts would
+   need the dense SVD). */
 static void assemble_at(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
                         const int *hrows, double t, const AnalysisOptions *opt)
 {
     const Model *m = mech->model;
-    int nq = m->nq, nh = m->nh;
-    memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
-    if (nh == 0) {
+    memcpy(rep->q, m->q0, (size_t)m->nq * sizeof *rep->q);
+    if (m->nh == 0) {
         rep->assembled = true;
         rep->assembly = (AssembleResult){.converged = true, .step = -1, .worst_row = -1, .rank = -1};
-    } else if (w) {
-        MechrtKernels k = mech_eval_kernels(me);
-        rep->constructed = construct_with_kernels(m, &k, t, rep->q);
-        rep->assembled = assemble_min_norm(&k, hrows, nh, t, rep->q, opt, w, &rep->assembly);
-        if (!rep->assembled) {      /* rough initial values: restarts, as run does */
-            AnalysisOptions rough = *opt;
-            rough.stall_iter = ASSEMBLE_ROUGH_STALL;
-            memcpy(rep->q, m->q0, (size_t)nq * sizeof *rep->q);
-            construct_with_kernels(m, &k, t, rep->q);
-            rep->assembled = assemble_restarting(&k, t, rep->q, &rough, &rep->assembly);
-        }
-    } else {            /* beyond the dense limit: sparse QR of Phi_q^T */
-        rep->assembled = assemble_sparse(me, nh, t, rep->q, opt, &rep->assembly);
+        return;
     }
+    InfoNewton n = {me, mech_eval_kernels(me), w, hrows, m->nh, t, opt, {0}};
+    AssembleT0Options ao = {.t0 = t, .no_construction = w == NULL, .newton = info_newton,
+                            .newton_ctx = &n, .robust = w != NULL, .rough = *opt};
+    AssembleT0Report t0rep;
+    rep->assembled = assemble_at_t0(m, &n.k, NULL, &ao, rep->q, &t0rep);
+    rep->constructed = t0rep.constructed;
+    rep->assembly = t0rep.robust ? t0rep.rough : n.res;
 }
 
 /* The ranks at rep->q, the redundant rows and, where rows are lost, the
