@@ -78,7 +78,7 @@ bool run_assemble(Run *r, AssembleNewtonFn newton, void *ctx, bool singular, Mec
     double *q0 = xmalloc(bytes + 1);
     memcpy(q0, r->q, bytes);
     AssembleT0Report ar;
-    bool ok = assemble_at_t0(r->m, r->k, NULL, &ao, r->q, &ar);
+    assemble_at_t0(r->m, r->k, NULL, &ao, r->q, &ar);
     *rep = ar.newton;
     res->constructed = ar.constructed;
     res->assembly_iterations = ar.iterations;
@@ -86,7 +86,7 @@ bool run_assemble(Run *r, AssembleNewtonFn newton, void *ctx, bool singular, Mec
     MechrtStatus st = ar.status;
     if (ar.robust && !ar.robust_ok) {
         run_fail_assembly(r, &ar);
-    } else if (!ok && !ao.robust && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
+    } else if (st != MECHRT_OK && !ao.robust && st != MECHRT_EINVAL && st != MECHRT_EBADLEN) {
         res->status = ANALYSIS_FAILED;     /* the robust assembly works on the dense Jacobian */
         res->cause = MECHRT_EMAXITER;
         res->t_fail = o->t0;
@@ -105,5 +105,5 @@ bool run_assemble(Run *r, AssembleNewtonFn newton, void *ctx, bool singular, Mec
             note_move(r, q0);
     }
     free(q0);
-    return st == MECHRT_OK && !(ar.robust && !ar.robust_ok);
+    return st == MECHRT_OK;     /* not after a failed robust assembly: Newton's failure */
 }
