@@ -180,6 +180,9 @@ firmware-check: deps
 # (tests/fuzz/seeds.sh, into $(FUZZ_BUILD)/seeds); new inputs go to
 # $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.
 FUZZ_SECONDS ?= 60
+# Seconds one input may take before it counts as a hang: the sanitizers
+# slow the largest example (a02_chain, 243 coordinates) to about a second.
+FUZZ_TIMEOUT ?= 3
 FUZZ_BUILD   := build-fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 fuzz:
@@ -190,7 +193,8 @@ fuzz:
 	  $(FUZZ_BUILD)/libmechc.a $(LDLIBS_TOOL) -o $(FUZZ_BUILD)/fuzz_frontend
 	$(Q)mkdir -p $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/artifacts
 	$(Q)rm -rf $(FUZZ_BUILD)/seeds && sh tests/fuzz/seeds.sh $(FUZZ_BUILD)/seeds
-	$(Q)$(FUZZ_BUILD)/fuzz_frontend -max_total_time=$(FUZZ_SECONDS) -timeout=1 -rss_limit_mb=2048 \
+	$(Q)$(FUZZ_BUILD)/fuzz_frontend -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	  -rss_limit_mb=2048 -entropic_scale_per_exec_time=1 \
 	  -dict=tests/fuzz/mech.dict -artifact_prefix=$(FUZZ_BUILD)/artifacts/ \
 	  $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/seeds tests/fuzz/corpus tests/fuzz/regressions
 
