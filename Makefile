@@ -47,7 +47,7 @@ LIB       := $(BUILD)/libmechc.a
 MECHC     := $(BUILD)/mechc
 TESTS     := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 
-.PHONY: all deps check test demo bench check-asan check-valgrind fuzz sanitize install uninstall clean help examples-check
+.PHONY: all deps check test demo bench check-asan check-ubsan check-valgrind fuzz sanitize install uninstall clean help examples-check
 all: $(MECHC)
 
 help:
@@ -56,6 +56,7 @@ help:
 	@echo "make demo       set up, build and run mechc on examples/slider_crank.mech"
 	@echo "make check      set up, build and run every test (cmocka + CLI + generated C)"
 	@echo "make check-asan the same tests under AddressSanitizer and UBSan"
+	@echo "make check-ubsan the same tests under clang's UBSan"
 	@echo "make check-valgrind  the cmocka suites under valgrind memcheck"
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
@@ -127,6 +128,13 @@ check-asan:
 	  SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined" check
 sanitize: check-asan
 
+# The same tests under clang's UBSan, which checks more than gcc's (pointer
+# arithmetic on NULL, pointer overflow): any report fails the suite.
+check-ubsan: deps
+	$(Q)sh .ci/deps fuzz
+	$(Q)$(MAKE) --no-print-directory BUILD=build-ubsan CC=clang OPT="-O1 -g -fno-omit-frame-pointer" \
+	  SAN="-fsanitize=undefined -fno-sanitize-recover=all" check
+
 # The cmocka suites under memcheck (the JIT's code included): any error or
 # definite leak fails.
 check-valgrind: deps
@@ -167,9 +175,14 @@ firmware-check: deps
 	  MECHC=$(abspath $(MECHC)) OUT=$(abspath $(BUILD))/firmware
 	$(Q)sh tests/firmware_rules.sh $(MECHC)
 
-# libFuzzer over the whole front end (tests/fuzz/README.md). New inputs go
-# to $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.
+# libFuzzer over the whole front end (tests/fuzz/README.md). The seeds are
+# tests/fuzz/corpus, the examples and what their generators write
+# (tests/fuzz/seeds.sh, into $(FUZZ_BUILD)/seeds); new inputs go to
+# $(FUZZ_BUILD)/corpus, crashes to $(FUZZ_BUILD)/artifacts.
 FUZZ_SECONDS ?= 60
+# Seconds one input may take before it counts as a hang: the sanitizers
+# slow the largest example (a02_chain, 243 coordinates) to about a second.
+FUZZ_TIMEOUT ?= 3
 FUZZ_BUILD   := build-fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 fuzz:
@@ -179,9 +192,11 @@ fuzz:
 	$(Q)clang -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -no-pie tests/fuzz/fuzz_frontend.c \
 	  $(FUZZ_BUILD)/libmechc.a $(LDLIBS_TOOL) -o $(FUZZ_BUILD)/fuzz_frontend
 	$(Q)mkdir -p $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/artifacts
-	$(Q)$(FUZZ_BUILD)/fuzz_frontend -max_total_time=$(FUZZ_SECONDS) -timeout=1 -rss_limit_mb=2048 \
+	$(Q)rm -rf $(FUZZ_BUILD)/seeds && sh tests/fuzz/seeds.sh $(FUZZ_BUILD)/seeds
+	$(Q)$(FUZZ_BUILD)/fuzz_frontend -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	  -rss_limit_mb=2048 -entropic_scale_per_exec_time=1 \
 	  -dict=tests/fuzz/mech.dict -artifact_prefix=$(FUZZ_BUILD)/artifacts/ \
-	  $(FUZZ_BUILD)/corpus tests/fuzz/corpus tests/fuzz/regressions
+	  $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/seeds tests/fuzz/corpus tests/fuzz/regressions
 
 demo: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC)

@@ -457,8 +457,8 @@ static void test_fast_time_and_velocity_rows_pass(void **state)
     static const char *const texts[] = {
         "point m x = 0.1 y = 0.2\ndriver d: m.x = t\nconstraint c: sin(300*t)*m.x = m.y\n",
         "point m x = 0.1 y = 0.2\ndriver d: m.x = sin(100*t)/100\nconstraint c: sin(100*(m.x + t)) = m.y\n",
-        "body b x = 0.1 y = 0.2 phi = 0\ndriver d: b.phi = t\nconstraint h: b.y = 0.2\n"
-        "velocity v: sin(1000*b.x)*der(b.x) + cos(1000*t)*der(b.phi) = 0\n",
+        ("body b x = 0.1 y = 0.2 phi = 0\ndriver d: b.phi = t\nconstraint h: b.y = 0.2\n"
+         "velocity v: sin(1000*b.x)*der(b.x) + cos(1000*t)*der(b.phi) = 0\n"),
     };
     for (size_t n = 0; n < sizeof texts / sizeof *texts; n++)
         for (unsigned long seed = 1; seed <= 3; seed++) {

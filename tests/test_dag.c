@@ -601,6 +601,57 @@ static void test_node_limit_names_statement(void **state)
     dag_free(&d);
 }
 
+/* A constant that is not finite is noted at the statement that asked for
+   it (the first one only) and reported by dag_check_finite. */
+static void test_nonfinite_constant_names_statement(void **state)
+{
+    (void)state;
+    const char *text = "first\nsecond\nthird\n";
+    Dag d;
+    dag_init(&d, 100);
+    Diag diag;
+    diag_init(&diag, "x.mech", text, (int)strlen(text));
+    d.where = 0;
+    dag_const(&d, 1e308);
+    assert_true(dag_check_finite(&d, &diag));
+    d.where = 6;                                /* "second" */
+    dag_const(&d, 1e308 * 10);
+    d.where = 13;
+    dag_const(&d, NAN);
+    assert_false(dag_check_finite(&d, &diag));
+    assert_int_equal(diag.line, 2);
+    assert_int_equal(diag.col, 1);
+    assert_string_equal(diag.message, "a constant mechc computes from this statement's numbers "
+                                      "is +inf: it overflows past the largest double (about "
+                                      "1.8e308); write them in other units, or nearer 1");
+    dag_free(&d);
+}
+
+/* dag_check_float names the first constant a float cannot hold among those
+   the roots reach: one folded away does not count. */
+static void test_float_range_only_reachable(void **state)
+{
+    (void)state;
+    const char *text = "first\nsecond\n";
+    Dag d;
+    dag_init(&d, 100);
+    Diag diag;
+    diag_init(&diag, "x.mech", text, (int)strlen(text));
+    d.where = 0;
+    NodeId x = dag_var(&d, 0);
+    NodeId folded = dag_div(&d, dag_const(&d, 1e200), dag_const(&d, 1e199));   /* 10 */
+    NodeId small = dag_mul(&d, folded, x);
+    assert_true(dag_check_float(&d, &small, 1, &diag));
+    d.where = 6;
+    NodeId tiny = dag_mul(&d, dag_const(&d, 1e-50), x);
+    NodeId roots[2] = {small, tiny};
+    assert_false(dag_check_float(&d, roots, 2, &diag));
+    assert_int_equal(diag.line, 2);
+    assert_non_null(strstr(diag.message, "is 1e-50, which a float (--real float) cannot hold: "
+                                         "it would become 0"));
+    dag_free(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -622,6 +673,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_format_shortest_numbers, setup, teardown),
         cmocka_unit_test(test_node_limit),
         cmocka_unit_test(test_node_limit_names_statement),
+        cmocka_unit_test(test_nonfinite_constant_names_statement),
+        cmocka_unit_test(test_float_range_only_reachable),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,9 +1,10 @@
 /* test_fuzz_replay.c - replays the fuzzing corpus and every saved regression through the harness.
  *
  * tests/fuzz/fuzz_frontend.c is compiled in here without libFuzzer: each
- * file of tests/fuzz/corpus (the seeds) and tests/fuzz/regressions (inputs
- * that once crashed, hung or leaked, see tests/fuzz/README.md) goes
- * through fuzz_frontend(), which aborts on a broken invariant. Each input
+ * file of tests/fuzz/corpus (the seeds), the .mech files of examples/ and
+ * tests/fuzz/regressions (inputs that once crashed, hung or leaked, see
+ * tests/fuzz/README.md) goes through fuzz_frontend(), which aborts on a
+ * broken invariant. Each input
  * must also finish within a time bound, the fuzzer's hang criterion.
  */
 #include "testutil.h"
@@ -65,8 +66,15 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Runs every regular file of tests/fuzz/SUB, in name order; returns the count. */
-static int replay(const char *sub)
+static bool ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && strcmp(s + n - k, suffix) == 0;
+}
+
+/* Runs every file of tests/fuzz/SUB whose name ends with suffix ("" for
+   all), in name order; returns the count. */
+static int replay(const char *sub, const char *suffix)
 {
     char path[2048];
     snprintf(path, sizeof path, "%s/%s", fuzz_dir(), sub);
@@ -77,7 +85,8 @@ static int replay(const char *sub)
     int n = 0;
     struct dirent *e;
     while ((e = readdir(d))) {
-        if (e->d_name[0] == '.' || strcmp(e->d_name, "README.md") == 0)
+        if (e->d_name[0] == '.' || strcmp(e->d_name, "README.md") == 0
+            || !ends_with(e->d_name, suffix))
             continue;
         names = realloc(names, (size_t)(n + 1) * sizeof *names);
         names[n++] = strdup(e->d_name);
@@ -108,13 +117,21 @@ static int replay(const char *sub)
 static void test_corpus(void **state)
 {
     (void)state;
-    assert_true(replay("corpus") > 0);
+    assert_true(replay("corpus", "") > 0);
+}
+
+/* The examples are seeds too (make fuzz takes them from examples/, with
+   what the generator scripts write: tests/fuzz/seeds.sh). */
+static void test_examples(void **state)
+{
+    (void)state;
+    assert_true(replay("../../examples", ".mech") > 30);
 }
 
 static void test_regressions(void **state)
 {
     (void)state;
-    assert_true(replay("regressions") > 0);
+    assert_true(replay("regressions", "") > 0);
 }
 
 /* The harness itself must notice bad output: a sanity check of its guards. */
@@ -138,6 +155,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_corpus),
+        cmocka_unit_test(test_examples),
         cmocka_unit_test(test_regressions),
         cmocka_unit_test(test_guards_detect),
     };

@@ -229,6 +229,29 @@ static bool dynamics_fit(const Mech *mech, int limit, Diag *diag)
     return false;
 }
 
+/* --real float: false (diag filled) when a constant the functions use
+   overflows a float or vanishes in one. */
+static bool constants_fit_float(const Mech *mech, Diag *diag)
+{
+    const Kinematics *kin = &mech->kin;
+    const Model *m = mech->model;
+    int n = 0, cap = m->nh + 2 * m->nr + kin->nnz + kin->dyn.nnz + m->nq;
+    NodeId *roots = xmalloc((size_t)(cap ? cap : 1) * sizeof *roots);
+    for (int r = 0; r < m->nh; r++)
+        roots[n++] = kin->phi[r];
+    for (int r = 0; r < m->nr; r++)
+        roots[n++] = kin->nu[r], roots[n++] = kin->gamma[r];
+    for (int k = 0; k < kin->nnz; k++)
+        roots[n++] = kin->jac[k].value;
+    for (int k = 0; kin->dyn.present && k < kin->dyn.nnz; k++)
+        roots[n++] = kin->dyn.mass[k].value;
+    for (int j = 0; kin->dyn.present && j < m->nq; j++)
+        roots[n++] = kin->dyn.force[j];
+    bool ok = dag_check_float(&m->dag, roots, n, diag);
+    free(roots);
+    return ok;
+}
+
 /* The generated C (or the rows) for the file. */
 static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
@@ -238,7 +261,8 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_OK;
     }
     c->emit.source_name = a->file;
-    if (c->emit.sparse_only && !dynamics_fit(mech, c->dense_limit, diag)) {
+    if ((c->emit.sparse_only && !dynamics_fit(mech, c->dense_limit, diag))
+        || (c->emit.real_float && !constants_fit_float(mech, diag))) {
         diag_print(diag, stderr);
         return EXIT_USAGE;
     }

@@ -116,6 +116,7 @@ void dag_init(Dag *dag, int32_t max_nodes)
     dag->max_nodes = max_nodes > 2 ? max_nodes : 2;
     dag->where = -1;
     dag->overflow_where = -1;
+    dag->nonfinite_where = -1;
     NodeId zero = dag_const(dag, 0.0), one = dag_const(dag, 1.0);
     (void)zero, (void)one;      /* DAG_ZERO and DAG_ONE by construction */
 }
@@ -139,12 +140,20 @@ void dag_free(Dag *dag)
 {
     free(dag->nodes);
     free(dag->table);
+    free(dag->wide);
     memset(dag, 0, sizeof *dag);
 }
 
 /* ---- leaves and queries ---- */
 
-NodeId dag_const(Dag *dag, double value) { return intern(dag, OP_CONST, -1, -1, value); }
+NodeId dag_const(Dag *dag, double value)
+{
+    int32_t before = dag->count;
+    NodeId id = intern(dag, OP_CONST, -1, -1, value);
+    if (dag->count > before)
+        dag_range_note(dag, id);        /* range.c: inf, NaN, past a float's range */
+    return id;
+}
 NodeId dag_var(Dag *dag, int index)      { return intern(dag, OP_VAR, index, -1, 0.0); }
 NodeId dag_vard(Dag *dag, int index)     { return intern(dag, OP_VARD, index, -1, 0.0); }
 NodeId dag_time(Dag *dag)                { return intern(dag, OP_TIME, -1, -1, 0.0); }

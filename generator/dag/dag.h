@@ -36,7 +36,26 @@ typedef struct Dag {
        once with dag_check_limit. No dag_* call ever jumps out. */
     bool overflow;
     int32_t overflow_where; /* where at the first overflow */
+    /* Sticky too: set when a constant that is not finite is asked for.
+       Folding keeps only finite results, so such a constant comes from the
+       numbers a builder combines itself (an offset turned by an
+       orientation, an axis normalised, m |com|^2, m g) past the range of a
+       double; it would print as inf or nan, which C does not read.
+       dag_check_finite reports it once, at its statement. */
+    bool nonfinite;
+    int32_t nonfinite_where; /* where at the first one */
+    double nonfinite_value;
+    /* The finite constants a float cannot hold (HUGE_VALF or 0 as a
+       float), with where they were made: gen --real float refuses the
+       ones its functions use (dag_check_float). */
+    struct DagWide *wide;
+    int32_t nwide, wide_cap;
 } Dag;
+
+typedef struct DagWide {
+    NodeId id;
+    int32_t where;
+} DagWide;
 
 void dag_init(Dag *dag, int32_t max_nodes);
 void dag_free(Dag *dag);
@@ -44,6 +63,15 @@ void dag_free(Dag *dag);
 /* True when no node was refused. Otherwise records the node-limit error in
    diag (at the statement that was being built, if any) and returns false. */
 bool dag_check_limit(const Dag *dag, Diag *diag);
+/* Constants out of range (range.c). dag_check_finite: true when every
+   constant asked for was finite; otherwise records in diag which (inf or
+   NaN) and why, at the statement it came from. dag_check_float: true when
+   no constant the roots reach overflows a float or vanishes in one;
+   otherwise the same about the first one. dag_range_note: dag_const's
+   record of a new constant node. */
+bool dag_check_finite(const Dag *dag, Diag *diag);
+bool dag_check_float(const Dag *dag, const NodeId *roots, int nroots, Diag *diag);
+void dag_range_note(Dag *dag, NodeId id);
 
 static inline const DagNode *dag_node(const Dag *dag, NodeId id) { return &dag->nodes[id]; }
 static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes[id].op; }

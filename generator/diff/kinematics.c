@@ -116,6 +116,7 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     }
     if (ok && m->nmasses > 0)
         ok = dynamics_build(m, &kin->dyn, diag);
+    ok = ok && dag_check_finite(dag, diag);     /* the model's constants, and M's and Q's */
     free(w.jac);
     free(w.cols);
     free(w.inner);

@@ -150,8 +150,10 @@ static int collect(Scheduler *s, SchedFunction *fn, int chunk, NodeId root, List
 static void hoist_calls(Scheduler *s, List *list, int before, int chunk)
 {
     const Dag *dag = s->dag;
-    NodeId *seg = list->items + before;
     int n = list->n - before, hoisted = 0;
+    if (n == 0)
+        return;                         /* items may still be NULL */
+    NodeId *seg = list->items + before;
     for (int j = 0; j < n; j++)
         s->uses[seg[j]] = 0;
     for (int j = n - 1; j >= 0; j--) {      /* operands come before their users */
@@ -176,12 +178,14 @@ static void hoist_calls(Scheduler *s, List *list, int before, int chunk)
     free(copy);
 }
 
-static void close_chunk(SchedFunction *fn, int first, int count, List *nodes, const int *ends)
+/* Closes the chunk of outputs first .. first+count-1 (their ends are
+   ends->items[first ..]): it takes nodes' array and leaves nodes empty. */
+static void close_chunk(SchedFunction *fn, int first, int count, List *nodes, const List *ends)
 {
     fn->chunks = xrealloc(fn->chunks, (size_t)fn->nchunks + 1, sizeof *fn->chunks);
     int *own_ends = xmalloc((size_t)(count ? count : 1) * sizeof *own_ends);
-    if (count)
-        memcpy(own_ends, ends, (size_t)count * sizeof *ends);
+    if (count)      /* ends->items is NULL when there are no outputs */
+        memcpy(own_ends, ends->items + first, (size_t)count * sizeof *own_ends);
     fn->chunks[fn->nchunks++] = (SchedChunk){first, count, nodes->items, nodes->n, own_ends};
     *nodes = (List){0};
 }
@@ -214,7 +218,7 @@ bool sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunct
             /* Cut before output i; it starts the next chunk afresh. */
             roll_back(s, &nodes, before, fn->nchunks);
             fn->ops += computed;
-            close_chunk(fn, first, i - first, &nodes, ends.items + first);
+            close_chunk(fn, first, i - first, &nodes, &ends);
             first = i;
             s->stamp++;
             more = collect(s, fn, fn->nchunks, outputs[i].value, &nodes);
@@ -231,7 +235,7 @@ bool sched_function(Scheduler *s, SchedOutput *outputs, int noutputs, SchedFunct
         }
     }
     fn->ops += computed;
-    close_chunk(fn, first, noutputs - first, &nodes, ends.items + first);
+    close_chunk(fn, first, noutputs - first, &nodes, &ends);
     free(ends.items);
     s->total_ops += fn->ops;
     return true;
