@@ -13,7 +13,7 @@
 #include "dag.h"
 
 #include "../base/arena.h"
-#include "../base/realfmt.h"
+#include "../../runtime/host/format_real.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -85,7 +85,7 @@ bool dag_check_float(const Dag *dag, const NodeId *roots, int nroots, Diag *diag
         return true;
     double v = dag->nodes[hit->id].value;
     char num[40], what[200];
-    realfmt_shortest(num, sizeof num, v);
+    mechrt_format_real(num, sizeof num, v, 0, false);
     snprintf(what, sizeof what, "is %s, which a float (--real float) cannot hold: it would "
              "become %s", num, isinf((float)v) ? (v > 0 ? "HUGE_VALF (about 3.4e38 is the largest "
              "float)" : "-HUGE_VALF (about -3.4e38 is the largest float)")
