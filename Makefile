@@ -117,7 +117,7 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 # (tests/run_all); a failing suite's output is shown at the end.
 # deps runs first and alone: under -j the objects would otherwise compile
 # before a fresh machine has the headers.
-TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),1)
+TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
 check: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
 	$(Q)sh tests/run_all $(BUILD) $(TEST_JOBS)
