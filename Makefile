@@ -113,18 +113,24 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 	@$(if $(filter 1,$(V)),,echo "  TEST-CC $<")
 	$(Q)$(CC) $(CFLAGS_TOOL) -Wno-missing-prototypes $(LDFLAGS_TOOL) $< $(LIB) $(LDLIBS_TEST) $(LDLIBS_TOOL) -o $@
 
-# The README's test command. Runs every cmocka suite, the CLI script and the
-# generated-C compile checks; stops at the first failing suite.
+# The README's test command. Runs every cmocka suite, the CLI scripts and the
+# generated-C compile checks, as many at a time as make's -j says
+# (tests/run_all); a failing suite's output is shown at the end.
 # deps runs first and alone: under -j the objects would otherwise compile
 # before a fresh machine has the headers.
+TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
 check: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
-	$(Q)sh tests/run_all $(BUILD)
+	$(Q)sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
 
+# MECHC_SKIP_GCC_ONLY: the suites leave out what only compiles and inspects
+# the written C with the system compiler (make check did it; the sanitizers
+# cannot see inside gcc).
 check-asan:
-	$(Q)$(MAKE) --no-print-directory BUILD=build-asan OPT="-O1 -g -fno-omit-frame-pointer" \
+	$(Q)MECHC_SKIP_GCC_ONLY=1 $(MAKE) --no-print-directory BUILD=build-asan \
+	  OPT="-O1 -g -fno-omit-frame-pointer" \
 	  SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined" check
 sanitize: check-asan
 
@@ -136,11 +142,11 @@ check-ubsan: deps
 	  SAN="-fsanitize=undefined -fno-sanitize-recover=all" check
 
 # The cmocka suites under memcheck (the JIT's code included): any error or
-# definite leak fails.
+# definite leak fails. As many at a time as make's -j says.
 check-valgrind: deps
 	$(Q)sh .ci/deps valgrind
 	$(Q)$(MAKE) --no-print-directory $(TESTS)
-	$(Q)sh tests/run_valgrind $(BUILD)
+	$(Q)sh tests/run_valgrind $(BUILD) $(TEST_JOBS)
 
 # An example's animated SVG rendered in headless Chromium at two instants
 # (tests/browser/run); installs Debian's chromium first when missing.
@@ -165,15 +171,16 @@ $(BUILD)/tests/browser/pngdiff: tests/browser/pngdiff.c
 
 # The firmware example (examples/firmware/README.md): the Cortex-M4F and
 # Cortex-M3 images run under QEMU's MPS2 boards and compared with the host
-# run, then tests/firmware_rules.sh with the Cortex-M builds. Installs the
-# cross toolchain and QEMU first when missing (.ci/deps firmware).
+# run, then tests/firmware_rules.sh with the Cortex-M builds only (make check
+# runs the host's). Installs the cross toolchain and QEMU first when missing
+# (.ci/deps firmware).
 .PHONY: firmware-check
 firmware-check: deps
 	$(Q)sh .ci/deps firmware
 	$(Q)$(MAKE) --no-print-directory $(MECHC)
 	$(Q)$(MAKE) --no-print-directory -C examples/firmware check \
 	  MECHC=$(abspath $(MECHC)) OUT=$(abspath $(BUILD))/firmware
-	$(Q)sh tests/firmware_rules.sh $(MECHC)
+	$(Q)FIRMWARE_RULES=cross sh tests/firmware_rules.sh $(MECHC)
 
 # libFuzzer over the whole front end (tests/fuzz/README.md). The seeds are
 # tests/fuzz/corpus, the examples and what their generators write

@@ -45,6 +45,12 @@
 # Cortex-M3 (double, software floating point) and checked the same way;
 # there the compiler's floating-point helpers (__aeabi_*) are allowed too.
 #
+# FIRMWARE_RULES=cross (make firmware-check, after make check) runs the
+# Cortex-M builds only, not the host's again. MECHC_SKIP_GCC_ONLY=1 (make
+# check-asan and check-valgrind, whose instruments cannot see inside the
+# compiler) keeps mechc gen and the source rules and skips what only
+# compiles and inspects the written C.
+#
 # The last line is "firmware_rules: N passed, M failed"; the exit status is
 # non-zero on any failure. POSIX sh, awk, cc, nm, size, objdump.
 # Flag lists ($FLAGS, $arch ...) are split into words on purpose.
@@ -92,21 +98,30 @@ done
 
 # ---- helpers over objects ---------------------------------------------------
 
-# undefined_only OBJ NM REGEX: every undefined symbol matches REGEX.
+# The rules read one `nm OBJ` listing, OBJ.nm (symbols_of): nm starts
+# slowly (it loads the linker plugins), and a defined symbol has three
+# fields there, an undefined one two (no address).
+
+# symbols_of OBJ NM: OBJ's symbols into OBJ.nm.
+symbols_of() {
+    "$2" "$1" > "$1.nm"
+}
+
+# undefined_only OBJ REGEX: every undefined symbol matches REGEX.
 undefined_only() {
-    "$2" -u "$1" | awk -v re="$3" '{ s = $NF } s !~ re { print "undefined: " s; bad = 1 } END { exit bad }'
+    awk -v re="$2" 'NF == 2 && $2 !~ re { print "undefined: " $2; bad = 1 } END { exit bad }' "$1.nm"
 }
 
-# no_writable_data OBJ NM SIZE: no data/bss symbols, empty .data and .bss.
+# no_writable_data OBJ SIZE: no data/bss symbols, empty .data and .bss.
 no_writable_data() {
-    "$2" "$1" | awk 'NF == 3 && $2 ~ /^[DdBbCGgSs]$/ { print "writable: " $0; bad = 1 } END { exit bad }' &&
-    "$3" -A "$1" | awk '$1 ~ /^\.(data|bss)/ && $2 != 0 { print "section " $1 " has " $2 " bytes"; bad = 1 } END { exit bad }'
+    awk 'NF == 3 && $2 ~ /^[DdBbCGgSs]$/ { print "writable: " $0; bad = 1 } END { exit bad }' "$1.nm" &&
+    "$2" -A "$1" | awk '$1 ~ /^\.(data|bss)/ && $2 != 0 { print "section " $1 " has " $2 " bytes"; bad = 1 } END { exit bad }'
 }
 
-# defined_prefixed OBJ NM REGEX: every defined symbol matches REGEX.
+# defined_prefixed OBJ REGEX: every defined symbol matches REGEX.
 defined_prefixed() {
-    "$2" --defined-only "$1" | awk -v re="$3" 'NF == 3 && $2 ~ /^[TtRrDdBb]$/ && $3 !~ /^[.$]/ && $3 !~ re {
-        print "foreign name: " $3; bad = 1 } END { exit bad }'
+    awk -v re="$2" 'NF == 3 && $2 ~ /^[TtRrDdBb]$/ && $3 !~ /^[.$]/ && $3 !~ re {
+        print "foreign name: " $3; bad = 1 } END { exit bad }' "$1.nm"
 }
 
 # The call graph of one object from `objdump -dr --no-show-raw-insn`, x86-64
@@ -229,8 +244,19 @@ source_rules() {
 
 # ---- the toolchains ---------------------------------------------------------
 # name|compiler|arch flags|nm|size|objdump|reals|extra allowed symbols
-toolchains="host|$CC|-fno-pie|nm|size|objdump|double float|"
-if command -v arm-none-eabi-gcc > /dev/null 2>&1; then
+toolchains=
+host=0
+if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
+    skip "MECHC_SKIP_GCC_ONLY: gen and the source rules only, no compile"
+elif [ "${FIRMWARE_RULES:-}" = cross ]; then
+    skip "FIRMWARE_RULES=cross: the host's builds (make check runs them)"
+else
+    toolchains="host|$CC|-fno-pie|nm|size|objdump|double float|"
+    host=1
+fi
+if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
+    :
+elif command -v arm-none-eabi-gcc > /dev/null 2>&1; then
     a=arm-none-eabi-
     toolchains="$toolchains
 m4f|${a}gcc|-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard|${a}nm|${a}size|${a}objdump|float|__aeabi_[a-z0-9]+
@@ -292,9 +318,10 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
             o=$d/$prefix-$tc.o
             try 10 "$name ($real, $tc): $cc $FLAGS $arch" \
                 $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" || continue
-            for rule in "undefined_only $o $nm_ $allowed" \
-                        "no_writable_data $o $nm_ $size_" \
-                        "defined_prefixed $o $nm_ ^${prefix}_" \
+            symbols_of "$o" "$nm_"
+            for rule in "undefined_only $o $allowed" \
+                        "no_writable_data $o $size_" \
+                        "defined_prefixed $o ^${prefix}_" \
                         "call_graph $o $objdump_ $allowed 0"; do
                 try 10 "$name ($real, $tc): ${rule%% *}" $rule
             done
@@ -342,8 +369,9 @@ while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
         fi
         ok
         allowed="^($MEM${extra:+|$extra})\$"
-        for rule in "undefined_only $d/core.o $nm_ $allowed" \
-                    "no_writable_data $d/core.o $nm_ $size_" \
+        symbols_of "$d/core.o" "$nm_"
+        for rule in "undefined_only $d/core.o $allowed" \
+                    "no_writable_data $d/core.o $size_" \
                     "call_graph $d/core.o $objdump_ $allowed 1"; do
             try 10 "runtime ($real, $tc): ${rule%% *}" $rule
         done
@@ -353,10 +381,17 @@ done <<EOF
 $toolchains
 EOF
 
+if [ $host = 0 ]; then
+    suite_end
+    exit
+fi
+
 # ---- two mechanisms and the runtime in one program ---------------------------
 # run_P.c steps mechanism P from t = 0 to t_end through the runtime, with
 # static memory as firmware would, and returns one coordinate. Three units:
-# slider_crank as sc and four_bar as fb in double, four_bar as fbf in float.
+# slider_crank as sc and four_bar as fb in double, four_bar as fbf in float;
+# the runtime is the host's core.o of each real, checked above (built
+# -fno-pie, hence linked -no-pie).
 link=$tmp/link
 mkdir -p "$link"
 LINKFLAGS="-std=c99 -O2 -Wall -Wextra -Wpedantic -Wdouble-promotion -Werror -I$link -I$root/runtime"
@@ -407,13 +442,10 @@ build_units() {
     for u in $units; do
         make_unit $(echo "$u" | tr ':' ' ') || return 1
     done
-    for src in $rt_sources; do
-        b=$(basename "$src" .c)
-        $CC $LINKFLAGS -c "$src" -o "$link/rt_$b.o" &&
-        $CC $LINKFLAGS -DMECHRT_REAL_FLOAT -c "$src" -o "$link/rtf_$b.o" || return 1
-    done
+    cp "$tmp/runtime-double-host/core.o" "$link/rt_core.o" &&
+    cp "$tmp/runtime-float-host/core.o" "$link/rtf_core.o"
 }
-try 12 "link: generate and compile sc, fb (double), fbf (float), both runtime builds" build_units
+try 12 "link: generate and compile sc, fb (double), fbf (float); both runtime builds" build_units
 # link_run NAME EXPECTED UNITS...: main calls run_UNIT(0.25, 25) for each
 # unit, links them with both runtime builds and compares with EXPECTED, a
 # list of VALUE:TOLERANCE.
@@ -431,7 +463,7 @@ link_run() {
     } > "$link/$name.c"
     objs=""
     for u in "$@"; do objs="$objs $link/run_$u.o $link/$u.o"; done
-    $CC $LINKFLAGS "$link/$name.c" $objs "$link"/rt_*.o "$link"/rtf_*.o -lm -o "$link/$name" &&
+    $CC $LINKFLAGS -no-pie "$link/$name.c" $objs "$link"/rt_*.o "$link"/rtf_*.o -lm -o "$link/$name" &&
     "$link/$name" > "$link/$name.out" &&
     echo "got: $(tr '\n' ' ' < "$link/$name.out"), expected: $expected" &&
     echo "$expected" | tr ' :' '\n ' | paste -d ' ' - "$link/$name.out" |
@@ -503,7 +535,7 @@ dyn_run() {
         echo '    return 0;'
         echo '}'
     } > "$link/dyn.c"
-    $CC $LINKFLAGS "$link/dyn.c" "$link/dyn_pd.o" "$link/pd.o" "$link/dyn_pdf.o" "$link/pdf.o" \
+    $CC $LINKFLAGS -no-pie "$link/dyn.c" "$link/dyn_pd.o" "$link/pd.o" "$link/dyn_pdf.o" "$link/pdf.o" \
         "$link"/rt_*.o "$link"/rtf_*.o -lm -o "$link/dyn" &&
     "$link/dyn" | tr ' ' '\n' > "$link/dyn.out" &&
     echo "got: $(cat "$link/dyn.out")" &&

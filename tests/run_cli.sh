@@ -589,6 +589,8 @@ for engine in generic aot; do
 done
 
 # ---- firmware: generated C + MECHRT_DEFINE_KERNELS + the runtime ----------
+# (at -O0: tests/firmware_rules.sh builds the runtime and the kernels at -O2
+# with stricter flags)
 if have cc; then
     cat > "$tmp/fw.c" <<'EOF'
 /* what firmware writes: the generated kernels and the runtime, no heap */
@@ -627,7 +629,7 @@ EOF
         [ $real = float ] && def="-DMECHRT_REAL_FLOAT"
         if "$mechc" gen "$ex/slider_crank.mech" --prefix fb --real $real \
                 -o "$tmp/fb.c" --header "$tmp/fb.h" 2> "$tmp/err" \
-           && cc -std=c99 -pedantic -Wall -Wextra -Werror -O2 $def -I"$tmp" -I"$root/runtime" \
+           && cc -std=c99 -pedantic -Wall -Wextra -Werror -O0 $def -I"$tmp" -I"$root/runtime" \
                 "$tmp/fw.c" "$tmp/fb.c" "$root"/runtime/*.c -lm -o "$tmp/fw_$real" 2> "$tmp/err"; then
             ok
             "$tmp/fw_$real" > "$tmp/fw.out" 2> "$tmp/err"

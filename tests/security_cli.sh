@@ -75,8 +75,8 @@ gen_path() {
         bad "$desc: the banner has $ends comment ends"
         return
     fi
-    if have gcc && ! gcc -std=c99 -pedantic -Wall -Wextra -Werror -c "$tmp/path.c" \
-            -o "$tmp/path.o" 2> "$tmp/err"; then
+    if have gcc && ! gcc -std=c99 -pedantic -Wall -Wextra -Werror -fsyntax-only "$tmp/path.c" \
+            2> "$tmp/err"; then
         bad "$desc: gcc rejects the C"
         return
     fi

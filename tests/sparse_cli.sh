@@ -286,7 +286,7 @@ check "check train 60 --linear sparse (velocity rows by groups of qd): exit 0" s
 
 # ---- singular, sparse ---------------------------------------------------------
 # the toggle passes on the sparse path too (the dense rank-revealing
-# fallback, tests/test_branch.c); a redundant row at t0 names KLU's pivot
+# fallback, tests/test_qr_rank.c); a redundant row at t0 names KLU's pivot
 run "$ex/slider_crank_toggle.mech" --linear sparse --stats
 check "toggle sparse: exit 0, through t = 0.25" status_is 0
 check "toggle sparse: the fallback is counted" err_has "where KLU found the Jacobian singular"

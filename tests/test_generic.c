@@ -69,7 +69,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    testcache_remove(cache_dir, 2);
+    testcache_release(cache_dir);
     return 0;
 }
 

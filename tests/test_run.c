@@ -471,7 +471,7 @@ static void test_substep_limit(void **state)
 
 /* slider_crank_toggle.mech (r = l) reaches its toggle at t = 0.25, where
    two branches cross: the run goes on along the smooth one it came on
-   (tests/test_branch.c checks it against the closed form). */
+   (tests/test_qr_rank.c checks it against the closed form). */
 static void test_toggle(void **state)
 {
     (void)state;

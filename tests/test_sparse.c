@@ -451,7 +451,7 @@ static void test_chain_agrees(void **state)
 }
 
 /* The toggle: KLU finds no pivot at t = 0.25, and the dense
-   rank-revealing corrector takes the step there (tests/test_branch.c), as
+   rank-revealing corrector takes the step there (tests/test_qr_rank.c), as
    on the dense path: the same states. A redundant row at t0 still names
    KLU's failing pivot. */
 static void test_toggle_sparse(void **state)

@@ -1,4 +1,4 @@
-/* testcache.h - a private AOT cache directory for one test suite (XDG_CACHE_HOME), removed afterwards. */
+/* testcache.h - the AOT cache of a test suite (XDG_CACHE_HOME): tests/run_all's, shared by the run, or a private one removed afterwards. */
 #ifndef MECHC_TESTCACHE_H
 #define MECHC_TESTCACHE_H
 
@@ -8,12 +8,22 @@
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
-/* Makes TMPDIR/mechc-test-SUITE-XXXXXX into dir (size n) and points
-   XDG_CACHE_HOME at it, so the suite never touches the user's cache. */
+/* Points XDG_CACHE_HOME at the run's cache, $MECHC_TEST_CACHE, which
+   tests/run_all sets for all its suites (the keys hash source, compiler
+   and flags: the suites build each library once between them); run alone,
+   at a new TMPDIR/mechc-test-SUITE-XXXXXX. dir (size n) gets the folder,
+   so the suite never touches the user's cache. */
 static inline bool testcache_make(char *dir, size_t n, const char *suite)
 {
+    const char *shared = getenv("MECHC_TEST_CACHE");
+    if (shared && shared[0] == '/' && strlen(shared) < n) {
+        snprintf(dir, n, "%s", shared);
+        setenv("XDG_CACHE_HOME", dir, 1);
+        return true;
+    }
     const char *tmp = getenv("TMPDIR");
     snprintf(dir, n, "%s/mechc-test-%s-XXXXXX", tmp && *tmp ? tmp : "/tmp", suite);
     if (!mkdtemp(dir))
@@ -43,6 +53,14 @@ static inline void testcache_remove(const char *dir, int depth)
     rmdir(dir);
 }
 
+/* Removes the suite's cache unless it is the run's. */
+static inline void testcache_release(const char *dir)
+{
+    const char *shared = getenv("MECHC_TEST_CACHE");
+    if (!shared || strcmp(shared, dir) != 0)
+        testcache_remove(dir, 2);
+}
+
 /* A suite's cache and whether a C compiler is there (the aot engine's
    tests run only then), for its cmocka setup and teardown. */
 typedef struct TestCache {
@@ -60,7 +78,7 @@ static inline int testcache_setup(TestCache *c, const char *suite)
 
 static inline int testcache_teardown(TestCache *c)
 {
-    testcache_remove(c->dir, 2);
+    testcache_release(c->dir);
     return 0;
 }
 

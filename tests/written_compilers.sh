@@ -21,6 +21,11 @@
 # (objdump, x86-64).
 . "$(dirname "$0")/lib.sh"
 suite_begin written_compilers "${1:-build/mechc}"
+if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
+    skip "MECHC_SKIP_GCC_ONLY (make check-asan, check-valgrind): every check here builds the written C"
+    suite_end
+    exit
+fi
 
 cat > "$tmp/driver.c" <<'EOF'
 /* Evaluates the written file m at q0 + 0.01 (i mod 5), qd 0.1 (i mod 7 - 3), t 0.3. */

@@ -1,4 +1,4 @@
-/* test_branch.c - kinematic analysis through change points and dead centres (runtime/rank.c, runtime/qr.c, generator/kin/).
+/* test_qr_rank.c - kinematic analysis through change points and dead centres (runtime/rank.c, runtime/qr.c, generator/kin/).
  *
  * The rank-revealing QR against known minimum-norm solutions, and the
  * corrector on a hand-written parallelogram at its fold (double and, at
