@@ -1,7 +1,7 @@
 /* test_dynamics_runtime.c - forward and inverse dynamics (runtime/dynamics.c), hand-written kernels. */
 #include "testutil.h"
 
-#include "../generator/analysis/sim.h"
+#include "../generator/dyn/sim.h"
 #include "../runtime/mechrt.h"
 
 #include <gsl/gsl_linalg.h>
