@@ -98,13 +98,15 @@ done
 
 # ---- helpers over objects ---------------------------------------------------
 
-# The rules read one `nm OBJ` listing, OBJ.nm (symbols_of): nm starts
-# slowly (it loads the linker plugins), and a defined symbol has three
-# fields there, an undefined one two (no address).
+# The rules read one `nm OBJ` listing, OBJ.nm (symbols_of), where a
+# defined symbol has three fields and an undefined one two (no address).
+# nm is given the object's format (objdump -f says it): guessing it, nm
+# tries the linker plugins (LLVMgold among them), eight times slower.
 
-# symbols_of OBJ NM: OBJ's symbols into OBJ.nm.
+# symbols_of OBJ NM OBJDUMP: OBJ's symbols into OBJ.nm.
 symbols_of() {
-    "$2" "$1" > "$1.nm"
+    format=$("$3" -f "$1" | sed -n 's/.* file format //p')
+    "$2" ${format:+--target="$format"} "$1" > "$1.nm"
 }
 
 # undefined_only OBJ REGEX: every undefined symbol matches REGEX.
@@ -318,7 +320,7 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
             o=$d/$prefix-$tc.o
             try 10 "$name ($real, $tc): $cc $FLAGS $arch" \
                 $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" || continue
-            symbols_of "$o" "$nm_"
+            symbols_of "$o" "$nm_" "$objdump_"
             for rule in "undefined_only $o $allowed" \
                         "no_writable_data $o $size_" \
                         "defined_prefixed $o ^${prefix}_" \
@@ -369,7 +371,7 @@ while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
         fi
         ok
         allowed="^($MEM${extra:+|$extra})\$"
-        symbols_of "$d/core.o" "$nm_"
+        symbols_of "$d/core.o" "$nm_" "$objdump_"
         for rule in "undefined_only $d/core.o $allowed" \
                     "no_writable_data $d/core.o $size_" \
                     "call_graph $d/core.o $objdump_ $allowed 1"; do
