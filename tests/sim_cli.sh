@@ -423,6 +423,11 @@ for m in rk8pd rkf45 rk4imp msbdf; do
         check "disk falling flat, $m $l: the states before written" out_lines 8
     done
 done
+# Smooth rows turn far in the long steps of loose tolerances: not a failure.
+for f in a01_pendulum heavy_top; do
+    run "$ex/$f.mech" --t1 5 --steps 2 --rtol 1e-2 --atol 1e-2
+    check "$f at --rtol 1e-2, long steps turning its rows: exit 0" status_is 0
+done
 
 # ---- bounded work: --max-steps, and --steps beyond it ----
 run "$ex/a01_pendulum.mech" --t1 1e9 --max-steps 2000

@@ -10,10 +10,11 @@
  * is watched: over a window of SIM_STALL_STEPS steps, a mean step below
  * SIM_STALL_SHARE of the largest taken before with most attempts
  * rejected, or below SIM_STALL_FLOOR max(1, |t|), is a collapse; and
- * each row's gradient (dense, or the sparse path's nonzeros) at the step's end is compared with the
- * one at its start, and a change larger than the gradient itself (a
- * turn beyond 60 degrees in one accepted step) names the rows. Both end
- * the simulation with exit 1, the time and the rows.
+ * each row's gradient (dense, or the sparse path's nonzeros) at the
+ * step's end is compared with the one at its start: a change larger than
+ * the gradient itself (a turn beyond 60 degrees) in one accepted step far
+ * shorter than those before names the rows. Both end the simulation with
+ * exit 1, the time and the rows.
  */
 #include "watch.h"
 
@@ -27,8 +28,11 @@
 #define SIM_STALL_SHARE 1e-6
 /* ... or against max(1, |t|), rejections or not. */
 #define SIM_STALL_FLOOR 1e-12
-/* A row's gradient changing by more than this share of its size in one step. */
+/* A row's gradient changing by more than this share of its size in one
+   step, a step below SIM_TURN_STEP of the largest before (a smooth row
+   turns that far only in a long step: a fast spin at loose tolerances). */
 #define SIM_TURN_SHARE 1.0
+#define SIM_TURN_STEP 1e-3
 
 /* The gradients are watched: rows and their Jacobian, dense or the
    sparse path's nonzeros. */
@@ -117,7 +121,8 @@ bool sim_watch_step(Sim *s, const double *y, double t, double t_before)
     double h = fabs(t - t_before);
     if (watch_rows(s)) {
         take_gradients(s, y, t);
-        if (s->wvalid && row_turns(s, s->wturn) > SIM_TURN_SHARE) {
+        if (s->wvalid && h < SIM_TURN_STEP * s->hmax
+            && row_turns(s, s->wturn) > SIM_TURN_SHARE) {
             sim_fail(s, MECHRT_ESING, t, "integration");
             msgf(s, "in the last step (of %.3g) the gradient of a row turned abruptly", h);
             name_rows(s, " (");
