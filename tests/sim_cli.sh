@@ -10,7 +10,9 @@
 # benchmark's own data files were not available); the free double
 # pendulum's energy; a stiff spring's closed form with the implicit
 # methods; the engines agreeing; a redundant parallelogram with masses
-# through its flat positions; exit statuses and messages of bad use.
+# through its flat positions; exit statuses and messages of bad use; motions
+# that cannot go on (a rolling disk falling flat), --max-steps, and the note
+# on moved initial values that run prints (issue 31).
 # The last line is "sim_cli: N passed, M failed".
 set -u
 # shellcheck source=tests/lib.sh
@@ -394,5 +396,67 @@ EOF
 run "$tmp/free.mech" --t1 1
 check "a massless free coordinate: exit 1" status_is 1
 check "a massless free coordinate: t = 0 and singular" err_matches 't = 0: .*singular'
+
+# ---- motions that cannot go on end with exit 1, the time and the rows (issue 31) ----
+# A disk rolling on z = 0, leaning 0.3 rad, falls flat at t = 0.607: its
+# contact's normal (the unit horizontal part of the axle) is 0/0 there, the
+# rows roll.h and roll.x not defined. rk8pd and rkf45 crept on with steps
+# of 5e-10 s for minutes, msbdf stepped through the flat state: every
+# method and both linear-algebra paths now stop there.
+cat > "$tmp/disk.mech" <<'EOF'
+spatial
+param R = 0.5
+param a = 0.3
+body disk x = 0  y = -R*sin(a)  z = R*cos(a)  orient = axis(1, 0, 0, a)
+rolling roll: disk  radius = R  axis(0, 1, 0)
+mass disk m = 1 J = (R^2/4, R^2/2, R^2/4)
+gravity (0, 0, -9.81)
+EOF
+for m in rk8pd rkf45 rk4imp msbdf; do
+    for l in dense sparse; do
+        run "$tmp/disk.mech" --t1 2 --steps 20 --method "$m" --linear "$l"
+        check "disk falling flat, $m $l: exit 1" status_is 1
+        check "disk falling flat, $m $l: the time it lies flat" \
+            err_matches 'error: t = 0\.6071[0-9]*: integration failed'
+        check "disk falling flat, $m $l: its rows, not defined there" \
+            err_matches 'turned abruptly (roll\.h and roll\.x): the rows are not smooth or not defined'
+        check "disk falling flat, $m $l: the states before written" out_lines 8
+    done
+done
+# Smooth rows turn far in the long steps of loose tolerances: not a failure.
+for f in a01_pendulum heavy_top; do
+    run "$ex/$f.mech" --t1 5 --steps 2 --rtol 1e-2 --atol 1e-2
+    check "$f at --rtol 1e-2, long steps turning its rows: exit 0" status_is 0
+done
+
+# ---- bounded work: --max-steps, and --steps beyond it ----
+run "$ex/a01_pendulum.mech" --t1 1e9 --max-steps 2000
+check "--t1 1e9 --max-steps 2000: exit 1" status_is 1
+check "--t1 1e9 --max-steps 2000: the time reached and the option" \
+    err_matches 'error: t = [0-9.]*: integration failed: more than 2000 integrator steps (--max-steps) at [0-9.e-]*% of the interval from t = 0 to 1000000000'
+run "$ex/a01_pendulum.mech" --steps 20000 --max-steps 1000
+check "--steps beyond --max-steps: exit 2" status_is 2
+check "--steps beyond --max-steps: says so" \
+    err_has "--steps 20000 output states need at least as many integrator steps, more than --max-steps 1000"
+check "--steps beyond --max-steps: nothing on stdout" out_lines 0
+run "$ex/a01_pendulum.mech" --max-steps 0
+check "--max-steps 0: exit 2" status_is 2
+
+# ---- the note run prints when assembly moves the file's values ----
+cat > "$tmp/moved.mech" <<'EOF'
+body rod x = 0.3 phi = -pi/3
+revolute O: ground rod
+driver D: rod.phi = -pi/3 + t
+mass rod m = 2 J = 2/12 com(0.5, 0)
+gravity (0, -9.81)
+EOF
+run_mechc run "$tmp/moved.mech" --steps 1
+cp "$tmp/err" "$tmp/run_err"
+run "$tmp/moved.mech" --t1 0.01 --steps 1
+check "moved initial values: sim exit 0" status_is 0
+check "moved initial values: sim notes the move" \
+    err_has "note: assembly at t = 0 moved the initial values by up to 0.3 (rod.x: 0.3 -> 0)"
+check "moved initial values: sim's note is run's" \
+    test "$(grep note: "$tmp/err")" = "$(grep note: "$tmp/run_err")"
 
 suite_end

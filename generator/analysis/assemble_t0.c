@@ -19,6 +19,7 @@
 #include "../base/arena.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,4 +106,48 @@ void assemble_t0_describe(const Model *m, const MechrtKernels *k, const Assemble
                   "nearer a configuration that does not exist; try other initial values%s%s)",
                   rep->more_option ? ", or more " : "", rep->more_option ? rep->more_option : "");
     free(phi), free(names);
+}
+
+/* The note after a successful assembly: how Newton started, or how far it
+   moved the file's values when that is beyond move_note * max|q0|; the
+   move (max |q - q0|). run and sim print the same words. */
+double assemble_t0_note(FILE *notes, const Model *m, const AssembleT0Report *rep,
+                        const double *q0, const double *q, double move_note)
+{
+    double moved = 0, scale = 0;
+    int at = 0, it = rep->iterations;
+    for (int i = 0; i < m->nq; i++) {
+        double d = fabs(q[i] - q0[i]);
+        if (d > moved) {
+            moved = d;
+            at = i;
+        }
+        scale = fmax(scale, fabs(q0[i]));
+    }
+    bool far = moved > move_note * (scale > 0 ? scale : 1);
+    if (!notes || (!rep->robust && !far))
+        return moved;
+    const char *its = it == 1 ? "iteration" : "iterations";
+    fprintf(notes, "%s: note: ", m->file);
+    if (rep->robust && rep->constructed > 0)
+        fprintf(notes, "Newton could not start from the file's initial values; %d of the %d "
+                "coordinates were placed by construction (drivers, pins, dyads: of two closures "
+                "the one nearer the initial values), then Newton assembled the mechanism at "
+                "t = %.10g in %d %s", rep->constructed, m->nq, rep->t0, it, its);
+    else if (rep->robust)
+        fprintf(notes, "Newton could not start from the file's initial values; minimum-norm "
+                "Newton assembled the mechanism at t = %.10g in %d %s (initial values "
+                "near the configuration you mean choose its assembly branch)", rep->t0, it, its);
+    else if (rep->constructed > 0)
+        fprintf(notes, "assembly at t = %.10g moved the initial values by up to %.6g "
+                "(%s: %.6g -> %.6g): %d of the %d coordinates were placed by construction "
+                "(drivers, pins, dyads: of two closures the one nearer the initial values), "
+                "then Newton took %d %s", rep->t0, moved, m->coord_names[at], q0[at], q[at],
+                rep->constructed, m->nq, it, its);
+    else
+        fprintf(notes, "assembly at t = %.10g moved the initial values by up to %.6g "
+                "(%s: %.6g -> %.6g); the file's values are only Newton's starting point",
+                rep->t0, moved, m->coord_names[at], q0[at], q[at]);
+    fputc('\n', notes);
+    return moved;
 }

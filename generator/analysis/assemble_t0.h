@@ -4,6 +4,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "../../runtime/mechrt.h"
 #include "../../runtime/host/mechrt_host.h"
@@ -67,5 +68,12 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
    closest, else Newton's), the residuals taken at q, the last attempt. */
 void assemble_t0_describe(const Model *m, const MechrtKernels *k, const AssembleT0Report *rep,
                           const double *q, char *msg, size_t size);
+
+/* After a successful assembly, the note ("FILE: note: ...") on notes
+   (NULL: none) when Newton could not start from the file's values q0 or
+   moved them by more than move_note * max|q0_i| (1 if all 0) to q; the
+   move max|q_i - q0_i|. run and sim say the same. */
+double assemble_t0_note(FILE *notes, const Model *m, const AssembleT0Report *rep,
+                        const double *q0, const double *q, double move_note);
 
 #endif

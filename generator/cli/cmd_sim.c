@@ -16,6 +16,7 @@
 #include "run_output.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,7 +28,7 @@ typedef struct SimCli {
     MechLimits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
     CliList traces;
-    int engine, method, digits, view, linear;
+    int engine, method, digits, view, linear, max_steps;
     bool json, stats;
     bool pictures, csv_stdout;      /* worked out from the above */
 } SimCli;
@@ -54,6 +55,9 @@ static const CliOption options[] = {
     {"--steps", CLI_INT_AT(SimCli, so.steps, 1, 100000000), .metavar = "N",
      .help = "output intervals (default 100); the integrator chooses\n"
              "its own steps in between"},
+    {"--max-steps", CLI_INT_AT(SimCli, max_steps, 1, INT_MAX), .metavar = "N",
+     .help = "integrator steps allowed in all (default 10000000): a\n"
+             "longer run stops with exit 1 and the time reached"},
     {"--engine", CLI_CHOICE_AT(SimCli, engine, engine_names), .metavar = "E",
      .help = "jit (default), generic or aot, as for eval"},
     {"--method", CLI_CHOICE_AT(SimCli, method, sim_method_names), .metavar = "M",
@@ -175,6 +179,13 @@ static bool finish(Args *a, void *opts)
                 c->so.t0);
         return false;
     }
+    c->so.max_steps = c->max_steps;
+    if (c->so.steps > c->so.max_steps && !c->so.interpolate) {
+        fprintf(stderr, "mechc sim: error: --steps %d output states need at least as many "
+                "integrator steps, more than --max-steps %d (raise it, or --interpolate)\n",
+                c->so.steps, c->max_steps);
+        return false;
+    }
     if (c->so.rtol >= 1) {      /* a relative error of 100 % or more: a misplaced exponent */
         fprintf(stderr, "mechc sim: error: --rtol %g is not below 1 (e.g. 1e-8)\n", c->so.rtol);
         return false;
@@ -234,6 +245,13 @@ static int report(const SimCli *c, const Model *m, const RunOutput *out, const R
     return status;
 }
 
+/* After each accepted integrator step: the progress bar by simulated time. */
+static void step_progress(void *ctx, double t)
+{
+    RunOutput *out = ctx;
+    progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
+}
+
 /* The simulation with the open engine, the states going where c says. */
 static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p)
 {
@@ -250,6 +268,8 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     c->so.notes = stderr;
     c->so.linear = (AnalysisLinear)c->linear;
     SimResult res;
+    c->so.on_step = step_progress;
+    c->so.on_step_ctx = &out;
     progress_start(&out.progress, "sim", 1000);
     AnalysisStatus st = sim_run(m, engine_kernels(e), engine_jac_nz(e), engine_mass_nz(e),
                                 &c->so, run_output_state, &out, &res);
@@ -311,5 +331,6 @@ int cmd_sim(int argc, char **argv)
 {
     SimCli c = {.so = sim_default_options(), .limits = mech_default_limits(),
                 .engine = ENGINE_JIT, .method = -1, .view = -1};
+    c.max_steps = (int)c.so.max_steps;
     return cli_main(&command, argc, argv, &c);
 }

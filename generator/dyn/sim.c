@@ -59,7 +59,8 @@
  * integrator is its quadrature; its own error does not steer the step size.
  *
  * The pieces: sim_state.c (set-up, failures), counting.c, rhs.c (the right
- * side), kkt.c (its sparse path), project.c, energy.c, step.c and
+ * side), kkt.c (its sparse path), project.c, energy.c, step.c, watch.c
+ * (a collapsing step size, rows that turn abruptly, --max-steps) and
  * hermite.c (output between steps); this file drives them.
  */
 #include "sim.h"
@@ -83,6 +84,10 @@
 #include <time.h>
 
 #include <gsl/gsl_errno.h>
+
+/* The note on how far assembly moved the file's values: beyond this
+   share of their size, as run's RunOptions.move_note. */
+#define SIM_MOVE_NOTE 1e-3
 
 const char *const sim_method_names[] = {"rk8pd", "rkf45", "rk4imp", "msbdf", NULL};
 
@@ -302,8 +307,8 @@ AnalysisStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
 }
 
 /* Construction, then Newton onto the rows from the file's values (as run
-   does at t0: assemble_at_t0, its default projection); q holds the
-   result. False with the message set. */
+   does at t0: assemble_at_t0, its default projection, run's note); q
+   holds the result. False with the message set. */
 static bool start_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
                         const MechrtHostMassNz *mnz, const SimOptions *o, double *q,
                         SimResult *res)
@@ -324,6 +329,8 @@ static bool start_at_t0(const Model *m, const MechrtKernels *k, const MechrtHost
         snprintf(res->message, sizeof res->message, "t = %.10g: out of memory", o->t0);
     else if (!ok)
         assemble_t0_describe(m, k, &rep, q, res->message, sizeof res->message);
+    else
+        res->assembly_move = assemble_t0_note(o->notes, m, &rep, m->q0, q, SIM_MOVE_NOTE);
     return ok;
 }
 
@@ -349,13 +356,14 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJ
         free(q);
         return ANALYSIS_FAILED;
     }
-    double move = 0;
-    for (int i = 0; i < m->nq; i++)
-        move = fmax(move, fabs(q[i] - m->q0[i]));
-    if (pre.assembled_robustly && o->notes)
-        fprintf(o->notes, "%s: note: Newton could not start from the file's initial values; "
-                "minimum-norm Newton assembled the mechanism at t = %.10g\n", m->file, o->t0);
-    AnalysisStatus st = sim_integrate(k, jnz, mnz, o, q, state, state_ctx, res);
+    double move = pre.assembly_move;
+    const char **names = xcalloc((size_t)m->nr + 1, sizeof *names);
+    for (int i = 0; i < m->nr; i++)
+        names[i] = m->rows[i].name;
+    SimOptions named = *o;
+    named.row_names = names;
+    AnalysisStatus st = sim_integrate(k, jnz, mnz, &named, q, state, state_ctx, res);
+    free(names);
     res->constructed = pre.constructed;
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;

@@ -62,6 +62,10 @@ typedef struct SimOptions {
     int assembly_max_iter;  /* minimum-norm Newton at t0 when projection fails; 100 */
     long max_steps;         /* integrator steps allowed in all; 10 000 000 */
     FILE *notes;            /* notes ("FILE: note: ..."); NULL: none */
+    const char *const *row_names; /* nr names for failures; NULL: unnamed (sim_run: the file's) */
+    /* called after every accepted step with its end (progress); NULL: none */
+    void (*on_step)(void *ctx, double t);
+    void *on_step_ctx;
     AnalysisLinear linear;  /* ANALYSIS_LINEAR_AUTO */
 } SimOptions;
 

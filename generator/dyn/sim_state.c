@@ -139,6 +139,10 @@ bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
     }
     if (!s->kkt && !sim_dense_ready(s))
         return false;
+    size_t watched = s->kkt ? (size_t)jnz->jac.nnz : m * n;   /* watch.c: Phi_q twice */
+    s->wjac = xcalloc(watched + 1, sizeof *s->wjac);
+    s->wjac0 = xcalloc(watched + 1, sizeof *s->wjac0);
+    s->wturn = xcalloc(3 * m + 1, sizeof *s->wturn);
     /* W's error must not steer the step: its absolute scale is huge */
     double *scale = xcalloc((size_t)s->dim, sizeof *scale);
     for (int i = 0; i < s->dim; i++)
@@ -162,6 +166,7 @@ void sim_close(Sim *s)
     free(s->y), free(s->active);
     free(s->cy), free(s->cf), free(s->ya), free(s->fa), free(s->fb), free(s->yi), free(s->yc), free(s->fc);
     free(s->qrw);
+    free(s->wjac), free(s->wjac0), free(s->wturn);
     mechrt_svd_free(s->svd);
     if (s->kkt)
         mechrt_host_kkt_counts(s->kkt, &s->res->kkt_fresh, &s->res->kkt_refactored);

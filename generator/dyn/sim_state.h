@@ -46,6 +46,13 @@ typedef struct Sim {
     bool cache_ok;
     double *yc, *fc, *ya, *fa;   /* --interpolate: the last two steps' starts, f there */
     double *fb, *yi;             /* f at the step's end, the output state */
+    /* watch.c: Phi_q at the last two step ends (dense, or the sparse
+       path's nonzeros), the rows' turns between them (3 nr: and room);
+       the collapse test's window */
+    double *wjac, *wjac0, *wturn;
+    bool whave, wvalid;          /* one gradient taken; two */
+    long wsteps, wrejected0;     /* steps in the window; rejections before it */
+    double wt0, hmax;            /* its start; the largest step so far */
 } Sim;
 
 /* Appends to res->message, truncating quietly. */

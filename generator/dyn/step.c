@@ -2,6 +2,7 @@
 #include "step.h"
 
 #include "rhs.h"
+#include "watch.h"
 
 #include <math.h>
 #include <string.h>
@@ -91,17 +92,17 @@ bool sim_one_step(Sim *s, double *y, double *t, double tn, double *h)
         return false;
     }
     s->res->steps++;
-    if ((fabs(*t - t_before) < hmin && *t != tn) || s->res->steps > s->o->max_steps) {
+    if (fabs(*t - t_before) < hmin && *t != tn) {
         sim_fail(s, MECHRT_ESTEP, *t, "integration");
-        if (s->res->steps > s->o->max_steps)
-            msgf(s, "more than %ld integrator steps: the motion is stiff or too fast for "
-                 "--rtol/--atol (an implicit --method may help)", s->o->max_steps);
-        else
-            msgf(s, "step size underflow (%.3g) before --rtol/--atol were met: a singular "
-                 "position, an impact or a stiff force? (an implicit --method may help)",
-                 fabs(*t - t_before));
+        msgf(s, "step size underflow (%.3g) before --rtol/--atol were met: a singular "
+             "position, an impact or a stiff force? (an implicit --method may help)",
+             fabs(*t - t_before));
         return false;
     }
+    if (!sim_watch_step(s, y, *t, t_before))
+        return false;
+    if (s->o->on_step)
+        s->o->on_step(s->o->on_step_ctx, *t);
     return true;
 }
 

@@ -17,44 +17,6 @@ bool run_dense_too_large(const Model *m, const RunOptions *o)
     return o->max_dense_entries > 0 && (long long)m->nr * m->nq > o->max_dense_entries;
 }
 
-/* A note when assembly moved the initial values much. */
-static void note_move(Run *r, const double *q0)
-{
-    double moved = 0, scale = 0;
-    int at = 0;
-    for (int i = 0; i < r->nq; i++) {
-        double d = fabs(r->q[i] - q0[i]);
-        if (d > moved) {
-            moved = d;
-            at = i;
-        }
-        if (fabs(q0[i]) > scale)
-            scale = fabs(q0[i]);
-    }
-    r->res->assembly_move = moved;
-    int it = r->res->assembly_iterations;
-    const char *its = it == 1 ? "iteration" : "iterations";
-    if (r->res->assembled_robustly && r->res->constructed > 0)
-        run_notef(r, "note", "Newton could not start from the file's initial values; %d of the %d "
-              "coordinates were placed by construction (drivers, pins, dyads: of two closures "
-              "the one nearer the initial values), then Newton assembled the mechanism at "
-              "t = %.10g in %d %s", r->res->constructed, r->nq, r->o->t0, it, its);
-    else if (r->res->assembled_robustly)
-        run_notef(r, "note", "Newton could not start from the file's initial values; minimum-norm "
-              "Newton assembled the mechanism at t = %.10g in %d %s (initial values "
-              "near the configuration you mean choose its assembly branch)", r->o->t0, it, its);
-    else if (moved > r->o->move_note * (scale > 0 ? scale : 1) && r->res->constructed > 0)
-        run_notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
-              "(%s: %.6g -> %.6g): %d of the %d coordinates were placed by construction "
-              "(drivers, pins, dyads: of two closures the one nearer the initial values), "
-              "then Newton took %d %s", r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at],
-              r->res->constructed, r->nq, it, its);
-    else if (moved > r->o->move_note * (scale > 0 ? scale : 1))
-        run_notef(r, "note", "assembly at t = %.10g moved the initial values by up to %.6g "
-              "(%s: %.6g -> %.6g); the file's values are only Newton's starting point",
-              r->o->t0, moved, r->m->coord_names[at], q0[at], r->q[at]);
-}
-
 /* The assembly at t0 (assemble_at_t0) with the run's Newton, from the
    file's values in r->q: the construction, Newton, and where Newton cannot
    start the robust minimum-norm Newton with restarts (dense: not beyond
@@ -102,7 +64,7 @@ bool run_assemble(Run *r, AssembleNewtonFn newton, void *ctx, bool singular, Mec
         if (st != MECHRT_OK)
             run_fail(r, st, o->t0, r->q, rep, what);
         else
-            note_move(r, q0);
+            res->assembly_move = assemble_t0_note(o->notes, r->m, &ar, q0, r->q, o->move_note);
     }
     free(q0);
     return st == MECHRT_OK;     /* not after a failed robust assembly: Newton's failure */
