@@ -239,6 +239,14 @@ check "--trace without --svg: exit 2" status_is 2
 run "$ex/slider_crank.mech" --plot "$tmp/p2.svg" --plot-vars 'nothing.x'
 check "--plot-vars with an unknown name: exit 2" status_is 2
 check "--plot-vars with an unknown name: names it" err_has "nothing"
+# every name there is, outputs included (once only the first 8 of 24)
+run "$ex/suspension.mech" --plot "$tmp/p2.svg" --plot-vars 'nothing.x'
+check "--plot-vars unknown on suspension: exit 2" status_is 2
+check "--plot-vars unknown on suspension: counts the names" \
+    err_has "mechc run: error: --plot-vars: unknown coordinate or output 'nothing.x'; the 21 coordinates and 3 outputs are lca.x, lca.y,"
+check "--plot-vars unknown on suspension: lists the last coordinate and the outputs" \
+    err_has "upright.e2, upright.e3, camber_deg, toe_deg, travel"
+check "--plot-vars unknown: no plot written" [ ! -e "$tmp/p2.svg" ]
 run "$ex/slider_crank.mech" --svg "$tmp/a2.svg" --trace 'ghost(0,0)'
 check "--trace of an unknown body: exit 2" status_is 2
 run "$ex/slider_crank.mech" --steps -1

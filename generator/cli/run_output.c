@@ -211,12 +211,15 @@ bool run_output_resolve_pictures(const char *cmd, const Model *m, const CliList 
     }
     add_point_outputs(m, p, p->svg_path != NULL);
     if (p->plot_path && plot_list) {
+        size_t size = svg_plot_err_size(m) + strlen(plot_list);
+        char *why = xmalloc(size);
         p->nvars = svg_plot_resolve_forces(m, plot_list, forces, p->vars,
-                                           RUN_OUTPUT_MAX_PLOT_VARS, err, sizeof err);
-        if (p->nvars <= 0) {
-            fprintf(stderr, "mechc %s: error: %s\n", cmd, err);
+                                           RUN_OUTPUT_MAX_PLOT_VARS, why, size);
+        if (p->nvars <= 0)
+            fprintf(stderr, "mechc %s: error: %s\n", cmd, why);
+        free(why);
+        if (p->nvars <= 0)
             return false;
-        }
     } else if (p->plot_path) {
         for (int i = 0; i < m->nq + m->nout && p->nvars < RUN_OUTPUT_MAX_PLOT_VARS; i++)
             p->vars[p->nvars++] = (SvgPlotVar){i, 0};
