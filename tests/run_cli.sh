@@ -437,6 +437,18 @@ check "out of reach: 5 states written" out_lines 6
 run "$ex/parallelogram_redundant.mech"
 check "redundant parallelogram: exit 1 at t = 0, singular" \
     sh -c '[ "$1" = 1 ] && grep -q "t = 0: .*singular" "$2"' - "$rc" "$tmp/err"
+check "redundant parallelogram: failing at t = 0, nothing on stdout (no bare header)" out_empty
+run "$ex/parallelogram_redundant.mech" --csv - --steps 4
+check "redundant parallelogram --csv -: exit 1" status_is 1
+check "redundant parallelogram --csv -: the error on stderr" \
+    err_has "parallelogram_redundant.mech: error: t = 0: assembly from the file's initial values failed: singular Jacobian"
+check "redundant parallelogram --csv -: no bare CSV header on stdout" out_empty
+printf 'mechanism stuck\nbody rod x = 0 y = 0 phi = 0\nrevolute O: ground rod\ndistance far: ground(5, 0) rod(1, 0) length = 1\nmass rod m = 1 J = 0.1 com(0.5, 0)\ngravity (0, -9.81)\n' \
+    > "$tmp/stuck.mech"
+run "$tmp/stuck.mech" --forces --csv -
+check "--forces failing at t = 0: exit 1" status_is 1
+check "--forces failing at t = 0: the error on stderr" err_has "stuck.mech: error: t = 0: could not assemble"
+check "--forces failing at t = 0: nothing on stdout" out_empty
 
 for f in pendulum_distance pendulum_constraint; do
     run "$ex/$f.mech"

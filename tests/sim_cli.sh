@@ -374,6 +374,14 @@ run "$tmp/over.mech"
 check "more rows than coordinates: exit 2" status_is 2
 check "more rows than coordinates: FILE:LINE:COL" err_matches "over\.mech:4:1: error: 3 holonomic rows for 2 coordinates"
 check "more rows than coordinates: nothing on stdout" out_lines 0
+# failing before its first state: the error, and no bare CSV header
+printf 'mechanism stuck\nbody rod x = 0 y = 0 phi = 0\nrevolute O: ground rod\ndistance far: ground(5, 0) rod(1, 0) length = 1\nmass rod m = 1 J = 0.1 com(0.5, 0)\ngravity (0, -9.81)\n' \
+    > "$tmp/stuck.mech"
+run "$tmp/stuck.mech"
+check "sim failing at t = 0: exit 1" status_is 1
+check "sim failing at t = 0: the error on stderr" err_has "stuck.mech: error: t = 0: could not assemble"
+check "sim failing at t = 0: nothing on stdout" out_empty
+
 run "$ex/double_pendulum.mech" --t0 1 --t1 1
 check "--t0 = --t1: exit 2" status_is 2
 check "--t0 = --t1: says so" err_has "nothing to simulate"

@@ -56,10 +56,6 @@ void run_output_open(RunOutput *out, const Model *m)
                            (const char *const *)out->outputs.wnames);
     if (out->lambda_use == RUN_OUTPUT_FORCES)
         open_forces(out, m);
-    if (out->csv)
-        mechrt_csv_header_extra(out->csv, out->nv, out->names, out->outputs.nw,
-                                (const char *const *)out->outputs.wnames, out->nx,
-                                (const char *const *)out->xnames);
 }
 
 void run_output_close(RunOutput *out)
@@ -135,6 +131,12 @@ void run_output_state(void *ctx, double t, const double *q, const double *qd,
         memcpy(out->x, lambda, (size_t)out->nr * sizeof *lambda);
         for (int i = 0; i < out->nd; i++)
             out->x[out->nr + i] = -lambda[out->drivers[i]];
+    }
+    if (out->csv && !out->headed) {
+        mechrt_csv_header_extra(out->csv, out->nv, out->names, out->outputs.nw,
+                                (const char *const *)out->outputs.wnames, out->nx,
+                                (const char *const *)out->xnames);
+        out->headed = true;
     }
     if (out->csv)
         mechrt_csv_row_extra(out->csv, out->nv, t, q, qd, qdd, out->outputs.nw, out->w,
