@@ -32,25 +32,21 @@
 # Initial velocities: every rod phi' = -1, centre (0.5, 0); every coupler
 # phi' = 0, centre (1, 0) (the --qd list).
 # Coords: x, y, phi of rod0, then of cpl i and rod i+1: NQ = 3 (2N + 1);
-# rows 2 (N + 1) + 4 N = NQ - 1: 1 DOF, free. POSIX sh and awk only.
+# rows 2 (N + 1) + 4 N = NQ - 1: 1 DOF, free. N is bounded as in the other
+# generator scripts (examples/size_arg.sh). POSIX sh and awk only.
 
-usage() {
-    echo "usage: sh examples/a02_four_bar.sh N [OUTFILE] | --qd N   (N a positive integer)" >&2
-    exit 2
-}
+. "$(dirname "$0")/size_arg.sh"
 
 qd=false
 if [ "${1:-}" = --qd ]; then
     qd=true
     shift
-    [ $# -eq 1 ] || usage
+    if [ $# -ne 1 ]; then
+        echo "usage: sh $0 N [OUTFILE] | --qd N   (N a positive integer)" >&2
+        exit 2
+    fi
 fi
-[ $# -ge 1 ] && [ $# -le 2 ] || usage
-case $1 in
-    ''|*[!0-9]*) usage ;;
-esac
-n=$1
-[ "$n" -ge 1 ] 2>/dev/null || usage
+size_arg 6 3 "$@"      # NQ = 6N + 3
 
 if $qd; then
     awk -v n="$n" 'BEGIN { s = "0.5,0,-1"; for (i = 0; i < n; i++) s = s ",1,0,0,0.5,0,-1"; print s }'
@@ -91,8 +87,4 @@ gen() {
     }'
 }
 
-if [ $# -eq 2 ]; then
-    gen > "$2"
-else
-    gen
-fi
+size_out

@@ -1,5 +1,5 @@
 # size_arg.sh - the command line of the generator scripts (chain.sh,
-# chain_spatial.sh, scissor.sh, train.sh), sourced by them:
+# chain_spatial.sh, scissor.sh, train.sh, a02_four_bar.sh), sourced by them:
 #
 #   . "$(dirname "$0")/size_arg.sh"
 #   size_arg A B "$@"      sets n to N (a positive integer whose

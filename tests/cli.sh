@@ -298,6 +298,16 @@ check "gen --prefix 1bad says why" err_has "error:"
 check "gen --prefix 1bad writes no file" [ ! -e "$tmp/bad_prefix.c" ]
 run gen "$ex/four_bar.mech" --prefix int
 check "gen --prefix int (a C keyword) exits 2" status_is 2
+# mechrt_real, MECHRT_OK, mechrtf_*: the runtime's names are not a prefix's
+for p in mechrt MECHRT mechrtf mechrt_x; do
+    run gen "$ex/four_bar.mech" --prefix $p -o "$tmp/rt_prefix.c"
+    check "gen --prefix $p (the runtime's) exits 2" status_is 2
+    check "gen --prefix $p says it clashes with the runtime" \
+        err_has "mechc gen: error: --prefix '$p' cannot be used: the runtime's names start with mechrt_, mechrtf_ and MECHRT_, which this prefix would clash with"
+    check "gen --prefix $p writes no file" [ ! -e "$tmp/rt_prefix.c" ]
+done
+run gen "$ex/four_bar.mech" --prefix mechrt2
+check "gen --prefix mechrt2 (no clash) exits 0" status_is 0
 
 # ---- gen --roll: loops for joints of one shape (doc/figures.md, "Loop-rolled code")
 sh "$ex/chain.sh" 90 "$tmp/chain90.mech"

@@ -31,6 +31,26 @@ run info "$ex/four_bar.mech" --rank-tol abc
 check "info --rank-tol abc exits 2" status_is 2
 run info "$tmp/does_not_exist.mech"
 check "info on a missing file exits 2" status_is 2
+# a named pipe with no writer once blocked open() forever: only regular
+# files are read (stdin is '-'), whatever command reads them
+if have mkfifo && mkfifo "$tmp/pipe.mech"; then
+    mechc_timeout=20
+    for cmd in info run; do
+        run $cmd "$tmp/pipe.mech"
+        check "$cmd on a named pipe exits 2 (does not block)" status_is 2
+        check "$cmd on a named pipe says it is one" \
+            err_has "pipe.mech: error: cannot read '$tmp/pipe.mech': a named pipe; give a regular file, or '-' for stdin"
+    done
+    mechc_timeout=
+else
+    skip "mkfifo: the named-pipe cases"
+fi
+run info /dev/null
+check "info on a device exits 2" status_is 2
+check "info on a device says it is one" err_has "'/dev/null': a device"
+run info "$tmp"
+check "info on a folder exits 2" status_is 2
+check "info on a folder says it is one" err_has "': a directory"
 printf 'body b x = 0\nrevolute J: ground crnk\n' > "$tmp/bad.mech"
 run info "$tmp/bad.mech"
 check "info on bad input exits 2" status_is 2

@@ -239,6 +239,14 @@ check "--trace without --svg: exit 2" status_is 2
 run "$ex/slider_crank.mech" --plot "$tmp/p2.svg" --plot-vars 'nothing.x'
 check "--plot-vars with an unknown name: exit 2" status_is 2
 check "--plot-vars with an unknown name: names it" err_has "nothing"
+# every name there is, outputs included (once only the first 8 of 24)
+run "$ex/suspension.mech" --plot "$tmp/p2.svg" --plot-vars 'nothing.x'
+check "--plot-vars unknown on suspension: exit 2" status_is 2
+check "--plot-vars unknown on suspension: counts the names" \
+    err_has "mechc run: error: --plot-vars: unknown coordinate or output 'nothing.x'; the 21 coordinates and 3 outputs are lca.x, lca.y,"
+check "--plot-vars unknown on suspension: lists the last coordinate and the outputs" \
+    err_has "upright.e2, upright.e3, camber_deg, toe_deg, travel"
+check "--plot-vars unknown: no plot written" [ ! -e "$tmp/p2.svg" ]
 run "$ex/slider_crank.mech" --svg "$tmp/a2.svg" --trace 'ghost(0,0)'
 check "--trace of an unknown body: exit 2" status_is 2
 run "$ex/slider_crank.mech" --steps -1
@@ -429,6 +437,18 @@ check "out of reach: 5 states written" out_lines 6
 run "$ex/parallelogram_redundant.mech"
 check "redundant parallelogram: exit 1 at t = 0, singular" \
     sh -c '[ "$1" = 1 ] && grep -q "t = 0: .*singular" "$2"' - "$rc" "$tmp/err"
+check "redundant parallelogram: failing at t = 0, nothing on stdout (no bare header)" out_empty
+run "$ex/parallelogram_redundant.mech" --csv - --steps 4
+check "redundant parallelogram --csv -: exit 1" status_is 1
+check "redundant parallelogram --csv -: the error on stderr" \
+    err_has "parallelogram_redundant.mech: error: t = 0: assembly from the file's initial values failed: singular Jacobian"
+check "redundant parallelogram --csv -: no bare CSV header on stdout" out_empty
+printf 'mechanism stuck\nbody rod x = 0 y = 0 phi = 0\nrevolute O: ground rod\ndistance far: ground(5, 0) rod(1, 0) length = 1\nmass rod m = 1 J = 0.1 com(0.5, 0)\ngravity (0, -9.81)\n' \
+    > "$tmp/stuck.mech"
+run "$tmp/stuck.mech" --forces --csv -
+check "--forces failing at t = 0: exit 1" status_is 1
+check "--forces failing at t = 0: the error on stderr" err_has "stuck.mech: error: t = 0: could not assemble"
+check "--forces failing at t = 0: nothing on stdout" out_empty
 
 for f in pendulum_distance pendulum_constraint; do
     run "$ex/$f.mech"

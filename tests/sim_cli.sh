@@ -376,6 +376,24 @@ run "$tmp/over.mech"
 check "more rows than coordinates: exit 2" status_is 2
 check "more rows than coordinates: FILE:LINE:COL" err_matches "over\.mech:4:1: error: 3 holonomic rows for 2 coordinates"
 check "more rows than coordinates: nothing on stdout" out_lines 0
+# --interpolate's degree, as generator/dyn/hermite.c has it (3 nodes: 9
+# conditions, degree 8; 2 on the first step: the quintic), in --help and doc
+run --help
+check "sim --help: exit 0" status_is 0
+check "sim --help: --interpolate's interpolant is of degree 8" \
+    sh -c 'tr -s " \n" "  " < "$1" | grep -q "Hermite interpolant of q, qd, qdd at the ends of the last two steps, degree 8 (quintic within the first step;"' _ "$tmp/out"
+check "sim --help: no longer calls it quintic alone" sh -c '! grep -q "quintic Hermite" "$1"' _ "$tmp/out"
+check "doc/commands.md: --interpolate's interpolant is of degree 8" \
+    sh -c 'tr -s " \n" "  " < "$1" | grep -q "and of the one before (degree 8; the quintic of the step alone on the first"' _ "$root/doc/commands.md"
+
+# failing before its first state: the error, and no bare CSV header
+printf 'mechanism stuck\nbody rod x = 0 y = 0 phi = 0\nrevolute O: ground rod\ndistance far: ground(5, 0) rod(1, 0) length = 1\nmass rod m = 1 J = 0.1 com(0.5, 0)\ngravity (0, -9.81)\n' \
+    > "$tmp/stuck.mech"
+run "$tmp/stuck.mech"
+check "sim failing at t = 0: exit 1" status_is 1
+check "sim failing at t = 0: the error on stderr" err_has "stuck.mech: error: t = 0: could not assemble"
+check "sim failing at t = 0: nothing on stdout" out_empty
+
 run "$ex/double_pendulum.mech" --t0 1 --t1 1
 check "--t0 = --t1: exit 2" status_is 2
 check "--t0 = --t1: says so" err_has "nothing to simulate"

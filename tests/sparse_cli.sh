@@ -251,6 +251,22 @@ sh "$ex/train.sh" 66666 "$tmp/tr_big.mech" 2> "$tmp/err"
 rc=$?
 check "train.sh 66666 (200001 coordinates): exit 2" status_is 2
 check "train.sh 66666: names its bound" err_has "N is at most 66665"
+# a02_four_bar.sh took any N (2.4 GB a minute); 6N + 3 coordinates as chain.sh
+for a in "99999999999 $tmp/a02_huge.mech" "33333 $tmp/a02_huge.mech" "--qd 33333"; do
+    # shellcheck disable=SC2086 # the arguments split on purpose
+    sh "$ex/a02_four_bar.sh" $a > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+    check "a02_four_bar.sh $a: exit 2" status_is 2
+    check "a02_four_bar.sh $a: names the bound" \
+        err_has "gives more than 200000 coordinates (mechc's default --max-coords): N is at most 33332"
+    check "a02_four_bar.sh $a: nothing written" sh -c '[ ! -s "$1" ] && [ ! -s "$2" ]' _ "$tmp/out" "$tmp/a02_huge.mech"
+done
+sh "$ex/a02_four_bar.sh" --qd 33332 > "$tmp/out" 2> "$tmp/err"
+rc=$?
+check "a02_four_bar.sh --qd 33332 (the bound): exit 0" status_is 0
+sh "$ex/a02_four_bar.sh" 0 > "$tmp/out" 2> "$tmp/err"
+rc=$?
+check "a02_four_bar.sh 0: the usage, exit 2" sh -c "[ $rc = 2 ] && grep -q 'positive integer' '$tmp/err'"
 sh "$ex/chain.sh" 0 "$tmp/c0.mech" 2> "$tmp/err"
 rc=$?
 check "chain.sh 0: the usage, exit 2" sh -c "[ $rc = 2 ] && grep -q 'positive integer' '$tmp/err'"

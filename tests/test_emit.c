@@ -339,11 +339,12 @@ static void test_check_prefix(void **state)
 {
     (void)state;
     const char *bad[] = {"1abc", "a-b", "int", "__x", "", "double", "_X", "a b", "a.b", "é",
+                         "mechrt", "MECHRT", "mechrtf", "mechrt_x", "Mechrtf_y",
                          "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
         if (emit_check_prefix(bad[i]) == NULL)
             fail_msg("emit_check_prefix accepted '%s'", bad[i]);
-    const char *good[] = {"fb", "_x", "four_bar2", "A", "mech_1"};
+    const char *good[] = {"fb", "_x", "four_bar2", "A", "mech_1", "mechrtx", "mechrt2"};
     for (size_t i = 0; i < sizeof good / sizeof *good; i++)
         if (emit_check_prefix(good[i]) != NULL)
             fail_msg("emit_check_prefix rejected '%s': %s", good[i], emit_check_prefix(good[i]));

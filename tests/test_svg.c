@@ -883,7 +883,8 @@ static void test_plot_resolve(void **state)
     svg_plot_var_name(m, v[2], name, sizeof name);
     assert_string_equal(name, "dd(slider.x)");
     struct { const char *list, *expect; } cases[] = {
-        {"crnk.phi", "unknown coordinate 'crnk.phi'; coordinates are crank.x, crank.y"},
+        {"crnk.phi", "unknown coordinate 'crnk.phi'; the 9 coordinates are crank.x, crank.y, "
+                     "crank.phi, rod.x, rod.y, rod.phi, slider.x, slider.y, slider.phi"},
         {"crank", "did you mean crank.x, crank.y, crank.phi"},
         {"d(crank.phi", "missing ')'"},
         {"crank.x,,rod.x", "empty name"},

@@ -78,8 +78,10 @@ static const CliOption options[] = {
              "projected onto the velocity equations"},
     {"--interpolate", CLI_FLAG_AT(SimCli, so.interpolate),
      .help = "step across the output times: states there from the\n"
-             "steps' quintic Hermite interpolant (fewer steps when\n"
-             "outputs are dense; default: a step ends at each)"},
+             "Hermite interpolant of q, qd, qdd at the ends of the\n"
+             "last two steps, degree 8 (quintic within the first step;\n"
+             "fewer steps when outputs are dense; default: a step\n"
+             "ends at each)"},
     {"--baumgarte", CLI_STRING_AT(SimCli, baumgarte), .metavar = "A,B",
      .help = "Baumgarte stabilisation gamma - 2A Phi' - B^2 Phi\n"
              "(1/s; default off: projection alone)"},

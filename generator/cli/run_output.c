@@ -56,10 +56,6 @@ void run_output_open(RunOutput *out, const Model *m)
                            (const char *const *)out->outputs.wnames);
     if (out->lambda_use == RUN_OUTPUT_FORCES)
         open_forces(out, m);
-    if (out->csv)
-        mechrt_csv_header_extra(out->csv, out->nv, out->names, out->outputs.nw,
-                                (const char *const *)out->outputs.wnames, out->nx,
-                                (const char *const *)out->xnames);
 }
 
 void run_output_close(RunOutput *out)
@@ -136,6 +132,12 @@ void run_output_state(void *ctx, double t, const double *q, const double *qd,
         for (int i = 0; i < out->nd; i++)
             out->x[out->nr + i] = -lambda[out->drivers[i]];
     }
+    if (out->csv && !out->headed) {
+        mechrt_csv_header_extra(out->csv, out->nv, out->names, out->outputs.nw,
+                                (const char *const *)out->outputs.wnames, out->nx,
+                                (const char *const *)out->xnames);
+        out->headed = true;
+    }
     if (out->csv)
         mechrt_csv_row_extra(out->csv, out->nv, t, q, qd, qdd, out->outputs.nw, out->w,
                              out->nx, out->x, out->digits);
@@ -211,12 +213,15 @@ bool run_output_resolve_pictures(const char *cmd, const Model *m, const CliList 
     }
     add_point_outputs(m, p, p->svg_path != NULL);
     if (p->plot_path && plot_list) {
+        size_t size = svg_plot_err_size(m) + strlen(plot_list);
+        char *why = xmalloc(size);
         p->nvars = svg_plot_resolve_forces(m, plot_list, forces, p->vars,
-                                           RUN_OUTPUT_MAX_PLOT_VARS, err, sizeof err);
-        if (p->nvars <= 0) {
-            fprintf(stderr, "mechc %s: error: %s\n", cmd, err);
+                                           RUN_OUTPUT_MAX_PLOT_VARS, why, size);
+        if (p->nvars <= 0)
+            fprintf(stderr, "mechc %s: error: %s\n", cmd, why);
+        free(why);
+        if (p->nvars <= 0)
             return false;
-        }
     } else if (p->plot_path) {
         for (int i = 0; i < m->nq + m->nout && p->nvars < RUN_OUTPUT_MAX_PLOT_VARS; i++)
             p->vars[p->nvars++] = (SvgPlotVar){i, 0};

@@ -56,6 +56,8 @@ typedef struct RunOutput {
     double *x;                  /* a state's extra columns */
     Progress progress;
     bool warned;                /* an output was not finite (said once) */
+    bool headed;                /* the CSV header is written: with the first state, so a
+                                   run that fails before it prints nothing */
 } RunOutput;
 
 /* Sets up out for m (out's first fields filled) and writes the CSV

@@ -42,10 +42,11 @@ typedef struct SimOptions {
     MechrtOptions mechrt;
     bool project;           /* coordinate projection; true */
     /* Steps across the output times instead of ending a step at each one;
-       the state at an output time is the quintic Hermite interpolant of
-       the enclosing step's ends (q, qd, qdd at both), its accelerations
-       and multipliers solved there (not projected: Phi = 0 holds to the
-       interpolation error). false: every output time is a step's end */
+       the state at an output time is the degree-8 Hermite interpolant of
+       q, qd, qdd at the ends of the enclosing step and the one before
+       (quintic, on the enclosing step's ends alone, in the first), its
+       accelerations and multipliers solved there (not projected: Phi = 0
+       holds to the interpolation error). false: every output time is a step's end */
     bool interpolate;
     /* At the start of every step (on the manifold), rows whose pivot in
        the rank-revealing elimination is <= row_tol * max|Phi_q_ij| are left

@@ -74,6 +74,22 @@ static bool is_keyword(const char *s)
     return false;
 }
 
+/* The runtime's names are mechrt_*, mechrtf_* (--real float) and MECHRT_*:
+   a prefix P whose P_ or upper-cased P_ can begin one of them would make a
+   generated name clash with the runtime's, so it is refused. */
+static bool is_runtime_prefix(const char *p)
+{
+    static const char *const reserved[] = {"mechrt", "mechrtf"};
+    for (size_t i = 0; i < sizeof reserved / sizeof *reserved; i++) {
+        size_t n = strlen(reserved[i]), k = 0;
+        while (k < n && tolower((unsigned char)p[k]) == reserved[i][k])
+            k++;
+        if (k == n && (p[n] == '\0' || p[n] == '_'))
+            return true;
+    }
+    return false;
+}
+
 const char *emit_check_prefix(const char *p)
 {
     if (!p[0])
@@ -89,6 +105,9 @@ const char *emit_check_prefix(const char *p)
         return "identifiers starting with '__' or '_' and a capital are reserved for the C implementation";
     if (is_keyword(p))
         return "it is a C keyword";
+    if (is_runtime_prefix(p))
+        return "the runtime's names start with mechrt_, mechrtf_ and MECHRT_, which this prefix "
+               "would clash with";
     return NULL;
 }
 

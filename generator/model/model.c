@@ -12,10 +12,13 @@
 #include "orient.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 const char *build_entity_word(EntityKind kind)
 {
@@ -622,13 +625,52 @@ const Body *model_find_body(const Model *m, const char *name)
     return NULL;
 }
 
-char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag)
+/* What a path that is not a regular file names, for the refusal. */
+static const char *file_kind(mode_t mode)
 {
-    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "rb");
-    if (!f) {
+    if (S_ISDIR(mode))
+        return "a directory";
+    if (S_ISFIFO(mode))
+        return "a named pipe";
+    if (S_ISCHR(mode) || S_ISBLK(mode))
+        return "a device";
+    if (S_ISSOCK(mode))
+        return "a socket";
+    return "not a regular file";
+}
+
+/* PATH opened for reading, or NULL with the reason in DIAG. O_NONBLOCK
+   because opening a named pipe with no writer blocks forever; only regular
+   files are read (stdin, "-", is the way to pipe a model in). */
+static FILE *open_model_file(const char *path, Diag *diag)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
         diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(errno));
+        if (fd >= 0)
+            close(fd);
         return NULL;
     }
+    if (!S_ISREG(st.st_mode)) {
+        diag_error_nopos(diag, "cannot read '%s': %s; give a regular file, or '-' for stdin",
+                         path, file_kind(st.st_mode));
+        close(fd);
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
+char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag)
+{
+    FILE *f = strcmp(path, "-") == 0 ? stdin : open_model_file(path, diag);
+    if (!f)
+        return NULL;
     size_t cap = 4096, n = 0;
     char *buf = xmalloc(cap);
     for (;;) {

@@ -367,8 +367,16 @@ static int find_coord(const Model *m, const char *name, size_t len)
     return -1;
 }
 
+size_t svg_plot_err_size(const Model *m)
+{
+    size_t size = 256;
+    for (int i = 0; i < m->nq + m->nout; i++)
+        size += strlen(svg_plot_var_label(m, i)) + 2;
+    return size;
+}
+
 /* Explains an unknown name: a body or point named without a coordinate, or
-   the list of coordinates (shortened for big mechanisms). */
+   every coordinate and output there is, counted. */
 static void unknown_name(const Model *m, const char *name, size_t len, char *err, size_t errlen)
 {
     int nv = m->nq + m->nout;
@@ -386,14 +394,16 @@ static void unknown_name(const Model *m, const char *name, size_t len, char *err
     }
     if (members > 0)
         return;
-    n = snprintf(err + used, used < errlen ? errlen - used : 0, "; %s are ",
-                 m->nout ? "coordinates and outputs" : "coordinates");
+    if (nv == 1)
+        n = snprintf(err + used, used < errlen ? errlen - used : 0, "; the only coordinate is ");
+    else if (m->nout)
+        n = snprintf(err + used, used < errlen ? errlen - used : 0,
+                     "; the %d coordinates and %d output%s are ", m->nq, m->nout,
+                     m->nout == 1 ? "" : "s");
+    else
+        n = snprintf(err + used, used < errlen ? errlen - used : 0, "; the %d coordinates are ", nv);
     used += n > 0 ? (size_t)n : 0;
     for (int i = 0; i < nv && used + 1 < errlen; i++) {
-        if (i == 8 && nv > 9) {
-            snprintf(err + used, errlen - used, ", ... (%d in all)", nv);
-            return;
-        }
         n = snprintf(err + used, errlen - used, "%s%s", i ? ", " : "", svg_plot_var_label(m, i));
         used += n > 0 ? (size_t)n : 0;
     }

@@ -48,10 +48,13 @@ enum { SVG_PLOT_LAMBDA = 3, SVG_PLOT_EFFORT = 4 };
 /* Parses a --plot-vars list: comma-separated NAME (a coordinate or an output), d(NAME)
    (its velocity) or dd(NAME) (its acceleration), blanks allowed around
    items. Fills out[0..max) and returns the count; on error returns -1 with
-   a one-line reason in err (an unknown name is reported with the
-   coordinates that exist). */
+   a one-line reason in err (an unknown name is reported with every
+   coordinate and output that exists: give err svg_plot_err_size(m) bytes plus the list's length). */
 int svg_plot_resolve(const Model *m, const char *list, SvgPlotVar *out, int max,
                      char *err, size_t errlen);
+/* Bytes that hold any reason svg_plot_resolve gives for model m, besides
+   the names quoted from the list. */
+size_t svg_plot_err_size(const Model *m);
 /* The same, also taking lambda(ROW) (a row's name) and effort(DRIVER) (a
    driver's name) when forces is true. */
 int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPlotVar *out,
