@@ -12,7 +12,7 @@
 # methods; the engines agreeing; a redundant parallelogram with masses
 # through its flat positions; exit statuses and messages of bad use; motions
 # that cannot go on (a rolling disk falling flat), --max-steps, and the note
-# on moved initial values that run prints (issue 31).
+# on moved initial values that run prints.
 # The last line is "sim_cli: N passed, M failed".
 set -u
 # shellcheck source=tests/lib.sh
@@ -415,7 +415,7 @@ run "$tmp/free.mech" --t1 1
 check "a massless free coordinate: exit 1" status_is 1
 check "a massless free coordinate: t = 0 and singular" err_matches 't = 0: .*singular'
 
-# ---- motions that cannot go on end with exit 1, the time and the rows (issue 31) ----
+# ---- motions that cannot go on end with exit 1, the time and the rows ----
 # A disk rolling on z = 0, leaning 0.3 rad, falls flat at t = 0.607: its
 # contact's normal (the unit horizontal part of the axle) is 0/0 there, the
 # rows roll.h and roll.x not defined. rk8pd and rkf45 crept on with steps
