@@ -176,9 +176,9 @@ static void print_stats(Mech *mech, const GenCli *c, const EmitResult *res, doub
             "%d Jacobian nonzeros\n", mech->model->name, mech->model->nq, mech->model->nr,
             mech->model->nh, mech->model->nv, mech->kin.nnz);
     fprintf(stderr, "mechc gen: operations after sharing:");
-    int nf = emit_function_count(&mech->kin);
-    for (int f = 0; f < nf; f++)
-        if (emit_function_written(&c->emit, (EmitFunction)f))
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        if (emit_function_present(&mech->kin, (EmitFunction)f)
+            && emit_function_written(&c->emit, (EmitFunction)f))
             fprintf(stderr, "%s %s %d", f ? "," : "", emit_function_names[f], res->ops[f]);
     fputc('\n', stderr);
     fprintf(stderr, "mechc gen: graph %d nodes; load %.3f s, derivatives %.3f s, emission %.3f s\n",

@@ -157,6 +157,7 @@ NodeId dag_const(Dag *dag, double value)
 NodeId dag_var(Dag *dag, int index)      { return intern(dag, OP_VAR, index, -1, 0.0); }
 NodeId dag_vard(Dag *dag, int index)     { return intern(dag, OP_VARD, index, -1, 0.0); }
 NodeId dag_time(Dag *dag)                { return intern(dag, OP_TIME, -1, -1, 0.0); }
+NodeId dag_param(Dag *dag, int index)    { return intern(dag, OP_PARAM, index, -1, 0.0); }
 
 bool dag_is_const(const Dag *dag, NodeId id, double *value)
 {
@@ -182,7 +183,7 @@ static bool is_value(const Dag *dag, NodeId id, double want)
 double dag_op_eval(DagOp op, double a, double b)
 {
     switch (op) {
-    case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: return NAN;
+    case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: case OP_PARAM: return NAN;
     case OP_NEG:   return -a;
     case OP_ADD:   return a + b;
     case OP_SUB:   return a - b;
@@ -614,6 +615,12 @@ static void format_node(const Dag *dag, NodeId id, const char *const *names,
         return;
     case OP_TIME:
         sb_puts(out, "t");
+        return;
+    case OP_PARAM:
+        if (dag->param_names)
+            sb_puts(out, dag->param_names[n->a]);
+        else
+            sb_printf(out, "p[%d]", n->a);
         return;
     case OP_NEG:
         sb_putc(out, '-');

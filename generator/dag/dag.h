@@ -50,6 +50,13 @@ typedef struct Dag {
        ones its functions use (dag_check_float). */
     struct DagWide *wide;
     int32_t nwide, wide_cap;
+    /* Design parameters (`design NAME = value`): OP_PARAM leaf a reads
+       param_values[a], the design every evaluation on the host sees (the
+       interpreter, the compiled units through engine.c); the model owns
+       both arrays. np 0: a file without design parameters. */
+    int np;
+    double *param_values;
+    const char *const *param_names;
 } Dag;
 
 typedef struct DagWide {
@@ -79,7 +86,7 @@ static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes
 static inline bool dag_is_leaf(const Dag *dag, NodeId id)
 {
     DagOp op = dag_op(dag, id);
-    return op == OP_CONST || op == OP_VAR || op == OP_VARD || op == OP_TIME;
+    return op == OP_CONST || op == OP_VAR || op == OP_VARD || op == OP_TIME || op == OP_PARAM;
 }
 bool dag_is_const(const Dag *dag, NodeId id, double *value);
 bool dag_is_zero(const Dag *dag, NodeId id);
@@ -89,6 +96,7 @@ NodeId dag_const(Dag *dag, double value);
 NodeId dag_var(Dag *dag, int index);     /* q[index] */
 NodeId dag_vard(Dag *dag, int index);    /* qd[index] */
 NodeId dag_time(Dag *dag);
+NodeId dag_param(Dag *dag, int index);   /* design parameter p[index] */
 
 /* Operators, simplified as they are built: constants folded when the
    result is finite, 0/1 identities, x - x, double negation, numeric

@@ -13,7 +13,8 @@
 
 enum { CODE_T = -1, CODE_TOTAL = -2, CODE_NOVEL = -3 };
 
-/* Variable codes: q_j is j, qd_j is nq + j, the rest are negative. */
+/* Variable codes: q_j is j, qd_j is nq + j, design parameter p_j is
+   2 nq + j, the rest are negative. */
 void differ_init(Differ *differ, Dag *dag, int nq)
 {
     differ->dag = dag;
@@ -51,6 +52,10 @@ static NodeId leaf_rule(const Differ *df, const DagNode *n, NodeId e, int code)
         if (code == CODE_NOVEL)
             return e;
         return code == CODE_T || code == CODE_TOTAL ? DAG_ONE : DAG_ZERO;
+    case OP_PARAM:      /* constant in time and in every state */
+        if (code == CODE_NOVEL)
+            return e;
+        return code == 2 * df->nq + n->a ? DAG_ONE : DAG_ZERO;
     default:
         return DAG_NONE;
     }
@@ -124,7 +129,7 @@ static NodeId chain_rule(Differ *df, NodeId e, int code)
     case OP_COSH: return dag_mul(d, dag_call(d, OP_SINH, a, DAG_NONE), da);
     /* tanh' = 1 - tanh^2 */
     case OP_TANH: return dag_mul(d, dag_sub(d, DAG_ONE, dag_mul(d, e, e)), da);
-    case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: case OP_COUNT:
+    case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: case OP_PARAM: case OP_COUNT:
         break;
     }
     return DAG_ZERO;
@@ -157,6 +162,7 @@ static NodeId derive(Differ *df, NodeId e, int code)
 
 NodeId diff_by_q(Differ *df, NodeId e, int j) { return derive(df, e, j); }
 NodeId diff_by_qd(Differ *df, NodeId e, int j) { return derive(df, e, df->nq + j); }
+NodeId diff_by_p(Differ *df, NodeId e, int j) { return derive(df, e, 2 * df->nq + j); }
 NodeId diff_by_t(Differ *df, NodeId e) { return derive(df, e, CODE_T); }
 NodeId diff_total(Differ *df, NodeId e) { return derive(df, e, CODE_TOTAL); }
 NodeId diff_without_velocities(Differ *df, NodeId e) { return derive(df, e, CODE_NOVEL); }

@@ -16,6 +16,7 @@ void differ_free(Differ *differ);
 
 NodeId diff_by_q(Differ *differ, NodeId e, int j);     /* de/dq_j */
 NodeId diff_by_qd(Differ *differ, NodeId e, int j);    /* de/dqd_j */
+NodeId diff_by_p(Differ *differ, NodeId e, int j);     /* de/dp_j (design parameter j) */
 NodeId diff_by_t(Differ *differ, NodeId e);            /* partial de/dt */
 
 /* Total time derivative along the motion with the accelerations left out:

@@ -31,6 +31,8 @@ typedef struct Kinematics {
     int nnz;
     int *row_start;     /* nr + 1: row r's entries are jac[row_start[r] .. row_start[r+1]) */
     Dynamics dyn;       /* M and Q, when the model has masses */
+    NodeId *phi_p;      /* nh x np, row-major: dPhi/dp, the design
+                           parameters' columns (NULL without them) */
 } Kinematics;
 
 /* Differentiates every row of the model. Returns false with diag filled

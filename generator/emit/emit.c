@@ -20,9 +20,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-int emit_function_count(const Kinematics *kin)
+bool emit_function_present(const Kinematics *kin, EmitFunction f)
 {
-    return kin->dyn.present ? EMIT_FUNCTION_COUNT : EMIT_KINEMATIC_COUNT;
+    switch (emit_function_family[f]) {
+    case EMIT_DYN: return kin->dyn.present;
+    case EMIT_DESIGN: return kin->model->np > 0;
+    case EMIT_KIN: case EMIT_DENSE: case EMIT_SPARSE: case EMIT_LU: case EMIT_FAMILY_COUNT: break;
+    }
+    return true;
 }
 
 /* A parameter of the generated functions. */
@@ -50,6 +55,24 @@ static const Param function_params[EMIT_GENERATED_COUNT][8] = {
 #undef OUT
 #undef NONE
 #undef P
+
+/* The parameters of function which in e's file, into out (NULL-named
+   end): the table's, with `const real *p` before the first output in a
+   file with design parameters. */
+static const Param *params_of(const Emitter *e, EmitFunction which, Param out[10])
+{
+    const Param *from = function_params[which];
+    if (e->kin->model->np == 0)
+        return from;
+    int n = 0;
+    for (; from->name && (from->input || from->scalar); from++)
+        out[n++] = *from;
+    out[n++] = (Param){"p", true, false};
+    for (; from->name; from++)
+        out[n++] = *from;
+    out[n] = (Param){NULL, false, false};
+    return out;
+}
 
 EmitOptions emit_default_options(void)
 {
@@ -153,9 +176,11 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
     if (!e->roll) {     /* a loop body's parameters are the function's */
+        Param buf[10];
+        const Param *params = params_of(e, which, buf);
         sb_puts(sb, "    ");
-        for (const Param *p = function_params[which]; p->name; p++)
-            sb_printf(sb, "%s(void)%s;", p == function_params[which] ? "" : " ", p->name);
+        for (const Param *p = params; p->name; p++)
+            sb_printf(sb, "%s(void)%s;", p == params ? "" : " ", p->name);
         sb_puts(sb, workspace ? " (void)ws;\n" : "\n");
     }
     trig_put_first(e, sb, fn, c);
@@ -182,18 +207,18 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
 }
 
 /* q, qd, t, gamma -> "const P_real *q, const P_real *qd, P_real t, P_real *gamma" */
-static void put_signature(StrBuf *sb, const char *prefix, EmitFunction which)
+static void put_signature(StrBuf *sb, const char *prefix, const Param *params)
 {
-    for (const Param *p = function_params[which]; p->name; p++)
-        sb_printf(sb, "%s%s%s_real %s%s", p == function_params[which] ? "" : ", ",
+    for (const Param *p = params; p->name; p++)
+        sb_printf(sb, "%s%s%s_real %s%s", p == params ? "" : ", ",
                   p->input ? "const " : "", prefix, p->scalar ? "" : "*", p->name);
 }
 
 /* q, qd, t, gamma -> "q, qd, t, gamma" */
-static void put_arguments(StrBuf *sb, EmitFunction which)
+static void put_arguments(StrBuf *sb, const Param *params)
 {
-    for (const Param *p = function_params[which]; p->name; p++)
-        sb_printf(sb, "%s%s", p == function_params[which] ? "" : ", ", p->name);
+    for (const Param *p = params; p->name; p++)
+        sb_printf(sb, "%s%s", p == params ? "" : ", ", p->name);
 }
 
 /* Fills parts (static helpers, one per chunk) and body (the function's
@@ -206,19 +231,21 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
         return;
     }
     const char *p = e->prefix;
+    Param buf[10];
+    const Param *params = params_of(e, which, buf);
     bool workspace = fn->nslots > 0;    /* values that cross parts */
     if (workspace)
         sb_printf(body, "    %s_real ws[%d];\n", p, fn->nslots);
     for (int c = 0; c < fn->nchunks; c++) {
         sb_printf(parts, "%s_PART void %s_%s_part%d(", e->prefix_upper, p, emit_function_names[which], c);
-        put_signature(parts, p, which);
+        put_signature(parts, p, params);
         if (workspace)
             sb_printf(parts, ", %s_real *ws", p);
         sb_puts(parts, ")\n{\n");
         put_chunk(e, parts, fn, c, which, workspace);
         sb_puts(parts, "}\n\n");
         sb_printf(body, "    %s_%s_part%d(", p, emit_function_names[which], c);
-        put_arguments(body, which);
+        put_arguments(body, params);
         sb_puts(body, workspace ? ", ws);\n" : ");\n");
     }
 }
@@ -260,6 +287,12 @@ static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutp
                     * sizeof **outs);
     *n = 0;
     bool all = which == EMIT_ALL || which == EMIT_ALL_NZ, eom = which == EMIT_EOM;
+    if (which == EMIT_PHI_P) {      /* dense: every entry written */
+        *outs = xrealloc(*outs, (size_t)m->nh * (size_t)m->np + 1, sizeof **outs);
+        for (int k = 0; k < m->nh * m->np; k++)
+            add_output(outs, n, "phi_p", k, kin->phi_p[k]);
+        return;
+    }
     if (which >= EMIT_MASS && !eom) {
         collect_dynamics(kin, which, outs, n);
         return;
@@ -386,7 +419,7 @@ bool emit_function_written(const EmitOptions *opt, EmitFunction f)
     case EMIT_DENSE: return !opt->sparse_only;
     case EMIT_SPARSE: return opt->all_nz || opt->sparse_only;
     case EMIT_LU: return opt->lu;
-    case EMIT_KIN: case EMIT_DYN: case EMIT_FAMILY_COUNT: break;
+    case EMIT_KIN: case EMIT_DYN: case EMIT_DESIGN: case EMIT_FAMILY_COUNT: break;
     }
     return true;
 }
@@ -402,7 +435,7 @@ bool emit_direct_jac_default(const Kinematics *kin, int roll)
    Jacobian is spread from jac_nz, jac_spread.tmpl, unless direct). */
 static bool is_written(const Emitter *e, EmitFunction f)
 {
-    return (int)f < emit_function_count(e->kin) && (f != EMIT_JAC || e->opt->direct_jac)
+    return emit_function_present(e->kin, f) && (f != EMIT_JAC || e->opt->direct_jac)
            && emit_function_written(e->opt, f);
 }
 
@@ -506,8 +539,9 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     StrBuf ops;
     sb_init(&ops);
     sb_puts(&ops, "");
-    for (int f = 0; f < emit_function_count(e->kin); f++)
-        if (emit_function_written(e->opt, (EmitFunction)f))
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        if (emit_function_present(e->kin, (EmitFunction)f)
+            && emit_function_written(e->opt, (EmitFunction)f))
             sb_printf(&ops, "%s%s %d", f ? ", " : "", emit_function_names[f], out->ops[f]);
     emit_render_files(e, parts, bodies, ops.data, out);
     sb_free(&ops);

@@ -23,9 +23,10 @@
 enum { EMIT_DIRECT_JAC_NNZ = 4000 };
 bool emit_direct_jac_default(const Kinematics *kin, int roll);
 
-/* The functions kin's file gets: the kinematic ones, and the dynamics
-   ones when it has masses (EMIT_KINEMATIC_COUNT or EMIT_FUNCTION_COUNT). */
-int emit_function_count(const Kinematics *kin);
+/* Whether kin's file gets function f by what the mechanism has: the
+   dynamics ones with masses, phi_p with design parameters, the rest
+   always (options decide further: emit_function_written). */
+bool emit_function_present(const Kinematics *kin, EmitFunction f);
 
 /* Whether a file emitted with opt gets function f (kin with masses
    permitting; for the LU's, a mechanism emit_lu serves): by its family,

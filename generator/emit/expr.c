@@ -46,6 +46,7 @@ void emit_put_expr(const Emitter *e, StrBuf *sb, NodeId id, bool top)
         return;
     case OP_VARD:  sb_printf(sb, "qd[%d]", n->a); return;
     case OP_TIME:  sb_puts(sb, "t"); return;
+    case OP_PARAM: sb_printf(sb, "p[%d]", n->a); return;
     case OP_NEG:
         if (sched_fused_negation(&e->sched, id)) {     /* (-c) * y */
             const DagNode *product = dag_node(e->dag, n->a);

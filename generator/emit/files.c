@@ -141,6 +141,48 @@ static const char *put_dynamics(const Emitter *e, TemplateVar *vars, int nvars, 
     return NULL;
 }
 
+/* The pieces of text the templates are filled with. */
+enum {
+    FILE_BANNER, FILE_Q0, FILE_COORDS, FILE_ROWS, FILE_JROW, FILE_JCOL, FILE_MATH,
+    FILE_IFACE, FILE_ZERO, FILE_JAC, FILE_INC, FILE_MOVES, FILE_NZ_DECL, FILE_NZ_DEF,
+    FILE_MROW, FILE_MCOL, FILE_DYN_C, FILE_DYN_H, FILE_JAC_DECL, FILE_ALL_DECL, FILE_ALL_DEF,
+    FILE_MARK, FILE_P0, FILE_DNAMES, FILE_DESIGN_C, FILE_DESIGN_H, FILE_PIN, FILE_PARG, FILE_COUNT
+};
+
+/* The design parameters' part of the source (DESIGN) and of the
+   interface (DESIGN_INTERFACE), and what the signatures add (PIN, PARG);
+   all empty in a file without design parameters, whose output is what it
+   always was. Returns a placeholder without value, or NULL. */
+static const char *put_design(const Emitter *e, TemplateVar *vars, int nvars, StrBuf *b)
+{
+    const Model *m = e->kin->model;
+    if (m->np == 0)
+        return NULL;
+    sb_printf(&b[FILE_PIN], "const %s_real *p, ", e->prefix);
+    sb_puts(&b[FILE_PARG], "p, ");
+    template_set(vars, nvars, "PIN", b[FILE_PIN].data);
+    template_set(vars, nvars, "PARG", b[FILE_PARG].data);
+    for (int j = 0; j < m->np; j++) {
+        sb_puts(&b[FILE_P0], "    ");
+        emit_put_literal(&b[FILE_P0], m->design_p0[j], e->opt->real_float);
+        sb_puts(&b[FILE_P0], ",\n");
+    }
+    put_string_list(&b[FILE_DNAMES], m->design_names, m->np);
+    template_set(vars, nvars, "P0", b[FILE_P0].data);
+    template_set(vars, nvars, "DESIGN_NAMES", b[FILE_DNAMES].data);
+    StrBuf *c = &b[FILE_DESIGN_C], *h = &b[FILE_DESIGN_H];
+    const char *bad = template_render(h, template_design_h, vars, nvars);
+    if (!bad)
+        bad = template_render(c, template_design, vars, nvars);
+    if (bad)
+        return bad;
+    h->data[--h->len] = '\0';
+    c->data[--c->len] = '\0';
+    template_set(vars, nvars, "DESIGN_INTERFACE", h->data);
+    template_set(vars, nvars, "DESIGN", c->data);
+    return NULL;
+}
+
 /* PREFIX_all_nz's declaration and definition (templates/all_nz*.tmpl);
    both empty unless asked for, so that other files keep their bytes. */
 static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodies, StrBuf *decl,
@@ -148,8 +190,11 @@ static void put_all_nz(const Emitter *e, const StrBuf *parts, const StrBuf *bodi
 {
     if (!e->opt->all_nz)
         return;
+    char pin[160] = "";
+    if (e->kin->model->np)
+        snprintf(pin, sizeof pin, "const %s_real *p, ", e->prefix);
     TemplateVar v[] = {
-        {"P", e->prefix}, {"PU", e->prefix_upper},
+        {"P", e->prefix}, {"PU", e->prefix_upper}, {"PIN", pin},
         {"ALL_NZ_PARTS", parts[EMIT_ALL_NZ].data}, {"ALL_NZ_BODY", bodies[EMIT_ALL_NZ].data},
     };
     int nv = (int)(sizeof v / sizeof *v);
@@ -194,7 +239,7 @@ static const char *put_dense(const Emitter *e, TemplateVar *vars, int nvars, Str
 
 /* The sizes and the include guard, as text for the templates. */
 typedef struct EmitSizes {
-    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], guard[160];
+    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], np[32], guard[160];
 } EmitSizes;
 
 static void put_sizes(const Emitter *e, EmitSizes *z)
@@ -203,6 +248,7 @@ static void put_sizes(const Emitter *e, EmitSizes *z)
     snprintf(z->nq, sizeof z->nq, "%d", m->nq);
     snprintf(z->nh, sizeof z->nh, "%d", m->nh);
     snprintf(z->nv, sizeof z->nv, "%d", m->nv);
+    snprintf(z->np, sizeof z->np, "%d", m->np);
     /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
        placeholder entry (row 0, column 0, value 0). */
     snprintf(z->nnz, sizeof z->nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
@@ -227,13 +273,6 @@ static void put_moves(StrBuf *moves, const Emitter *e)
 }
 
 /* The texts the templates take besides the functions, in b[FILE_*]. */
-enum {
-    FILE_BANNER, FILE_Q0, FILE_COORDS, FILE_ROWS, FILE_JROW, FILE_JCOL, FILE_MATH,
-    FILE_IFACE, FILE_ZERO, FILE_JAC, FILE_INC, FILE_MOVES, FILE_NZ_DECL, FILE_NZ_DEF,
-    FILE_MROW, FILE_MCOL, FILE_DYN_C, FILE_DYN_H, FILE_JAC_DECL, FILE_ALL_DECL, FILE_ALL_DEF,
-    FILE_MARK, FILE_COUNT
-};
-
 static void put_pieces(const Emitter *e, const StrBuf *parts, const StrBuf *bodies,
                        EmitResult *out, StrBuf *b)
 {
@@ -258,7 +297,9 @@ static const char *render(const Emitter *e, TemplateVar *vars, int nvars, StrBuf
 {
     StrBuf *dense[5] = {&b[FILE_JAC_DECL], &b[FILE_ALL_DECL], &b[FILE_JAC], &b[FILE_ALL_DEF],
                         &b[FILE_MARK]};
-    const char *bad = put_dynamics(e, vars, nvars, &b[FILE_DYN_C], &b[FILE_DYN_H]);
+    const char *bad = put_design(e, vars, nvars, b);
+    if (!bad)
+        bad = put_dynamics(e, vars, nvars, &b[FILE_DYN_C], &b[FILE_DYN_H]);
     if (!bad)
         bad = put_dense(e, vars, nvars, dense);
     if (!bad)
@@ -315,6 +356,9 @@ void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const ch
         {"FORCE_PARTS", parts[EMIT_FORCE].data}, {"FORCE_BODY", bodies[EMIT_FORCE].data},
         {"EOM_PARTS", parts[EMIT_EOM].data}, {"EOM_BODY", bodies[EMIT_EOM].data},
         {"JAC_DECL", ""}, {"ALL_DECL", ""}, {"ALL", ""}, {"SPARSE_ONLY", ""},
+        {"PIN", ""}, {"PARG", ""}, {"NP", z.np}, {"P0", ""}, {"DESIGN_NAMES", ""},
+        {"DESIGN", ""}, {"DESIGN_INTERFACE", ""},
+        {"PHI_P_PARTS", parts[EMIT_PHI_P].data}, {"PHI_P_BODY", bodies[EMIT_PHI_P].data},
     };
     const char *bad = render(e, vars, (int)(sizeof vars / sizeof *vars), b, out);
     for (int i = 0; i < FILE_COUNT; i++)

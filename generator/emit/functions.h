@@ -8,8 +8,11 @@
      EMIT_SPARSE  one written with EmitOptions.all_nz or sparse_only
      EMIT_DYN     a file with masses (all of the family or none)
      EMIT_LU      one written with EmitOptions.lu, for a mechanism the
-                  unrolled LU serves (all of the family or none) */
-typedef enum EmitFamily { EMIT_KIN, EMIT_DENSE, EMIT_SPARSE, EMIT_DYN, EMIT_LU, EMIT_FAMILY_COUNT } EmitFamily;
+                  unrolled LU serves (all of the family or none)
+     EMIT_DESIGN  a file with design parameters (dPhi/dp) */
+typedef enum EmitFamily {
+    EMIT_KIN, EMIT_DENSE, EMIT_SPARSE, EMIT_DYN, EMIT_LU, EMIT_DESIGN, EMIT_FAMILY_COUNT
+} EmitFamily;
 
 /* The spec's function order (jac and all count 0 in a sparse-only file);
    then all_nz, an extension (written only with EmitOptions.all_nz or

@@ -146,6 +146,9 @@ static void put_node(Roll *r, Member *m, NodeId e, int *nlocal)
         put_code(r, new_slot(r, m, n->a));
     } else if (n->op == OP_TIME) {
         put_code(r, W_TIME);
+    } else if (n->op == OP_PARAM) {    /* not rolled: a design is not a slot */
+        m->ok = false;
+        put_code(r, W_TIME);
     } else {
         put_code(r, n->op);
         put_code(r, r->local[n->a]);

@@ -6,6 +6,8 @@ extern const char template_all[];
 extern const char template_all_decl[];
 extern const char template_all_nz[];
 extern const char template_all_nz_decl[];
+extern const char template_design[];
+extern const char template_design_h[];
 extern const char template_dynamics[];
 extern const char template_dynamics_h[];
 extern const char template_interface[];

@@ -104,6 +104,9 @@ void tape_compile_roots(Tape *p, const Dag *dag, const NodeId *roots, int nroots
         case OP_TIME:
             p->has_t = true;
             break;
+        case OP_PARAM:
+            p->params = dag->param_values;
+            break;
         default:
             in->a = cs->slot[node->a];
             in->b = dag_op_info[node->op].arity == 2 ? cs->slot[node->b] : in->a;
@@ -142,6 +145,7 @@ void tape_run(const Tape *p, const double *q, const double *qd, double t, double
         case OP_VAR:   reg[k] = q[in->a]; break;
         case OP_VARD:  reg[k] = qd ? qd[in->a] : 0.0; break;
         case OP_TIME:  reg[k] = t; break;
+        case OP_PARAM: reg[k] = p->params[in->a]; break;
         default:       reg[k] = dag_op_eval((DagOp)in->op, reg[in->a], reg[in->b]); break;
         }
     }
@@ -225,12 +229,15 @@ Jet tape_jet(const Tape *p, const Seed *s, int order, Jet *reg)
         case OP_TIME:
             reg[k] = (Jet){s->t, s->dt, 0.0};
             continue;
+        case OP_PARAM:
+            reg[k] = (Jet){p->params[in->a], 0.0, 0.0};
+            continue;
         default:
             break;
         }
         Jet a = reg[in->a], b = reg[in->b], r;
         switch ((DagOp)in->op) {
-        case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME:
+        case OP_CONST: case OP_VAR: case OP_VARD: case OP_TIME: case OP_PARAM:
             r = a;      /* handled above */
             break;
         case OP_NEG:

@@ -36,6 +36,8 @@ typedef struct Tape {
     int *qdcols;        /* velocities it reads (OP_VARD), ascending */
     int nqdcols;
     bool has_t;         /* reads t */
+    const double *params;   /* OP_PARAM reads params[a]: the graph's design
+                               (Dag.param_values) as it is when run */
 } Tape;
 
 /* A truncated Taylor expansion along one direction s of (q, qd, t):

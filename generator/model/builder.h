@@ -15,7 +15,8 @@ typedef struct Entity {
     const char *name;
     SrcPos pos;
     int q;              /* first coordinate (body, point, coord); joint: its index */
-    double value;       /* param */
+    double value;       /* param: its value (a design-dependent one's at the file's design) */
+    NodeId node;        /* param: its node (a constant, or an expression of design parameters) */
 } Entity;
 
 typedef struct Builder {
@@ -35,6 +36,7 @@ typedef struct Builder {
     int cap_masses, cap_forces;
     const Stmt *first_force;    /* the first force or gravity statement */
     int gravity_line;           /* the gravity statement's line, 0 if none */
+    int cap_design;             /* of model->design_names and design_p0 */
 } Builder;
 
 /* What an expression may use, from the most to the least restricted. */
@@ -75,8 +77,15 @@ const Joint *build_spatial_joint(Builder *b, const Ast *ast, const Entity *e, co
 NodeId build_lower_expr(Builder *b, const Ast *ast, ExprContext ctx);
 /* The same, the node limit checked once the expression is built. */
 NodeId build_lower(Builder *b, const Ast *ast, ExprContext ctx);
-/* A constant expression's value (NULL: 0), or fails naming what. */
+/* A constant expression's value (NULL: 0), or fails naming what (also
+   when it depends on a design parameter, which what cannot). */
 double build_constant(Builder *b, const Ast *ast, const char *what);
+/* A constant that may depend on design parameters (an offset, a derived
+   param): its node, and its value at the file's design in *nominal. */
+NodeId build_design_value(Builder *b, const Ast *ast, const char *what, double *nominal);
+/* A starting value (an initial position): a constant, or an expression of
+   design parameters taken at the file's design. */
+double build_nominal(Builder *b, const Ast *ast, const char *what);
 bool build_mentions_der(const Ast *ast);
 
 /* ---- masses, gravity and forces (dynamics.c) ---- */

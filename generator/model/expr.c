@@ -6,6 +6,8 @@
  */
 #include "builder.h"
 
+#include "../eval/interp.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -117,7 +119,7 @@ NodeId build_lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
         }
         Entity *e = build_lookup(b, ast->name, ast->pos);
         if (e->kind == ENT_PARAM)
-            return dag_const(dag, e->value);
+            return e->node;
         if (ctx <= EXPR_TIMED)
             diag_fail(b->diag, ast->pos, "'%s' is %s; only params may appear in %s",
                       e->name, build_entity_word(e->kind), context_what(ctx));
@@ -185,14 +187,51 @@ NodeId build_lower(Builder *b, const Ast *ast, ExprContext ctx)
     return id;
 }
 
+/* The first design parameter e uses (e is no constant), for messages. */
+static const char *first_design(const Dag *dag, NodeId e)
+{
+    const DagNode *n = dag_node(dag, e);
+    if (n->op == OP_PARAM)
+        return dag->param_names[n->a];
+    if (dag_is_leaf(dag, e))
+        return NULL;
+    const char *a = first_design(dag, n->a);
+    return a || dag_op_info[n->op].arity < 2 ? a : first_design(dag, n->b);
+}
+
 double build_constant(Builder *b, const Ast *ast, const char *what)
 {
     if (!ast)
         return 0.0;
+    Dag *dag = &b->model->dag;
     NodeId id = build_lower(b, ast, EXPR_CONSTANT);
     double v;
-    if (!dag_is_const(&b->model->dag, id, &v) || !isfinite(v))
+    if (!dag_is_const(dag, id, &v) && first_design(dag, id))
+        diag_fail(b->diag, ast->pos, "%s cannot depend on design parameter '%s' (design "
+                  "parameters may set offsets, lengths, drivers, constraints, outputs and "
+                  "initial values)", what, first_design(dag, id));
+    if (!dag_is_const(dag, id, &v) || !isfinite(v))
         diag_fail(b->diag, ast->pos, "%s is not a finite number", what);
+    return v;
+}
+
+NodeId build_design_value(Builder *b, const Ast *ast, const char *what, double *nominal)
+{
+    Dag *dag = &b->model->dag;
+    NodeId id = build_lower(b, ast, EXPR_CONSTANT);
+    if (dag_is_const(dag, id, nominal) && isfinite(*nominal))
+        return id;
+    *nominal = node_value_at(dag, id, NULL, NULL, 0.0);
+    if (!isfinite(*nominal))
+        diag_fail(b->diag, ast->pos, "%s is not a finite number at the file's design", what);
+    return id;
+}
+
+double build_nominal(Builder *b, const Ast *ast, const char *what)
+{
+    double v = 0.0;
+    if (ast)
+        build_design_value(b, ast, what, &v);
     return v;
 }
 

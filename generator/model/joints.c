@@ -53,6 +53,12 @@ static Vec rotate(Dag *d, NodeId phi, Vec v)
     return (Vec){x, y};
 }
 
+/* An attachment's offset s: its design's nodes, or constants. */
+static Vec offset_of(Dag *d, Attach at)
+{
+    return at.designed ? (Vec){at.s_node[0], at.s_node[1]} : vec_const(d, at.sx, at.sy);
+}
+
 static NodeId angle_of(Dag *d, Attach at)
 {
     return at.has_phi ? dag_var(d, at.q + 2) : DAG_ZERO;
@@ -62,12 +68,12 @@ static NodeId angle_of(Dag *d, Attach at)
 static Vec position(Dag *d, Attach at)
 {
     if (at.q < 0)
-        return vec_const(d, at.sx, at.sy);
+        return offset_of(d, at);
     NodeId rx = dag_var(d, at.q);
     NodeId ry = dag_var(d, at.q + 1);
     if (!at.has_phi)
         return (Vec){rx, ry};
-    Vec local = vec_const(d, at.sx, at.sy);
+    Vec local = offset_of(d, at);
     Vec s = rotate(d, angle_of(d, at), local);
     NodeId x = dag_add(d, rx, s.x);
     NodeId y = dag_add(d, ry, s.y);
@@ -84,7 +90,7 @@ static Vec velocity(Dag *d, Attach at)
     if (!at.has_phi)
         return (Vec){vx, vy};
     NodeId w = dag_vard(d, at.q + 2);
-    Vec local = vec_const(d, at.sx, at.sy);
+    Vec local = offset_of(d, at);
     Vec s = rotate(d, angle_of(d, at), local);
     NodeId wy = dag_mul(d, w, s.y);
     NodeId x = dag_sub(d, vx, wy);

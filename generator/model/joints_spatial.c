@@ -111,6 +111,8 @@ static Vec3 euler_vector(Dag *d, Attach at)
 /* A(p) s = (2 e0^2 - 1) s + e (e^T 2s) + e0 (e x 2s): the factor 2 in
    the constant vector, where it folds into s's components; ground and
    points do not turn: s itself. */
+static Vec3 rotate3_nodes(Dag *d, Attach at, Vec3 s, Vec3 s2);
+
 static Vec3 rotate3(Dag *d, Attach at, const double local[3])
 {
     Vec3 s = v3_const(d, local);
@@ -118,6 +120,12 @@ static Vec3 rotate3(Dag *d, Attach at, const double local[3])
         return s;
     double twice[3] = {2 * local[0], 2 * local[1], 2 * local[2]};
     Vec3 s2 = v3_const(d, twice);
+    return rotate3_nodes(d, at, s, s2);
+}
+
+/* The same with s and 2 s given as nodes (an offset of design parameters). */
+static Vec3 rotate3_nodes(Dag *d, Attach at, Vec3 s, Vec3 s2)
+{
     NodeId two = dag_const(d, 2.0);
     NodeId e0 = dag_var(d, at.q + 3);
     Vec3 e = euler_vector(d, at);
@@ -133,9 +141,25 @@ static Vec3 rotate3(Dag *d, Attach at, const double local[3])
     return v3_add(d, cs, sum);
 }
 
+/* position3 of an attachment whose offset depends on design parameters. */
+static Vec3 designed_position3(Dag *d, Attach at)
+{
+    Vec3 s = {at.s_node[0], at.s_node[1], at.s_node[2]};
+    if (at.q < 0)
+        return s;
+    Vec3 r = {dag_var(d, at.q), dag_var(d, at.q + 1), dag_var(d, at.q + 2)};
+    if (!at.has_p)
+        return r;
+    NodeId two = dag_const(d, 2.0);
+    Vec3 s2 = v3_scale(d, two, s);
+    return v3_add(d, r, rotate3_nodes(d, at, s, s2));
+}
+
 /* P = r + A(p) s (ground: s, the global point; a point: r). */
 static Vec3 position3(Dag *d, Attach at)
 {
+    if (at.designed)
+        return designed_position3(d, at);
     double s[3] = {at.sx, at.sy, at.sz};
     if (at.q < 0)
         return v3_const(d, s);

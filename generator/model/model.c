@@ -149,12 +149,12 @@ static void declare_spatial(Builder *b, const Stmt *s)
     double v[7];
     for (int i = 0; i < 3; i++) {
         snprintf(what, sizeof what, "the initial %s", word[i]);
-        v[i] = build_constant(b, s->init[i], what);
+        v[i] = build_nominal(b, s->init[i], what);
     }
     double arg[4] = {0, 0, 0, 0};
     int nargs = s->orient == ORIENT_AXIS ? 4 : s->orient == ORIENT_NONE ? 0 : 3;
     for (int i = 0; i < nargs; i++)
-        arg[i] = build_constant(b, s->orient_arg[i], "an orientation component");
+        arg[i] = build_nominal(b, s->orient_arg[i], "an orientation component");
     if (body && !orient_to_euler(s->orient, arg, v + 3))
         diag_fail(b->diag, s->orient_pos, "the orientation of body '%s' cannot be normalised: "
                   "its axis is zero", s->name);
@@ -179,7 +179,7 @@ static void declare_coordinates(Builder *b, const Stmt *s)
     char what[64];
     if (s->kind == STMT_COORD) {
         Entity *e = build_declare(b, ENT_COORD, s->name, s->name_pos);
-        double v = build_constant(b, s->value, "the initial value");
+        double v = build_nominal(b, s->value, "the initial value");
         e->q = add_coord(b, s->name, "", v, s->name_pos);
         return;
     }
@@ -191,7 +191,7 @@ static void declare_coordinates(Builder *b, const Stmt *s)
     double v[3];
     for (int i = 0; i < n; i++) {
         snprintf(what, sizeof what, "the initial %s", word[i]);
-        v[i] = build_constant(b, s->init[i], what);
+        v[i] = build_nominal(b, s->init[i], what);
     }
     Entity *e = build_declare(b, s->kind == STMT_BODY ? ENT_BODY : ENT_POINT, s->name, s->name_pos);
     for (int i = 0; i < n; i++) {
@@ -206,10 +206,13 @@ Attach build_attach(Builder *b, const AstAttach *at, AttachRule rule,
 {
     Attach r = {.q = -1, .spatial = b->spatial};
     if (at->has_offset) {
-        r.sx = build_constant(b, at->sx, "an attachment offset");
-        r.sy = build_constant(b, at->sy, "an attachment offset");
-        if (b->spatial)
-            r.sz = build_constant(b, at->sz, "an attachment offset");
+        const Ast *ast[3] = {at->sx, at->sy, b->spatial ? at->sz : NULL};
+        double *value[3] = {&r.sx, &r.sy, &r.sz};
+        for (int k = 0; k < 3; k++) {
+            r.s_node[k] = ast[k] ? build_design_value(b, ast[k], "an attachment offset", value[k])
+                                 : DAG_ZERO;
+            r.designed |= !dag_is_const(&b->model->dag, r.s_node[k], NULL);
+        }
     }
     if (strcmp(at->name, "ground") == 0) {
         if (rule == ATTACH_BODY || rule == ATTACH_BODY_ONLY)
@@ -497,6 +500,36 @@ static void build_output(Builder *b, const Stmt *s)
     push_output(b, s->name, ".y", xy[1]);
 }
 
+/* param NAME = value folds to a constant unless value uses a design
+   parameter; design NAME = value is the leaf p[index] of every kernel. */
+static void declare_param(Builder *b, const Stmt *s)
+{
+    Model *m = b->model;
+    if (!s->design) {
+        double v;
+        NodeId node = build_design_value(b, s->value, "the param value", &v);
+        Entity *e = build_declare(b, ENT_PARAM, s->name, s->name_pos);
+        e->value = v;
+        e->node = node;
+        return;
+    }
+    double v = build_constant(b, s->value, "the design value");
+    Entity *e = build_declare(b, ENT_PARAM, s->name, s->name_pos);
+    int cap = b->cap_design;
+    build_grow(&m->arena, (void **)&m->design_names, &cap, m->np + 1, sizeof *m->design_names);
+    build_grow(&m->arena, (void **)&m->design_p0, &b->cap_design, m->np + 1,
+               sizeof *m->design_p0);
+    m->design_names[m->np] = arena_strdup(&m->arena, e->name);
+    m->design_p0[m->np] = v;
+    e->value = v;
+    e->node = dag_param(&m->dag, m->np);
+    m->np++;
+    /* until model_set_design, the graph sees the file's design */
+    m->dag.np = m->np;
+    m->dag.param_values = m->design_p0;
+    m->dag.param_names = m->design_names;
+}
+
 static void build(Builder *b, const Program *prog, const char *default_name)
 {
     Model *m = b->model;
@@ -514,11 +547,9 @@ static void build(Builder *b, const Program *prog, const char *default_name)
         case STMT_SPATIAL:
             m->spatial = b->spatial = true;
             break;
-        case STMT_PARAM: {
-            double v = build_constant(b, s->value, "the param value");
-            build_declare(b, ENT_PARAM, s->name, s->name_pos)->value = v;
+        case STMT_PARAM:
+            declare_param(b, s);
             break;
-        }
         case STMT_BODY: case STMT_POINT: case STMT_COORD:
             declare_coordinates(b, s);
             break;
@@ -535,6 +566,10 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     }
     build_dynamics_check(b);
     m->dag.where = -1;
+    if (m->np) {    /* the design evaluated from now on, apart from the file's */
+        m->dag.param_values = arena_alloc_array(&m->arena, (size_t)m->np, sizeof(double));
+        model_set_design(m, NULL);
+    }
     collect_bodies(b);
     SrcPos where = last ? last->pos : (SrcPos){0};
     m->last_pos = where;
@@ -615,6 +650,11 @@ void model_free(Model *model)
     dag_free(&model->dag);
     arena_free(&model->arena);
     free(model);
+}
+
+void model_set_design(Model *model, const double *p)
+{
+    memcpy(model->dag.param_values, p ? p : model->design_p0, (size_t)model->np * sizeof *p);
 }
 
 const Body *model_find_body(const Model *m, const char *name)

@@ -18,6 +18,10 @@ typedef struct Attach {
     bool has_p;         /* a spatial body (not a point, not ground) */
     double sx, sy;      /* body-local offset, or global point for ground */
     double sz;          /* spatial only */
+    /* An offset that depends on design parameters: its nodes (sx, sy, sz
+       are their values at the file's design, for drawings and first guesses) */
+    bool designed;
+    NodeId s_node[3];
 } Attach;
 
 typedef struct Joint {
@@ -138,6 +142,11 @@ typedef struct Model {
     int nforces;
     AppliedForce *forces;
     double gravity[3];  /* (0, 0, 0) without a gravity statement; gz spatial only */
+    /* Design parameters in statement order: names and the file's values.
+       The design evaluated now is dag.param_values (model_set_design). */
+    int np;
+    const char **design_names;
+    double *design_p0;
 } Model;
 
 /* Reads, parses and resolves a .mech text. Returns NULL with diag filled
@@ -146,6 +155,9 @@ typedef struct Model {
 Model *model_load(const char *text, int text_len, const char *file,
                   const char *default_name, const MechLimits *limits, Diag *diag);
 void model_free(Model *model);
+/* Sets the design the model's graph is evaluated at (np values; NULL: the
+   file's): every engine and interpreted expression of this model sees it. */
+void model_set_design(Model *model, const double *p);
 
 /* The body or point called name, or NULL (ground, a scalar coord, a param,
    a joint or an unknown name). */

@@ -85,7 +85,7 @@ typedef struct Ast {
 typedef enum StmtKind {
     STMT_MECHANISM,     /* mechanism NAME */
     STMT_SPATIAL,       /* spatial (first statement after mechanism) */
-    STMT_PARAM,         /* param NAME = value */
+    STMT_PARAM,         /* param NAME = value; design NAME = value (design) */
     STMT_BODY,          /* body NAME [x = e] [y = e] [phi = e] */
     STMT_POINT,         /* point NAME [x = e] [y = e] */
     STMT_COORD,         /* coord NAME [= value] */
@@ -169,6 +169,7 @@ typedef struct Stmt {
                                torque or generalised force, lhs a torque's
                                angle(e) or gforce's coordinate */
     bool declares;          /* MASS, FORCE: name is declared (mass NAME: ...) */
+    bool design;            /* PARAM: a design parameter, an input of the kernels */
     Ast *key[DKEY_COUNT];   /* MASS, FORCE: key = value (NULL: absent) */
     SrcPos key_pos[DKEY_COUNT];
     Ast *vec[3];            /* force (fx, fy), gravity (gx, gy), com(sx, sy);

@@ -448,7 +448,7 @@ static void output(Parser *p, Stmt *s)
    unknown-statement message. */
 static void list_keywords(char *buf, size_t size, bool spatial)
 {
-    int n = snprintf(buf, size, "mechanism, %sparam, body, point, coord, output",
+    int n = snprintf(buf, size, "mechanism, %sparam, design, body, point, coord, output",
                      spatial ? "spatial, " : "");
     const char *words[JOINT_KIND_COUNT + FORCE_KIND_COUNT + 2];
     int count = 0;
@@ -493,6 +493,7 @@ static _Noreturn void wrong_dimension(Parser *p, const Token *kw)
 
 /* statement = 'mechanism' NAME
              | 'param' NAME '=' expr
+             | 'design' NAME '=' expr
              | body | point
              | 'coord' NAME ['=' expr]
              | output
@@ -521,12 +522,14 @@ static Stmt *statement(Parser *p)
         s->kind = STMT_MECHANISM;
         parse_advance(p);
         s->name = parse_declared_name(p, "mechanism", &s->name_pos);
-    } else if (lex_is_word(&kw, "param")) {
+    } else if (lex_is_word(&kw, "param") || lex_is_word(&kw, "design")) {
         s->kind = STMT_PARAM;
+        s->design = lex_is_word(&kw, "design");
+        const char *word = s->design ? "design" : "param";
         parse_advance(p);
-        s->name = parse_declared_name(p, "param", &s->name_pos);
+        s->name = parse_declared_name(p, word, &s->name_pos);
         if (p->tok.kind != TOK_EQ)
-            parse_expected(p, "'=' after 'param %s'", s->name);
+            parse_expected(p, "'=' after '%s %s'", word, s->name);
         parse_advance(p);
         s->value = parse_expr(p);
     } else if (lex_is_word(&kw, "body") || lex_is_word(&kw, "point")) {
