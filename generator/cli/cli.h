@@ -23,6 +23,9 @@ typedef struct Args {
     bool options_done;      /* after "--": every argument is a file name */
     char name[64];          /* the option name split off --opt=value */
     bool failed;
+    /* --design NAME=VALUE[,NAME=VALUE ...], every command's (design.c) */
+    const char *design[16];
+    int ndesign;
 } Args;
 
 void args_init(Args *a, const char *command, int argc, char **argv);
@@ -134,6 +137,13 @@ int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts);
    (NULL: the defaults). On bad input prints the diagnostic and returns
    NULL: exit status 2. diag must outlive the Mech (pipeline_load). */
 Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag);
+/* --design's values into m's design (design.c): the design the command
+   evaluates and gen writes as P_p0. false (reported, exit status 2) for an
+   unknown name, a value that is not a finite number, or a file without
+   design parameters. */
+bool cli_apply_design(const Args *a, Model *m);
+/* --design's line of --help. */
+void cli_print_design_help(FILE *out);
 /* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
 void cli_error(const Args *a, const Diag *diag);
 /* engine_open_with (options NULL: the defaults), the failure reported by

@@ -12,6 +12,10 @@ int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts)
     Mech *mech = cli_load(&a, (const MechLimits *)((const char *)opts + cmd->limits_offset), &diag);
     if (!mech)
         return EXIT_USAGE;
+    if (!cli_apply_design(&a, mech->model)) {
+        pipeline_free(mech);
+        return EXIT_USAGE;
+    }
     int status = cmd->run(&a, mech, &diag, opts);
     pipeline_free(mech);
     return status;

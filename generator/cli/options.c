@@ -98,7 +98,16 @@ bool cli_parse(Args *a, const CliCommand *cmd, int argc, char **argv, void *opts
             cli_print_help(cmd, stdout);
             return false;
         }
-        if ((o = find(limit_options, LIMIT_COUNT, name)))
+        if (strcmp(name, "--design") == 0) {
+            const char *v = args_value(a, name);
+            if (v && a->ndesign == (int)(sizeof a->design / sizeof *a->design)) {
+                fprintf(stderr, "mechc %s: error: --design given more than %d times\n",
+                        a->command, a->ndesign);
+                a->failed = true;
+            } else if (v) {
+                a->design[a->ndesign++] = v;
+            }
+        } else if ((o = find(limit_options, LIMIT_COUNT, name)))
             read_option(a, o, name, (char *)opts + cmd->limits_offset);
         else if ((o = find(cmd->options, cmd->count, name)))
             read_option(a, o, name, opts);
@@ -166,5 +175,6 @@ void cli_print_help(const CliCommand *cmd, FILE *out)
     }
     if (cmd->epilogue)
         fputs(cmd->epilogue, out);
+    cli_print_design_help(out);
     print_limits(out);
 }

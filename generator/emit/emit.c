@@ -547,6 +547,44 @@ static void render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, EmitRe
     sb_free(&ops);
 }
 
+/* EmitOptions.host_design: the file's functions renamed PREFIX_NAME_design
+   by macros before its text, and after it PREFIX_NAME without p, calling
+   them with the design PREFIX_design_bind was given. The written file
+   (gen) never has these: its p is an argument. */
+static void put_host_design(const Emitter *e, EmitResult *out)
+{
+    const char *pre = e->prefix;
+    StrBuf sb;
+    sb_init(&sb);
+    sb_puts(&sb, "");
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++)
+        if (emit_function_present(e->kin, (EmitFunction)f)
+            && emit_function_written(e->opt, (EmitFunction)f))
+            sb_printf(&sb, "#define %s_%s %s_%s_design\n", pre, emit_function_names[f], pre,
+                      emit_function_names[f]);
+    sb_puts(&sb, out->c_text);
+    sb_printf(&sb, "\n/* ---- the host's context-free twins ---- */\n"
+              "static const %s_real *%s_design_p;\n"
+              "void %s_design_bind(const %s_real *p) { %s_design_p = p; }\n", pre, pre, pre, pre, pre);
+    for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
+        if (!emit_function_present(e->kin, (EmitFunction)f)
+            || !emit_function_written(e->opt, (EmitFunction)f))
+            continue;
+        const char *name = emit_function_names[f];
+        sb_printf(&sb, "#undef %s_%s\nvoid %s_%s(", pre, name, pre, name);
+        put_signature(&sb, pre, function_params[f]);
+        sb_printf(&sb, ")\n{\n    %s_%s_design(", pre, name);
+        Param buf[10];
+        const Param *params = params_of(e, (EmitFunction)f, buf);
+        for (const Param *p = params; p->name; p++)
+            sb_printf(&sb, "%s%s%s", p == params ? "" : ", ",
+                      strcmp(p->name, "p") == 0 ? pre : "", strcmp(p->name, "p") == 0 ? "_design_p" : p->name);
+        sb_puts(&sb, ");\n}\n");
+    }
+    free(out->c_text);
+    out->c_text = sb_take(&sb);
+}
+
 bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResult *out, Diag *diag)
 {
     const Model *m = kin->model;
@@ -579,6 +617,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
     trig_free(&e.trig);
     if (fits)
         render_files(&e, parts, bodies, out);
+    if (fits && opt->host_design && m->np > 0)
+        put_host_design(&e, out);
     else
         diag_error_nopos(diag, "the generated code would have more than %ld operations, "
                          "the limit (see --max-code-ops)", opt->max_ops);

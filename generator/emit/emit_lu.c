@@ -627,6 +627,8 @@ static bool lu_refused(const Kinematics *kin, char *why, size_t size)
         snprintf(why, size, "%d coordinates, more than %d", m->nq, LU_MAX_N);
     else if (m->nq < 1 || kin->nnz < 1)
         snprintf(why, size, "the Jacobian has no nonzero entries");
+    else if (m->np > 0)     /* PREFIX_step's signature has no p */
+        snprintf(why, size, "the mechanism has design parameters");
     else
         return false;
     return true;

@@ -33,6 +33,10 @@ typedef struct EmitOptions {
                                    interface defines PREFIX_SPARSE_ONLY 1
                                    (gen --sparse-only; engines above
                                    EMIT_DENSE_MAX_ENTRIES) */
+    bool host_design;           /* a file with design parameters also gets
+                                   context-free twins of its functions that
+                                   read p from PREFIX_design_bind's pointer
+                                   (the engines': jit.h's Kernels have no p) */
     bool lu;                    /* also PREFIX_lu_factor and PREFIX_lu_solve
                                    (emit_lu.c; gen --lu): the Jacobian's LU
                                    unrolled for its pattern */

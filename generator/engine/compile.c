@@ -17,6 +17,7 @@ EmitOptions engine_emit_options(const Mech *mech, EngineKind kind)
     eo.all_nz = true;       /* run's sparse path */
     eo.lu = true;           /* run's dense path: the unrolled LU */
     eo.sparse_only = sparse_only(mech);
+    eo.host_design = true;  /* engine.c binds the design (model_set_design's) */
     switch (kind) {
     case ENGINE_JIT:
         eo.declare_math = true;

@@ -149,6 +149,8 @@ static void gen_mass_nz(void *ctx, const double *q, double *vals)
 static void bind_code(Engine *e, const Kernels *code)
 {
     void *ctx = (void *)code;
+    if (code->design_bind)  /* the unit reads the model's design (model_set_design) */
+        code->design_bind(e->mech->model->dag.param_values);
     e->compiled = true;
     e->kernels = *code;
     e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = ctx,

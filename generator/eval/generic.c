@@ -220,6 +220,11 @@ static void collect_rotations(Generic *g, const char *need)
         }
 }
 
+static bool designed(const Joint *j)
+{
+    return j->a.designed || j->b.designed;
+}
+
 Generic *generic_open(const Model *m)
 {
     Generic *g = xcalloc(1, sizeof *g);
@@ -245,10 +250,12 @@ Generic *generic_open(const Model *m)
         *p = (Plan){.j = j, .row = j->first_row, .velocity = j->velocity, .prog = -1,
                     .opt = {.constant = true, .prog = -1}};
         p->of = j;
-        p->rows = generic_joint_formula(j, need);
-        if (!p->rows && j->kind == JOINT_DRIVER && j->measures != 0) {
+        /* formulas hold offsets as numbers: a joint whose offsets are
+           design parameters' is interpreted from its rows (which read p) */
+        p->rows = designed(j) ? NULL : generic_joint_formula(j, need);
+        if (!p->rows && !designed(j) && j->kind == JOINT_DRIVER && j->measures != 0) {
             p->of = &m->joints[abs(j->measures) - 1];
-            p->rows = generic_measure_rows(j, p->of, need);
+            p->rows = designed(p->of) ? NULL : generic_measure_rows(j, p->of, need);
         }
         if (!p->rows) {
             interpret_rows(g, p, &cs);

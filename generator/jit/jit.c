@@ -94,6 +94,7 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->jac_col = kernel(find, handle, prefix, "jac_col");
     k->mass_row = kernel(find, handle, prefix, "mass_row");
     k->mass_col = kernel(find, handle, prefix, "mass_col");
+    *(void **)&k->design_bind = kernel(find, handle, prefix, "design_bind");
     bool mass_pattern = k->mass_row && k->mass_col;
     bool dynamics = found[EMIT_DYN] == rows[EMIT_DYN] && mass_pattern;
     bool none = found[EMIT_DYN] == 0 && !k->mass_row && !k->mass_col;

@@ -31,6 +31,9 @@ typedef struct Kernels {
 #undef X
     const int *jac_row, *jac_col;
     const int *mass_row, *mass_col;
+    /* a unit with design parameters (EmitOptions.host_design): where its
+       functions read p from; NULL otherwise */
+    void (*design_bind)(const double *p);
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
