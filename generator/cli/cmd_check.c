@@ -94,6 +94,14 @@ static const char *col_name(const Model *m, int col)
     return col >= 0 && col < m->nq ? m->coord_names[col] : "-";
 }
 
+/* An item's column: a coordinate, or a design parameter (dPhi/dp's items). */
+static const char *item_col(const Model *m, const CheckItem *it)
+{
+    if (it->design_col)
+        return it->col >= 0 && it->col < m->np ? m->design_names[it->col] : "-";
+    return col_name(m, it->col);
+}
+
 static void print_json(const Model *m, const CheckReport *rep)
 {
     printf("{\"ok\": %s, \"samples\": %d, \"assembled\": %s, \"engines\": [",
@@ -120,7 +128,7 @@ static void print_json(const Model *m, const CheckReport *rep)
             printf("null");
         if (it->col >= 0) {
             printf(", \"col\": ");
-            json_string(stdout, m->coord_names[it->col]);
+            json_string(stdout, item_col(m, it));
         }
         printf(", \"tol\": ");
         json_number(stdout, it->tol);
@@ -176,8 +184,8 @@ static void print_text(const Model *m, const CheckReport *rep)
             continue;
         if ((int)strlen(row_name(m, it->row)) > rw)
             rw = (int)strlen(row_name(m, it->row));
-        if (it->col >= 0 && (int)strlen(m->coord_names[it->col]) > cw)
-            cw = (int)strlen(m->coord_names[it->col]);
+        if (it->col >= 0 && (int)strlen(item_col(m, it)) > cw)
+            cw = (int)strlen(item_col(m, it));
     }
     printf("     %-17s  %11s  %9s  %-*s  %-*s  %-10s  %s\n", "what", "worst error", "tolerance", rw, "row",
            cw, "col", "t", "fd step");
@@ -185,7 +193,7 @@ static void print_text(const Model *m, const CheckReport *rep)
         const CheckItem *it = &rep->items[w];
         if (!it->checked)
             continue;
-        if (w == CHECK_PAIR_FIRST || w == CHECK_DYN_FIRST)
+        if (w == CHECK_PAIR_FIRST || w == CHECK_DYN_FIRST || w == CHECK_PHI_P_FD)
             printf("\n");
         char step[40] = "";
         if (item_fd(it, rep)) {
@@ -195,7 +203,7 @@ static void print_text(const Model *m, const CheckReport *rep)
                 snprintf(step, sizeof step, "exact");
         }
         printf("%-4s %-17s  %11.3g  %9.3g  %-*s  %-*s  %-*.6g%s%s\n", item_ok(it) ? "ok" : "FAIL", it->what,
-               it->error, it->tol, rw, row_name(m, it->row), cw, col_name(m, it->col), step[0] ? 10 : 0, it->t,
+               it->error, it->tol, rw, row_name(m, it->row), cw, item_col(m, it), step[0] ? 10 : 0, it->t,
                step[0] ? "  " : "", step);
         if (item_fd(it, rep) && it->refined > 0)
             printf("       refined: %d comparison%s judged at another step than the default (a fast-varying row)\n",
@@ -223,7 +231,7 @@ static void report_failures(const char *file, const Model *m, const CheckReport 
         if (it->checked && !item_ok(it)) {
             fprintf(stderr, "%s: error: %s of row %s%s%s is off by %.3g (tolerance %.3g) at t = %.17g%s%s\n",
                     file, it->what, row_name(m, it->row),
-                    it->col >= 0 ? ", column " : "", it->col >= 0 ? col_name(m, it->col) : "",
+                    it->col >= 0 ? ", column " : "", it->col >= 0 ? item_col(m, it) : "",
                     it->error, it->tol, it->t, it->hint[0] ? ": " : "", it->hint);
             break;
         }

@@ -20,7 +20,8 @@ static const char usage[] =
     "                  [--engine jit|generic|aot] [--json]\n"
     "\n"
     "Evaluates Phi, Phi_q, nu and gamma at exactly the given state (no assembly);\n"
-    "with masses also M and Q (M(q) qdd + Phi_q^T lambda = Q(q, qd, t)).\n"
+    "with masses also M and Q (M(q) qdd + Phi_q^T lambda = Q(q, qd, t)); with\n"
+    "design parameters also Phi_p (dPhi/dp).\n"
     "\n";
 
 static const CliOption options[] = {
@@ -57,9 +58,50 @@ static void print_json_dynamics(const Model *m, const double *M, const double *Q
     printf("]");
 }
 
+/* "design", "p" and "phi_p" (a file with design parameters): after the others. */
+static void print_json_design(const Model *m, const double *phi_p)
+{
+    printf(",\n \"design\": ");
+    json_string_list(stdout, m->design_names, m->np);
+    printf(",\n \"p\": [");
+    for (int j = 0; j < m->np; j++) {
+        printf(j ? ", " : "");
+        json_number(stdout, m->dag.param_values[j]);
+    }
+    printf("],\n \"phi_p\": [");
+    for (int r = 0; r < m->nh; r++) {
+        printf(r ? ",\n           [" : "[");
+        for (int j = 0; j < m->np; j++) {
+            printf(j ? ", " : "");
+            json_number(stdout, phi_p[(size_t)r * (size_t)m->np + (size_t)j]);
+        }
+        printf("]");
+    }
+    printf("]");
+}
+
+/* The design and dPhi/dp's nonzero entries row by row. */
+static void print_text_design(const Model *m, const double *phi_p)
+{
+    printf("\nDesign parameters:");
+    for (int j = 0; j < m->np; j++)
+        printf("%s %s = %.17g", j ? "," : "", m->design_names[j], m->dag.param_values[j]);
+    printf("\n\nSensitivity Phi_p (nonzero entries, row by row):\n");
+    for (int r = 0; r < m->nh; r++) {
+        printf("  %s:", m->rows[r].name);
+        int shown = 0;
+        for (int j = 0; j < m->np; j++) {
+            double v = phi_p[(size_t)r * (size_t)m->np + (size_t)j];
+            if (v != 0.0)
+                printf("%s d/d%s = %.17g", shown++ ? "," : "", m->design_names[j], v);
+        }
+        printf("%s\n", shown ? "" : " (all zero)");
+    }
+}
+
 static void print_json(const Model *m, double t, const double *q, const double *qd, const double *phi,
                        const double *jac, const double *nu, const double *gamma, const double *M,
-                       const double *Q)
+                       const double *Q, const double *phi_p)
 {
     printf("{\"coords\": ");
     json_string_list(stdout, m->coord_names, m->nq);
@@ -99,6 +141,8 @@ static void print_json(const Model *m, double t, const double *q, const double *
     printf("]");
     if (M)
         print_json_dynamics(m, M, Q);
+    if (phi_p)
+        print_json_design(m, phi_p);
     printf("}\n");
 }
 
@@ -196,15 +240,22 @@ static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const do
         e.k.mass(e.k.ctx, q, M);
         e.k.force(e.k.ctx, q, qd, c->t, Q);
     }
+    double *phi_p = NULL;
+    if (m->np > 0) {
+        phi_p = xcalloc((size_t)m->nh * (size_t)m->np + 1, sizeof *phi_p);
+        engine_phi_p(&e, q, c->t, phi_p);
+    }
     engine_close(&e);
     if (c->json) {
-        print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q);
+        print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q, phi_p);
     } else {
         print_text(m, c->t, q, qd, phi, jac, nu, gamma);
         if (M)
             print_text_dynamics(m, M, Q);
+        if (phi_p)
+            print_text_design(m, phi_p);
     }
-    free(phi), free(nu), free(gamma), free(jac), free(M), free(Q);
+    free(phi), free(nu), free(gamma), free(jac), free(M), free(Q), free(phi_p);
     return true;
 }
 

@@ -230,6 +230,7 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
         e->k = (MechrtKernels){.nq = e->nq, .nh = e->nh, .nv = e->nv, .ctx = e->generic,
                                .phi = gen_phi, .jac = gen_jac, .nu = gen_nu,
                                .gamma = gen_gamma, .all = gen_all};
+        engine_design_open(e);
         if (mech->model->nmasses > 0) {
             e->k.mass = gen_mass;
             e->k.force = gen_force;
@@ -270,6 +271,7 @@ void engine_close(Engine *e)
     jit_free(e->jit);
     aot_unload(e->aot);
     generic_free(e->generic);
+    engine_design_free(e);
     free(e->pattern);
     emit_result_free(&e->emitted);
     memset(e, 0, sizeof *e);

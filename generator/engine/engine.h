@@ -52,6 +52,9 @@ typedef struct Engine {
     double gen_seconds;     /* emission time (generic: set-up time) */
     double compile_seconds; /* libtcc or cc time (aot: with the cache lookup and dlopen) */
     bool aot_cached;        /* aot: the library came from the cache */
+    /* generic with design parameters: dPhi/dp interpreted from the graph
+       (design.c); NULL otherwise */
+    struct NodeValues *phi_p_values;
 } Engine;
 
 /* How to open an engine; engine_default_options() for the usual. */
@@ -132,6 +135,14 @@ static inline void engine_nu(const Engine *e, const double *q, double t, double 
 {
     e->k.nu(e->k.ctx, q, t, nu);
 }
+
+/* dPhi/dp at (q, t) and the model's design: nh x np, row-major (design.c).
+   Needs np > 0. */
+void engine_phi_p(const Engine *e, const double *q, double t, double *phi_p);
+/* The generic engine's interpreted dPhi/dp (nothing without design
+   parameters), and its release (engine_close). */
+void engine_design_open(Engine *e);
+void engine_design_free(Engine *e);
 
 static inline void engine_gamma(const Engine *e, const double *q, const double *qd, double t,
                                 double *gamma)

@@ -54,11 +54,12 @@
  * Richardson step (error O(h^4)), on the same ladder of steps as gamma's.
  *
  * The pieces: checker.c (the state), engines.c, fd.c, groups.c,
- * dynamics.c (M and Q), hints.c (the verdict and its hints).
+ * dynamics.c (M and Q), design.c (dPhi/dp), hints.c (the verdict and its hints).
  */
 #include "check.h"
 
 #include "checker.h"
+#include "design.h"
 #include "dynamics.h"
 #include "engines.h"
 #include "fd.h"
@@ -95,6 +96,7 @@ static const char *const pair_names[PAIR_COUNT * QTY_COUNT] = {
 static const char *const dyn_names[CHECK_WHAT_COUNT - CHECK_DYN_FIRST] = {
     "M jit/generic", "Q jit/generic", "M jit/aot", "Q jit/aot", "M generic/aot", "Q generic/aot",
     "M symmetric", "M semi-definite", "Q velocity fd",
+    "phi_p", "phi_p jit/generic", "phi_p jit/aot", "phi_p generic/aot",
 };
 
 /* The base state's Newton (assemble_at_t0's, on the engine under test's
@@ -164,7 +166,9 @@ static void init_items(CheckReport *rep, const CheckOptions *opt)
         it->what = w < CHECK_PAIR_FIRST ? fd_names[w]
                    : w < CHECK_DYN_FIRST ? pair_names[w - CHECK_PAIR_FIRST]
                    : dyn_names[w - CHECK_DYN_FIRST];
-        it->tol = w < CHECK_PAIR_FIRST || w == CHECK_QV_FD ? opt->tol : opt->tol_engines;
+        it->tol = w < CHECK_PAIR_FIRST || w == CHECK_QV_FD || w == CHECK_PHI_P_FD
+                  ? opt->tol : opt->tol_engines;
+        it->design_col = w >= CHECK_PHI_P_FD;
         it->row = it->col = -1;
         it->unsettled_row = it->unsettled_col = -1;
     }
@@ -227,6 +231,8 @@ static void sample_loop(Checker *c)
         check_fd(c, c->scratch, c->vec);
         if (c->dyn)
             check_dynamics(c);
+        if (c->m->np > 0)
+            check_design(c);
     }
     c->rep->samples = c->opt->samples;
 }

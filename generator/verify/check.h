@@ -68,7 +68,12 @@ typedef enum CheckWhat {
     CHECK_M_SYMMETRIC = CHECK_DYN_FIRST + 2 * CHECK_PAIR_COUNT,
     CHECK_M_PSD,
     CHECK_QV_FD,
-    CHECK_WHAT_COUNT
+    /* a file with design parameters: the jit's dPhi/dp against finite
+       differences in p, then every pair of engines on it (col: the
+       design parameter) */
+    CHECK_PHI_P_FD,
+    CHECK_PHI_P_PAIR_FIRST,
+    CHECK_WHAT_COUNT = CHECK_PHI_P_PAIR_FIRST + CHECK_PAIR_COUNT
 } CheckWhat;
 
 typedef struct CheckItem {
@@ -89,6 +94,7 @@ typedef struct CheckItem {
                                three neighbouring steps agreed): neither passed nor
                                failed, as the differences cannot tell */
     int unsettled_row, unsettled_col; /* the first of them */
+    bool design_col;        /* col is a design parameter, not a coordinate */
     char hint[240];         /* when above tolerance: what mistake it looks like */
 } CheckItem;
 
