@@ -10,6 +10,7 @@
 
 #include "../kin/outputs.h"
 #include "../kin/run.h"
+#include "../kin/sens.h"
 #include "../base/arena.h"
 #include "run_output.h"
 #include "run_table.h"
@@ -32,7 +33,7 @@ typedef struct RunCli {
     int engine, ode, digits;
     int view;               /* --view: an SvgView; -1: not given (iso) */
     int linear;             /* --linear, an AnalysisLinear */
-    bool json, stats, forces;
+    bool json, stats, forces, sens;
     bool pictures, csv_stdout, table;   /* worked out from the above */
 } RunCli;
 
@@ -87,6 +88,11 @@ static const CliOption options[] = {
              "= -lambda(D) of every driver, as CSV columns after the\n"
              "others and JSON \"rows\", \"lambda\", \"drivers\", \"efforts\";\n"
              "--svg draws the joints' reaction forces as arrows"},
+    {"--sens", CLI_FLAG_AT(RunCli, sens),
+     .help = "sensitivities to the design parameters (a file with\n"
+             "`design` statements, holonomic): CSV columns d(NAME)/d(P),\n"
+             "d(d(NAME))/d(P) and d(dd(NAME))/d(P) after the others for\n"
+             "every coordinate and output NAME and design parameter P"},
     {"--digits", CLI_INT_AT(RunCli, digits, 1, 17), .metavar = "N",
      .help = "significant digits of numbers (default: the fewest that\n"
              "read back exactly, at most 17)"},
@@ -327,6 +333,11 @@ static bool finish(Args *a, void *opts)
         fprintf(stderr, "mechc run: error: --view goes with --svg FILE\n");
         return false;
     }
+    if (c->sens && (c->forces || c->json)) {
+        fprintf(stderr, "mechc run: error: --sens writes CSV columns: not with %s\n",
+                c->forces ? "--forces" : "--json");
+        return false;
+    }
     c->pictures = c->svg_path || c->plot_path;
     if (c->pictures && c->ro.steps == 0) {
         fprintf(stderr, "mechc run: error: %s needs a motion: one instant (--steps 0 or --at) "
@@ -419,8 +430,43 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
     return status;
 }
 
+/* --sens: the sensitivities at each state into the extra columns x; a
+   state where they cannot be had (Phi_q singular) gets NaN, said once. */
+typedef struct SensColumns {
+    Sens sens;
+    bool warned;
+} SensColumns;
+
+static void fill_sens(void *ctx, double t, const double *q, const double *qd, const double *qdd,
+                      double *x)
+{
+    SensColumns *sc = ctx;
+    MechrtStatus st = sens_eval(&sc->sens, t, q, qd, qdd);
+    if (st == MECHRT_OK) {
+        sens_columns(&sc->sens, x);
+        return;
+    }
+    for (int i = 0; i < sens_column_count(&sc->sens); i++)
+        x[i] = NAN;
+    if (!sc->warned)
+        fprintf(stderr, "%s: warning: no sensitivities at t = %.10g: %s (NaN there; later "
+                "ones are not reported)\n", sc->sens.m->file, t, mechrt_strerror(st));
+    sc->warned = true;
+}
+
+/* The extra columns of --sens on out. */
+static void open_sens(RunOutput *out, SensColumns *sc)
+{
+    int n = sens_column_count(&sc->sens);
+    char **names = xcalloc((size_t)n + 1, sizeof *names);
+    for (int i = 0; i < n; i++)
+        names[i] = sens_column_name(&sc->sens, out->names, i);
+    run_output_set_extra(out, n, names, fill_sens, sc);
+}
+
 /* Runs the analysis with the open engine, the states going where c says. */
-static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics)
+static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics,
+                   SensColumns *sc)
 {
     RunOutput out = {.cmd = "run", .keep = c->json || c->pictures || c->table,
                      .lambda_use = c->forces ? RUN_OUTPUT_FORCES : RUN_OUTPUT_NO_LAMBDA,
@@ -432,6 +478,8 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
         return EXIT_USAGE;
     }
     run_output_open(&out, m);
+    if (sc)
+        open_sens(&out, sc);
     const MechrtKernels *k = engine_kernels(e);
     const MechrtHostJacNz *jnz = engine_jac_nz(e);
     RunResult res;
@@ -465,7 +513,17 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
                 "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
                 e.gen_seconds, e.compile_seconds);
-    int status = analyse(c, mech->model, &e, &pics);
+    SensColumns sc = {0};
+    char why[200];
+    if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, &e, why, sizeof why)) {
+        diag_error(diag, mech->model->last_pos, "run --sens: %s", why);
+        diag_print(diag, stderr);
+        engine_close(&e);
+        return EXIT_USAGE;
+    }
+    int status = analyse(c, mech->model, &e, &pics, c->sens ? &sc : NULL);
+    if (c->sens)
+        sens_free(&sc.sens);
     engine_close(&e);
     return status;
 }

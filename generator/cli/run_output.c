@@ -58,6 +58,17 @@ void run_output_open(RunOutput *out, const Model *m)
         open_forces(out, m);
 }
 
+void run_output_set_extra(RunOutput *out, int n, char **names,
+                          void (*fill)(void *ctx, double t, const double *q, const double *qd,
+                                       const double *qdd, double *x), void *ctx)
+{
+    out->nx = n;
+    out->xnames = names;
+    out->x = xcalloc((size_t)n + 1, sizeof *out->x);
+    out->extra = fill;
+    out->extra_ctx = ctx;
+}
+
 void run_output_close(RunOutput *out)
 {
     outputs_free(&out->outputs);
@@ -122,6 +133,8 @@ void run_output_state(void *ctx, double t, const double *q, const double *qd,
 {
     RunOutput *out = ctx;
     outputs_omega(&out->outputs, q, qd, out->w);
+    if (out->extra)     /* before q becomes the variables (outputs appended) */
+        out->extra(out->extra_ctx, t, q, qd, qdd, out->x);
     if (out->nv > out->nq) {
         fill_variables(out, t, q, qd, qdd);
         q = out->v, qd = out->v + out->nv, qdd = out->v + 2 * out->nv;

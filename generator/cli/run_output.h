@@ -58,12 +58,23 @@ typedef struct RunOutput {
     bool warned;                /* an output was not finite (said once) */
     bool headed;                /* the CSV header is written: with the first state, so a
                                    run that fails before it prints nothing */
+    /* extra columns a command computes itself (run --sens): called at each
+       state to fill x (run_output_set_extra); NULL: none */
+    void (*extra)(void *ctx, double t, const double *q, const double *qd, const double *qdd,
+                  double *x);
+    void *extra_ctx;
 } RunOutput;
 
 /* Sets up out for m (out's first fields filled) and writes the CSV
    header when there is a CSV. */
 void run_output_open(RunOutput *out, const Model *m);
 void run_output_close(RunOutput *out);
+/* Extra CSV columns (not with RUN_OUTPUT_FORCES), after run_output_open:
+   n of them named names (taken: freed by run_output_close), filled by
+   fill at each state. */
+void run_output_set_extra(RunOutput *out, int n, char **names,
+                          void (*fill)(void *ctx, double t, const double *q, const double *qd,
+                                       const double *qdd, double *x), void *ctx);
 
 /* A state: the CSV row, the kept row, the progress. lambda: nr values
    (NULL when lambda_use is RUN_OUTPUT_NO_LAMBDA). Shaped as RunForcesFn

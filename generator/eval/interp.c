@@ -224,13 +224,14 @@ Jet tape_jet(const Tape *p, const Seed *s, int order, Jet *reg)
             reg[k] = (Jet){s->q[in->a], s->dq ? s->dq[in->a] : (in->a == s->col_q ? 1.0 : 0.0), 0.0};
             continue;
         case OP_VARD:
-            reg[k] = (Jet){s->qd ? s->qd[in->a] : 0.0, in->a == s->col_qd ? 1.0 : 0.0, 0.0};
+            reg[k] = (Jet){s->qd ? s->qd[in->a] : 0.0,
+                           s->dqd ? s->dqd[in->a] : in->a == s->col_qd ? 1.0 : 0.0, 0.0};
             continue;
         case OP_TIME:
             reg[k] = (Jet){s->t, s->dt, 0.0};
             continue;
         case OP_PARAM:
-            reg[k] = (Jet){p->params[in->a], 0.0, 0.0};
+            reg[k] = (Jet){p->params[in->a], s->dp ? s->dp[in->a] : 0.0, 0.0};
             continue;
         default:
             break;

@@ -55,6 +55,8 @@ typedef struct Seed {
     int col_q;              /* -1: none */
     int col_qd;             /* direction of qd: unit vector col_qd, -1: none */
     double dt;              /* direction of t */
+    const double *dqd;      /* direction of qd as a vector (then col_qd unused); NULL: col_qd */
+    const double *dp;       /* direction of the design parameters; NULL: none */
 } Seed;
 
 /* Scratch for compiling: marks the nodes of one root at a time. Sized for

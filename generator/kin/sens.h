@@ -1,0 +1,57 @@
+/* sens.h - the sensitivities of a state of the motion to the design parameters (mechc run --sens).
+ *
+ * Along a motion Phi(q, p, t) = 0 of a holonomic mechanism with as many
+ * rows as coordinates, each design parameter p_j moves the state:
+ *
+ *   Phi_q q_pj   = -Phi_pj                                   (positions)
+ *   Phi_q qd_pj  = -(V_q q_pj + V_pj),       V = Phi_q qd + Phi_t
+ *   Phi_q qdd_pj = -(W_q q_pj + W_qd qd_pj + W_pj),  W = Phi_q qdd - gamma
+ *
+ * one LU of Phi_q per state serving every right-hand side. Phi_p comes
+ * from the engine (the generated PREFIX_phi_p); the right-hand sides of
+ * the velocities and accelerations, and the outputs' sensitivities, are
+ * directional derivatives of graph expressions taken in forward mode by
+ * the interpreter (interp.h: exact, no finite differences).
+ */
+#ifndef MECHC_SENS_H
+#define MECHC_SENS_H
+
+#include "../engine/engine.h"
+#include "../eval/interp.h"
+
+typedef struct Sens {
+    const Model *m;
+    const Engine *e;
+    int nq, np, nout;
+    /* the results at the last sens_eval, variable-major: [i * np + j] is
+       d(variable i)/d(p_j) */
+    double *q_p, *qd_p, *qdd_p;     /* nq x np */
+    double *y_p, *yd_p, *ydd_p;     /* nout x np: the outputs' */
+    /* the rest is sens.c's */
+    Tape *tapes;                    /* V, gamma, outputs f, Df, DDf */
+    Jet *reg;
+    double *jac, *piv, *phi_p, *rhs, *dp, *zero, *col, *cold, *coldd;
+} Sens;
+
+/* Prepares s for the motion of m through e (np > 0, no velocity-level
+   rows, as many rows as coordinates); adds the nodes it needs (V, the
+   outputs' time derivatives) to m's graph. false with why (size bytes)
+   when m is not such a mechanism. */
+bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size);
+void sens_free(Sens *s);
+
+/* The sensitivities at the state (t, q, qd, qdd) of the motion, at the
+   model's design. MECHRT_OK, or the LU's status when Phi_q is singular
+   there. */
+MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, const double *qdd);
+
+/* The CSV names of sens's columns, in sens_columns' order: d(NAME)/d(P)
+   for every coordinate and output and design parameter, then
+   d(d(NAME))/d(P) (velocities), then d(dd(NAME))/d(P); count:
+   3 (nq + nout) np. Strings malloc'ed, freed by the caller. */
+int sens_column_count(const Sens *s);
+char *sens_column_name(const Sens *s, const char *const *names, int column);
+/* The last sens_eval's values in that order, into out. */
+void sens_columns(const Sens *s, double *out);
+
+#endif
