@@ -40,7 +40,7 @@ int main(int argc, char **argv)
     }
     static const struct { const char *name; int (*fn)(int, char **); } commands[] = {
         {"gen", cmd_gen}, {"eval", cmd_eval}, {"run", cmd_run}, {"sim", cmd_sim},
-        {"check", cmd_check}, {"info", cmd_info}, {"bench", cmd_bench},
+        {"check", cmd_check}, {"info", cmd_info}, {"bench", cmd_bench}, {"fit", cmd_fit},
     };
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         if (strcmp(cmd, commands[i].name) == 0)

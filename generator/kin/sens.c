@@ -108,7 +108,7 @@ static void pass(Sens *s, int tape, const double *q, const double *qd, double t,
     tape_jet(&s->tapes[tape], &seed, 1, s->reg);
 }
 
-/* Column j of a variable-major nq x np array, into and out of col. */
+/* Column j of a variable-major nq x np array, from col. */
 static void put_column(const Sens *s, double *a, int j, const double *col)
 {
     for (int i = 0; i < s->nq; i++)
@@ -171,17 +171,39 @@ static void column(Sens *s, int j, double t, const double *q, const double *qd, 
     s->dp[j] = 0.0;
 }
 
-MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, const double *qdd)
+/* Phi_q factored and Phi_p at (q, t). */
+static MechrtStatus factor(Sens *s, double t, const double *q)
 {
     int n = s->nq;
     engine_jac(s->e, q, t, s->jac);
     engine_phi_p(s->e, q, t, s->phi_p);
-    MechrtStatus st = mechrt_lu_factor(n, s->jac, n, s->piv, mechrt_default_options().pivot_tol, NULL);
-    if (st != MECHRT_OK)
-        return st;
-    for (int j = 0; j < s->np; j++)
+    return mechrt_lu_factor(n, s->jac, n, s->piv, mechrt_default_options().pivot_tol, NULL);
+}
+
+MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, const double *qdd)
+{
+    MechrtStatus st = factor(s, t, q);
+    for (int j = 0; j < s->np && st == MECHRT_OK; j++)
         column(s, j, t, q, qd, qdd);
-    return MECHRT_OK;
+    return st;
+}
+
+MechrtStatus sens_eval_positions(Sens *s, double t, const double *q)
+{
+    MechrtStatus st = factor(s, t, q);
+    size_t np = (size_t)s->np;
+    for (int j = 0; j < s->np && st == MECHRT_OK; j++) {
+        for (int i = 0; i < s->nq; i++)
+            s->col[i] = -s->phi_p[(size_t)i * np + (size_t)j];
+        mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
+        put_column(s, s->q_p, j, s->col);
+        s->dp[j] = 1.0;
+        pass(s, TAPE_F, q, NULL, t, s->col, s->zero);
+        s->dp[j] = 0.0;
+        for (int k = 0; k < s->nout; k++)
+            s->y_p[(size_t)k * np + (size_t)j] = jet_d(s, TAPE_F, k);
+    }
+    return st;
 }
 
 int sens_column_count(const Sens *s)

@@ -44,6 +44,8 @@ void sens_free(Sens *s);
    model's design. MECHRT_OK, or the LU's status when Phi_q is singular
    there. */
 MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, const double *qdd);
+/* The same for positions alone: q_p and y_p (what fitting positions needs). */
+MechrtStatus sens_eval_positions(Sens *s, double t, const double *q);
 
 /* The CSV names of sens's columns, in sens_columns' order: d(NAME)/d(P)
    for every coordinate and output and design parameter, then
