@@ -46,7 +46,8 @@ static const CliOption options[] = {
      .help = "keep parameter P in [LO, HI] (repeatable)"},
     {"--steps", CLI_INT_AT(FitCli, fo.steps, 1, 100000000), .metavar = "N",
      .help = "intervals over the data's time span when following the\n"
-             "motion between samples (default 100)"},
+             "motion between samples (default 20; steps that would\n"
+             "leave the assembly branch are subdivided, as in run)"},
     {"--max-iter", CLI_INT_AT(FitCli, fo.max_iter, 1, 100000), .metavar = "N",
      .help = "solver iterations (default 200)"},
     {"--tol", CLI_REAL_AT(FitCli, tol), CLI_POSITIVE, .what = "a positive number", .echo = true,
@@ -160,10 +161,10 @@ static void print_text(const Model *m, const FitData *d, const FitResult *r, con
     printf("fit %s: %d parameter%s from %d measured value%s at %d sample%s (%s)\n", m->name, r->k,
            r->k == 1 ? "" : "s", r->n, r->n == 1 ? "" : "s", d->nsamples,
            d->nsamples == 1 ? "" : "s", path);
-    printf("%s: %s after %d iterations (%d evaluations of the motion, %d of its sensitivities); "
-           "cost %.6g -> %.6g\n\n", r->status == FIT_OK ? "converged" : "not converged",
-           r->reason[0] ? r->reason : "stopped", r->iterations, r->nevalf, r->nevaldf, r->cost0,
-           r->cost);
+    printf("%s: %s after %d iterations (%d evaluations of the motion, %d of its sensitivities, "
+           "%.3g ms of CPU); cost %.6g -> %.6g\n\n",
+           r->status == FIT_OK ? "converged" : "not converged", r->reason[0] ? r->reason : "stopped",
+           r->iterations, r->nevalf, r->nevaldf, 1e3 * r->cpu_seconds, r->cost0, r->cost);
     printf("%-14s %24s %24s %12s\n", "parameter", "start", "estimate", "std error");
     for (int a = 0; a < r->k; a++) {
         int j = r->index[a];
@@ -215,6 +216,8 @@ static void print_json(const Model *m, const FitData *d, const FitResult *r, int
     json_number(stdout, r->cost);
     printf(", \"condition\": ");
     json_number(stdout, r->cond);
+    printf(", \"cpu_seconds\": ");
+    json_number(stdout, r->cpu_seconds);
     if (r->status != FIT_OK) {
         printf(", \"error\": ");
         json_string(stdout, r->message);

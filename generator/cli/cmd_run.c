@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 
@@ -435,13 +436,18 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
 typedef struct SensColumns {
     Sens sens;
     bool warned;
+    long states;
+    double cpu_seconds;     /* in sens_eval (clock()), for --stats */
 } SensColumns;
 
 static void fill_sens(void *ctx, double t, const double *q, const double *qd, const double *qdd,
                       double *x)
 {
     SensColumns *sc = ctx;
+    clock_t start = clock();
     MechrtStatus st = sens_eval(&sc->sens, t, q, qd, qdd);
+    sc->cpu_seconds += (double)(clock() - start) / CLOCKS_PER_SEC;
+    sc->states++;
     if (st == MECHRT_OK) {
         sens_columns(&sc->sens, x);
         return;
@@ -522,6 +528,10 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_USAGE;
     }
     int status = analyse(c, mech->model, &e, &pics, c->sens ? &sc : NULL);
+    if (c->sens && c->stats && sc.states > 0)
+        fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters: %.6g ms of "
+                "CPU time, %.0f ns per state\n", sc.sens.np, 1e3 * sc.cpu_seconds,
+                1e9 * sc.cpu_seconds / (double)sc.states);
     if (c->sens)
         sens_free(&sc.sens);
     engine_close(&e);

@@ -12,10 +12,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 FitOptions fit_default_options(void)
 {
-    return (FitOptions){.max_iter = 200, .xtol = 1e-15, .gtol = 1e-15, .ftol = 0.0, .steps = 100,
+    return (FitOptions){.max_iter = 200, .xtol = 1e-15, .gtol = 1e-15, .ftol = 0.0, .steps = 20,
                         .newton_tol = 1e-12};
 }
 
@@ -299,6 +300,7 @@ static FitStatus solve(Problem *pr, FitResult *r, gsl_vector *x0)
 FitStatus fit_run(Model *m, const Kinematics *kin, const Engine *e, const FitData *d,
                   const FitOptions *o, FitResult *r)
 {
+    clock_t start = clock();
     result_alloc(r, m, d);
     Problem pr = {.m = m, .d = d, .o = o};
     gsl_vector *x0 = NULL;
@@ -316,6 +318,7 @@ FitStatus fit_run(Model *m, const Kinematics *kin, const Engine *e, const FitDat
         gsl_vector_free(x0);
     fit_sampler_free(&pr.smp);
     free(pr.at), free(pr.value), free(pr.dvalue), free(pr.x_done);
+    r->cpu_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return r->status;
 }
 

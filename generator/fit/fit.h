@@ -20,7 +20,7 @@ typedef struct FitOptions {
     double *lo, *hi;        /* np: bounds (-inf, +inf: none) */
     int max_iter;           /* solver iterations (default 200) */
     double xtol, gtol, ftol;/* GSL's tests (default 1e-15, 1e-15, 0): to round-off */
-    int steps;              /* intervals over the data's span (default 100) */
+    int steps;              /* intervals over the data's span (default 20; run subdivides where it must) */
     double newton_tol;      /* the positions' Newton tolerances (default 1e-12) */
 } FitOptions;
 
@@ -39,6 +39,7 @@ typedef struct FitResult {
     int iterations, nevalf, nevaldf;
     const char *reason;     /* the solver's stopping test */
     double cond;            /* J's condition number (2-norm) at the solution */
+    double cpu_seconds;     /* the process's CPU time in fit_run (clock()) */
     double *model;          /* the data's shape: model values at the solution */
 } FitResult;
 

@@ -21,7 +21,7 @@ bool fit_sampler_init(FitSampler *s, Model *m, const Kinematics *kin, const Engi
        quadratically, so the last iteration costs little */
     s->ro.mechrt.tol_phi = s->ro.mechrt.tol_dq = newton_tol;
     double span = d->t[d->nsamples - 1] - d->t[0];
-    s->step = span > 0 ? span / (steps > 0 ? steps : 100) : 1.0;
+    s->step = span > 0 ? span / (steps > 0 ? steps : 20) : 1.0;
     s->q = xcalloc((size_t)m->nq, sizeof *s->q);
     s->start = xcalloc((size_t)m->nq, sizeof *s->start);
     s->y = xcalloc((size_t)m->nout + 1, sizeof *s->y);
