@@ -116,14 +116,8 @@ bool kinematics_build(Model *m, Kinematics *kin, Diag *diag)
     }
     if (ok && m->nmasses > 0)
         ok = dynamics_build(m, &kin->dyn, diag);
-    if (ok && m->np > 0) {      /* after everything else: files without design keep their ids */
-        kin->phi_p = arena_alloc_array(&m->arena, (size_t)m->nh * (size_t)m->np + 1,
-                                       sizeof *kin->phi_p);
-        for (int r = 0; r < m->nh; r++)
-            for (int j = 0; j < m->np; j++)
-                kin->phi_p[(size_t)r * (size_t)m->np + (size_t)j] = diff_by_p(&w.df, kin->phi[r], j);
-        ok = dag_check_limit(dag, diag);
-    }
+    if (ok && m->np > 0)        /* after everything else: files without design keep their ids */
+        ok = design_build(m, kin, diag);
     ok = ok && dag_check_finite(dag, diag);     /* the model's constants, and M's and Q's */
     free(w.jac);
     free(w.cols);

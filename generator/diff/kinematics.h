@@ -21,6 +21,19 @@ typedef struct Dynamics {
                            - J theta_q^T (thetadot_q qd): nq values (check) */
 } Dynamics;
 
+/* The partial derivatives the sensitivities of a motion to the design
+   parameters are made of (generator/diff/design.c, kin/sens.h), dense and
+   row-major, for a file with design parameters: V = D(Phi) = Phi_q qd +
+   Phi_t and gamma by q, qd and p (nh rows), and each output f, D f and
+   D(D f) by q, qd and p (nout rows). */
+enum { DESIGN_Y_COUNT = 8 };
+typedef struct DesignKin {
+    NodeId *v_q, *v_p;              /* nh x nq, nh x np */
+    NodeId *g_q, *g_qd, *g_p;       /* nh x nq, nh x nq, nh x np */
+    /* f_q, f_p, Df_q, Df_qd, Df_p, DDf_q, DDf_qd, DDf_p: nout x (nq or np) */
+    NodeId *y[DESIGN_Y_COUNT];
+} DesignKin;
+
 /* Everything the emitter and the interpreters need, row by row. */
 typedef struct Kinematics {
     const Model *model;
@@ -33,6 +46,7 @@ typedef struct Kinematics {
     Dynamics dyn;       /* M and Q, when the model has masses */
     NodeId *phi_p;      /* nh x np, row-major: dPhi/dp, the design
                            parameters' columns (NULL without them) */
+    DesignKin design;   /* what sensitivities need, with design parameters */
 } Kinematics;
 
 /* Differentiates every row of the model. Returns false with diag filled
@@ -44,5 +58,18 @@ bool kinematics_build(Model *model, Kinematics *kin, Diag *diag);
 /* M and Q of a model with masses, by the mass-element formulas (every
    derivative symbolic). False with diag filled past the node limit. */
 bool dynamics_build(Model *model, Dynamics *dyn, Diag *diag);
+
+/* Phi_p and kin->design for a model with design parameters (design.c).
+   False with diag filled past the node limit. */
+bool design_build(Model *model, Kinematics *kin, Diag *diag);
+/* Whether entry k of y[] is by p (np columns), else by q or qd (nq). */
+static inline bool design_y_by_p(int k) { return k == 1 || k == 4 || k == 7; }
+
+/* The generated functions of a design file (functions.def's EMIT_DESIGN
+   rows, in order) and the arrays each writes: from[i] holds count[i] nodes
+   (phi_p; v_q, v_p; g_q, g_qd, g_p; y[0 .. 7]). Returns how many. */
+typedef enum DesignFn { DESIGN_PHI_P, DESIGN_V, DESIGN_G, DESIGN_Y, DESIGN_FN_COUNT } DesignFn;
+int design_arrays(const Kinematics *kin, DesignFn fn, const NodeId *from[DESIGN_Y_COUNT],
+                  size_t count[DESIGN_Y_COUNT]);
 
 #endif

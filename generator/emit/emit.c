@@ -45,7 +45,7 @@ typedef struct Param {
 /* Parameters of each generated function (functions.def), in order, up to
    a NULL name (all are void-cast so no mechanism triggers an
    unused-parameter warning); none for the LU's, which emit_lu.c writes. */
-static const Param function_params[EMIT_GENERATED_COUNT][8] = {
+static const Param function_params[EMIT_GENERATED_COUNT][12] = {
 #define X(E, name, type, family, params) [EMIT_##E] = params,
 #include "functions.def"
 #undef X
@@ -59,7 +59,7 @@ static const Param function_params[EMIT_GENERATED_COUNT][8] = {
 /* The parameters of function which in e's file, into out (NULL-named
    end): the table's, with `const real *p` before the first output in a
    file with design parameters. */
-static const Param *params_of(const Emitter *e, EmitFunction which, Param out[10])
+static const Param *params_of(const Emitter *e, EmitFunction which, Param out[13])
 {
     const Param *from = function_params[which];
     if (e->kin->model->np == 0)
@@ -176,7 +176,7 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
     e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
     if (!e->roll) {     /* a loop body's parameters are the function's */
-        Param buf[10];
+        Param buf[13];
         const Param *params = params_of(e, which, buf);
         sb_puts(sb, "    ");
         for (const Param *p = params; p->name; p++)
@@ -231,7 +231,7 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
         return;
     }
     const char *p = e->prefix;
-    Param buf[10];
+    Param buf[13];
     const Param *params = params_of(e, which, buf);
     bool workspace = fn->nslots > 0;    /* values that cross parts */
     if (workspace)
@@ -276,6 +276,26 @@ static void collect_dynamics(const Kinematics *kin, EmitFunction which, SchedOut
             add_output(outs, n, "Q", j, dyn->force[j]);
 }
 
+/* A design file's sensitivity functions: dense arrays, every entry
+   written, in the parameters' order (functions.def). */
+static void collect_design(const Kinematics *kin, EmitFunction which, SchedOutput **outs, int *n)
+{
+    const char *name[DESIGN_Y_COUNT];
+    const NodeId *from[DESIGN_Y_COUNT];
+    size_t count[DESIGN_Y_COUNT], total = 0;
+    int k = 0;
+    for (const Param *p = function_params[which]; p->name; p++)
+        if (!p->input && !p->scalar)
+            name[k++] = p->name;
+    int arrays = design_arrays(kin, (DesignFn)(which - EMIT_PHI_P), from, count);
+    for (int i = 0; i < arrays; i++)
+        total += count[i];
+    *outs = xrealloc(*outs, total + 1, sizeof **outs);
+    for (int i = 0; i < arrays && i < k; i++)
+        for (size_t e = 0; e < count[i]; e++)
+            add_output(outs, n, name[i], (int)e, from[i][e]);
+}
+
 /* The outputs of each function. The fused _all and _all_nz go row by row
    (phi, Jacobian row, nu, gamma of row r, then row r + 1) so that a chunk holds
    whole rows and shares their sin/cos and products across the four; _eom
@@ -287,10 +307,8 @@ static void collect_outputs(const Kinematics *kin, EmitFunction which, SchedOutp
                     * sizeof **outs);
     *n = 0;
     bool all = which == EMIT_ALL || which == EMIT_ALL_NZ, eom = which == EMIT_EOM;
-    if (which == EMIT_PHI_P) {      /* dense: every entry written */
-        *outs = xrealloc(*outs, (size_t)m->nh * (size_t)m->np + 1, sizeof **outs);
-        for (int k = 0; k < m->nh * m->np; k++)
-            add_output(outs, n, "phi_p", k, kin->phi_p[k]);
+    if (emit_function_family[which] == EMIT_DESIGN) {
+        collect_design(kin, which, outs, n);
         return;
     }
     if (which >= EMIT_MASS && !eom) {
@@ -574,7 +592,7 @@ static void put_host_design(const Emitter *e, EmitResult *out)
         sb_printf(&sb, "#undef %s_%s\nvoid %s_%s(", pre, name, pre, name);
         put_signature(&sb, pre, function_params[f]);
         sb_printf(&sb, ")\n{\n    %s_%s_design(", pre, name);
-        Param buf[10];
+        Param buf[13];
         const Param *params = params_of(e, (EmitFunction)f, buf);
         for (const Param *p = params; p->name; p++)
             sb_printf(&sb, "%s%s%s", p == params ? "" : ", ",

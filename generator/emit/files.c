@@ -239,7 +239,7 @@ static const char *put_dense(const Emitter *e, TemplateVar *vars, int nvars, Str
 
 /* The sizes and the include guard, as text for the templates. */
 typedef struct EmitSizes {
-    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], np[32], guard[160];
+    char nq[32], nh[32], nv[32], nnz[32], mnnz[32], np[32], nout[32], guard[160];
 } EmitSizes;
 
 static void put_sizes(const Emitter *e, EmitSizes *z)
@@ -249,6 +249,7 @@ static void put_sizes(const Emitter *e, EmitSizes *z)
     snprintf(z->nh, sizeof z->nh, "%d", m->nh);
     snprintf(z->nv, sizeof z->nv, "%d", m->nv);
     snprintf(z->np, sizeof z->np, "%d", m->np);
+    snprintf(z->nout, sizeof z->nout, "%d", m->nout);
     /* C has no zero-length arrays: a Jacobian with no nonzeros keeps one
        placeholder entry (row 0, column 0, value 0). */
     snprintf(z->nnz, sizeof z->nnz, "%d", e->kin->nnz > 0 ? e->kin->nnz : 1);
@@ -359,6 +360,10 @@ void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const ch
         {"PIN", ""}, {"PARG", ""}, {"NP", z.np}, {"P0", ""}, {"DESIGN_NAMES", ""},
         {"DESIGN", ""}, {"DESIGN_INTERFACE", ""},
         {"PHI_P_PARTS", parts[EMIT_PHI_P].data}, {"PHI_P_BODY", bodies[EMIT_PHI_P].data},
+        {"SENS_V_PARTS", parts[EMIT_SENS_V].data}, {"SENS_V_BODY", bodies[EMIT_SENS_V].data},
+        {"SENS_G_PARTS", parts[EMIT_SENS_G].data}, {"SENS_G_BODY", bodies[EMIT_SENS_G].data},
+        {"SENS_Y_PARTS", parts[EMIT_SENS_Y].data}, {"SENS_Y_BODY", bodies[EMIT_SENS_Y].data},
+        {"NOUT", z.nout},
     };
     const char *bad = render(e, vars, (int)(sizeof vars / sizeof *vars), b, out);
     for (int i = 0; i < FILE_COUNT; i++)

@@ -52,9 +52,10 @@ typedef struct Engine {
     double gen_seconds;     /* emission time (generic: set-up time) */
     double compile_seconds; /* libtcc or cc time (aot: with the cache lookup and dlopen) */
     bool aot_cached;        /* aot: the library came from the cache */
-    /* generic with design parameters: dPhi/dp interpreted from the graph
-       (design.c); NULL otherwise */
-    struct NodeValues *phi_p_values;
+    /* generic with design parameters: the sensitivity functions
+       interpreted from the graph, one program per DesignFn (design.c);
+       NULL otherwise */
+    struct NodeValues *design_values;
 } Engine;
 
 /* How to open an engine; engine_default_options() for the usual. */
@@ -139,8 +140,14 @@ static inline void engine_nu(const Engine *e, const double *q, double t, double 
 /* dPhi/dp at (q, t) and the model's design: nh x np, row-major (design.c).
    Needs np > 0. */
 void engine_phi_p(const Engine *e, const double *q, double t, double *phi_p);
-/* The generic engine's interpreted dPhi/dp (nothing without design
-   parameters), and its release (engine_close). */
+/* A design file's sensitivity function fn at (q, qd, t) (qd unused by
+   phi_p) and the model's design, into the arrays out (design_arrays'
+   sizes): the generated PREFIX_phi_p, _sens_v, _sens_g, _sens_y (jit,
+   aot) or the graph interpreted (generic). */
+void engine_design(const Engine *e, DesignFn fn, const double *q, const double *qd, double t,
+                   double *const *out);
+/* The generic engine's interpreted programs (nothing without design
+   parameters), and their release (engine_close). */
 void engine_design_open(Engine *e);
 void engine_design_free(Engine *e);
 

@@ -13,6 +13,12 @@ typedef int (*KernelLuFactor)(const double *a, double *lu, double pivot_tol, dou
 typedef void (*KernelLuSolve)(const double *lu, const double *b, double *x);
 typedef int (*KernelLuStep)(double *q, double *qd, double *qdd, double t, double h,
                             const double *tol, int max_iter, double *out, int *iout);
+typedef void (*KernelSensV)(const double *q, const double *qd, double t, double *v_q, double *v_p);
+typedef void (*KernelSensG)(const double *q, const double *qd, double t, double *g_q,
+                            double *g_qd, double *g_p);
+typedef void (*KernelSensY)(const double *q, const double *qd, double t, double *f_q,
+                            double *f_p, double *df_q, double *df_qd, double *df_p,
+                            double *ddf_q, double *ddf_qd, double *ddf_p);
 typedef void (*KernelEom)(const double *q, const double *qd, double t,
                           double *M, double *Q, double *jac, double *gamma);
 

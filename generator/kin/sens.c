@@ -1,44 +1,33 @@
 /* sens.c - the sensitivities of a state of the motion to the design parameters (mechc run --sens).
  *
- * The right-hand sides come from five interpreted programs: V = D(Phi)
- * (Phi_q qd + Phi_t, diff_total), gamma = -D(D(Phi)), and each output f
- * with D f and D(D f). A first-order jet along (q_pj, qd direction, e_j)
- * gives a total derivative in p_j. The acceleration's term
- * d/dp (Phi_q qdd) needs Phi_q qdd as an expression: it is V with qd set
- * to qdd, less V with qd set to 0 (Phi_t), so no new nodes are made for it.
+ * Every partial derivative comes from the engine's sensitivity functions
+ * (the generated PREFIX_phi_p, _sens_v, _sens_g, _sens_y, or the graph
+ * interpreted by the generic engine), and the sensitivities of all design
+ * parameters at once are dense products and solves with one LU of Phi_q:
+ *
+ *   Q_p   = -Phi_q^-1 Phi_p
+ *   Qd_p  = -Phi_q^-1 (V_q Q_p + V_p)                          V at qd
+ *   Qdd_p =  Phi_q^-1 (G_q Q_p + G_qd Qd_p + G_p - (Phi_q qdd)_q Q_p - (Phi_q qdd)_p)
+ *
+ * where Phi_q qdd = V(qd := qdd) - V(qd := 0), so its partials are V's at
+ * those two velocities; an output f gives f_q Q_p + f_p, D f the same with
+ * its qd partials on Qd_p, and D(D f) + f_q qdd likewise.
  */
 #include "sens.h"
 
 #include "../base/arena.h"
-#include "../diff/diff.h"
-#include "../eval/interp.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { TAPE_V, TAPE_GAMMA, TAPE_F, TAPE_DF, TAPE_DDF, TAPE_COUNT };
-
-/* The nodes of each program, from the kinematics and new derivatives. */
-static void build_roots(Model *m, const Kinematics *kin, NodeId *roots[TAPE_COUNT])
-{
-    Differ df;
-    differ_init(&df, &m->dag, m->nq);
-    for (int r = 0; r < m->nh; r++) {
-        roots[TAPE_V][r] = diff_total(&df, kin->phi[r]);
-        roots[TAPE_GAMMA][r] = kin->gamma[r];
-    }
-    for (int k = 0; k < m->nout; k++) {
-        roots[TAPE_F][k] = m->outputs[k].expr;
-        roots[TAPE_DF][k] = diff_total(&df, m->outputs[k].expr);
-        roots[TAPE_DDF][k] = diff_total(&df, roots[TAPE_DF][k]);
-    }
-    differ_free(&df);
-}
+/* Where the engine's functions write, per velocity they are taken at. */
+enum { AT_QD, AT_QDD, AT_ZERO, AT_COUNT };
 
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size)
 {
     memset(s, 0, sizeof *s);
+    (void)kin;
     if (m->np == 0)
         snprintf(why, size, "the file has no design parameters (`design NAME = value`)");
     else if (m->nv > 0)
@@ -51,124 +40,73 @@ bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *
     if (why)
         return false;
     s->m = m, s->e = e, s->nq = m->nq, s->np = m->np, s->nout = m->nout;
-    int nmax = m->nh > m->nout ? m->nh : m->nout;
-    NodeId *roots[TAPE_COUNT];
-    for (int t = 0; t < TAPE_COUNT; t++)
-        roots[t] = xcalloc((size_t)nmax + 1, sizeof *roots[t]);
-    build_roots(m, kin, roots);
-    s->tapes = xcalloc(TAPE_COUNT, sizeof *s->tapes);
-    CompileScratch cs;
-    compile_scratch_init(&cs, &m->dag);
-    int longest = 1;
-    for (int t = 0; t < TAPE_COUNT; t++) {
-        tape_compile_roots(&s->tapes[t], &m->dag, roots[t], t <= TAPE_GAMMA ? m->nh : m->nout, &cs);
-        if (s->tapes[t].n > longest)
-            longest = s->tapes[t].n;
-        free(roots[t]);
+    size_t nq = (size_t)m->nq, np = (size_t)m->np, ny = (size_t)m->nout;
+    size_t qq = nq * nq, qp = nq * np, yq = ny * nq + 1, yp = ny * np + 1;
+    s->q_p = xcalloc(qp, sizeof(double)), s->qd_p = xcalloc(qp, sizeof(double));
+    s->qdd_p = xcalloc(qp, sizeof(double));
+    s->y_p = xcalloc(yp, sizeof(double)), s->yd_p = xcalloc(yp, sizeof(double));
+    s->ydd_p = xcalloc(yp, sizeof(double));
+    s->jac = xcalloc(qq, sizeof(double)), s->piv = xcalloc(nq, sizeof(double));
+    s->phi_p = xcalloc(qp, sizeof(double)), s->col = xcalloc(nq, sizeof(double));
+    for (int a = 0; a < AT_COUNT; a++) {
+        s->v[a][0] = xcalloc(qq, sizeof(double)), s->v[a][1] = xcalloc(qp, sizeof(double));
+        for (int k = 0; k < DESIGN_Y_COUNT; k++)
+            s->y[a][k] = xcalloc(design_y_by_p(k) ? yp : yq, sizeof(double));
     }
-    compile_scratch_free(&cs);
-    s->reg = xcalloc((size_t)longest, sizeof *s->reg);
-    size_t nq = (size_t)m->nq, np = (size_t)m->np, ny = (size_t)m->nout * np + 1;
-    s->q_p = xcalloc(nq * np, sizeof(double)), s->qd_p = xcalloc(nq * np, sizeof(double));
-    s->qdd_p = xcalloc(nq * np, sizeof(double));
-    s->y_p = xcalloc(ny, sizeof(double)), s->yd_p = xcalloc(ny, sizeof(double));
-    s->ydd_p = xcalloc(ny, sizeof(double));
-    s->jac = xcalloc(nq * nq, sizeof(double)), s->piv = xcalloc(nq, sizeof(double));
-    s->phi_p = xcalloc(nq * np, sizeof(double)), s->rhs = xcalloc(nq, sizeof(double));
-    s->dp = xcalloc(np, sizeof(double)), s->zero = xcalloc(nq, sizeof(double));
-    s->col = xcalloc(nq, sizeof(double)), s->cold = xcalloc(nq, sizeof(double));
-    s->coldd = xcalloc(nq, sizeof(double));
+    for (int k = 0; k < 3; k++)
+        s->g[k] = xcalloc(k == 2 ? qp : qq, sizeof(double));
+    s->work = xcalloc(qp + yp, sizeof(double));
     return true;
 }
 
 void sens_free(Sens *s)
 {
-    for (int t = 0; s->tapes && t < TAPE_COUNT; t++)
-        tape_free(&s->tapes[t]);
-    free(s->tapes), free(s->reg);
     free(s->q_p), free(s->qd_p), free(s->qdd_p), free(s->y_p), free(s->yd_p), free(s->ydd_p);
-    free(s->jac), free(s->piv), free(s->phi_p), free(s->rhs), free(s->dp), free(s->zero);
-    free(s->col), free(s->cold), free(s->coldd);
+    free(s->jac), free(s->piv), free(s->phi_p), free(s->col), free(s->work);
+    for (int a = 0; a < AT_COUNT; a++) {
+        free(s->v[a][0]), free(s->v[a][1]);
+        for (int k = 0; k < DESIGN_Y_COUNT; k++)
+            free(s->y[a][k]);
+    }
+    for (int k = 0; k < 3; k++)
+        free(s->g[k]);
     memset(s, 0, sizeof *s);
 }
 
-/* Root k's derivative along seed in the last jet pass of tape t. */
-static double jet_d(const Sens *s, int t, int k)
+/* c (n x np) += sign * a (n x nq) b (nq x np), all row-major. */
+static void add_product(double *c, double sign, const double *a, const double *b, int n, int nq,
+                        int np)
 {
-    int r = s->tapes[t].out[k];
-    return r >= 0 ? s->reg[r].d : 0.0;
+    for (int r = 0; r < n; r++)
+        for (int k = 0; k < nq; k++) {
+            double f = sign * a[(size_t)r * (size_t)nq + (size_t)k];
+            if (f == 0.0)
+                continue;
+            const double *bk = b + (size_t)k * (size_t)np;
+            double *cr = c + (size_t)r * (size_t)np;
+            for (int j = 0; j < np; j++)
+                cr[j] += f * bk[j];
+        }
 }
 
-/* One first-order pass of tape t at (q, qd, t) along (dq, dqd, e_j). */
-static void pass(Sens *s, int tape, const double *q, const double *qd, double t, const double *dq,
-                 const double *dqd)
+/* c (n x np) = sign * a, element by element. */
+static void set_scaled(double *c, double sign, const double *a, size_t n)
 {
-    Seed seed = {.q = q, .qd = qd, .t = t, .dq = dq, .col_q = -1, .col_qd = -1, .dqd = dqd,
-                 .dp = s->dp};
-    tape_jet(&s->tapes[tape], &seed, 1, s->reg);
+    for (size_t i = 0; i < n; i++)
+        c[i] = sign * a[i];
 }
 
-/* Column j of a variable-major nq x np array, from col. */
-static void put_column(const Sens *s, double *a, int j, const double *col)
-{
-    for (int i = 0; i < s->nq; i++)
-        a[(size_t)i * (size_t)s->np + (size_t)j] = col[i];
-}
-
-/* The outputs' sensitivities to p_j from the coordinates'. */
-static void output_column(Sens *s, int j, double t, const double *q, const double *qd,
-                          const double *qdd)
+/* x (nq x np) = Phi_q^-1 x, column by column. */
+static void solve_columns(Sens *s, double *x)
 {
     size_t np = (size_t)s->np;
-    for (int k = 0; k < s->nout; k++)
-        s->ydd_p[(size_t)k * np + (size_t)j] = 0.0;
-    pass(s, TAPE_F, q, NULL, t, s->col, s->zero);
-    for (int k = 0; k < s->nout; k++)
-        s->y_p[(size_t)k * np + (size_t)j] = jet_d(s, TAPE_F, k);
-    pass(s, TAPE_DF, q, qd, t, s->col, s->cold);
-    for (int k = 0; k < s->nout; k++)
-        s->yd_p[(size_t)k * np + (size_t)j] = jet_d(s, TAPE_DF, k);
-    /* ydd = f_q qdd + D(D f), f_q qdd = Df(qd := qdd) - Df(qd := 0) */
-    pass(s, TAPE_DDF, q, qd, t, s->col, s->cold);
-    for (int k = 0; k < s->nout; k++)
-        s->ydd_p[(size_t)k * np + (size_t)j] += jet_d(s, TAPE_DDF, k);
-    pass(s, TAPE_DF, q, qdd, t, s->col, s->coldd);
-    for (int k = 0; k < s->nout; k++)
-        s->ydd_p[(size_t)k * np + (size_t)j] += jet_d(s, TAPE_DF, k);
-    pass(s, TAPE_DF, q, NULL, t, s->col, s->zero);
-    for (int k = 0; k < s->nout; k++)
-        s->ydd_p[(size_t)k * np + (size_t)j] -= jet_d(s, TAPE_DF, k);
-}
-
-/* Column j of q_p, qd_p, qdd_p (and the outputs'), with Phi_q factored. */
-static void column(Sens *s, int j, double t, const double *q, const double *qd, const double *qdd)
-{
-    int n = s->nq;
-    for (int i = 0; i < n; i++)
-        s->col[i] = -s->phi_p[(size_t)i * (size_t)s->np + (size_t)j];
-    mechrt_lu_solve(n, s->jac, n, s->piv, s->col);
-    s->dp[j] = 1.0;
-    pass(s, TAPE_V, q, qd, t, s->col, s->zero);
-    for (int r = 0; r < n; r++)
-        s->cold[r] = -jet_d(s, TAPE_V, r);
-    mechrt_lu_solve(n, s->jac, n, s->piv, s->cold);
-    /* Phi_q qdd_p = d gamma/dp - d(Phi_q qdd)/dp */
-    pass(s, TAPE_GAMMA, q, qd, t, s->col, s->cold);
-    for (int r = 0; r < n; r++)
-        s->coldd[r] = jet_d(s, TAPE_GAMMA, r);
-    pass(s, TAPE_V, q, qdd, t, s->col, s->zero);
-    for (int r = 0; r < n; r++)
-        s->coldd[r] -= jet_d(s, TAPE_V, r);
-    pass(s, TAPE_V, q, NULL, t, s->col, s->zero);
-    for (int r = 0; r < n; r++)
-        s->coldd[r] += jet_d(s, TAPE_V, r);
-    mechrt_lu_solve(n, s->jac, n, s->piv, s->coldd);
-    put_column(s, s->q_p, j, s->col);
-    put_column(s, s->qd_p, j, s->cold);
-    put_column(s, s->qdd_p, j, s->coldd);
-    if (s->nout)
-        output_column(s, j, t, q, qd, qdd);
-    s->dp[j] = 0.0;
+    for (int j = 0; j < s->np; j++) {
+        for (int i = 0; i < s->nq; i++)
+            s->col[i] = x[(size_t)i * np + (size_t)j];
+        mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
+        for (int i = 0; i < s->nq; i++)
+            x[(size_t)i * np + (size_t)j] = s->col[i];
+    }
 }
 
 /* Phi_q factored and Phi_p at (q, t). */
@@ -180,30 +118,81 @@ static MechrtStatus factor(Sens *s, double t, const double *q)
     return mechrt_lu_factor(n, s->jac, n, s->piv, mechrt_default_options().pivot_tol, NULL);
 }
 
+/* The outputs' sensitivities from the coordinates' (y partials taken). */
+static void outputs(Sens *s)
+{
+    int n = s->nout, nq = s->nq, np = s->np;
+    double *const *y = s->y[AT_QD], *const *y2 = s->y[AT_QDD], *const *y0 = s->y[AT_ZERO];
+    size_t len = (size_t)n * (size_t)np;
+    set_scaled(s->y_p, 1.0, y[1], len);                 /* f_q Q_p + f_p */
+    add_product(s->y_p, 1.0, y[0], s->q_p, n, nq, np);
+    set_scaled(s->yd_p, 1.0, y[4], len);                /* Df_q Q_p + Df_qd Qd_p + Df_p */
+    add_product(s->yd_p, 1.0, y[2], s->q_p, n, nq, np);
+    add_product(s->yd_p, 1.0, y[3], s->qd_p, n, nq, np);
+    set_scaled(s->ydd_p, 1.0, y[7], len);               /* D(D f) by q, qd, p ... */
+    add_product(s->ydd_p, 1.0, y[5], s->q_p, n, nq, np);
+    add_product(s->ydd_p, 1.0, y[6], s->qd_p, n, nq, np);
+    add_product(s->ydd_p, 1.0, y2[2], s->q_p, n, nq, np);   /* ... f_q qdd by q and p ... */
+    add_product(s->ydd_p, -1.0, y0[2], s->q_p, n, nq, np);
+    for (size_t i = 0; i < len; i++)
+        s->ydd_p[i] += y2[4][i] - y0[4][i];
+    add_product(s->ydd_p, 1.0, y[0], s->qdd_p, n, nq, np);  /* ... and f_q Qdd_p */
+}
+
+/* The engine's V and outputs' partials at the velocity v (slot a). */
+static void partials_at(Sens *s, int a, const double *q, const double *v, double t)
+{
+    engine_design(s->e, DESIGN_V, q, v, t, s->v[a]);
+    if (s->nout)
+        engine_design(s->e, DESIGN_Y, q, v, t, s->y[a]);
+}
+
 MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, const double *qdd)
 {
     MechrtStatus st = factor(s, t, q);
-    for (int j = 0; j < s->np && st == MECHRT_OK; j++)
-        column(s, j, t, q, qd, qdd);
-    return st;
+    if (st != MECHRT_OK)
+        return st;
+    int n = s->nq, np = s->np;
+    size_t len = (size_t)n * (size_t)np;
+    double *zero = s->work;     /* nq zeros: the velocity of V(qd := 0) */
+    memset(zero, 0, (size_t)n * sizeof *zero);
+    partials_at(s, AT_QD, q, qd, t);
+    partials_at(s, AT_QDD, q, qdd, t);
+    partials_at(s, AT_ZERO, q, zero, t);
+    engine_design(s->e, DESIGN_G, q, qd, t, s->g);
+    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    solve_columns(s, s->q_p);
+    set_scaled(s->qd_p, -1.0, s->v[AT_QD][1], len);
+    add_product(s->qd_p, -1.0, s->v[AT_QD][0], s->q_p, n, n, np);
+    solve_columns(s, s->qd_p);
+    set_scaled(s->qdd_p, 1.0, s->g[2], len);
+    add_product(s->qdd_p, 1.0, s->g[0], s->q_p, n, n, np);
+    add_product(s->qdd_p, 1.0, s->g[1], s->qd_p, n, n, np);
+    add_product(s->qdd_p, -1.0, s->v[AT_QDD][0], s->q_p, n, n, np);
+    add_product(s->qdd_p, 1.0, s->v[AT_ZERO][0], s->q_p, n, n, np);
+    for (size_t i = 0; i < len; i++)
+        s->qdd_p[i] -= s->v[AT_QDD][1][i] - s->v[AT_ZERO][1][i];
+    solve_columns(s, s->qdd_p);
+    if (s->nout)
+        outputs(s);
+    return MECHRT_OK;
 }
 
 MechrtStatus sens_eval_positions(Sens *s, double t, const double *q)
 {
     MechrtStatus st = factor(s, t, q);
-    size_t np = (size_t)s->np;
-    for (int j = 0; j < s->np && st == MECHRT_OK; j++) {
-        for (int i = 0; i < s->nq; i++)
-            s->col[i] = -s->phi_p[(size_t)i * np + (size_t)j];
-        mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
-        put_column(s, s->q_p, j, s->col);
-        s->dp[j] = 1.0;
-        pass(s, TAPE_F, q, NULL, t, s->col, s->zero);
-        s->dp[j] = 0.0;
-        for (int k = 0; k < s->nout; k++)
-            s->y_p[(size_t)k * np + (size_t)j] = jet_d(s, TAPE_F, k);
+    if (st != MECHRT_OK)
+        return st;
+    size_t len = (size_t)s->nq * (size_t)s->np;
+    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    solve_columns(s, s->q_p);
+    if (s->nout) {
+        memset(s->work, 0, (size_t)s->nq * sizeof *s->work);
+        engine_design(s->e, DESIGN_Y, q, s->work, t, s->y[AT_QD]);
+        set_scaled(s->y_p, 1.0, s->y[AT_QD][1], (size_t)s->nout * (size_t)s->np);
+        add_product(s->y_p, 1.0, s->y[AT_QD][0], s->q_p, s->nout, s->nq, s->np);
     }
-    return st;
+    return MECHRT_OK;
 }
 
 int sens_column_count(const Sens *s)

@@ -7,17 +7,15 @@
  *   Phi_q qd_pj  = -(V_q q_pj + V_pj),       V = Phi_q qd + Phi_t
  *   Phi_q qdd_pj = -(W_q q_pj + W_qd qd_pj + W_pj),  W = Phi_q qdd - gamma
  *
- * one LU of Phi_q per state serving every right-hand side. Phi_p comes
- * from the engine (the generated PREFIX_phi_p); the right-hand sides of
- * the velocities and accelerations, and the outputs' sensitivities, are
- * directional derivatives of graph expressions taken in forward mode by
- * the interpreter (interp.h: exact, no finite differences).
+ * one LU of Phi_q per state serving every right-hand side. The partial
+ * derivatives come from the engine's sensitivity functions (generated:
+ * PREFIX_phi_p, _sens_v, _sens_g, _sens_y; generic: interpreted), and all
+ * design parameters are handled at once by dense products (sens.c).
  */
 #ifndef MECHC_SENS_H
 #define MECHC_SENS_H
 
 #include "../engine/engine.h"
-#include "../eval/interp.h"
 
 typedef struct Sens {
     const Model *m;
@@ -27,16 +25,17 @@ typedef struct Sens {
        d(variable i)/d(p_j) */
     double *q_p, *qd_p, *qdd_p;     /* nq x np */
     double *y_p, *yd_p, *ydd_p;     /* nout x np: the outputs' */
-    /* the rest is sens.c's */
-    Tape *tapes;                    /* V, gamma, outputs f, Df, DDf */
-    Jet *reg;
-    double *jac, *piv, *phi_p, *rhs, *dp, *zero, *col, *cold, *coldd;
+    /* the rest is sens.c's: Phi_q's LU, Phi_p, the engine's partials at
+       qd, qdd and 0 (V's and the outputs'), gamma's, scratch */
+    double *jac, *piv, *phi_p, *col, *work;
+    double *v[3][2];
+    double *y[3][DESIGN_Y_COUNT];
+    double *g[3];
 } Sens;
 
 /* Prepares s for the motion of m through e (np > 0, no velocity-level
-   rows, as many rows as coordinates); adds the nodes it needs (V, the
-   outputs' time derivatives) to m's graph. false with why (size bytes)
-   when m is not such a mechanism. */
+   rows, as many rows as coordinates; kin: m's). false with why (size
+   bytes) when m is not such a mechanism. */
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size);
 void sens_free(Sens *s);
 
