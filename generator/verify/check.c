@@ -97,6 +97,7 @@ static const char *const dyn_names[CHECK_WHAT_COUNT - CHECK_DYN_FIRST] = {
     "M jit/generic", "Q jit/generic", "M jit/aot", "Q jit/aot", "M generic/aot", "Q generic/aot",
     "M symmetric", "M semi-definite", "Q velocity fd",
     "phi_p", "phi_p jit/generic", "phi_p jit/aot", "phi_p generic/aot",
+    "sens jit/generic", "sens jit/aot", "sens generic/aot",
 };
 
 /* The base state's Newton (assemble_at_t0's, on the engine under test's

@@ -73,7 +73,10 @@ typedef enum CheckWhat {
        design parameter) */
     CHECK_PHI_P_FD,
     CHECK_PHI_P_PAIR_FIRST,
-    CHECK_WHAT_COUNT = CHECK_PHI_P_PAIR_FIRST + CHECK_PAIR_COUNT
+    /* and every pair on the other sensitivity functions (sens_v, sens_g,
+       sens_y: row and col -1) */
+    CHECK_SENS_PAIR_FIRST = CHECK_PHI_P_PAIR_FIRST + CHECK_PAIR_COUNT,
+    CHECK_WHAT_COUNT = CHECK_SENS_PAIR_FIRST + CHECK_PAIR_COUNT
 } CheckWhat;
 
 typedef struct CheckItem {

@@ -21,6 +21,42 @@ static void central(Checker *c, int j, double h, double *plus, double *d)
         d[r] = (plus[r] - d[r]) / (2 * h);
 }
 
+/* Every value of the sensitivity functions fn of engine k at the sample,
+   in one array (design_arrays' order); its length in *n. */
+static double *sens_values(Checker *c, int k, DesignFn fn, size_t *n)
+{
+    const NodeId *from[DESIGN_Y_COUNT];
+    size_t count[DESIGN_Y_COUNT];
+    const Engine *e = &c->eng[k];
+    int arrays = design_arrays(&e->mech->kin, fn, from, count);
+    *n = 0;
+    for (int i = 0; i < arrays; i++)
+        *n += count[i];
+    double *all = xcalloc(*n + 1, sizeof *all), *out[DESIGN_Y_COUNT], *at = all;
+    for (int i = 0; i < arrays; i++, at += count[i - 1])
+        out[i] = at;
+    engine_design(e, fn, c->q, c->qd, c->t, out);
+    return all;
+}
+
+/* sens_v, sens_g and sens_y of every pair of engines. */
+static void compare_sens(Checker *c)
+{
+    for (int pair = 0; pair < PAIR_COUNT; pair++) {
+        EngineKind a = check_pair_engines[pair][0], b = check_pair_engines[pair][1];
+        if (!c->open[a] || !c->open[b])
+            continue;
+        c->rep->items[CHECK_SENS_PAIR_FIRST + pair].checked = true;
+        for (int fn = DESIGN_V; fn < DESIGN_FN_COUNT; fn++) {
+            size_t n;
+            double *va = sens_values(c, a, (DesignFn)fn, &n), *vb = sens_values(c, b, (DesignFn)fn, &n);
+            for (size_t i = 0; i < n; i++)
+                check_record(c, CHECK_SENS_PAIR_FIRST + pair, -1, -1, va[i], vb[i], 0.0);
+            free(va), free(vb);
+        }
+    }
+}
+
 void check_design(Checker *c)
 {
     const Model *m = c->m;
@@ -57,4 +93,5 @@ void check_design(Checker *c)
     free(w);
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         free(phi_p[k]);
+    compare_sens(c);
 }
