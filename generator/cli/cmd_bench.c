@@ -55,10 +55,10 @@ static const CliOption options[] = {
 /* jac_nz (the sparse Jacobian) exists only in generated code; the
    dynamics rows only for a file with masses. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_MASS, FN_FORCE, FN_MQ, FN_EOM,
-       FN_MASS_NZ, FN_MQ_NZ, FN_COUNT };
+       FN_MASS_NZ, FN_MQ_NZ, FN_PHI_P, FN_SENS_V, FN_SENS_G, FN_SENS_Y, FN_COUNT };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz",
                                                "mass", "force", "m+q", "eom", "mass_nz",
-                                               "m+q_nz"};
+                                               "m+q_nz", "phi_p", "sens_v", "sens_g", "sens_y"};
 
 /* Functions only generated code has (no generic counterpart, no ratio). */
 static bool generated_only(int fn)
@@ -73,6 +73,8 @@ typedef struct Bench {
     double *q, *qd, t;
     double *phi, *jac, *nu, *gamma, *mass, *force;
     bool dynamics;                              /* the file has masses */
+    bool design;                                /* the file has design parameters: */
+    double *sens, *sens_out[DESIGN_Y_COUNT];    /* where its sensitivity functions write */
     long batch[ENGINE_KIND_COUNT][FN_COUNT];
     double *ns[ENGINE_KIND_COUNT][FN_COUNT];    /* one per repeat */
     double median[ENGINE_KIND_COUNT][FN_COUNT];
@@ -108,6 +110,10 @@ static double time_batch(Bench *b, EngineKind k, int fn, long n)
     const Engine *e = &b->eng[k];
     double t0 = pipeline_now();
     for (long i = 0; i < n; i++) {
+        if (fn >= FN_PHI_P) {
+            engine_design(e, (DesignFn)(fn - FN_PHI_P), b->q, b->qd, b->t, b->sens_out);
+            continue;
+        }
         if (fn >= FN_MASS) {
             call_dynamics(b, e, fn);
             continue;
@@ -130,17 +136,18 @@ static int compare_doubles(const void *x, const void *y)
     return (a > c) - (a < c);
 }
 
-static bool has_fn(const Bench *b, int k, int fn)
-{
-    return b->open[k] && (!generated_only(fn) || b->eng[k].compiled)
-           && (fn < FN_MASS || b->dynamics);
-}
-
-/* A row of the tables: every function but the dynamics ones without masses. */
+/* A row of the tables: every function but the dynamics ones without masses, the design
+   ones without design parameters. */
 static bool shown(const Bench *b, int fn)
 {
-    return fn < FN_MASS || b->dynamics;
+    return fn < FN_MASS || (fn < FN_PHI_P && b->dynamics) || (fn >= FN_PHI_P && b->design);
 }
+
+static bool has_fn(const Bench *b, int k, int fn)
+{
+    return b->open[k] && (!generated_only(fn) || b->eng[k].compiled) && shown(b, fn);
+}
+
 
 static void measure(Bench *b, int repeat)
 {
@@ -329,6 +336,26 @@ static bool open_engines(const Args *a, Bench *b, const Mech *mech, bool use_aot
     return true;
 }
 
+/* Room for the sensitivity functions' outputs, each array as long as
+   the longest, for a file with design parameters. */
+static void open_design(Bench *b, const Model *m)
+{
+    b->design = m->np > 0;
+    if (!b->design)
+        return;
+    size_t most = 0;
+    for (int fn = 0; fn < DESIGN_FN_COUNT; fn++) {
+        const NodeId *from[DESIGN_Y_COUNT];
+        size_t count[DESIGN_Y_COUNT];
+        int arrays = design_arrays(&b->eng[ENGINE_JIT].mech->kin, (DesignFn)fn, from, count);
+        for (int i = 0; i < arrays; i++)
+            most = count[i] > most ? count[i] : most;
+    }
+    b->sens = xcalloc(DESIGN_Y_COUNT * most + 1, sizeof *b->sens);
+    for (int i = 0; i < DESIGN_Y_COUNT; i++)
+        b->sens_out[i] = b->sens + (size_t)i * most;
+}
+
 /* Times the open engines at one fixed state and prints the report. */
 static void run_bench(Bench *b, const Model *m, int repeat, bool json)
 {
@@ -344,6 +371,7 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         if (b->open[k])
             b->dynamics = b->eng[k].k.mass != NULL && b->eng[k].k.force != NULL;
+    open_design(b, m);
     for (size_t i = 0; i < nq; i++) {
         b->q[i] = m->q0[i] + 0.01 * (double)((i * 7) % 5);
         b->qd[i] = 0.3 + 0.1 * (double)((i * 3) % 7);
@@ -361,7 +389,7 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
         for (int fn = 0; fn < FN_COUNT; fn++)
             free(b->ns[k][fn]);
     free(b->q), free(b->qd), free(b->phi), free(b->jac), free(b->nu), free(b->gamma);
-    free(b->mass), free(b->force);
+    free(b->mass), free(b->force), free(b->sens);
 }
 
 /* The engines timed and reported. */
