@@ -344,10 +344,13 @@ static void open_design(Bench *b, const Model *m)
     if (!b->design)
         return;
     size_t most = 0;
-    for (int fn = 0; fn < DESIGN_FN_COUNT; fn++) {
+    const Kinematics *kin = NULL;
+    for (int k = 0; k < ENGINE_KIND_COUNT && !kin; k++)
+        kin = b->open[k] ? &b->eng[k].mech->kin : NULL;
+    for (int fn = 0; fn < DESIGN_FN_COUNT && kin; fn++) {
         const NodeId *from[DESIGN_Y_COUNT];
         size_t count[DESIGN_Y_COUNT];
-        int arrays = design_arrays(&b->eng[ENGINE_JIT].mech->kin, (DesignFn)fn, from, count);
+        int arrays = design_arrays(kin, (DesignFn)fn, from, count);
         for (int i = 0; i < arrays; i++)
             most = count[i] > most ? count[i] : most;
     }
