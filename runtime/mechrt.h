@@ -90,6 +90,40 @@ typedef enum MechrtStatus {
         P##_NQ, P##_NH, P##_NV, NULL, p##_mechrt_phi, p##_mechrt_jac,            \
         p##_mechrt_nu, p##_mechrt_gamma, p##_mechrt_all, NULL, NULL}
 
+/* MECHRT_DEFINE_DESIGN_KERNELS(fb, FB) does the same for a file with design
+   parameters (`design NAME = value`), whose functions take p: the wrappers
+   pass ctx as p, and `fb_design_kernels(p)` returns the MechrtKernels of
+   the design p (FB_NP values; fb_p0 is the file's), which must outlive
+   them. */
+#define MECHRT_DEFINE_DESIGN_KERNELS(p, P)                                       \
+    static void p##_mechrt_phi(void *ctx, const mechrt_real *q, mechrt_real t,   \
+                               mechrt_real *out)                                 \
+    { p##_phi(q, t, (const mechrt_real *)ctx, out); }                            \
+    static void p##_mechrt_jac(void *ctx, const mechrt_real *q, mechrt_real t,   \
+                               mechrt_real *out)                                 \
+    { p##_jac(q, t, (const mechrt_real *)ctx, out); }                            \
+    static void p##_mechrt_nu(void *ctx, const mechrt_real *q, mechrt_real t,    \
+                              mechrt_real *out)                                  \
+    { p##_nu(q, t, (const mechrt_real *)ctx, out); }                             \
+    static void p##_mechrt_gamma(void *ctx, const mechrt_real *q,                \
+                                 const mechrt_real *qd, mechrt_real t,           \
+                                 mechrt_real *out)                               \
+    { p##_gamma(q, qd, t, (const mechrt_real *)ctx, out); }                      \
+    static void p##_mechrt_all(void *ctx, const mechrt_real *q,                  \
+                               const mechrt_real *qd, mechrt_real t,             \
+                               mechrt_real *phi, mechrt_real *jac,               \
+                               mechrt_real *nu, mechrt_real *gamma)              \
+    { p##_all(q, qd, t, (const mechrt_real *)ctx, phi, jac, nu, gamma); }        \
+    static MechrtKernels p##_design_kernels(const mechrt_real *design)           \
+    {   /* ctx is void *: the design is only ever read back as const */         \
+        union { const mechrt_real *c; void *v; } ctx;                            \
+        ctx.c = design;                                                          \
+        MechrtKernels k = {P##_NQ, P##_NH, P##_NV, ctx.v,                        \
+                           p##_mechrt_phi, p##_mechrt_jac, p##_mechrt_nu,        \
+                           p##_mechrt_gamma, p##_mechrt_all, NULL, NULL};        \
+        return k;                                                                \
+    }
+
 /* Pattern LU (lu_pattern.c): the largest n (its n*n index map is of int),
    and its workspaces' lengths for n coordinates, usable as static array
    sizes: reals (the factors' slots n*n, the dense fallback's n*n, 4n
