@@ -217,6 +217,7 @@ bench: deps
 	$(Q)sh bench/roll.sh $(MECHC)
 	$(Q)sh bench/sympy_time.sh $(MECHC)
 	$(Q)sh bench/dynamics.sh $(MECHC)
+	$(Q)sh bench/design.sh $(MECHC)
 
 install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/bin
