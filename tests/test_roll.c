@@ -39,6 +39,7 @@ static void emit_real(const Mech *mech, int roll, bool jit, bool direct_jac, boo
     opt.roll = roll;
     opt.prefix = jit ? "mechc_jit" : "mechc_aot";
     opt.max_ops = 0;
+    opt.host_design = true;     /* a design file's kernels read the model's design */
     Diag diag;
     if (!emit_mechanism(&mech->kin, &opt, res, &diag))
         fail_msg("%s: %s", mech->model->name, diag.message);
@@ -147,6 +148,9 @@ static bool check(const char *name, const Mech *mech, bool jit, bool direct_jac)
     Unit a, b;
     const Kernels *ka = unit_open(&a, &straight, jit, name);
     const Kernels *kb = unit_open(&b, &rolled, jit, name);
+    for (int k = 0; k < 2; k++)
+        if ((k ? kb : ka)->design_bind)
+            (k ? kb : ka)->design_bind(mech->model->dag.param_values);
     compare_kernels(name, mech, ka, kb);
     unit_close(&a);
     unit_close(&b);

@@ -203,7 +203,8 @@ static int ops_of(const EmitResult *er, int fn)
 {
     static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL,
                                       EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM,
-                                      EMIT_MASS_NZ, -1};
+                                      EMIT_MASS_NZ, -1, EMIT_PHI_P, EMIT_SENS_V, EMIT_SENS_G,
+                                      EMIT_SENS_Y};
     if (fn == FN_MQ)
         return er->ops[EMIT_MASS] + er->ops[EMIT_FORCE];
     if (fn == FN_MQ_NZ)

@@ -633,13 +633,13 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
         fits = put_functions(&e, parts, bodies, out);
     }
     trig_free(&e.trig);
+    if (!fits)
+        diag_error_nopos(diag, "the generated code would have more than %ld operations, "
+                         "the limit (see --max-code-ops)", opt->max_ops);
     if (fits)
         render_files(&e, parts, bodies, out);
     if (fits && opt->host_design && m->np > 0)
         put_host_design(&e, out);
-    else
-        diag_error_nopos(diag, "the generated code would have more than %ld operations, "
-                         "the limit (see --max-code-ops)", opt->max_ops);
     free_functions(parts, bodies);
     return fits;
 }

@@ -95,6 +95,10 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->mass_row = kernel(find, handle, prefix, "mass_row");
     k->mass_col = kernel(find, handle, prefix, "mass_col");
     *(void **)&k->design_bind = kernel(find, handle, prefix, "design_bind");
+    /* a unit with design parameters but no context-free twins has
+       functions that take p: calling them through k would be wrong */
+    if (!k->design_bind && kernel(find, handle, prefix, "p0"))
+        return false;
     bool mass_pattern = k->mass_row && k->mass_col;
     bool dynamics = found[EMIT_DYN] == rows[EMIT_DYN] && mass_pattern;
     bool none = found[EMIT_DYN] == 0 && !k->mass_row && !k->mass_col;

@@ -30,7 +30,9 @@ typedef void (*KernelEom)(const double *q, const double *qd, double t,
    all_nz without EmitOptions.all_nz, jac and all in a sparse-only unit,
    the dynamics without masses (mass_row and mass_col with them), the
    unrolled LU (lu_factor, lu_solve and step, the kinematic step over
-   them; above 24 coordinates one that declines) where it was not written. */
+   them; above 24 coordinates one that declines) where it was not written.
+   A unit with design parameters binds only with its context-free twins
+   (EmitOptions.host_design), which read the design design_bind was given. */
 typedef struct Kernels {
 #define X(E, name, type, family, params) Kernel##type name;
 #include "../emit/functions.def"

@@ -357,7 +357,10 @@ int fuzz_frontend(const uint8_t *data, size_t size)
     EmitResult emitted;
     Jit *jit = engine_jit(mech, &emitted, NULL, NULL, &diag);
     if (jit) {
-        run_kernels(mech, jit_kernels(jit));
+        const Kernels *k = jit_kernels(jit);
+        if (k->design_bind)     /* a design file's kernels read the model's design */
+            k->design_bind(mech->model->dag.param_values);
+        run_kernels(mech, k);
         jit_free(jit);
     } else if (strstr(diag.message, "did not compile")) {
         fputs(diag.message, stderr);
