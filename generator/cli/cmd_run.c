@@ -93,7 +93,8 @@ static const CliOption options[] = {
      .help = "sensitivities to the design parameters (a file with\n"
              "`design` statements, holonomic): CSV columns d(NAME)/d(P),\n"
              "d(d(NAME))/d(P) and d(dd(NAME))/d(P) after the others for\n"
-             "every coordinate and output NAME and design parameter P"},
+             "every coordinate and output NAME and design parameter P;\n"
+             "JSON \"sens_columns\" (those names) and \"sens\" (a row each)"},
     {"--digits", CLI_INT_AT(RunCli, digits, 1, 17), .metavar = "N",
      .help = "significant digits of numbers (default: the fewest that\n"
              "read back exactly, at most 17)"},
@@ -334,9 +335,8 @@ static bool finish(Args *a, void *opts)
         fprintf(stderr, "mechc run: error: --view goes with --svg FILE\n");
         return false;
     }
-    if (c->sens && (c->forces || c->json)) {
-        fprintf(stderr, "mechc run: error: --sens writes CSV columns: not with %s\n",
-                c->forces ? "--forces" : "--json");
+    if (c->sens && c->forces) {
+        fprintf(stderr, "mechc run: error: --sens and --forces each add columns: give one\n");
         return false;
     }
     c->pictures = c->svg_path || c->plot_path;

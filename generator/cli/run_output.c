@@ -76,7 +76,7 @@ void run_output_close(RunOutput *out)
     free(out->lambda), free(out->efforts), free(out->drivers), free(out->dnames);
     for (int i = 0; i < out->nx; i++)
         free(out->xnames[i]);
-    free(out->xnames), free(out->x);
+    free(out->xnames), free(out->x), free(out->xkept);
     mechrt_trace_free(&out->trace);
 }
 
@@ -128,6 +128,23 @@ static bool keep_lambda(RunOutput *out, const double *lambda)
     return true;
 }
 
+/* Keeps a state's extra columns for the kept row about to be pushed;
+   false when out of memory. */
+static bool keep_extra(RunOutput *out)
+{
+    size_t nx = (size_t)out->nx, row = out->trace.rows;
+    if (row + 1 > out->xcap) {
+        size_t cap = out->xcap ? 2 * out->xcap : 64;
+        double *p = realloc(out->xkept, cap * (nx + 1) * sizeof *p);
+        if (!p)
+            return false;
+        out->xkept = p;
+        out->xcap = cap;
+    }
+    memcpy(out->xkept + row * nx, out->x, nx * sizeof *out->x);
+    return true;
+}
+
 void run_output_state(void *ctx, double t, const double *q, const double *qd,
                       const double *qdd, const double *lambda)
 {
@@ -156,6 +173,7 @@ void run_output_state(void *ctx, double t, const double *q, const double *qd,
                              out->nx, out->x, out->digits);
     if (out->keep && ((lambda && out->lambda_use != RUN_OUTPUT_NO_LAMBDA
                        && !keep_lambda(out, lambda))
+                      || (out->extra && !keep_extra(out))
                       || !mechrt_trace_push_omega(&out->trace, t, q, qd, qdd, out->w)))
         out->full = true;
     if (out->t1 != out->t0)
@@ -171,6 +189,13 @@ void run_output_kinematic_state(void *ctx, double t, const double *q, const doub
 void run_output_json(FILE *f, const RunOutput *out, const char *error_message, double error_t)
 {
     const Model *m = out->m;
+    if (out->extra) {       /* run --sens: its columns, no multipliers */
+        MechrtJsonLambda lam = {.nx = out->nx, .xnames = (const char *const *)out->xnames,
+                                .x = out->xkept, .xnames_key = "sens_columns", .x_key = "sens"};
+        mechrt_json_write_lambda(f, &out->trace, m->nq, out->names, out->digits, error_message,
+                                 error_t, &lam);
+        return;
+    }
     if (out->lambda_use == RUN_OUTPUT_NO_LAMBDA) {
         mechrt_json_write_outputs(f, &out->trace, m->nq, out->names, out->digits, error_message,
                                   error_t);
@@ -179,7 +204,7 @@ void run_output_json(FILE *f, const RunOutput *out, const char *error_message, d
     const char **rows = xcalloc((size_t)m->nr + 1, sizeof *rows);
     for (int i = 0; i < m->nr; i++)
         rows[i] = m->rows[i].name;
-    MechrtJsonLambda lam = {m->nr, rows, out->lambda, 0, NULL, NULL};
+    MechrtJsonLambda lam = {.nr = m->nr, .rows = rows, .lambda = out->lambda};
     if (out->lambda_use == RUN_OUTPUT_FORCES)
         lam.nd = out->nd, lam.drivers = out->dnames, lam.efforts = out->efforts;
     mechrt_json_write_lambda(f, &out->trace, m->nq, out->names, out->digits, error_message,

@@ -63,6 +63,8 @@ typedef struct RunOutput {
     void (*extra)(void *ctx, double t, const double *q, const double *qd, const double *qdd,
                   double *x);
     void *extra_ctx;
+    double *xkept;              /* the extra columns of the kept rows (JSON) */
+    size_t xcap;                /* kept rows' room in xkept */
 } RunOutput;
 
 /* Sets up out for m (out's first fields filled) and writes the CSV

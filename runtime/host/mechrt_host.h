@@ -387,7 +387,9 @@ void mechrt_json_write_outputs(FILE *out, const MechrtTrace *tr, int ncoords,
 
 /* The multipliers of dynamics kept beside a trace, one set per trace row:
    lambda (rows x nr, the rows named rows) and, when nd > 0, the efforts
-   of the nd drivers (rows x nd, named drivers). */
+   of the nd drivers (rows x nd, named drivers); and when nx > 0 other
+   columns (rows x nx, named xnames) under the keys xnames_key and x_key
+   (mechc run --sens: "sens_columns", "sens"). */
 typedef struct MechrtJsonLambda {
     int nr;
     const char *const *rows;
@@ -395,10 +397,15 @@ typedef struct MechrtJsonLambda {
     int nd;
     const char *const *drivers;
     const double *efforts;
+    int nx;
+    const char *const *xnames;
+    const double *x;
+    const char *xnames_key, *x_key;
 } MechrtJsonLambda;
 
-/* mechrt_json_write_outputs, then (lam not NULL) "rows" and "lambda" and,
-   with drivers, "drivers" and "efforts", after "ok" and "error". */
+/* mechrt_json_write_outputs, then (lam not NULL) "rows" and "lambda" (when
+   nr > 0) and, with drivers, "drivers" and "efforts", and the other
+   columns, after "ok" and "error". */
 void mechrt_json_write_lambda(FILE *out, const MechrtTrace *tr, int ncoords,
                               const char *const *names, int digits, const char *error_message,
                               double error_t, const MechrtJsonLambda *lam);

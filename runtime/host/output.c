@@ -302,12 +302,13 @@ void mechrt_json_write_lambda(FILE *out, const MechrtTrace *tr, int ncoords,
         mechrt_json_string(out, error_message);
         fputs("}", out);
     }
-    if (lam) {
+    if (lam && lam->nr > 0)
         json_table(out, "rows", lam->rows, lam->nr, "lambda", lam->lambda, tr->rows, digits);
-        if (lam->nd > 0)
-            json_table(out, "drivers", lam->drivers, lam->nd, "efforts", lam->efforts, tr->rows,
-                       digits);
-    }
+    if (lam && lam->nd > 0)
+        json_table(out, "drivers", lam->drivers, lam->nd, "efforts", lam->efforts, tr->rows,
+                   digits);
+    if (lam && lam->nx > 0)
+        json_table(out, lam->xnames_key, lam->xnames, lam->nx, lam->x_key, lam->x, tr->rows, digits);
     fputs("}\n", out);
 }
 
