@@ -23,6 +23,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Rows whose residual at the failed assembly's best point is below this
+   fraction of the largest are rounding, not violated (and never below the
+   tolerance). */
+#define ASSEMBLE_T0_NOISE 1e-6
+
 /* The default Newton: minimum-norm projection onto the holonomic rows, by
    SuiteSparseQR on the sparse bundle (the dense SVD is O(nq^3)), else
    dense. */
@@ -53,7 +58,8 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
                     const AssembleT0Options *o, double *q, AssembleT0Report *rep)
 {
     size_t bytes = (size_t)m->nq * sizeof *q;
-    *rep = (AssembleT0Report){.t0 = o->t0, .more_option = o->more_option};
+    *rep = (AssembleT0Report){.t0 = o->t0, .more_option = o->more_option,
+                              .tol_phi = o->mechrt ? o->mechrt->tol_phi : o->rough.tol_phi};
     if (!o->no_construction)
         rep->constructed = construct_with_kernels(m, k, o->t0, q);
     double *start = xmalloc(bytes + 1);
@@ -74,38 +80,68 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
     return rep->status == MECHRT_OK;
 }
 
+/* What a violated normalisation row of a spatial body means, and the
+   length of its Euler parameters there: the row is |p|^2 - 1 (phi signed,
+   violated where |phi| >= floor). */
+static void describe_norms(const Model *m, const double *phi, double floor, char *msg,
+                           size_t size)
+{
+    for (int i = 0; i < m->nh; i++)
+        if (m->rows[i].kind == JOINT_S_NORM && fabs(phi[i]) >= floor)
+            analysis_msgf(msg, size, "; %s is the normalisation of %s's Euler parameters "
+                          "(e0^2 + e1^2 + e2^2 + e3^2 = 1), and there |p| = %.6g",
+                          m->rows[i].name, m->joints[m->rows[i].joint].name,
+                          sqrt(fmax(0.0, 1.0 + phi[i])));
+}
+
+bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                          const double *q, AssembleViolated *v, char *msg, size_t size)
+{
+    size_t nh = (size_t)k->nh;
+    double *phi = xcalloc(nh + 1, sizeof *phi), *size_of = xcalloc(nh + 1, sizeof *size_of);
+    const char **names = xcalloc(nh + 1, sizeof *names);
+    k->phi(k->ctx, q, t, phi);
+    bool finite = true;
+    *v = (AssembleViolated){0, -1};
+    for (size_t i = 0; i < nh; i++) {
+        finite = finite && isfinite(phi[i]);
+        size_of[i] = fabs(phi[i]);
+        if (size_of[i] > v->largest) {
+            v->largest = size_of[i];
+            v->worst = (int)i;
+        }
+        names[i] = m->rows[i].name;
+    }
+    if (finite) {
+        /* every row violated there, not only those near the largest */
+        double floor = fmax(tol_phi, ASSEMBLE_T0_NOISE * v->largest);
+        analysis_name_above(msg, size, names, size_of, (int)nh, floor);
+        describe_norms(m, phi, floor, msg, size);
+    }
+    free(phi), free(size_of), free(names);
+    return finite;
+}
+
 void assemble_t0_describe(const Model *m, const MechrtKernels *k, const AssembleT0Report *rep,
                           const double *q, char *msg, size_t size)
 {
     int iterations = rep->robust ? rep->rough.iterations : rep->newton.iterations;
-    double residual = rep->robust ? rep->rough.residual : rep->newton.residual;
-    int worst = rep->robust ? rep->rough.worst_row : rep->newton.worst_row;
     const char *its = iterations == 1 ? "iteration" : "iterations";
+    char rows[ASSEMBLE_VIOLATED_SIZE] = "";
+    AssembleViolated v;
     msg[0] = '\0';
     analysis_msgf(msg, size, "t = %.10g: could not assemble from these initial values: ", rep->t0);
-    size_t nh = (size_t)k->nh;
-    double *phi = xcalloc(nh + 1, sizeof *phi);
-    const char **names = xcalloc(nh + 1, sizeof *names);
-    k->phi(k->ctx, q, rep->t0, phi);
-    bool finite = true;
-    for (size_t i = 0; i < nh; i++) {
-        finite = finite && isfinite(phi[i]);
-        phi[i] = fabs(phi[i]);
-        names[i] = m->rows[i].name;
-    }
-    if (!finite) {
+    if (!assemble_t0_violated(m, k, rep->t0, rep->tol_phi, q, &v, rows, sizeof rows))
         analysis_msgf(msg, size, "minimum-norm Newton reached NaN or infinity after %d %s",
                       iterations, its);
-    } else {
-        analysis_msgf(msg, size, "after %d %s of minimum-norm Newton the largest residual is "
-                      "%.3g in row %s; rows left unsatisfied: ", iterations, its, residual,
-                      worst >= 0 && worst < (int)nh ? names[worst] : "?");
-        analysis_name_list(msg, size, names, phi, (int)nh);
-    }
+    else    /* q: the iterate with the smallest residual (min_norm_newton, project) */
+        analysis_msgf(msg, size, "after %d %s of minimum-norm Newton the largest residual at "
+                      "the best point found is %.3g in row %s; rows left unsatisfied there: %s",
+                      iterations, its, v.largest, v.worst >= 0 ? m->rows[v.worst].name : "?",
+                      rows);
     analysis_msgf(msg, size, " (the mechanism may not close with these lengths, or the guess is "
                   "nearer a configuration that does not exist; try other initial values%s%s)",
                   rep->more_option ? ", or more " : "", rep->more_option ? rep->more_option : "");
-    free(phi), free(names);
 }
 
 /* The note after a successful assembly: how Newton started, or how far it
