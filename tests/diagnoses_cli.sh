@@ -1,8 +1,10 @@
 #!/bin/sh
 # tests/diagnoses_cli.sh MECHC - failures whose diagnosis must name the
-# real cause: a spatial loop that cannot close (the rows violated at the
-# best point Newton found, the Euler parameters' normalisation among them,
-# never a diverged iterate; `info` shows that point as not assembled).
+# real cause: a spatial loop that cannot close (the loop, then the rows
+# violated at the best point Newton found, the Euler parameters'
+# normalisation among them, never a diverged iterate; `info` shows that
+# point as not assembled); a rail out of reach (the loop, the rail in it,
+# before the rod's rows).
 #
 #   sh tests/diagnoses_cli.sh build/mechc
 #
@@ -21,11 +23,11 @@ sed 's/^param L     = sqrt(10)$/param L     = 1/' "$ex/rssr.mech" > "$tmp/rssr_s
 run_mechc run "$tmp/rssr_short.mech"
 check "spatial loop too short: run exit 1" status_is 1
 check "spatial loop too short: the best point's residual, not a diverged one" \
-    err_has "rssr_short.mech: error: t = 0: could not assemble from these initial values: after 99 iterations of minimum-norm Newton the largest residual at the best point found is 3 in row C; rows left unsatisfied there: C and rocker.norm; rocker.norm is the normalisation of rocker's Euler parameters (e0^2 + e1^2 + e2^2 + e3^2 = 1), and there |p| = 1.0"
+    err_has "rssr_short.mech: error: t = 0: could not assemble from these initial values: the loop of R1, R2, C and D cannot close (without any one of them the other rows assemble: a length, a pivot, a rail or a driven position out of reach); after 99 iterations of minimum-norm Newton the largest residual at the best point found is 3 in row C; rows left unsatisfied there: C and rocker.norm; rocker.norm is the normalisation of rocker's Euler parameters (e0^2 + e1^2 + e2^2 + e3^2 = 1), and there |p| = 1.0"
 run_mechc info "$tmp/rssr_short.mech"
 check "spatial loop too short: info exit 1" status_is 1
 check "spatial loop too short: info names the rows violated at the best point" \
-    err_has "the assembly did not converge (residual 3, worst row C); rows left unsatisfied at the best point found: C and rocker.norm"
+    err_has "the assembly did not converge (residual 3, worst row C): the loop of R1, R2, C and D cannot close (without any one of them the other rows assemble: a length, a pivot, a rail or a driven position out of reach); rows left unsatisfied at the best point found: C and rocker.norm"
 check "spatial loop too short: info does not call the point assembled" \
     out_has "coordinates (initial value, best point found, NOT assembled, at t = 0):"
 check "spatial loop too short: nor the configuration of its rank" \
@@ -49,7 +51,33 @@ EOF2
 run_mechc sim "$tmp/rssr_long.mech"
 check "spatial loop too long: sim exit 1" status_is 1
 check "spatial loop too long: every violated row, the normalisations too" \
-    err_has "the largest residual at the best point found is 1.81e+03 in row C; rows left unsatisfied there: C, rocker.norm and crank.norm; crank.norm is the normalisation of crank's Euler parameters"
+    err_has "C cannot be met (without it the other rows assemble); after 254 iterations of minimum-norm Newton the largest residual at the best point found is 1.81e+03 in row C; rows left unsatisfied there: C, rocker.norm and crank.norm; crank.norm is the normalisation of crank's Euler parameters"
 check "spatial loop too long: nothing on stdout" out_empty
+
+# ---- a rail out of reach ----
+# examples/slider_crank_spatial.mech with its rail (translational P) moved
+# to y = 0.5: crank and rod reach 0.4. The best point keeps the slider on
+# the rail and breaks the rod's joints, and the diagnosis was "worst row
+# rod.norm", the rod's orientation. Now the loop comes first, P in it (and
+# not the driver, which can stay).
+sed 's/^translational P: ground(0, 0, 0)/translational P: ground(0, 0.5, 0)/' \
+    "$ex/slider_crank_spatial.mech" > "$tmp/rail.mech"
+grep -q 'ground(0, 0.5, 0)' "$tmp/rail.mech" || bad "rail.mech: the rail was not moved"
+for cmd in run info; do
+    run_mechc $cmd "$tmp/rail.mech"
+    check "rail out of reach: $cmd exit 1" status_is 1
+    check "rail out of reach: $cmd names the loop, the rail P in it, the driver not" \
+        err_has "the loop of O, A, B and P cannot close (without any one of them the other rows assemble: a length, a pivot, a rail or a driven position out of reach)"
+done
+run_mechc run "$tmp/rail.mech"
+check "rail out of reach: the loop before the rows left unsatisfied" \
+    err_matches "error: t = 0: could not assemble from these initial values: the loop of O, A, B and P cannot close ([^)]*); after [0-9]* iterations .* in row rod.norm; rows left unsatisfied there: rod.norm, "
+# the same in a plane, with masses, under sim
+sed 's/^prismatic P: ground(0, 0)/prismatic P: ground(0, 0.5)/' \
+    "$ex/slider_crank_dynamics.mech" > "$tmp/rail_planar.mech"
+run_mechc sim "$tmp/rail_planar.mech"
+check "planar rail out of reach: sim exit 1" status_is 1
+check "planar rail out of reach: sim names the loop with P" \
+    err_has "rail_planar.mech: error: t = 0: could not assemble from these initial values: the loop of O, A, B and P cannot close"
 
 suite_end

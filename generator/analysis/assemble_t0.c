@@ -28,6 +28,11 @@
    tolerance). */
 #define ASSEMBLE_T0_NOISE 1e-6
 
+/* A failed assembly looks for the loop that cannot close (describe_loop)
+   in mechanisms of at most this many statements (and the dense limit's
+   coordinates). */
+#define ASSEMBLE_T0_LOOP_JOINTS 64
+
 /* The default Newton: minimum-norm projection onto the holonomic rows, by
    SuiteSparseQR on the sparse bundle (the dense SVD is O(nq^3)), else
    dense. */
@@ -94,6 +99,56 @@ static void describe_norms(const Model *m, const double *phi, double floor, char
                           sqrt(fmax(0.0, 1.0 + phi[i])));
 }
 
+/* One dense minimum-norm Newton per statement, from the file's values
+   then from q, on the other rows: those without which the rest closes. */
+int assemble_t0_loop(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                     const double *q, char *msg, size_t size)
+{
+    int nq = k->nq, nh = k->nh, nj = m->njoints, found = 0;
+    if (nq > ANALYSIS_DENSE_MAX_NQ || nj > ASSEMBLE_T0_LOOP_JOINTS)
+        return 0;
+    int *rows = xcalloc((size_t)nh + 1, sizeof *rows);
+    double *trial = xcalloc((size_t)nq + 1, sizeof *trial);
+    double *in_loop = xcalloc((size_t)nj + 1, sizeof *in_loop);
+    const char **names = xcalloc((size_t)nj + 1, sizeof *names);
+    AnalysisOptions opt = analysis_default_options();
+    opt.tol_phi = tol_phi;
+    opt.stall_iter = ASSEMBLE_ROUGH_STALL;
+    MechrtSvd *w = mechrt_svd_new(nh, nq);
+    for (int j = 0; j < nj && w; j++) {
+        names[j] = m->joints[j].name;
+        int n = 0;
+        for (int i = 0; i < nh; i++)
+            if (m->rows[i].joint != j)
+                rows[n++] = i;
+        if (n == nh || m->joints[j].kind == JOINT_S_NORM)
+            continue;   /* no holonomic rows; a body's normalisation is no suspect */
+        /* from the file's values, then from the best point */
+        AssembleResult res;
+        bool closes = false;
+        for (int from = 0; from < 2 && !closes; from++) {
+            memcpy(trial, from ? q : m->q0, (size_t)nq * sizeof *trial);
+            closes = assemble_min_norm(k, rows, n, t, trial, &opt, w, &res);
+        }
+        if (closes) {
+            in_loop[j] = 1;
+            found++;
+        }
+    }
+    if (found > 1) {
+        analysis_msgf(msg, size, "the loop of ");
+        analysis_name_above(msg, size, names, in_loop, nj, 1);
+        analysis_msgf(msg, size, " cannot close (without any one of them the other rows "
+                      "assemble: a length, a pivot, a rail or a driven position out of reach)");
+    } else if (found == 1) {
+        analysis_name_above(msg, size, names, in_loop, nj, 1);
+        analysis_msgf(msg, size, " cannot be met (without it the other rows assemble)");
+    }
+    mechrt_svd_free(w);
+    free(rows), free(trial), free(in_loop), free(names);
+    return found;
+}
+
 bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, double tol_phi,
                           const double *q, AssembleViolated *v, char *msg, size_t size)
 {
@@ -127,11 +182,14 @@ void assemble_t0_describe(const Model *m, const MechrtKernels *k, const Assemble
 {
     int iterations = rep->robust ? rep->rough.iterations : rep->newton.iterations;
     const char *its = iterations == 1 ? "iteration" : "iterations";
-    char rows[ASSEMBLE_VIOLATED_SIZE] = "";
+    char rows[ASSEMBLE_VIOLATED_SIZE] = "", loop[ASSEMBLE_VIOLATED_SIZE] = "";
     AssembleViolated v;
     msg[0] = '\0';
     analysis_msgf(msg, size, "t = %.10g: could not assemble from these initial values: ", rep->t0);
-    if (!assemble_t0_violated(m, k, rep->t0, rep->tol_phi, q, &v, rows, sizeof rows))
+    bool finite = assemble_t0_violated(m, k, rep->t0, rep->tol_phi, q, &v, rows, sizeof rows);
+    if (finite && assemble_t0_loop(m, k, rep->t0, rep->tol_phi, q, loop, sizeof loop) > 0)
+        analysis_msgf(msg, size, "%s; ", loop);     /* the cause first */
+    if (!finite)
         analysis_msgf(msg, size, "minimum-norm Newton reached NaN or infinity after %d %s",
                       iterations, its);
     else    /* q: the iterate with the smallest residual (min_norm_newton, project) */

@@ -89,6 +89,17 @@ typedef struct AssembleViolated {
 bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, double tol_phi,
                           const double *q, AssembleViolated *v, char *msg, size_t size);
 
+/* The statements without any one of which the other holonomic rows
+   assemble at t (from the file's values or from q, the best point found):
+   the loop that cannot close, each of its joints as much a suspect as the
+   rows left unsatisfied at q (a rail out of reach keeps its own rows and
+   breaks the joints next to it). Appends to msg "the loop of O, A, B and P
+   cannot close (...)", or for one statement "C cannot be met (...)";
+   returns how many. Small mechanisms only (one dense assembly each): 0
+   beyond ANALYSIS_DENSE_MAX_NQ coordinates or 64 statements. */
+int assemble_t0_loop(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                     const double *q, char *msg, size_t size);
+
 /* After a successful assembly, the note ("FILE: note: ...") on notes
    (NULL: none) when Newton could not start from the file's values q0 or
    moved them by more than move_note * max|q0_i| (1 if all 0) to q; the

@@ -572,6 +572,8 @@ static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
         fprintf(stderr, ")");
+        if (rep.loop && rep.loop[0])
+            fprintf(stderr, ": %s", rep.loop);
         if (rep.violated && rep.violated[0])
             fprintf(stderr, "; rows left unsatisfied at the best point found: %s", rep.violated);
         fprintf(stderr, "\n");

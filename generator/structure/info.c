@@ -419,7 +419,10 @@ static void assemble_at(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
     if (!rep->assembled) {      /* rep->q: the best point found */
         AssembleViolated v;
         rep->violated = xcalloc(ASSEMBLE_VIOLATED_SIZE, 1);
-        assemble_t0_violated(m, &n.k, t, opt->tol_phi, rep->q, &v, rep->violated,
+        rep->loop = xcalloc(ASSEMBLE_VIOLATED_SIZE, 1);
+        if (assemble_t0_violated(m, &n.k, t, opt->tol_phi, rep->q, &v, rep->violated,
+                                 ASSEMBLE_VIOLATED_SIZE))
+            assemble_t0_loop(m, &n.k, t, opt->tol_phi, rep->q, rep->loop,
                              ASSEMBLE_VIOLATED_SIZE);
     }
 }
@@ -572,6 +575,7 @@ void info_report_free(InfoReport *rep)
     free(rep->q);
     free(rep->verdict);
     free(rep->violated);
+    free(rep->loop);
     free(rep->singular);
     free(rep->state.dependent);
     free(rep->state.null);

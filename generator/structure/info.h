@@ -72,6 +72,8 @@ typedef struct InfoReport {
     bool assembled;         /* converged, or nothing to assemble */
     char *violated;         /* not assembled: the rows violated at q, the
                                best point found (malloc'd); else NULL */
+    char *loop;             /* not assembled: the loop that cannot close
+                               (assemble_t0_loop; malloc'd, maybe ""); else NULL */
     int constructed;        /* coordinates placed by construction before
                                Newton (construct.h) */
     /* rank of the holonomic rows at q */
