@@ -4,7 +4,8 @@
 # violated at the best point Newton found, the Euler parameters'
 # normalisation among them, never a diverged iterate; `info` shows that
 # point as not assembled); a rail out of reach (the loop, the rail in it,
-# before the rod's rows).
+# before the rod's rows); a spring of length 0 (named, with its place in
+# the file and why its force is NaN).
 #
 #   sh tests/diagnoses_cli.sh build/mechc
 #
@@ -79,5 +80,30 @@ run_mechc sim "$tmp/rail_planar.mech"
 check "planar rail out of reach: sim exit 1" status_is 1
 check "planar rail out of reach: sim names the loop with P" \
     err_has "rail_planar.mech: error: t = 0: could not assemble from these initial values: the loop of O, A, B and P cannot close"
+
+# ---- a spring of length 0 ----
+# Its ends at one point: the direction of its force, (B - A)/|B - A|, is
+# 0/0. sim and run --forces said "NaN or infinity in the mass matrix, the
+# forces, ..." without naming it.
+cat > "$tmp/zero_spring.mech" <<'EOF2'
+body rod x = 0.5 y = 0 phi = 0
+revolute O: ground(0, 0) rod(-0.5, 0)
+mass rod m = 1 J = 0.1
+gravity (0, -9.81)
+spring S: ground(0, 0) rod(-0.5, 0)  k = 100  length = 0.2
+EOF2
+for l in dense sparse; do
+    run_mechc sim "$tmp/zero_spring.mech" --linear $l
+    check "spring of length 0, sim --linear $l: exit 1" status_is 1
+    check "spring of length 0, sim --linear $l: names it, where, and why" \
+        err_has "zero_spring.mech: error: t = 0: forward dynamics failed: spring 'S' ($tmp/zero_spring.mech:5:1) has length 0 here, its two ends at one point: the direction of its force, (B - A)/|B - A|, is undefined (0/0)"
+done
+run_mechc sim "$tmp/zero_spring.mech" --engine generic
+check "spring of length 0, sim --engine generic: names it" err_has "spring 'S' ($tmp/zero_spring.mech:5:1) has length 0 here"
+printf 'driver D: rod.phi = t\n' | cat "$tmp/zero_spring.mech" - | grep -v gravity > "$tmp/zero_spring_run.mech"
+run_mechc run "$tmp/zero_spring_run.mech" --forces
+check "spring of length 0, run --forces: exit 1" status_is 1
+check "spring of length 0, run --forces: names it" \
+    err_has "zero_spring_run.mech: error: t = 0: inverse dynamics failed: spring 'S' ($tmp/zero_spring_run.mech:4:1) has length 0 here"
 
 suite_end

@@ -420,7 +420,8 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
 }
 
 /* Runs the analysis with the open engine, the states going where c says. */
-static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics)
+static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics,
+                   const Diag *source)
 {
     RunOutput out = {.cmd = "run", .keep = c->json || c->pictures || c->table,
                      .lambda_use = c->forces ? RUN_OUTPUT_FORCES : RUN_OUTPUT_NO_LAMBDA,
@@ -436,6 +437,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
     const MechrtHostJacNz *jnz = engine_jac_nz(e);
     RunResult res;
     c->ro.notes = stderr;
+    c->ro.source = source;
     c->ro.linear = (AnalysisLinear)c->linear;
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
@@ -465,7 +467,7 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
                 "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
                 e.gen_seconds, e.compile_seconds);
-    int status = analyse(c, mech->model, &e, &pics);
+    int status = analyse(c, mech->model, &e, &pics, diag);
     engine_close(&e);
     return status;
 }

@@ -147,7 +147,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
                                                 s->lambda, s->work, s->lwork, &rep);
     if (st != MECHRT_OK) {
         sim_fail(s, st, t, "forward dynamics");
-        sim_explain_dynamics(s, st, &rep);
+        sim_explain_dynamics(s, st, &rep, y);
         return false;
     }
     state(ctx, t, y, y + n, s->f0, s->lambda);
@@ -362,6 +362,7 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJ
         names[i] = m->rows[i].name;
     SimOptions named = *o;
     named.row_names = names;
+    named.model = m;
     AnalysisStatus st = sim_integrate(k, jnz, mnz, &named, q, state, state_ctx, res);
     free(names);
     res->constructed = pre.constructed;

@@ -65,6 +65,7 @@
 #include "subdivide.h"
 
 #include "../base/arena.h"
+#include "../dyn/blame.h"
 #include "../pipeline/pipeline.h"
 
 #include <math.h>
@@ -118,9 +119,12 @@ static bool inverse_at(Run *r, double t)
     r->res->cause = st;
     r->res->t_fail = t;
     r->res->message[0] = '\0';
-    msgf(r, "t = %.10g: inverse dynamics failed: %s", t,
-         st == MECHRT_ENOTFINITE ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
-                                 : mechrt_strerror(st));
+    msgf(r, "t = %.10g: inverse dynamics failed: ", t);
+    if (st != MECHRT_ENOTFINITE || !blame_force(r->m, r->o->source, t, r->q, r->qd,
+                                                r->res->message, sizeof r->res->message))
+        msgf(r, "%s", st == MECHRT_ENOTFINITE
+                          ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
+                          : mechrt_strerror(st));
     return false;
 }
 
