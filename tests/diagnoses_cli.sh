@@ -106,4 +106,29 @@ check "spring of length 0, run --forces: exit 1" status_is 1
 check "spring of length 0, run --forces: names it" \
     err_has "zero_spring_run.mech: error: t = 0: inverse dynamics failed: spring 'S' ($tmp/zero_spring_run.mech:4:1) has length 0 here"
 
+# ---- a driver pushed past reach ----
+# examples/four_bar.mech with its rocker driven at 2 rad/s: at t = 0.3614
+# crank and coupler line up and the rocker can turn no further. sim said
+# "step size underflow ... a stiff force?" (or, with rk4imp, "tighten
+# --rtol/--atol"); run put it at t = 0.37, its output time.
+sed 's/^driver drive: crank.phi = omega\*t$/driver drive: rocker.phi = 1.6961 + 2*t/' \
+    "$ex/four_bar.mech" > "$tmp/past_reach.mech"
+{ cat "$tmp/past_reach.mech"
+  printf 'mass crank m = 1 J = 0.1\nmass coupler m = 1 J = 0.1\nmass rocker m = 1 J = 0.1\n'
+  printf 'gravity (0, -9.81)\n'; } > "$tmp/past_reach_dyn.mech"
+for m in rk8pd rk4imp msbdf; do
+    run_mechc sim "$tmp/past_reach_dyn.mech" --method $m
+    check "driver past reach, sim --method $m: exit 1" status_is 1
+    check "driver past reach, sim --method $m: cannot reach, the time, the driver and the rows" \
+        err_matches "past_reach_dyn.mech: error: t = 0\.361379[0-9]*: the mechanism cannot reach the driven position: driver 'drive' pushes it past a limit position, where the Jacobian loses rank (smallest singular value [0-9.e-]* of the largest, along rows drive, "
+    check "driver past reach, sim --method $m: the integrator's words after" \
+        err_matches "; where it stopped: [a-z ]* failed: "
+    check "driver past reach, sim --method $m: the states before written" out_lines 38
+done
+run_mechc run "$tmp/past_reach.mech"
+check "driver past reach, run: exit 1" status_is 1
+check "driver past reach, run: the time it stopped (not the output time 0.37), the driver, the rows" \
+    err_has "past_reach.mech: error: t = 0.36140625: the mechanism cannot reach the driven position: driver 'drive' pushes it past a limit position, where the Jacobian loses rank (smallest singular value 0.003 of the largest, along rows drive, O2.y, A.y, O4.y, B.y and O4.x)"
+check "driver past reach, run: no headline at t = 0.37" sh -c '! grep -q "error: t = 0.37" "$1"' _ "$tmp/err"
+
 suite_end

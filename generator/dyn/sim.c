@@ -74,6 +74,7 @@
 #include "step.h"
 
 #include "../analysis/assemble_t0.h"
+#include "../analysis/limit.h"
 #include "../base/arena.h"
 #include "../pipeline/pipeline.h"
 
@@ -297,6 +298,9 @@ AnalysisStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
     clock_t cpu0 = clock();
     if (sim_settle(&s, y, o->t0, true))
         status = integrate(&s, y, state, state_ctx);
+    if (status == ANALYSIS_FAILED && res->states > 0 && o->model && isfinite(res->t_fail)
+        && limit_explain(o->model, k, y, res->t_fail, LIMIT_STOPPED, res->message, sizeof res->message))
+        res->cause = MECHRT_ESING;      /* a limit position, said first */
     res->seconds = pipeline_now() - c0;
     res->cpu_seconds = (double)(clock() - cpu0) / CLOCKS_PER_SEC;
     gsl_set_error_handler(old);
