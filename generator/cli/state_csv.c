@@ -9,7 +9,6 @@
    between a time run computed (t0 + k h) and the decimal one typed. */
 #define STATE_CSV_T_MATCH 1e-9
 
-#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
