@@ -32,6 +32,9 @@
    in mechanisms of at most this many statements (and the dense limit's
    coordinates). */
 #define ASSEMBLE_T0_LOOP_JOINTS 64
+/* Iterations of each of its probes: the rows without a statement of the
+   loop close from the file's values in a few; the others only stall. */
+#define ASSEMBLE_T0_LOOP_ITER 20
 
 /* The default Newton: minimum-norm projection onto the holonomic rows, by
    SuiteSparseQR on the sparse bundle (the dense SVD is O(nq^3)), else
@@ -114,6 +117,7 @@ int assemble_t0_loop(const Model *m, const MechrtKernels *k, double t, double to
     AnalysisOptions opt = analysis_default_options();
     opt.tol_phi = tol_phi;
     opt.stall_iter = ASSEMBLE_ROUGH_STALL;
+    opt.max_iter = ASSEMBLE_T0_LOOP_ITER;
     MechrtSvd *w = mechrt_svd_new(nh, nq);
     for (int j = 0; j < nj && w; j++) {
         names[j] = m->joints[j].name;
