@@ -288,7 +288,7 @@ printf 'point p x = 0 y = 0\nconstraint a: p.x = 1e-50*p.y\ndriver d: p.y = t\n'
 run gen "$tmp/tiny.mech" --real float
 check "gen --real float with a constant float rounds to 0: exit 2" status_is 2
 check "gen --real float with a constant float rounds to 0: the file and why" \
-    err_has "tiny.mech:2:1: error: a constant mechc computes from this statement's numbers is 1e-50, which a float (--real float) cannot hold: it would become 0"
+    err_has "tiny.mech:2:21: error: this constant is 1e-50, which a float (--real float) cannot hold: it would become 0"
 run gen "$ex/four_bar.mech" --jac sideways
 check "gen --jac sideways exits 2" status_is 2
 check "gen --jac sideways names the choices" err_has "auto, spread or direct"

@@ -266,7 +266,25 @@ run info "$ex/four_bar.mech" --state "$tmp/nothing.csv"
 check "--state on a missing file: exit 2" status_is 2
 run info "$ex/four_bar.mech" --state "$tmp"
 check "--state on a folder: exit 2" status_is 2
-check "--state on a folder: says why" err_has "$tmp: error: cannot read: Is a directory"
+check "--state on a folder: says why" \
+    err_has "$tmp: error: cannot read '$tmp': a directory; give a regular file, or '-' for stdin"
+# the state CSV is read as a .mech file is: a named pipe with no writer
+# does not block (it once did, in fopen), and '-' is stdin
+if have mkfifo && mkfifo "$tmp/pipe.csv"; then
+    mechc_timeout=20
+    run info "$ex/four_bar.mech" --state "$tmp/pipe.csv"
+    check "--state on a named pipe: exit 2 (does not block)" status_is 2
+    check "--state on a named pipe: says it is one" \
+        err_has "pipe.csv: error: cannot read '$tmp/pipe.csv': a named pipe; give a regular file, or '-' for stdin"
+    mechc_timeout=
+else
+    skip "mkfifo: --state on a named pipe"
+fi
+"$mechc" run "$ex/four_bar.mech" --steps 2 > "$tmp/fb2.csv"
+"$mechc" info "$ex/four_bar.mech" --state - --at 0.5 < "$tmp/fb2.csv" > "$tmp/out" 2> "$tmp/err"
+rc=$?
+check "--state - (stdin): exit 0" status_is 0
+check "--state - (stdin): the state at t = 0.5" out_has "read from the CSV"
 # a number that is not finite, where it is read: FILE:LINE:COL and a caret
 sed '2s/^[^,]*/inf/' "$tmp/fb.csv" > "$tmp/fb_inf.csv"
 run info "$ex/four_bar.mech" --state "$tmp/fb_inf.csv"

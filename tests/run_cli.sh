@@ -428,7 +428,8 @@ driver pull: p.x = 0.55 + t
 EOF
 run "$tmp/reach.mech" --steps 10
 check "out of reach: exit 1" status_is 1
-check "out of reach: t = 0.5, no convergence" err_matches "error: t = 0\.5: .*no convergence"
+check "out of reach: the time it stopped, the driver, then no convergence" \
+    err_matches "error: t = 0\.4515625: the mechanism cannot reach the driven position: driver 'pull' pushes it past a limit position.*no convergence"
 check "out of reach: names the row" err_has "row circle"
 check "out of reach: assembly moved the rough initial values: a note" \
     err_has "note: assembly at t = 0 moved"

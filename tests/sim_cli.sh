@@ -11,7 +11,8 @@
 # pendulum's energy; a stiff spring's closed form with the implicit
 # methods; the engines agreeing; a redundant parallelogram with masses
 # through its flat positions; exit statuses and messages of bad use; motions
-# that cannot go on (a rolling disk falling flat), --max-steps, and the note
+# that cannot go on (a rolling disk falling flat, dry friction that sticks:
+# the step size collapses), --max-steps, and the note
 # on moved initial values that run prints.
 # The last line is "sim_cli: N passed, M failed".
 set -u
@@ -224,7 +225,7 @@ sed 's/^revolute g20: ground(20, 0)/revolute g20: ground(20, 5)/' "$tmp/a02_40.m
 run "$tmp/a02_40bad.mech" --t1 0.01 --qd "$(sh "$ex/a02_four_bar.sh" --qd 40)"
 check "a02 N = 40, a pivot moved: exit 1" status_is 1
 check "a02 N = 40, a pivot moved: could not assemble, in which row" err_matches \
-    "t = 0: could not assemble from these initial values: after [0-9]* iterations of minimum-norm Newton the largest residual is [0-9.e+-]* in row [ab][0-9]*\.[xy]"
+    "t = 0: could not assemble from these initial values: after [0-9]* iterations of minimum-norm Newton the largest residual at the best point found is [0-9.e+-]* in row [ab][0-9]*\.[xy]"
 # --interpolate: rk8pd's own steps across the 400 output times, the states
 # there from the steps' Hermite interpolant
 run "$tmp/a02_40.mech" --t1 20 --steps 400 --rtol 1e-6 --atol 1e-6 --interpolate \
@@ -440,6 +441,24 @@ for m in rk8pd rkf45 rk4imp msbdf; do
             err_matches 'turned abruptly (roll\.h and roll\.x): the rows are not smooth or not defined'
         check "disk falling flat, $m $l: the states before written" out_lines 8
     done
+done
+# A pendulum braked by dry friction (a torque -20 sign(w), written
+# -20 w / sqrt(w^2 + 1e-200)) comes to rest at t = 0.0337 and sticks: the
+# right side jumps at w = 0 and the steps collapse (watch.c) rather than
+# underflow, with smooth rows.
+cat > "$tmp/friction.mech" <<'EOF'
+body rod x = 0.5 y = 0 phi = 0
+revolute O: ground(0, 0) rod(-0.5, 0)
+mass rod m = 1 J = 0.1
+gravity (0, -9.81)
+torque F: rod = -20*der(rod.phi)/sqrt(der(rod.phi)^2 + 1e-200)
+EOF
+for m in rk8pd msbdf; do
+    run "$tmp/friction.mech" --t1 1 --qd 0,0,3 --method "$m" --linear dense
+    check "dry friction sticking, $m: exit 1" status_is 1
+    check "dry friction sticking, $m: the step size collapsed, and when" \
+        err_matches 'friction.mech: error: t = 0\.03373[0-9]*: integration failed: the step size collapsed (1000 steps of [0-9.e-]* on average, [0-9]* attempts rejected; steps of [0-9.e-]* before): the motion reached a state the integrator cannot cross'
+    check "dry friction sticking, $m: the 4 states before written" out_lines 5
 done
 # Smooth rows turn far in the long steps of loose tolerances: not a failure.
 for f in a01_pendulum heavy_top; do

@@ -623,7 +623,30 @@ static void test_nonfinite_constant_names_statement(void **state)
     assert_int_equal(diag.col, 1);
     assert_string_equal(diag.message, "a constant mechc computes from this statement's numbers "
                                       "is +inf: it overflows past the largest double (about "
-                                      "1.8e308); write them in other units, or nearer 1");
+                                      "1.8e308); write the numbers in other units, or nearer 1");
+    dag_free(&d);
+}
+
+/* Made while a sub-expression is lowered (where_expr), a constant out of
+   range is reported at that sub-expression, as "this constant". */
+static void test_nonfinite_constant_names_expression(void **state)
+{
+    (void)state;
+    const char *text = "first\nsecond x = 1e200\n";
+    Dag d;
+    dag_init(&d, 100);
+    Diag diag;
+    diag_init(&diag, "x.mech", text, (int)strlen(text));
+    d.where = 6;                                /* "second" */
+    d.where_expr = 17;                          /* "1e200" */
+    dag_const(&d, -INFINITY);
+    d.where_expr = -1;
+    assert_false(dag_check_finite(&d, &diag));
+    assert_int_equal(diag.line, 2);
+    assert_int_equal(diag.col, 12);
+    assert_string_equal(diag.message, "this constant is -inf: it overflows past the largest "
+                                      "double (about -1.8e308); write the numbers in other "
+                                      "units, or nearer 1");
     dag_free(&d);
 }
 
@@ -674,6 +697,7 @@ int main(void)
         cmocka_unit_test(test_node_limit),
         cmocka_unit_test(test_node_limit_names_statement),
         cmocka_unit_test(test_nonfinite_constant_names_statement),
+        cmocka_unit_test(test_nonfinite_constant_names_expression),
         cmocka_unit_test(test_float_range_only_reachable),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

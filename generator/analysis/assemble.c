@@ -40,6 +40,15 @@ typedef struct NewtonPath {
     void *ctx;
 } NewtonPath;
 
+/* The iterate with the smallest ||Phi||_2 so far: its norms and worst row.
+   A failure ends there, not at the last iterate: a full step that found no
+   descent may have carried Newton far off (Euler parameters grown without
+   bound), and what is violated there says nothing about the mechanism. */
+typedef struct BestIterate {
+    double norm, inf;
+    int worst;
+} BestIterate;
+
 static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
                             const AnalysisOptions *opt, AssembleResult *res)
 {
@@ -53,6 +62,8 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
     }
     double *dq = xcalloc((size_t)nq, sizeof *dq);
     double *trial = xcalloc((size_t)nq, sizeof *trial);
+    double *bestq = xmalloc((size_t)nq * sizeof *bestq);
+    memcpy(bestq, q, (size_t)nq * sizeof *bestq);
     double inf = 0.0;
     int worst = -1;
     double norm = p->eval(p->ctx, q, true, &inf, &worst);
@@ -60,6 +71,7 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
     res->worst_row = worst;
     bool ok = false;
     double best = norm;
+    BestIterate least = {norm, inf, worst};
     int improved = 0;       /* the iteration that last cut the best norm by 1 % */
     for (int iter = 0; isfinite(norm); iter++) {
         /* at least one step: a start that satisfies the rows only to
@@ -100,9 +112,18 @@ static bool min_norm_newton(const NewtonPath *p, int nrows, int nq, double *q,
         norm = p->eval(p->ctx, q, true, &inf, &worst);
         res->residual = isfinite(norm) ? inf : NAN;
         res->worst_row = worst;
+        if (norm < least.norm || !isfinite(least.norm)) {
+            least = (BestIterate){norm, inf, worst};
+            memcpy(bestq, q, (size_t)nq * sizeof *bestq);
+        }
+    }
+    if (!ok && isfinite(least.norm) && !(norm <= least.norm)) {
+        memcpy(q, bestq, (size_t)nq * sizeof *bestq);
+        res->residual = least.inf;
+        res->worst_row = least.worst;
     }
     res->converged = ok;
-    free(dq), free(trial);
+    free(dq), free(trial), free(bestq);
     return ok;
 }
 

@@ -23,6 +23,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Rows whose residual at the failed assembly's best point is below this
+   fraction of the largest are rounding, not violated (and never below the
+   tolerance). */
+#define ASSEMBLE_T0_NOISE 1e-6
+
+/* A failed assembly looks for the loop that cannot close (describe_loop)
+   in mechanisms of at most this many statements (and the dense limit's
+   coordinates). */
+#define ASSEMBLE_T0_LOOP_JOINTS 64
+/* Iterations of each of its probes: the rows without a statement of the
+   loop close from the file's values in a few; the others only stall. */
+#define ASSEMBLE_T0_LOOP_ITER 20
+
 /* The default Newton: minimum-norm projection onto the holonomic rows, by
    SuiteSparseQR on the sparse bundle (the dense SVD is O(nq^3)), else
    dense. */
@@ -53,7 +66,8 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
                     const AssembleT0Options *o, double *q, AssembleT0Report *rep)
 {
     size_t bytes = (size_t)m->nq * sizeof *q;
-    *rep = (AssembleT0Report){.t0 = o->t0, .more_option = o->more_option};
+    *rep = (AssembleT0Report){.t0 = o->t0, .more_option = o->more_option,
+                              .tol_phi = o->mechrt ? o->mechrt->tol_phi : o->rough.tol_phi};
     if (!o->no_construction)
         rep->constructed = construct_with_kernels(m, k, o->t0, q);
     double *start = xmalloc(bytes + 1);
@@ -74,38 +88,122 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
     return rep->status == MECHRT_OK;
 }
 
+/* What a violated normalisation row of a spatial body means, and the
+   length of its Euler parameters there: the row is |p|^2 - 1 (phi signed,
+   violated where |phi| >= floor). */
+static void describe_norms(const Model *m, const double *phi, double floor, char *msg,
+                           size_t size)
+{
+    for (int i = 0; i < m->nh; i++)
+        if (m->rows[i].kind == JOINT_S_NORM && fabs(phi[i]) >= floor)
+            analysis_msgf(msg, size, "; %s is the normalisation of %s's Euler parameters "
+                          "(e0^2 + e1^2 + e2^2 + e3^2 = 1), and there |p| = %.6g",
+                          m->rows[i].name, m->joints[m->rows[i].joint].name,
+                          sqrt(fmax(0.0, 1.0 + phi[i])));
+}
+
+/* One dense minimum-norm Newton per statement, from the file's values
+   then from q, on the other rows: those without which the rest closes. */
+int assemble_t0_loop(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                     const double *q, char *msg, size_t size)
+{
+    int nq = k->nq, nh = k->nh, nj = m->njoints, found = 0;
+    if (nq > ANALYSIS_DENSE_MAX_NQ || nj > ASSEMBLE_T0_LOOP_JOINTS)
+        return 0;
+    int *rows = xcalloc((size_t)nh + 1, sizeof *rows);
+    double *trial = xcalloc((size_t)nq + 1, sizeof *trial);
+    double *in_loop = xcalloc((size_t)nj + 1, sizeof *in_loop);
+    const char **names = xcalloc((size_t)nj + 1, sizeof *names);
+    AnalysisOptions opt = analysis_default_options();
+    opt.tol_phi = tol_phi;
+    opt.stall_iter = ASSEMBLE_ROUGH_STALL;
+    opt.max_iter = ASSEMBLE_T0_LOOP_ITER;
+    MechrtSvd *w = mechrt_svd_new(nh, nq);
+    for (int j = 0; j < nj && w; j++) {
+        names[j] = m->joints[j].name;
+        int n = 0;
+        for (int i = 0; i < nh; i++)
+            if (m->rows[i].joint != j)
+                rows[n++] = i;
+        if (n == nh || m->joints[j].kind == JOINT_S_NORM)
+            continue;   /* no holonomic rows; a body's normalisation is no suspect */
+        /* from the file's values, then from the best point */
+        AssembleResult res;
+        bool closes = false;
+        for (int from = 0; from < 2 && !closes; from++) {
+            memcpy(trial, from ? q : m->q0, (size_t)nq * sizeof *trial);
+            closes = assemble_min_norm(k, rows, n, t, trial, &opt, w, &res);
+        }
+        if (closes) {
+            in_loop[j] = 1;
+            found++;
+        }
+    }
+    if (found > 1) {
+        analysis_msgf(msg, size, "the loop of ");
+        analysis_name_above(msg, size, names, in_loop, nj, 1);
+        analysis_msgf(msg, size, " cannot close (without any one of them the other rows "
+                      "assemble: a length, a pivot, a rail or a driven position out of reach)");
+    } else if (found == 1) {
+        analysis_name_above(msg, size, names, in_loop, nj, 1);
+        analysis_msgf(msg, size, " cannot be met (without it the other rows assemble)");
+    }
+    mechrt_svd_free(w);
+    free(rows), free(trial), free(in_loop), free(names);
+    return found;
+}
+
+bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                          const double *q, AssembleViolated *v, char *msg, size_t size)
+{
+    size_t nh = (size_t)k->nh;
+    double *phi = xcalloc(nh + 1, sizeof *phi), *size_of = xcalloc(nh + 1, sizeof *size_of);
+    const char **names = xcalloc(nh + 1, sizeof *names);
+    k->phi(k->ctx, q, t, phi);
+    bool finite = true;
+    *v = (AssembleViolated){0, -1};
+    for (size_t i = 0; i < nh; i++) {
+        finite = finite && isfinite(phi[i]);
+        size_of[i] = fabs(phi[i]);
+        if (size_of[i] > v->largest) {
+            v->largest = size_of[i];
+            v->worst = (int)i;
+        }
+        names[i] = m->rows[i].name;
+    }
+    if (finite) {
+        /* every row violated there, not only those near the largest */
+        double floor = fmax(tol_phi, ASSEMBLE_T0_NOISE * v->largest);
+        analysis_name_above(msg, size, names, size_of, (int)nh, floor);
+        describe_norms(m, phi, floor, msg, size);
+    }
+    free(phi), free(size_of), free(names);
+    return finite;
+}
+
 void assemble_t0_describe(const Model *m, const MechrtKernels *k, const AssembleT0Report *rep,
                           const double *q, char *msg, size_t size)
 {
     int iterations = rep->robust ? rep->rough.iterations : rep->newton.iterations;
-    double residual = rep->robust ? rep->rough.residual : rep->newton.residual;
-    int worst = rep->robust ? rep->rough.worst_row : rep->newton.worst_row;
     const char *its = iterations == 1 ? "iteration" : "iterations";
+    char rows[ASSEMBLE_VIOLATED_SIZE] = "", loop[ASSEMBLE_VIOLATED_SIZE] = "";
+    AssembleViolated v;
     msg[0] = '\0';
     analysis_msgf(msg, size, "t = %.10g: could not assemble from these initial values: ", rep->t0);
-    size_t nh = (size_t)k->nh;
-    double *phi = xcalloc(nh + 1, sizeof *phi);
-    const char **names = xcalloc(nh + 1, sizeof *names);
-    k->phi(k->ctx, q, rep->t0, phi);
-    bool finite = true;
-    for (size_t i = 0; i < nh; i++) {
-        finite = finite && isfinite(phi[i]);
-        phi[i] = fabs(phi[i]);
-        names[i] = m->rows[i].name;
-    }
-    if (!finite) {
+    bool finite = assemble_t0_violated(m, k, rep->t0, rep->tol_phi, q, &v, rows, sizeof rows);
+    if (finite && assemble_t0_loop(m, k, rep->t0, rep->tol_phi, q, loop, sizeof loop) > 0)
+        analysis_msgf(msg, size, "%s; ", loop);     /* the cause first */
+    if (!finite)
         analysis_msgf(msg, size, "minimum-norm Newton reached NaN or infinity after %d %s",
                       iterations, its);
-    } else {
-        analysis_msgf(msg, size, "after %d %s of minimum-norm Newton the largest residual is "
-                      "%.3g in row %s; rows left unsatisfied: ", iterations, its, residual,
-                      worst >= 0 && worst < (int)nh ? names[worst] : "?");
-        analysis_name_list(msg, size, names, phi, (int)nh);
-    }
+    else    /* q: the iterate with the smallest residual (min_norm_newton, project) */
+        analysis_msgf(msg, size, "after %d %s of minimum-norm Newton the largest residual at "
+                      "the best point found is %.3g in row %s; rows left unsatisfied there: %s",
+                      iterations, its, v.largest, v.worst >= 0 ? m->rows[v.worst].name : "?",
+                      rows);
     analysis_msgf(msg, size, " (the mechanism may not close with these lengths, or the guess is "
                   "nearer a configuration that does not exist; try other initial values%s%s)",
                   rep->more_option ? ", or more " : "", rep->more_option ? rep->more_option : "");
-    free(phi), free(names);
 }
 
 /* The note after a successful assembly: how Newton started, or how far it

@@ -50,6 +50,7 @@ typedef struct AssembleT0Report {
     AssembleResult rough;   /* its result */
     bool out_of_memory;     /* the default Newton's projector could not be made */
     const char *more_option;
+    double tol_phi;         /* the residual below which a row counts as satisfied */
 } AssembleT0Report;
 
 /* Assembles at o->t0 from the file's values in q (nq, updated in place):
@@ -63,11 +64,41 @@ bool assemble_at_t0(const Model *m, const MechrtKernels *k, const MechrtHostJacN
 
 /* The one wording of an assembly that found no configuration, into msg
    (size bytes): "t = T: could not assemble from these initial values:
-   after N iterations of minimum-norm Newton the largest residual is R in
-   row NAME; rows left unsatisfied: ..." (the robust attempt that came
-   closest, else Newton's), the residuals taken at q, the last attempt. */
+   after N iterations of minimum-norm Newton the largest residual at the
+   best point found is R in row NAME; rows left unsatisfied there: ..."
+   (every row above the tolerance; what a violated spatial .norm row
+   means), the residuals taken at q: the best point of the robust attempt
+   that came closest, else Newton's (each attempt ends at its iterate
+   with the smallest residual). */
 void assemble_t0_describe(const Model *m, const MechrtKernels *k, const AssembleT0Report *rep,
                           const double *q, char *msg, size_t size);
+
+/* The largest residual of a failed assembly and its row (-1: none). */
+typedef struct AssembleViolated {
+    double largest;
+    int worst;
+} AssembleViolated;
+
+/* Room for assemble_t0_violated's text. */
+#define ASSEMBLE_VIOLATED_SIZE 1024
+
+/* Appends to msg (size bytes) the holonomic rows violated at q and t
+   (above tol_phi and rounding, largest first: "C and rocker.norm") and
+   what a violated spatial .norm row means there; *v the largest. False,
+   nothing appended, when a residual is NaN or infinite. */
+bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                          const double *q, AssembleViolated *v, char *msg, size_t size);
+
+/* The statements without any one of which the other holonomic rows
+   assemble at t (from the file's values or from q, the best point found):
+   the loop that cannot close, each of its joints as much a suspect as the
+   rows left unsatisfied at q (a rail out of reach keeps its own rows and
+   breaks the joints next to it). Appends to msg "the loop of O, A, B and P
+   cannot close (...)", or for one statement "C cannot be met (...)";
+   returns how many. Small mechanisms only (one dense assembly each): 0
+   beyond ANALYSIS_DENSE_MAX_NQ coordinates or 64 statements. */
+int assemble_t0_loop(const Model *m, const MechrtKernels *k, double t, double tol_phi,
+                     const double *q, char *msg, size_t size);
 
 /* After a successful assembly, the note ("FILE: note: ...") on notes
    (NULL: none) when Newton could not start from the file's values q0 or

@@ -30,21 +30,19 @@ void analysis_msgf(char *msg, size_t size, const char *fmt, ...)
     va_end(ap);
 }
 
-void analysis_name_list(char *msg, size_t size, const char *const *names, const double *w,
-                        int n)
+/* The names of the components of w at or above floor, largest first (at
+   most NAMED_MAX); how many were named. */
+static int name_picked(char *msg, size_t size, const char *const *names, const double *w, int n,
+                       double floor)
 {
     int picked[NAMED_MAX], count = 0;
-    double wmax = 0;
-    for (int i = 0; i < n; i++)
-        if (w[i] > wmax)
-            wmax = w[i];
     while (count < NAMED_MAX) {
         int best = -1;
         for (int i = 0; i < n; i++) {
             bool taken = false;
             for (int c = 0; c < count; c++)
                 taken = taken || picked[c] == i;
-            if (!taken && w[i] >= NAMED_SHARE * wmax && (best < 0 || w[i] > w[best]))
+            if (!taken && w[i] >= floor && (best < 0 || w[i] > w[best]))
                 best = i;
         }
         if (best < 0)
@@ -54,4 +52,27 @@ void analysis_name_list(char *msg, size_t size, const char *const *names, const 
     for (int c = 0; c < count; c++)
         analysis_msgf(msg, size, "%s%s", c == 0 ? "" : c + 1 == count ? " and " : ", ",
                       names[picked[c]]);
+    return count;
+}
+
+void analysis_name_list(char *msg, size_t size, const char *const *names, const double *w,
+                        int n)
+{
+    double wmax = 0;
+    for (int i = 0; i < n; i++)
+        if (w[i] > wmax)
+            wmax = w[i];
+    name_picked(msg, size, names, w, n, NAMED_SHARE * wmax);
+}
+
+int analysis_name_above(char *msg, size_t size, const char *const *names, const double *w,
+                        int n, double floor)
+{
+    int above = 0;
+    for (int i = 0; i < n; i++)
+        above += w[i] >= floor;
+    int count = name_picked(msg, size, names, w, n, floor);
+    if (above > count)
+        analysis_msgf(msg, size, ", and %d more", above - count);
+    return count;
 }

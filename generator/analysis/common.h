@@ -43,4 +43,10 @@ void analysis_msgf(char *msg, size_t size, const char *fmt, ...) __attribute__((
 void analysis_name_list(char *msg, size_t size, const char *const *names, const double *w,
                         int n);
 
+/* Appends to msg the names of the components of w at or above floor,
+   largest first (six at most, then ", and N more"); returns how many were
+   named. */
+int analysis_name_above(char *msg, size_t size, const char *const *names, const double *w,
+                        int n, double floor);
+
 #endif

@@ -315,7 +315,9 @@ static void print_structure(const InfoReport *rep)
            m->name, m->nq, m->nq == 1 ? "" : "s", m->nr, m->nr == 1 ? "" : "s", m->nh, m->nv);
 
     int cw = width(m->nq, coord_name, m, 5);
-    printf("coordinates (initial value, assembled at t = %g):\n", rep->t);
+    /* a failed assembly shows its best point, never as assembled */
+    printf("coordinates (initial value, %s at t = %g):\n",
+           rep->assembled ? "assembled" : "best point found, NOT assembled,", rep->t);
     for (int i = 0; i < m->nq; i++)
         printf("  %-*s  %14.8g  %14.8g\n", cw, m->coord_names[i], m->q0[i], rep->q[i]);
 
@@ -381,7 +383,8 @@ static void print_assembly(const InfoReport *rep)
 static void print_rank(const InfoReport *rep)
 {
     const Model *m = rep->model;
-    printf("\nrank (%s at the assembled configuration):\n", rep->dense ? "SVD" : "sparse QR");
+    printf("\nrank (%s at the %s):\n", rep->dense ? "SVD" : "sparse QR",
+           rep->assembled ? "assembled configuration" : "best point found, not assembled");
     if (rep->rank < 0) {
         printf("  not computed (%s)\n", rep->dense ? "NaN or Inf in the Jacobian"
                                                    : "NaN or Inf, or too much fill in the sparse QR");
@@ -568,7 +571,12 @@ static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
                 rep.state.asked ? 0.0 : t, rep.assembly.residual);
         if (rep.assembly.worst_row >= 0)
             fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
-        fprintf(stderr, ")\n");
+        fprintf(stderr, ")");
+        if (rep.loop && rep.loop[0])
+            fprintf(stderr, ": %s", rep.loop);
+        if (rep.violated && rep.violated[0])
+            fprintf(stderr, "; rows left unsatisfied at the best point found: %s", rep.violated);
+        fprintf(stderr, "\n");
         status = EXIT_ANALYSIS;
     }
     info_report_free(&rep);

@@ -472,7 +472,7 @@ static void open_sens(RunOutput *out, SensColumns *sc)
 
 /* Runs the analysis with the open engine, the states going where c says. */
 static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics,
-                   SensColumns *sc)
+                   const Diag *source, SensColumns *sc)
 {
     RunOutput out = {.cmd = "run", .keep = c->json || c->pictures || c->table,
                      .lambda_use = c->forces ? RUN_OUTPUT_FORCES : RUN_OUTPUT_NO_LAMBDA,
@@ -490,6 +490,7 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
     const MechrtHostJacNz *jnz = engine_jac_nz(e);
     RunResult res;
     c->ro.notes = stderr;
+    c->ro.source = source;
     c->ro.linear = (AnalysisLinear)c->linear;
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
@@ -527,7 +528,7 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         engine_close(&e);
         return EXIT_USAGE;
     }
-    int status = analyse(c, mech->model, &e, &pics, c->sens ? &sc : NULL);
+    int status = analyse(c, mech->model, &e, &pics, diag, c->sens ? &sc : NULL);
     if (c->sens && c->stats && sc.states > 0)
         fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters: %.6g ms of "
                 "CPU time, %.0f ns per state\n", sc.sens.np, 1e3 * sc.cpu_seconds,

@@ -255,7 +255,8 @@ static void step_progress(void *ctx, double t)
 }
 
 /* The simulation with the open engine, the states going where c says. */
-static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p)
+static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p,
+                    const Diag *source)
 {
     RunOutput out = {.cmd = "sim", .keep = c->json || c->pictures,
                      .lambda_use = RUN_OUTPUT_LAMBDA_JSON, .digits = c->digits, .t0 = c->so.t0,
@@ -268,6 +269,7 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     }
     run_output_open(&out, m);
     c->so.notes = stderr;
+    c->so.source = source;
     c->so.linear = (AnalysisLinear)c->linear;
     SimResult res;
     c->so.on_step = step_progress;
@@ -316,7 +318,7 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
                    "projection needs at most one row per coordinate", m->nh, m->nq);
         diag_print(diag, stderr);
     } else {
-        status = simulate(c, m, &e, &pics);
+        status = simulate(c, m, &e, &pics, diag);
     }
     engine_close(&e);
     free(qd0);

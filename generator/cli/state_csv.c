@@ -2,13 +2,13 @@
 #include "state_csv.h"
 
 #include "../base/arena.h"
+#include "../base/limits.h"
 
 /* A row is at time `at` when their times differ by at most this times
    max(1, |at|) (a relative tolerance on seconds): it absorbs the rounding
    between a time run computed (t0 + k h) and the decimal one typed. */
 #define STATE_CSV_T_MATCH 1e-9
 
-#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -94,34 +94,6 @@ static bool parse_row(char *line, int offset, double *v, int ncols, const bool *
     return true;
 }
 
-/* The whole file, NUL-terminated, its length in *len; NULL with errno set. */
-static char *read_all(const char *path, int *len)
-{
-    FILE *in = fopen(path, "rb");
-    if (!in)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    char *buf = xmalloc(cap);
-    size_t got;
-    while ((got = fread(buf + n, 1, cap - n - 1, in)) > 0) {
-        n += got;
-        if (cap - n < 2)
-            buf = xrealloc(buf, cap *= 2, 1);
-    }
-    /* a directory opens, then fails to read (EISDIR): not an empty file */
-    if (ferror(in) || n > INT_MAX) {
-        int e = ferror(in) ? errno : EFBIG;
-        fclose(in);
-        free(buf);
-        errno = e;
-        return NULL;
-    }
-    fclose(in);
-    buf[n] = '\0';
-    *len = (int)n;
-    return buf;
-}
-
 /* Which fields are read: t and the coordinates. */
 static bool *used_fields(const int *col, int nq, int tcol, int ncols)
 {
@@ -167,13 +139,16 @@ static bool scan_rows(char *rest, const char *work, const Model *m, const int *c
 bool state_csv_read(const char *path, const Model *m, double at, double *q, double *t,
                     Diag *diag)
 {
+    /* read as a .mech file is (model_read_file): a regular file or stdin
+       ('-'), never a named pipe with no writer, which would block; any
+       size an int holds */
+    MechLimits limits = mech_default_limits();
+    limits.max_file_bytes = INT_MAX - 1;
     int len = 0;
-    char *text = read_all(path, &len);
-    if (!text) {
-        diag_init(diag, path, NULL, 0);
-        diag_error_nopos(diag, "cannot read: %s", strerror(errno));
+    diag_init(diag, path, NULL, 0);
+    char *text = model_read_file(path, &limits, &len, diag);
+    if (!text)
         return false;
-    }
     /* work is cut in place by strsep and next_field; text stays whole
        for the line echoed under an error */
     diag_init(diag, path, text, len);

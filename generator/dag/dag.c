@@ -115,6 +115,7 @@ void dag_init(Dag *dag, int32_t max_nodes)
     memset(dag, 0, sizeof *dag);
     dag->max_nodes = max_nodes > 2 ? max_nodes : 2;
     dag->where = -1;
+    dag->where_expr = -1;
     dag->overflow_where = -1;
     dag->nonfinite_where = -1;
     NodeId zero = dag_const(dag, 0.0), one = dag_const(dag, 1.0);

@@ -29,6 +29,11 @@ typedef struct Dag {
     int32_t max_nodes;      /* limit on count */
     int32_t where;          /* offset of the statement being built, for the
                                limit's error; -1: none */
+    int32_t where_expr;     /* offset of the sub-expression being lowered (a
+                               number, an operator, a call), where a constant
+                               out of range is reported; -1: at where */
+    const char *what;       /* what a builder is combining ("the weight m g"),
+                               named with a constant out of range; NULL: none */
     /* Sticky, like ferror: set when a node past max_nodes is asked for.
        From then on every new node comes back as DAG_ZERO (existing ones are
        still found), which every rule folds away: a phase goes on to its end
@@ -43,7 +48,9 @@ typedef struct Dag {
        double; it would print as inf or nan, which C does not read.
        dag_check_finite reports it once, at its statement. */
     bool nonfinite;
-    int32_t nonfinite_where; /* where at the first one */
+    int32_t nonfinite_where; /* where_expr, else where, at the first one */
+    bool nonfinite_expr;     /* ... and it was where_expr */
+    const char *nonfinite_what; /* what at the first one */
     double nonfinite_value;
     /* The finite constants a float cannot hold (HUGE_VALF or 0 as a
        float), with where they were made: gen --real float refuses the
@@ -62,6 +69,8 @@ typedef struct Dag {
 typedef struct DagWide {
     NodeId id;
     int32_t where;
+    bool expr;              /* where is a sub-expression's (where_expr) */
+    const char *what;       /* Dag.what when it was made */
 } DagWide;
 
 void dag_init(Dag *dag, int32_t max_nodes);
@@ -79,6 +88,9 @@ bool dag_check_limit(const Dag *dag, Diag *diag);
 bool dag_check_finite(const Dag *dag, Diag *diag);
 bool dag_check_float(const Dag *dag, const NodeId *roots, int nroots, Diag *diag);
 void dag_range_note(Dag *dag, NodeId id);
+/* dag_const of a value a builder combined, named (what: "the weight m g")
+   if it is out of range. */
+NodeId dag_const_named(Dag *dag, double value, const char *what);
 
 static inline const DagNode *dag_node(const Dag *dag, NodeId id) { return &dag->nodes[id]; }
 static inline DagOp dag_op(const Dag *dag, NodeId id) { return (DagOp)dag->nodes[id].op; }

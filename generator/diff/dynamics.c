@@ -29,6 +29,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What the constants a mass adds are, named when one is out of range. */
+#define DYN_WEIGHT "its weight m g"
+#define DYN_INERTIA_AT_BODY "its moment of inertia about the body's reference point, J + m |com|^2"
+
 /* Scratch of one build. */
 typedef struct DynWork {
     Model *m;
@@ -115,17 +119,18 @@ static void add_body(DynWork *w, const MassElement *e)
     NodeId muy = dag_mul(d, m, uy);
     add_mass(w, x, phi, dag_neg(d, muy));
     add_mass(w, y, phi, dag_mul(d, m, ux));
-    add_mass(w, phi, phi, dag_const(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy)));
+    add_mass(w, phi, phi, dag_const_named(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy),
+                                          DYN_INERTIA_AT_BODY));
     NodeId rate = dag_vard(d, phi);
     NodeId w2 = dag_mul(d, rate, rate);
     NodeId mw2 = dag_mul(d, m, w2);
     accumulate(w, w->velocity, x, dag_mul(d, mw2, ux));
     accumulate(w, w->velocity, y, dag_mul(d, mw2, uy));
     double gx = w->m->gravity[0], gy = w->m->gravity[1];
-    accumulate(w, w->applied, x, dag_const(d, e->m * gx));
-    accumulate(w, w->applied, y, dag_const(d, e->m * gy));
-    NodeId mgx = dag_const(d, -e->m * gx);
-    NodeId mgy = dag_const(d, e->m * gy);
+    accumulate(w, w->applied, x, dag_const_named(d, e->m * gx, DYN_WEIGHT));
+    accumulate(w, w->applied, y, dag_const_named(d, e->m * gy, DYN_WEIGHT));
+    NodeId mgx = dag_const_named(d, -e->m * gx, DYN_WEIGHT);
+    NodeId mgy = dag_const_named(d, e->m * gy, DYN_WEIGHT);
     accumulate(w, w->applied, phi, dot2(d, uy, mgx, ux, mgy));
 }
 
@@ -261,7 +266,7 @@ static void add_spatial_element(DynWork *w, const MassElement *e)
     }
     NodeId g[3];
     for (int c = 0; c < 3; c++)
-        g[c] = dag_const(d, e->m * w->m->gravity[c]);
+        g[c] = dag_const_named(d, e->m * w->m->gravity[c], DYN_WEIGHT);
     for (int k = 0; k < n && !d->overflow; k++) {
         int j = w->cols[k];
         const NodeId *u = dp + 3 * k;
@@ -333,8 +338,8 @@ static void add_element(DynWork *w, const MassElement *e)
     NodeId ay = diff_total(&w->df, vy);
     NodeId vth = diff_total(&w->df, e->theta);
     NodeId ath = diff_total(&w->df, vth);
-    NodeId gx = dag_const(d, e->m * w->m->gravity[0]);
-    NodeId gy = dag_const(d, e->m * w->m->gravity[1]);
+    NodeId gx = dag_const_named(d, e->m * w->m->gravity[0], DYN_WEIGHT);
+    NodeId gy = dag_const_named(d, e->m * w->m->gravity[1], DYN_WEIGHT);
     for (int k = 0; k < n && !d->overflow; k++) {
         int j = w->cols[k];
         NodeId pa = dot2(d, dx[k], ax, dy[k], ay);

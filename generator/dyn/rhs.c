@@ -86,6 +86,7 @@ static int sim_rhs_solve(Sim *s, double t, const double y[], double f[])
         s->fail_status = st;
         s->fail_t = t;
         s->fail_rep = rep;
+        memcpy(s->fail_y, y, 2 * (size_t)n * sizeof *y);
     }
     return GSL_EBADFUNC;
 }

@@ -74,6 +74,7 @@
 #include "step.h"
 
 #include "../analysis/assemble_t0.h"
+#include "../analysis/limit.h"
 #include "../base/arena.h"
 #include "../pipeline/pipeline.h"
 
@@ -147,7 +148,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
                                                 s->lambda, s->work, s->lwork, &rep);
     if (st != MECHRT_OK) {
         sim_fail(s, st, t, "forward dynamics");
-        sim_explain_dynamics(s, st, &rep);
+        sim_explain_dynamics(s, st, &rep, y);
         return false;
     }
     state(ctx, t, y, y + n, s->f0, s->lambda);
@@ -297,6 +298,9 @@ AnalysisStatus sim_integrate(const MechrtKernels *k, const MechrtHostJacNz *jnz,
     clock_t cpu0 = clock();
     if (sim_settle(&s, y, o->t0, true))
         status = integrate(&s, y, state, state_ctx);
+    if (status == ANALYSIS_FAILED && res->states > 0 && o->model && isfinite(res->t_fail)
+        && limit_explain(o->model, k, y, res->t_fail, LIMIT_STOPPED, res->message, sizeof res->message))
+        res->cause = MECHRT_ESING;      /* a limit position, said first */
     res->seconds = pipeline_now() - c0;
     res->cpu_seconds = (double)(clock() - cpu0) / CLOCKS_PER_SEC;
     gsl_set_error_handler(old);
@@ -362,6 +366,7 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJ
         names[i] = m->rows[i].name;
     SimOptions named = *o;
     named.row_names = names;
+    named.model = m;
     AnalysisStatus st = sim_integrate(k, jnz, mnz, &named, q, state, state_ctx, res);
     free(names);
     res->constructed = pre.constructed;

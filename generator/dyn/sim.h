@@ -68,6 +68,11 @@ typedef struct SimOptions {
     void (*on_step)(void *ctx, double t);
     void *on_step_ctx;
     AnalysisLinear linear;  /* ANALYSIS_LINEAR_AUTO */
+    /* the model whose force element a NaN right side is blamed on
+       (blame.c; sim_run: its own), and the file's text for its line and
+       column; NULL: no element named, its name alone */
+    const Model *model;
+    const Diag *source;
 } SimOptions;
 
 SimOptions sim_default_options(void);

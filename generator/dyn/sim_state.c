@@ -1,6 +1,7 @@
 /* sim_state.c - the state of one simulation, its set-up and its failure messages. */
 #include "sim_state.h"
 
+#include "blame.h"
 #include "rhs.h"
 
 #include "../base/arena.h"
@@ -23,8 +24,13 @@ void sim_fail(Sim *s, MechrtStatus st, double t, const char *what)
 }
 
 /* Why mechrt_forward_dynamics failed, after sim_fail(). */
-void sim_explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep)
+void sim_explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep, const double *y)
 {
+    SimResult *res = s->res;
+    if (st == MECHRT_ENOTFINITE && y && s->o->model
+        && blame_force(s->o->model, s->o->source, res->t_fail, y, y + s->nq, res->message,
+                           sizeof res->message))
+        return;
     switch (st) {
     case MECHRT_ESING:
         msgf(s, "the augmented matrix is singular: the mass matrix is singular on the motions "
@@ -110,6 +116,7 @@ bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
     s->f0 = xcalloc((size_t)s->dim, sizeof *s->f0);
     s->f1 = xcalloc((size_t)s->dim, sizeof *s->f1);
     s->y = xcalloc((size_t)s->dim, sizeof *s->y);
+    s->fail_y = xcalloc((size_t)s->dim, sizeof *s->fail_y);
     s->cy = xcalloc((size_t)s->dim, sizeof *s->cy);
     s->cf = xcalloc((size_t)s->dim, sizeof *s->cf);
     s->ya = xcalloc((size_t)s->dim, sizeof *s->ya);
@@ -163,7 +170,7 @@ void sim_close(Sim *s)
 {
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
-    free(s->y), free(s->active);
+    free(s->y), free(s->fail_y), free(s->active);
     free(s->cy), free(s->cf), free(s->ya), free(s->fa), free(s->fb), free(s->yi), free(s->yc), free(s->fc);
     free(s->qrw);
     free(s->wjac), free(s->wjac0), free(s->wturn);

@@ -26,6 +26,7 @@ typedef struct Sim {
     MechrtStatus fail_status;    /* set by the right-hand side */
     double fail_t;
     MechrtDynReport fail_rep;
+    double *fail_y;              /* q, qd there (2 nq) */
     double e0;                   /* E at t0 */
     MechrtDynOptions dyn;        /* the caller's, with the rows of this step */
     unsigned char *active;       /* nr: the rows kept during this step */
@@ -77,7 +78,8 @@ bool sim_dense_ready(Sim *s);
 /* The failure at t: status, cause and message start "t = T: WHAT: ". */
 void sim_fail(Sim *s, MechrtStatus st, double t, const char *what);
 
-/* Why mechrt_forward_dynamics failed, after sim_fail(). */
-void sim_explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep);
+/* Why mechrt_forward_dynamics failed at y (q, qd; NULL: unknown), after
+   sim_fail(). */
+void sim_explain_dynamics(Sim *s, MechrtStatus st, const MechrtDynReport *rep, const double *y);
 
 #endif

@@ -83,7 +83,7 @@ bool sim_one_step(Sim *s, double *y, double *t, double tn, double *h)
     if (gs != GSL_SUCCESS) {
         if (s->fail_status != MECHRT_OK) {
             sim_fail(s, s->fail_status, s->fail_t, "forward dynamics");
-            sim_explain_dynamics(s, s->fail_status, &s->fail_rep);
+            sim_explain_dynamics(s, s->fail_status, &s->fail_rep, s->fail_y);
         } else {
             sim_fail(s, MECHRT_ESTEP, *t, "integration");
             msgf(s, "the integrator (%s) gave up (GSL: %s)", sim_method_names[s->o->method],
@@ -118,7 +118,7 @@ bool sim_end_rhs(Sim *s, const double *y, double t, double *f)
         return false;
     }
     sim_fail(s, s->fail_status, s->fail_t, "forward dynamics");
-    sim_explain_dynamics(s, s->fail_status, &s->fail_rep);
+    sim_explain_dynamics(s, s->fail_status, &s->fail_rep, s->fail_y);
     return false;
 }
 

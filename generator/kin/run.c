@@ -64,7 +64,9 @@
 #include "step.h"
 #include "subdivide.h"
 
+#include "../analysis/limit.h"
 #include "../base/arena.h"
+#include "../dyn/blame.h"
 #include "../pipeline/pipeline.h"
 
 #include <math.h>
@@ -118,9 +120,12 @@ static bool inverse_at(Run *r, double t)
     r->res->cause = st;
     r->res->t_fail = t;
     r->res->message[0] = '\0';
-    msgf(r, "t = %.10g: inverse dynamics failed: %s", t,
-         st == MECHRT_ENOTFINITE ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
-                                 : mechrt_strerror(st));
+    msgf(r, "t = %.10g: inverse dynamics failed: ", t);
+    if (st != MECHRT_ENOTFINITE || !blame_force(r->m, r->o->source, t, r->q, r->qd,
+                                                r->res->message, sizeof r->res->message))
+        msgf(r, "%s", st == MECHRT_ENOTFINITE
+                          ? "NaN or infinity in M(q), Q(q, qd, t) or the multipliers"
+                          : mechrt_strerror(st));
     return false;
 }
 
@@ -166,8 +171,14 @@ static AnalysisStatus run_holonomic(Run *r, RunStateFn state, void *ctx)
         r->res->rank_failed = false;
         MechrtStatus st = run_checked_step(r, t, tn - t, &rep, &quiet, &chk);
         bool ok = quiet || run_subdivide(r, t, tn, st, &rep, &chk);
-        if (!ok && r->res->rank_failed)
+        if (!ok && r->res->rank_failed) {
             run_note_rank_failure(r);
+            /* the start of the step that failed (sq), the last state
+               reached: a driver past its reach, said first */
+            if (limit_explain(r->m, r->k, r->sq, r->res->rank_t, LIMIT_STEPPED,
+                              r->res->message, sizeof r->res->message))
+                r->res->t_fail = r->res->rank_t;
+        }
         if (ok && !inverse_at(r, tn))
             ok = false;
         r->res->step_seconds += pipeline_now() - c0;

@@ -40,6 +40,9 @@ typedef struct RunOptions {
        guess, no convergence); default 100 */
     int assembly_max_iter;
     FILE *notes;             /* notes and warnings, "FILE: warning: ..."; NULL: none */
+    /* the file's text, for the line and column of a force element that
+       inverse dynamics finds NaN (dyn/blame.c); NULL: its name alone */
+    const Diag *source;
     AnalysisLinear linear;   /* ANALYSIS_LINEAR_AUTO */
     /* most rows x coordinates of a dense Jacobian, checked when the run
        would form one (dense linear algebra, the robust assembly at t0);

@@ -99,7 +99,21 @@ const Joint *build_spatial_joint(Builder *b, const Ast *ast, const Entity *e, co
     return j;
 }
 
+static NodeId lower_node(Builder *b, const Ast *ast, ExprContext ctx);
+
+/* The node of one sub-expression: a constant made there (a number, a fold)
+   and out of range is reported at it (range.c). */
 NodeId build_lower_expr(Builder *b, const Ast *ast, ExprContext ctx)
+{
+    Dag *dag = &b->model->dag;
+    int32_t outer = dag->where_expr;
+    dag->where_expr = ast->pos.offset;
+    NodeId id = lower_node(b, ast, ctx);
+    dag->where_expr = outer;
+    return id;
+}
+
+static NodeId lower_node(Builder *b, const Ast *ast, ExprContext ctx)
 {
     Dag *dag = &b->model->dag;
     build_check_nodes(b);         /* before this operand's names are looked up */

@@ -119,7 +119,10 @@ static Vec3 rotate3(Dag *d, Attach at, const double local[3])
     if (!at.has_p)
         return s;
     double twice[3] = {2 * local[0], 2 * local[1], 2 * local[2]};
+    const char *outer = d->what;
+    d->what = "an attachment's offset s, doubled in A(p) s";
     Vec3 s2 = v3_const(d, twice);
+    d->what = outer;
     return rotate3_nodes(d, at, s, s2);
 }
 

@@ -318,6 +318,20 @@ static void check_not_flat(Builder *b, const Stmt *s, const Joint *j, const doub
                   s->name);
 }
 
+/* An axis that is not zero but whose squared length underflows to 0
+   (axis(1e-200, 1e-200, 0): normalised, 0/0) or overflows (1e200: the
+   unit axis would be 0), as joints_spatial_frame computes it; refused at
+   the axis itself. */
+static void check_normalisable(Builder *b, SrcPos pos, const double u[3])
+{
+    double n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(n > 0) || !isfinite(n))
+        diag_fail(b->diag, pos, "this axis (%g, %g, %g) cannot be normalised: its squared "
+                  "length %s, so the unit axis would be %s; write it nearer 1", u[0], u[1],
+                  u[2], n > 0 ? "overflows past the largest double" : "underflows to 0",
+                  n > 0 ? "0" : "NaN (0/0)");
+}
+
 /* A spatial joint's axes: A's (ux, uy, uz), B's (bx, by, bz), neither zero. */
 static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
 {
@@ -330,6 +344,7 @@ static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
             u[k][i] = build_constant(b, ax[i], "an axis component");
         if (u[k][0] == 0.0 && u[k][1] == 0.0 && u[k][2] == 0.0)
             diag_fail(b->diag, pos, "the axis of %s '%s' is zero", info->keyword, s->name);
+        check_normalisable(b, pos, u[k]);
     }
     j->ux = u[0][0], j->uy = u[0][1], j->uz = u[0][2];
     j->bx = u[1][0], j->by = u[1][1], j->bz = u[1][2];

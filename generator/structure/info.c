@@ -155,7 +155,7 @@ static char *make_verdict(const InfoReport *rep)
     sb_init(&sb);
     int drivers = rep->nh_drivers + rep->nv_drivers;
     if (!rep->assembled)
-        sb_printf(&sb, "assembly failed (residual %.3g): ranks are those of the last iterate; ",
+        sb_printf(&sb, "assembly failed (residual %.3g): ranks are those of the best point found; ",
                   rep->assembly.residual);
     sb_printf(&sb, "the count says %d DOF", rep->dof);
     if (rep->nv > 0)
@@ -416,6 +416,15 @@ static void assemble_at(Mech *mech, MechEval *me, MechrtSvd *w, InfoReport *rep,
     rep->assembled = assemble_at_t0(m, &n.k, NULL, &ao, rep->q, &t0rep);
     rep->constructed = t0rep.constructed;
     rep->assembly = t0rep.robust ? t0rep.rough : n.res;
+    if (!rep->assembled) {      /* rep->q: the best point found */
+        AssembleViolated v;
+        rep->violated = xcalloc(ASSEMBLE_VIOLATED_SIZE, 1);
+        rep->loop = xcalloc(ASSEMBLE_VIOLATED_SIZE, 1);
+        if (assemble_t0_violated(m, &n.k, t, opt->tol_phi, rep->q, &v, rep->violated,
+                                 ASSEMBLE_VIOLATED_SIZE))
+            assemble_t0_loop(m, &n.k, t, opt->tol_phi, rep->q, rep->loop,
+                             ASSEMBLE_VIOLATED_SIZE);
+    }
 }
 
 /* The ranks at rep->q, the redundant rows and, where rows are lost, the
@@ -565,6 +574,8 @@ void info_report_free(InfoReport *rep)
     involutivity_free(&rep->system);
     free(rep->q);
     free(rep->verdict);
+    free(rep->violated);
+    free(rep->loop);
     free(rep->singular);
     free(rep->state.dependent);
     free(rep->state.null);

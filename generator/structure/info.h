@@ -66,9 +66,14 @@ typedef struct InfoReport {
     int dof;                /* nq - nh - nv */
     int mobility;           /* nq - rows without drivers */
     /* assembly */
-    double *q;              /* the assembled configuration (nq, malloc'd) */
+    double *q;              /* the assembled configuration, or the best
+                               point found (nq, malloc'd) */
     AssembleResult assembly;
     bool assembled;         /* converged, or nothing to assemble */
+    char *violated;         /* not assembled: the rows violated at q, the
+                               best point found (malloc'd); else NULL */
+    char *loop;             /* not assembled: the loop that cannot close
+                               (assemble_t0_loop; malloc'd, maybe ""); else NULL */
     int constructed;        /* coordinates placed by construction before
                                Newton (construct.h) */
     /* rank of the holonomic rows at q */

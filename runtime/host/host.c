@@ -38,6 +38,7 @@ struct MechrtHost {
     double *phi;                /* nh (at least 1) */
     double *jac;                /* nr * nq */
     double *dq, *y;             /* nq each */
+    double *qbest;              /* nq: a failed projection's best iterate */
     MechrtSvd *svd;             /* nh x nq (svd.c) */
     /* the sparse host (mechrt_host_new_sparse): no jac, svd or dense work */
     MechrtHostSparse *sp;       /* KLU of [Phi_q; A] (sparse_klu.c) */
@@ -89,6 +90,7 @@ void mechrt_host_free(MechrtHost *h)
     free(h->jac);
     free(h->dq);
     free(h->y);
+    free(h->qbest);
     free(h->fail_q);
     mechrt_svd_free(h->svd);
     mechrt_host_sparse_free(h->sp);
@@ -127,9 +129,10 @@ static MechrtHost *host_new(const MechrtKernels *k, const MechrtHostJacNz *jnz,
     h->jac = jnz ? NULL : malloc((size_t)h->nr * nq * sizeof *h->jac + 1);
     h->dq = malloc(nq * sizeof *h->dq);
     h->y = malloc(nq * sizeof *h->y);
+    h->qbest = malloc(nq * sizeof *h->qbest);
     h->fail_q = calloc(nq, sizeof *h->fail_q);
     bool ok = (h->work || project_only) && h->phi && (jnz || h->jac) && h->dq && h->y
-              && h->fail_q;
+              && h->qbest && h->fail_q;
     if (ok && jnz) {
         h->sp = project_only ? NULL : mechrt_host_sparse_new(k->nq, jnz);
         h->mn = nh > 0 ? mechrt_host_minnorm_new(k->nh, k->nq, jnz) : NULL;
@@ -248,10 +251,16 @@ static MechrtStatus project(MechrtHost *h, const MechrtOptions *o, double *q, do
             *r = rep;
         return MECHRT_OK;
     }
+    MechrtReport best = {0};
+    best.residual = INFINITY;
     for (;;) {
         st = eval_phi(h, q, t, &rep.residual, &rep.worst_row);
         if (st != MECHRT_OK)
             break;
+        if (rep.residual < best.residual) {
+            best = rep;
+            memcpy(h->qbest, q, (size_t)h->nq * sizeof *q);
+        }
         if (rep.step >= 0 && rep.residual <= o->tol_phi && rep.step <= o->tol_dq)
             break;
         if (rep.iterations >= o->max_iter) {
@@ -276,6 +285,13 @@ static MechrtStatus project(MechrtHost *h, const MechrtOptions *o, double *q, do
         rep.step = step;
         rep.iterations++;
         h->stats.project_iterations++;
+    }
+    /* out of iterations or off to NaN: the iterate with the smallest
+       residual, not wherever the full steps had carried Newton */
+    if ((st == MECHRT_EMAXITER || st == MECHRT_ENOTFINITE) && !(rep.residual <= best.residual)) {
+        memcpy(q, h->qbest, (size_t)h->nq * sizeof *q);
+        rep.residual = best.residual;
+        rep.worst_row = best.worst_row;
     }
     if (r)
         *r = rep;

@@ -90,7 +90,8 @@ const MechrtHostStats *mechrt_host_stats(const MechrtHost *h);
  * consistent redundant rows are harmless). Stops like Newton (newton.c):
  * ||Phi||_inf <= tol_phi and ||dq||_inf <= tol_dq, at most max_iter
  * iterations. q is updated in place; report (may be NULL) gets iterations,
- * residual, step and worst_row. MECHRT_EMAXITER, MECHRT_ENOTFINITE. */
+ * residual, step and worst_row. MECHRT_EMAXITER, MECHRT_ENOTFINITE: q and
+ * the residual are those of the iterate with the smallest residual. */
 MechrtStatus mechrt_host_project(MechrtHost *h, const MechrtOptions *o, double *q, double t,
                                  MechrtReport *report);
 
