@@ -150,7 +150,12 @@ static double condition(const Problem *pr, const gsl_matrix *J, char *why, size_
     singular_values(J, s, V);
     double smax = gsl_vector_get(s, 0), smin = gsl_vector_get(s, J->size2 - 1);
     why[0] = '\0';
-    if (!(smin > FIT_RANK_TOL * smax)) {
+    if (!(smax > 0)) {
+        size_t n = (size_t)snprintf(why, size, "the measured values do not depend on");
+        for (int c = 0; c < pr->k && n < size; c++)
+            n += (size_t)snprintf(why + n, size - n, "%s %s", c ? "," : "",
+                                  pr->m->design_names[pr->index[c]]);
+    } else if (!(smin > FIT_RANK_TOL * smax)) {
         char dir[300];
         name_direction(pr, V, dir, sizeof dir);
         snprintf(why, size, "the measurements do not identify the combination %s (the "
