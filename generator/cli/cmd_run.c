@@ -142,8 +142,9 @@ static const CliOption options[] = {
     {"--plot-vars", CLI_STRING_AT(RunCli, plot_list), .metavar = "LIST",
      .help = "what --plot shows: coordinate or output names, d(NAME)\n"
              "for a velocity, dd(NAME) for an acceleration, with\n"
-             "--forces lambda(ROW) and effort(DRIVER) (default:\n"
-             "every coordinate and output)"},
+             "--forces lambda(ROW) and effort(DRIVER), with --sens\n"
+             "its columns d(NAME)/d(P) (default: every coordinate and\n"
+             "output)"},
 };
 
 static const char epilogue[] =
@@ -362,6 +363,7 @@ static bool resolve_pictures(const Model *m, const RunCli *c, RunPictures *p)
     p->svg_path = c->svg_path;
     p->plot_path = c->plot_path;
     p->view = c->view;
+    p->sens = c->sens;
     return run_output_resolve_pictures("run", m, &c->traces, c->plot_list, c->forces, p);
 }
 

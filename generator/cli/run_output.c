@@ -253,8 +253,8 @@ bool run_output_resolve_pictures(const char *cmd, const Model *m, const CliList 
     if (p->plot_path && plot_list) {
         size_t size = svg_plot_err_size(m) + strlen(plot_list);
         char *why = xmalloc(size);
-        p->nvars = svg_plot_resolve_forces(m, plot_list, forces, p->vars,
-                                           RUN_OUTPUT_MAX_PLOT_VARS, why, size);
+        p->nvars = svg_plot_resolve_columns(m, plot_list, forces, p->sens, p->vars,
+                                            RUN_OUTPUT_MAX_PLOT_VARS, why, size);
         if (p->nvars <= 0)
             fprintf(stderr, "mechc %s: error: %s\n", cmd, why);
         free(why);
@@ -277,6 +277,8 @@ static SvgSeries plot_series(const RunOutput *out, SvgPlotVar v, const char *nam
     size_t nv = (size_t)out->trace.nq, w = 1 + 3 * nv;
     if (v.order == SVG_PLOT_LAMBDA)
         return (SvgSeries){name, out->lambda + v.coord, out->nr};
+    if (v.order == SVG_PLOT_SENS)
+        return (SvgSeries){name, out->xkept + v.coord, out->nx};
     if (v.order == SVG_PLOT_EFFORT) {
         int d = 0;
         while (d + 1 < out->nd && out->drivers[d] != v.coord)

@@ -104,6 +104,7 @@ typedef struct RunPictures {
     int nvars;
     const char *svg_path, *plot_path;
     int view;                   /* an SvgView; -1: the default */
+    bool sens;                  /* run --sens: its columns can be plotted */
 } RunPictures;
 
 /* Resolves the --trace texts and the --plot-vars list (NULL: every

@@ -428,10 +428,55 @@ static void trim(const char **a, const char **b)
         (*b)--;
 }
 
-/* One item [a, b) of a --plot-vars list into *v; false with the reason. */
-static bool parse_item(const Model *m, const char *a, const char *b, bool forces, SvgPlotVar *v,
-                       char *err, size_t errlen)
+/* The design parameter named [a, b), or -1. */
+static int find_design(const Model *m, const char *a, size_t len)
 {
+    for (int j = 0; j < m->np; j++)
+        if (strlen(m->design_names[j]) == len && strncmp(m->design_names[j], a, len) == 0)
+            return j;
+    return -1;
+}
+
+/* [a, b) as a run --sens column d(X)/d(P), X = NAME, d(NAME) or dd(NAME):
+   its column, or -1 when it is not one. */
+static int find_sens(const Model *m, const char *a, const char *b)
+{
+    const char *sep = NULL;
+    for (const char *s = a; s + 4 <= b; s++)
+        if (strncmp(s, ")/d(", 4) == 0)
+            sep = s;
+    if (!sep || b - a < 9 || strncmp(a, "d(", 2) != 0 || b[-1] != ')')
+        return -1;
+    int j = find_design(m, sep + 4, (size_t)(b - 1 - (sep + 4)));
+    const char *x = a + 2, *xe = sep;
+    int level = 0;
+    if (xe - x > 3 && xe[-1] == ')' && (strncmp(x, "d(", 2) == 0 || strncmp(x, "dd(", 3) == 0)) {
+        level = x[1] == 'd' ? 2 : 1;
+        x += level + 1;
+        xe--;
+    }
+    int v = find_coord(m, x, (size_t)(xe - x));
+    if (j < 0 || v < 0)
+        return -1;
+    return (level * (m->nq + m->nout) + v) * m->np + j;
+}
+
+/* One item [a, b) of a --plot-vars list into *v; false with the reason. */
+static bool parse_item(const Model *m, const char *a, const char *b, bool forces, bool sens,
+                       SvgPlotVar *v, char *err, size_t errlen)
+{
+    int column = sens ? find_sens(m, a, b) : -1;
+    if (column >= 0) {
+        *v = (SvgPlotVar){column, SVG_PLOT_SENS};
+        return true;
+    }
+    for (const char *s = a; s + 4 <= b; s++)
+        if (strncmp(s, ")/d(", 4) == 0) {    /* a sensitivity that cannot be */
+            snprintf(err, errlen, "--plot-vars: '%.*s' %s", (int)(b - a), a,
+                     sens ? "names no coordinate or output and design parameter of the file"
+                          : "is a sensitivity: it needs --sens");
+            return false;
+        }
     static const char *const prefix[] = {"", "d(", "dd(", "lambda(", "effort("};
     int order = 0;
     for (int k = 1; k <= SVG_PLOT_EFFORT; k++) {
@@ -466,6 +511,12 @@ static bool parse_item(const Model *m, const char *a, const char *b, bool forces
 int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPlotVar *out,
                             int max, char *err, size_t errlen)
 {
+    return svg_plot_resolve_columns(m, list, forces, false, out, max, err, errlen);
+}
+
+int svg_plot_resolve_columns(const Model *m, const char *list, bool forces, bool sens,
+                             SvgPlotVar *out, int max, char *err, size_t errlen)
+{
     if (!list) {
         snprintf(err, errlen, "--plot-vars: no names given");
         return -1;
@@ -484,7 +535,7 @@ int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPl
             return -1;
         }
         SvgPlotVar v;
-        if (!parse_item(m, a, b, forces, &v, err, errlen))
+        if (!parse_item(m, a, b, forces, sens, &v, err, errlen))
             return -1;
         if (count >= max) {
             snprintf(err, errlen, "--plot-vars: more than %d names", max);
@@ -514,6 +565,14 @@ const char *svg_plot_var_label(const Model *m, int coord)
 
 void svg_plot_var_name(const Model *m, SvgPlotVar v, char *buf, size_t len)
 {
+    if (v.order == SVG_PLOT_SENS && m->np > 0) {
+        int per = (m->nq + m->nout) * m->np, level = v.coord / per;
+        SvgPlotVar x = {v.coord % per / m->np, level};
+        char inner[160];
+        svg_plot_var_name(m, x, inner, sizeof inner);
+        snprintf(buf, len, "d(%s)/d(%s)", inner, m->design_names[v.coord % m->np]);
+        return;
+    }
     if (v.order >= SVG_PLOT_LAMBDA) {
         snprintf(buf, len, "%s(%s)", v.order == SVG_PLOT_LAMBDA ? "lambda" : "effort",
                  v.coord >= 0 && v.coord < m->nr ? m->rows[v.coord].name : "?");

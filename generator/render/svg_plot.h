@@ -37,13 +37,14 @@ bool svg_write_plot_opt(FILE *out, const char *title, const double *t, int n,
 /* A quantity to plot: coordinate coord (nq + k: the model's output k),
    derivative order 0 (q), 1 (qd) or 2 (qdd); or (run --forces) the
    multiplier of row coord (SVG_PLOT_LAMBDA) or the effort of the driver
-   whose row is coord (SVG_PLOT_EFFORT). */
+   whose row is coord (SVG_PLOT_EFFORT); or (run --sens) the sensitivity
+   column coord (SVG_PLOT_SENS). */
 typedef struct SvgPlotVar {
     int coord;
     int order;
 } SvgPlotVar;
 
-enum { SVG_PLOT_LAMBDA = 3, SVG_PLOT_EFFORT = 4 };
+enum { SVG_PLOT_LAMBDA = 3, SVG_PLOT_EFFORT = 4, SVG_PLOT_SENS = 5 };
 
 /* Parses a --plot-vars list: comma-separated NAME (a coordinate or an output), d(NAME)
    (its velocity) or dd(NAME) (its acceleration), blanks allowed around
@@ -59,6 +60,12 @@ size_t svg_plot_err_size(const Model *m);
    driver's name) when forces is true. */
 int svg_plot_resolve_forces(const Model *m, const char *list, bool forces, SvgPlotVar *out,
                             int max, char *err, size_t errlen);
+
+/* The same, also taking (sens) run --sens's columns d(NAME)/d(P),
+   d(d(NAME))/d(P) and d(dd(NAME))/d(P): SVG_PLOT_SENS, coord their
+   column (sens.h's order). */
+int svg_plot_resolve_columns(const Model *m, const char *list, bool forces, bool sens,
+                             SvgPlotVar *out, int max, char *err, size_t errlen);
 
 /* The name of coordinate coord, or of output coord - nq. */
 const char *svg_plot_var_label(const Model *m, int coord);
