@@ -222,7 +222,7 @@ static void collect_rotations(Generic *g, const char *need)
 
 static bool designed(const Joint *j)
 {
-    return j->a.designed || j->b.designed;
+    return j->a.designed || j->b.designed || j->axis_designed;
 }
 
 Generic *generic_open(const Model *m)
@@ -250,8 +250,9 @@ Generic *generic_open(const Model *m)
         *p = (Plan){.j = j, .row = j->first_row, .velocity = j->velocity, .prog = -1,
                     .opt = {.constant = true, .prog = -1}};
         p->of = j;
-        /* formulas hold offsets as numbers: a joint whose offsets are
-           design parameters' is interpreted from its rows (which read p) */
+        /* formulas hold offsets and axes as numbers: a joint whose offsets
+           or axis are design parameters' is interpreted from its rows
+           (which read p) */
         p->rows = designed(j) ? NULL : generic_joint_formula(j, need);
         if (!p->rows && !designed(j) && j->kind == JOINT_DRIVER && j->measures != 0) {
             p->of = &m->joints[abs(j->measures) - 1];

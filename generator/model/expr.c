@@ -222,8 +222,8 @@ double build_constant(Builder *b, const Ast *ast, const char *what)
     double v;
     if (!dag_is_const(dag, id, &v) && first_design(dag, id))
         diag_fail(b->diag, ast->pos, "%s cannot depend on design parameter '%s' (design "
-                  "parameters may set offsets, lengths, drivers, constraints, outputs and "
-                  "initial values)", what, first_design(dag, id));
+                  "parameters may set offsets, planar axes, lengths, drivers, constraints, "
+                  "outputs and initial values)", what, first_design(dag, id));
     if (!dag_is_const(dag, id, &v) || !isfinite(v))
         diag_fail(b->diag, ast->pos, "%s is not a finite number", what);
     return v;

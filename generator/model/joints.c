@@ -99,11 +99,25 @@ static Vec velocity(Dag *d, Attach at)
     return (Vec){x, y};
 }
 
-/* n_A = A(phi_A) (-uy, ux): the body-fixed normal of the axis. */
-static Vec normal(Dag *d, Attach at, double ux, double uy)
+/* n_A = A(phi_A) (-uy, ux): the body-fixed normal of j's axis. */
+static Vec normal(Dag *d, const Joint *j)
 {
-    Vec n = vec_const(d, -uy, ux);
-    return at.has_phi ? rotate(d, angle_of(d, at), n) : n;
+    Vec n = !j->axis_designed ? vec_const(d, -j->uy, j->ux)
+                              : (Vec){dag_neg(d, j->u_node[1]), j->u_node[0]};
+    return j->a.has_phi ? rotate(d, angle_of(d, j->a), n) : n;
+}
+
+/* j's unit axis u / |u| (in A's frame). */
+static Vec unit_axis(Dag *d, const Joint *j)
+{
+    if (!j->axis_designed) {
+        double len = sqrt(j->ux * j->ux + j->uy * j->uy);
+        return vec_const(d, j->ux / len, j->uy / len);
+    }
+    Vec u = {j->u_node[0], j->u_node[1]};
+    NodeId len = dag_call(d, OP_SQRT, dot(d, u, u), DAG_NONE);
+    NodeId x = dag_div(d, u.x, len);
+    return (Vec){x, dag_div(d, u.y, len)};
 }
 
 /* P_p - P_q (P_q's nodes made first) */
@@ -134,7 +148,7 @@ static void lower_REVOLUTE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 static void lower_PRISMATIC(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     Vec e = difference(d, j->b, j->a);
-    rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
+    rows[0] = dot(d, normal(d, j), e);
     rows[1] = relative_angle(d, j->b, j->a, j->option);
 }
 
@@ -150,7 +164,7 @@ static void lower_DISTANCE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 static void lower_POINTLINE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     Vec e = difference(d, j->b, j->a);
-    rows[0] = dot(d, normal(d, j->a, j->ux, j->uy), e);
+    rows[0] = dot(d, normal(d, j), e);
 }
 
 /* weld J: J.x, J.y = P_A - P_B; J.phi = phi_B - phi_A - theta */
@@ -181,7 +195,7 @@ static void lower_ROLLING(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 static void lower_KNIFE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     Vec v = velocity(d, j->a);
-    Vec n = normal(d, j->a, j->ux, j->uy);
+    Vec n = normal(d, j);
     rows[0] = dot(d, n, v);
 }
 
@@ -211,8 +225,7 @@ void joints_point(Model *model, Attach at, NodeId xy[2])
 NodeId joints_slide(Model *model, const Joint *j)
 {
     Dag *d = &model->dag;
-    double len = sqrt(j->ux * j->ux + j->uy * j->uy);
-    Vec u = vec_const(d, j->ux / len, j->uy / len);
+    Vec u = unit_axis(d, j);
     if (j->a.has_phi)
         u = rotate(d, angle_of(d, j->a), u);
     Vec e = difference(d, j->b, j->a);

@@ -426,8 +426,11 @@ static void build_joint(Builder *b, const Stmt *s)
     if (info->axis && b->spatial) {
         spatial_axes(b, s, j);
     } else if (info->axis) {
-        j->ux = build_constant(b, s->axis[0], "the axis component ux");
-        j->uy = build_constant(b, s->axis[1], "the axis component uy");
+        NodeId ux = build_design_value(b, s->axis[0], "the axis component ux", &j->ux);
+        NodeId uy = build_design_value(b, s->axis[1], "the axis component uy", &j->uy);
+        j->axis_designed = !dag_is_const(&m->dag, ux, NULL) || !dag_is_const(&m->dag, uy, NULL);
+        j->u_node[0] = ux;
+        j->u_node[1] = uy;
         if (j->ux == 0.0 && j->uy == 0.0)
             diag_fail(b->diag, s->axis_pos, "the axis of %s '%s' is zero", info->keyword, s->name);
     }

@@ -29,7 +29,9 @@ typedef struct Joint {
     const char *name;
     SrcPos pos;
     Attach a, b;
-    double ux, uy;      /* axis, as written */
+    double ux, uy;      /* axis, as written (a designed one's at the file's design) */
+    bool axis_designed; /* a planar axis of design parameters: */
+    NodeId u_node[2];   /* its nodes */
     double uz;          /* spatial: A's axis is (ux, uy, uz) in A's frame, */
     double bx, by, bz;  /* and B's (bx, by, bz) in B's (A's vector unless given) */
     NodeId option;      /* length, angle or radius (angle absent: 0); a
