@@ -145,10 +145,10 @@ static bool finish(Args *a, void *opts)
     c->emit.direct_jac = c->jac == 2;     /* auto: gen_file, once the size is known */
     c->emit.roll = c->roll;     /* rolls[] is in EmitRoll's order */
     c->emit.max_ops = c->limits.max_code_ops;
-    if (c->emit.sparse_only) {      /* checked in gen_file, where it binds */
-        c->dense_limit = c->limits.max_jac_entries;
-        c->limits.max_jac_entries = 0;
-    }
+    /* The dense Jacobian's size is checked in gen_file, on the whole
+       model: past the limit the file is written sparse-only by itself. */
+    c->dense_limit = c->limits.max_jac_entries;
+    c->limits.max_jac_entries = 0;
     const char *why;
     char buf[256];
     if (c->emit.prefix && (why = emit_check_prefix(c->emit.prefix))) {
@@ -215,17 +215,19 @@ static bool write_outputs(const GenCli *c, const EmitResult *res)
 /* --sparse-only on a file with masses: its mass and eom stay dense (M,
    and eom's Jacobian), so the dense limit still binds; false (diag
    filled) past it. */
-static bool dynamics_fit(const Mech *mech, int limit, Diag *diag)
+static bool dynamics_fit(const Mech *mech, int limit, bool sparse_only, Diag *diag)
 {
     const Model *m = mech->model;
     long long jac = (long long)m->nr * m->nq, mass = (long long)m->nq * m->nq;
     long long most = jac > mass ? jac : mass;
-    if (!mech->kin.dyn.present || most <= limit)
+    if (!mech->kin.dyn.present || limit <= 0 || most <= limit)
         return true;
-    diag_error_nopos(diag, "the file has masses, and its _mass and _eom stay dense with "
-                     "--sparse-only: the dense %s would have %lld entries, more than the "
-                     "limit of %d (--max-jac-entries)", jac >= mass ? "Jacobian" : "mass matrix",
-                     most, limit);
+    diag_error_nopos(diag, "the file has masses, and its _mass and _eom stay dense%s: the "
+                     "dense %s would have %d rows x %d coordinates = %lld entries, more than "
+                     "the limit of %d (--max-jac-entries)",
+                     sparse_only ? " with --sparse-only" : " (also with --sparse-only)",
+                     jac >= mass ? "Jacobian" : "mass matrix", jac >= mass ? m->nr : m->nq,
+                     m->nq, most, limit);
     return false;
 }
 
@@ -261,7 +263,18 @@ static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_OK;
     }
     c->emit.source_name = a->file;
-    if ((c->emit.sparse_only && !dynamics_fit(mech, c->dense_limit, diag))
+    const Model *m = mech->model;
+    bool asked = c->emit.sparse_only;
+    if (!c->emit.sparse_only && c->dense_limit > 0
+        && (long long)m->nr * m->nq > c->dense_limit && !mech->kin.dyn.present) {
+        c->emit.sparse_only = true;
+        fprintf(stderr, "%s: note: the dense Jacobian would have %d rows x %d coordinates = "
+                "%lld entries, more than the limit of %d (--max-jac-entries): written "
+                "--sparse-only (PREFIX_all_nz and the Jacobian's nonzeros, no PREFIX_jac or "
+                "PREFIX_all)\n", a->file, m->nr, m->nq, (long long)m->nr * m->nq,
+                c->dense_limit);
+    }
+    if (!dynamics_fit(mech, c->dense_limit, asked, diag)
         || (c->emit.real_float && !constants_fit_float(mech, diag))) {
         diag_print(diag, stderr);
         return EXIT_USAGE;
