@@ -81,6 +81,19 @@ for engine in jit generic; do
     }
     check "heavy top ($engine): the tilt stays theta (height l cos theta to 1e-9 m)" height
 done
+# the same start as an angular velocity (--w, global frame): w = Omega z + psi' k,
+# k = (0, -sin theta, cos theta), psi' = w3 - Omega cos theta
+top_w=$(awk -v O="$omega" 'BEGIN { th = 0.3; p = 100 - O * cos(th)
+    printf "%.17g,%.17g,%.17g", 0, -p * sin(th), O + p * cos(th) }')
+sim "$ex/heavy_top.mech" --t1 1 --steps 10 --qd 0.078444083484950244,0,0,0,0,0,0 --w "top=$top_w" \
+    --csv "$tmp/topw.csv"
+check "heavy top, --w top=...: exit 0" status_is 0
+az=$(awk -F, 'NR > 1 && $1 == 1 { printf "%.17g", atan2($3, $2) + atan2(1, 0) }' "$tmp/topw.csv")
+check "heavy top, --w: azimuth at t = 1 is Omega t to 1e-7 (the rates from w)" close_rel "$az" "$omega" 1e-7
+sim "$ex/heavy_top.mech" --w "ground=1,2,3"
+check "--w of ground: exit 2 naming what it takes" err_has "--w takes B=WX,WY,WZ with B a spatial body"
+sim "$ex/heavy_top.mech" --w "top=1,2"
+check "--w with two numbers: exit 2" status_is 2
 # the gyroscopic approximation m g l / (I3 w3) = 2.4525 is not it (the test can tell them apart)
 check "heavy top: the exact rate differs from the gyroscopic approximation" \
     awk -v w="$omega" 'BEGIN { exit !(w - 2.4525 > 0.1) }'

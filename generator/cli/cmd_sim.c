@@ -10,6 +10,8 @@
  */
 #include "cli.h"
 
+#include "../kin/outputs.h"
+
 #include "../kin/run.h"
 #include "../dyn/sim.h"
 #include "../base/arena.h"
@@ -27,6 +29,7 @@ typedef struct SimCli {
     SimOptions so;
     MechLimits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
+    CliList omegas;         /* --w BODY=wx,wy,wz */
     CliList traces;
     int engine, method, digits, view, linear, max_steps;
     bool json, stats;
@@ -76,6 +79,9 @@ static const CliOption options[] = {
     {"--qd", CLI_STRING_AT(SimCli, qd_text), .metavar = "V1,V2,...",
      .help = "initial velocities, one per coordinate (default 0);\n"
              "projected onto the velocity equations"},
+    {"--w", CLI_LIST_AT(SimCli, omegas, CLI_LIST_MAX), .what = "bodies", .metavar = "B=WX,WY,WZ",
+     .help = "initial angular velocity of spatial body B, global frame\n"
+             "(rad/s; repeatable): its Euler-parameter rates, after --qd"},
     {"--interpolate", CLI_FLAG_AT(SimCli, so.interpolate),
      .help = "step across the output times: states there from the\n"
              "Hermite interpolant of q, qd, qdd at the ends of the\n"
@@ -290,6 +296,30 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
     return status;
 }
 
+/* --w B=wx,wy,wz into qd0: B's Euler-parameter rates at the file's
+   orientation; false (reported) for a name that is no spatial body or a
+   value that is not three numbers. */
+static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
+{
+    for (int i = 0; i < c->omegas.n; i++) {
+        const char *item = c->omegas.items[i], *eq = strchr(item, '=');
+        char name[256];
+        size_t len = eq ? (size_t)(eq - item) : 0;
+        snprintf(name, sizeof name, "%.*s", (int)(len < sizeof name ? len : sizeof name - 1), item);
+        const Body *b = eq ? model_find_body(m, name) : NULL;
+        if (!b || b->nq != 7) {
+            fprintf(stderr, "mechc sim: error: --w takes B=WX,WY,WZ with B a spatial body, "
+                    "not '%s'\n", item);
+            return false;
+        }
+        double w[3];
+        if (!args_vector("sim", "--w", eq + 1, 3, w))
+            return false;
+        outputs_euler_rates(m->q0 + b->q + 3, w, qd0 + b->q + 3);
+    }
+    return true;
+}
+
 /* Masses, velocities and pictures checked, the engine opened, then the simulation. */
 static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
 {
@@ -300,7 +330,7 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     double *qd0 = xcalloc((size_t)m->nq, sizeof *qd0);
     int status = EXIT_USAGE;
     if ((c->qd_text && !args_vector("sim", "--qd", c->qd_text, m->nq, qd0))
-        || !resolve_pictures(m, c, &pics)) {
+        || !read_omegas(c, m, qd0) || !resolve_pictures(m, c, &pics)) {
         free(qd0);
         return EXIT_USAGE;
     }

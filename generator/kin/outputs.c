@@ -17,6 +17,7 @@
 
 #include "../base/arena.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -55,6 +56,17 @@ void outputs_omega(const OutputEval *oe, const double *q, const double *qd, doub
         w[3 * i + 1] = 2 * (-p[2] * v[0] + p[3] * v[1] + p[0] * v[2] - p[1] * v[3]);
         w[3 * i + 2] = 2 * (-p[3] * v[0] - p[2] * v[1] + p[1] * v[2] + p[0] * v[3]);
     }
+}
+
+void outputs_euler_rates(const double *e, const double *w, double *ed)
+{
+    double n = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+    double p[4] = {e[0] / n, e[1] / n, e[2] / n, e[3] / n};
+    /* E's rows (-e1, e0, -e3, e2), (-e2, e3, e0, -e1), (-e3, -e2, e1, e0), as above */
+    ed[0] = 0.5 * (-p[1] * w[0] - p[2] * w[1] - p[3] * w[2]);
+    ed[1] = 0.5 * (p[0] * w[0] + p[3] * w[1] - p[2] * w[2]);
+    ed[2] = 0.5 * (-p[3] * w[0] + p[0] * w[1] + p[1] * w[2]);
+    ed[3] = 0.5 * (p[2] * w[0] - p[1] * w[1] + p[0] * w[2]);
 }
 
 void outputs_init(OutputEval *oe, const Model *m)

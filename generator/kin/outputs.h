@@ -26,5 +26,9 @@ void outputs_eval(const OutputEval *oe, const double *q, const double *qd, const
 /* The angular velocity omega = 2 E(p) p' (global frame), E = [-e, e~ + e0 I],
    of every spatial body: w[3 i .. 3 i + 2] for the i-th, oe->nw values. */
 void outputs_omega(const OutputEval *oe, const double *q, const double *qd, double *w);
+/* The other way: the Euler-parameter rates ed (4) of a body whose Euler
+   parameters are e (4; normalised here) turning at w (3, global frame):
+   ed = 1/2 E(e)^T w, so that 2 E ed = w and e . ed = 0. */
+void outputs_euler_rates(const double *e, const double *w, double *ed);
 
 #endif
