@@ -1,8 +1,9 @@
-/* testcache.h - the AOT cache of a test suite (XDG_CACHE_HOME): tests/run_all's, shared by the run, or a private one removed afterwards. */
+/* testcache.h - the AOT cache of a test suite (XDG_CACHE_HOME): tests/run_all's, shared by the run, or a private one removed afterwards; engines opened with it. */
 #ifndef MECHC_TESTCACHE_H
 #define MECHC_TESTCACHE_H
 
 #include "../generator/engine/aot.h"
+#include "../generator/engine/engine.h"
 
 #include <dirent.h>
 #include <stdbool.h>
@@ -80,6 +81,19 @@ static inline int testcache_teardown(TestCache *c)
 {
     testcache_release(c->dir);
     return 0;
+}
+
+/* Opens an engine of kind for mech, failing the test when it cannot;
+   false (nothing opened) for aot without a C compiler. */
+static inline bool testcache_open_engine(const TestCache *c, Engine *e, EngineKind kind,
+                                         const Mech *mech)
+{
+    if (kind == ENGINE_AOT && !c->have_cc)
+        return false;
+    Diag diag;
+    if (!engine_open(e, kind, mech, &diag))
+        fail_msg("%s: %s", engine_names[kind], diag.message);
+    return true;
 }
 
 #endif

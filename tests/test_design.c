@@ -1,0 +1,509 @@
+/* test_design.c - design parameters: parsed and refused where they may not go, emitted as p, evaluated alike by every engine, and the sensitivities against finite differences of whole runs.
+ *
+ * `design NAME = value` makes NAME the graph leaf p[j]: a derived `param`
+ * of it works, an axis, a mass, an inertia or gravity depending on it is
+ * an error naming it (FILE:LINE:COL). The generated C of such a file takes
+ * `const PREFIX_real *p`, defines PREFIX_NP and PREFIX_phi_p; a file
+ * without design parameters emits what it did before. jit, aot (when a C
+ * compiler is there) and generic give the same Phi and Phi_p at a design
+ * set by model_set_design after the engines were opened, and Phi_p is the
+ * central difference of Phi in p. Finally kin/sens.c's sensitivities of
+ * positions, velocities, accelerations and outputs at every state of a run
+ * are the central differences of whole runs at p +- h, for a planar
+ * four-bar with a slider on a rod (designed lengths, pivots and a rod
+ * length) and a spatial RSSR (designed crank offset, ground pivot and
+ * rod length). The aot library cache goes to the run's (testcache.h).
+ */
+#include "testutil.h"
+#include "testcache.h"
+#include "testload.h"
+
+#include "../generator/base/arena.h"
+#include "../generator/emit/emit.h"
+#include "../generator/engine/engine.h"
+#include "../generator/jit/jit.h"
+#include "../generator/kin/outputs.h"
+#include "../generator/kin/run.h"
+#include "../generator/kin/sens.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static TestCache cache;
+
+static int setup(void **state)
+{
+    (void)state;
+    return testcache_setup(&cache, "design");
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    return testcache_teardown(&cache);
+}
+
+/* A four-bar with designed link lengths (b through a derived param) and
+   ground pivots, and a point m on the ground line at a designed distance
+   L from a coupler point; a coupler point and an angle difference as
+   outputs. */
+static const char planar_text[] =
+    "mechanism fbd\n"
+    "design a  = 1\n"
+    "design b  = 3\n"
+    "design c  = 2.5\n"
+    "design ax = 0.1\n"
+    "design dx = 3\n"
+    "design L  = 2.5\n"
+    "param omega = 2*pi\n"
+    "param h = b/2\n"
+    "body crank   x = 0.5     y = 0       phi = 0\n"
+    "body coupler x = 1.8438  y = 1.2402  phi = 0.9734\n"
+    "body rocker  x = 2.8438  y = 1.2402  phi = 1.6961\n"
+    "point m x = 3.9 y = 0\n"
+    "revolute O2: ground(ax, 0)  crank(-a/2, 0)\n"
+    "revolute A:  crank(a/2, 0)  coupler(-h, 0)\n"
+    "revolute B:  coupler(h, 0)  rocker(c/2, 0)\n"
+    "revolute O4: ground(dx, 0)  rocker(-c/2, 0)\n"
+    "distance rod: coupler(0, 0.2) m length = L\n"
+    "driver drive: crank.phi = omega*t\n"
+    "driver slide: m.y = 0\n"
+    "output P: coupler(0.5, 0.2)\n"
+    "output r = rocker.phi - crank.phi\n";
+
+/* examples/rssr.mech with its crank offset a, the rod's length L and the
+   rocker's ground pivot gx designed; the rocker's angle and a point of it
+   as outputs. */
+static const char spatial_text[] =
+    "mechanism rssr_design\n"
+    "spatial\n"
+    "design a  = 1\n"
+    "design L  = sqrt(10)\n"
+    "design gx = 2\n"
+    "param c     = 3\n"
+    "param omega = 2*pi\n"
+    "body crank  x = 0  y = 0  z = 0\n"
+    "body rocker x = 2  y = 0  z = 0  orient = axis(0, 1, 1, pi/2)\n"
+    "revolute R1: ground(0, 0, 0)   crank(0, 0, 0)   axis(0, 0, 1)\n"
+    "revolute R2: ground(gx, 0, 0)  rocker(0, 0, 0)  axis(0, 1, 1)\n"
+    "distance C:  crank(a, 0, 0)    rocker(c, 0, 0)  length = L\n"
+    "driver   D:  angle(R1) = omega*t\n"
+    "output psi = angle(R2)\n"
+    "output Q: rocker(c, 0, 0)\n";
+
+static int row_index(const Model *m, const char *name)
+{
+    for (int r = 0; r < m->nr; r++)
+        if (strcmp(m->rows[r].name, name) == 0)
+            return r;
+    fail_msg("no row %s", name);
+    return -1;
+}
+
+/* ---- parsing ------------------------------------------------------------ */
+
+/* design declares p[0] = 2; h = L/2 is a folded param of it: the pin's row
+   moves by dh = 1/2 per unit of L. */
+static void test_parse_design_and_derived_param(void **s)
+{
+    (void)s;
+    Mech *mech = load_text("design L = 2\n"
+                           "param h = L/2\n"
+                           "body a x = 1 y = 0 phi = 0\n"
+                           "revolute O: ground(0, 0) a(-h, 0)\n"
+                           "driver d: a.phi = t\n", "derived.mech");
+    Model *m = mech->model;
+    assert_int_equal(m->np, 1);
+    assert_string_equal(m->design_names[0], "L");
+    assert_near(m->design_p0[0], 2.0, 0, 0);
+    assert_near(m->dag.param_values[0], 2.0, 0, 0);
+    Engine e;
+    Diag diag;
+    if (!engine_open(&e, ENGINE_JIT, mech, &diag))
+        fail_msg("jit: %s", diag.message);
+    double q[3] = {1, 0, 0}, phi[3], phi3[3], phi_p[3];
+    int ox = row_index(m, "O.x");
+    engine_phi(&e, q, 0.0, phi);
+    engine_phi_p(&e, q, 0.0, phi_p);
+    assert_near(phi[ox], 0.0, 0, 1e-15);    /* a(-1, 0) is at the origin */
+    assert_near(fabs(phi_p[ox]), 0.5, 0, 1e-15);
+    model_set_design(m, (double[]){3.0});
+    engine_phi(&e, q, 0.0, phi3);
+    assert_near(phi3[ox] - phi[ox], phi_p[ox], 0, 1e-15);
+    assert_near(m->design_p0[0], 2.0, 0, 0);    /* the file's design stays */
+    model_set_design(m, NULL);
+    assert_near(m->dag.param_values[0], 2.0, 0, 0);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+/* text does not load: FILE:LINE:COL and the message naming the parameter. */
+static void expect_refused(const char *text, const char *where, const char *what)
+{
+    MechLimits limits = mech_default_limits();
+    Diag diag;
+    Mech *mech = pipeline_load_text(text, "bad.mech", &limits, &diag);
+    if (mech)
+        fail_msg("%s: loaded", what);
+    char out[2048] = "";
+    FILE *f = fmemopen(out, sizeof out - 1, "w");
+    diag_print(&diag, f);
+    fclose(f);
+    if (strncmp(out, where, strlen(where)) != 0 || !strstr(out, what))
+        fail_msg("expected \"%s ...%s...\", got:\n%s", where, what, out);
+}
+
+static void test_parse_refuses_design_in_constants(void **s)
+{
+    (void)s;
+    expect_refused("spatial\ndesign L = 1\nbody a x = 0 y = 0 z = 0\n"
+                   "revolute O: ground(0, 0, 0) a(0, 0, 0) axis(L, 0, 1)\n",
+                   "bad.mech:4:45: error: ", "an axis component cannot depend on design parameter 'L'");
+    const char *pendulum = "design k = 2\nparam twice = 2*k\n"
+                           "body rod x = 0.5 y = 0 phi = 0\nrevolute O: ground(0, 0) rod(-0.5, 0)\n";
+    static const struct {
+        const char *stmt, *where, *what;
+    } cases[] = {
+        {"mass rod m = k J = 1 com(0, 0)\n", "bad.mech:5:14: error: ",
+         "the mass m cannot depend on design parameter 'k'"},
+        {"mass rod m = 1 J = twice com(0, 0)\n", "bad.mech:5:20: error: ",
+         "the moment of inertia J cannot depend on design parameter 'k'"},
+        {"mass rod m = 1 J = 1 com(k, 0)\n", "bad.mech:5:26: error: ",
+         "a centre-of-mass offset cannot depend on design parameter 'k'"},
+        {"mass rod m = 1 J = 1 com(0, 0)\ngravity (0, -twice)\n", "bad.mech:6:13: error: ",
+         "the gravity component gy cannot depend on design parameter 'k'"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char text[512];
+        snprintf(text, sizeof text, "%s%s", pendulum, cases[i].stmt);
+        expect_refused(text, cases[i].where, cases[i].what);
+    }
+    expect_refused("design m = 2\ndesign n = m\nbody a x = 0 y = 0 phi = 0\n", "bad.mech:2:12: error: ",
+                   "the design value cannot depend on design parameter 'm'");
+}
+
+/* ---- emission ----------------------------------------------------------- */
+
+static void emit(const Mech *mech, const EmitOptions *opt, EmitResult *res)
+{
+    Diag diag;
+    diag_init(&diag, "test", "", 0);
+    if (!emit_mechanism(&mech->kin, opt, res, &diag))
+        fail_msg("emit_mechanism: %s", diag.message);
+    /* a success records no error (it once did: an aot compiler's failure
+       was then reported as "more than N operations") */
+    assert_false(diag.failed);
+}
+
+/* gen's file: p after q and t in phi, PREFIX_NP, p0, names and phi_p; it
+   compiles under libtcc. */
+static void test_emit_design_file(void **s)
+{
+    (void)s;
+    Mech *mech = load_text(planar_text, "fbd.mech");
+    EmitOptions opt = emit_default_options();
+    EmitResult res;
+    emit(mech, &opt, &res);
+    const char *phi = strstr(res.c_text, "void fbd_phi(");
+    assert_non_null(phi);
+    const char *eol = strchr(phi, '\n'), *p = strstr(phi, "const fbd_real *p");
+    assert_true(p && p < eol);
+    assert_non_null(strstr(res.c_text, "#define FBD_NP   6"));
+    assert_non_null(strstr(res.c_text, "void fbd_phi_p(const fbd_real *q, fbd_real t, "
+                                       "const fbd_real *p, fbd_real *phi_p)"));
+    assert_non_null(strstr(res.c_text, "fbd_p0[FBD_NP]"));
+    assert_non_null(strstr(res.c_text, "fbd_design_names[FBD_NP]"));
+    assert_null(strstr(res.c_text, "design_bind"));    /* the engines' twins only */
+    emit_result_free(&res);
+
+    opt.declare_math = true;    /* libtcc has no system headers: as the jit */
+    opt.direct_jac = true;
+    emit(mech, &opt, &res);
+    Diag diag;
+    diag_init(&diag, "test", "", 0);
+    Jit *jit = jit_compile(res.c_text, res.prefix, &diag);
+    if (!jit)
+        fail_msg("jit_compile: %s", diag.message);
+    jit_free(jit);
+    emit_result_free(&res);
+
+    opt.host_design = true;     /* what the engines compile */
+    emit(mech, &opt, &res);
+    assert_non_null(strstr(res.c_text, "void fbd_design_bind(const fbd_real *p)"));
+    emit_result_free(&res);
+    pipeline_free(mech);
+}
+
+/* A file without design parameters: no p anywhere, and host_design changes
+   nothing. */
+static void test_emit_file_without_design(void **s)
+{
+    (void)s;
+    Mech *mech = load_example("four_bar.mech");
+    EmitOptions opt = emit_default_options();
+    EmitResult plain, host;
+    emit(mech, &opt, &plain);
+    opt.host_design = true;
+    emit(mech, &opt, &host);
+    assert_null(strstr(plain.c_text, "_design"));
+    assert_null(strstr(plain.c_text, "_NP"));
+    assert_null(strstr(plain.c_text, "_phi_p"));
+    assert_null(strstr(plain.c_text, "_real *p,"));
+    assert_string_equal(plain.c_text, host.c_text);
+    assert_string_equal(plain.h_text, host.h_text);
+    emit_result_free(&plain);
+    emit_result_free(&host);
+    pipeline_free(mech);
+}
+
+/* ---- engines ------------------------------------------------------------ */
+
+static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
+{
+    return testcache_open_engine(&cache, e, kind, mech);
+}
+
+/* Phi and Phi_p of every engine at a design set after they were opened,
+   the same to 1e-12; Phi_p the central difference of Phi (1e-7). */
+static void check_engines(const char *text, const char *name, const double *dp)
+{
+    Mech *mech = load_text(text, name);
+    Model *m = mech->model;
+    int nh = m->nh, np = m->np, nq = m->nq;
+    Engine e[ENGINE_KIND_COUNT];
+    bool open[ENGINE_KIND_COUNT];
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        open[k] = open_kind(&e[k], (EngineKind)k, mech);
+    double *p = xcalloc((size_t)np, sizeof *p), *q = xcalloc((size_t)nq, sizeof *q);
+    for (int j = 0; j < np; j++)
+        p[j] = m->design_p0[j] + dp[j];
+    for (int i = 0; i < nq; i++)
+        q[i] = m->q0[i] + 0.05 * (i % 4) - 0.07;
+    double t = 0.137;
+    model_set_design(m, p);
+    size_t nhp = (size_t)nh * (size_t)np;
+    double *phi = xcalloc((size_t)nh, sizeof *phi), *phi0 = xcalloc((size_t)nh, sizeof *phi0);
+    double *phi_p = xcalloc(nhp, sizeof *phi_p), *ref_p = xcalloc(nhp, sizeof *ref_p);
+    double *plus = xcalloc((size_t)nh, sizeof *plus), *minus = xcalloc((size_t)nh, sizeof *minus);
+    engine_phi(&e[ENGINE_JIT], q, t, phi0);
+    engine_phi_p(&e[ENGINE_JIT], q, t, ref_p);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++) {
+        if (!open[k])
+            continue;
+        engine_phi(&e[k], q, t, phi);
+        engine_phi_p(&e[k], q, t, phi_p);
+        for (int r = 0; r < nh; r++)
+            assert_near(phi[r], phi0[r], 0, 1e-12);
+        for (size_t i = 0; i < nhp; i++)
+            assert_near(phi_p[i], ref_p[i], 0, 1e-12);
+    }
+    for (int j = 0; j < np; j++) {
+        double h = 1e-5 * fmax(1.0, fabs(p[j])), pj = p[j];
+        m->dag.param_values[j] = pj + h;
+        engine_phi(&e[ENGINE_GENERIC], q, t, plus);
+        m->dag.param_values[j] = pj - h;
+        engine_phi(&e[ENGINE_GENERIC], q, t, minus);
+        m->dag.param_values[j] = pj;
+        for (int r = 0; r < nh; r++)
+            assert_near((plus[r] - minus[r]) / (2 * h), ref_p[(size_t)r * (size_t)np + (size_t)j],
+                        0, 1e-7);
+    }
+    /* the nominal design gives other values: the engines saw p */
+    model_set_design(m, NULL);
+    engine_phi(&e[ENGINE_JIT], q, t, phi);
+    double moved = 0;
+    for (int r = 0; r < nh; r++)
+        moved = fmax(moved, fabs(phi[r] - phi0[r]));
+    assert_true(moved > 1e-3);
+    for (int k = 0; k < ENGINE_KIND_COUNT; k++)
+        if (open[k])
+            engine_close(&e[k]);
+    free(p), free(q), free(phi), free(phi0), free(phi_p), free(ref_p), free(plus), free(minus);
+    pipeline_free(mech);
+}
+
+static void test_engines_agree_planar(void **s)
+{
+    (void)s;
+    check_engines(planar_text, "fbd.mech", (double[]){0.07, -0.11, 0.05, 0.02, -0.08, 0.13});
+}
+
+static void test_engines_agree_spatial(void **s)
+{
+    (void)s;
+    check_engines(spatial_text, "rssr_design.mech", (double[]){0.1, -0.2, 0.15});
+}
+
+/* ---- sensitivities against whole runs ----------------------------------- */
+
+enum { STEPS = 24 };
+
+/* Every state of a run: per state q, y, qd, yd, qdd, ydd (y the outputs),
+   and with sens the sensitivity columns (sens_columns' order). */
+typedef struct Motion {
+    const Model *m;
+    OutputEval oe;
+    Sens *sens;
+    int n, nv, ncol;
+    double *x, *cols;
+} Motion;
+
+static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
+{
+    Motion *mo = ctx;
+    int nq = mo->m->nq, nv = mo->nv;
+    assert_true(mo->n <= STEPS);
+    double *x = mo->x + (size_t)mo->n * 3 * (size_t)nv;
+    memcpy(x, q, (size_t)nq * sizeof *x);
+    memcpy(x + nv, qd, (size_t)nq * sizeof *x);
+    memcpy(x + 2 * nv, qdd, (size_t)nq * sizeof *x);
+    outputs_eval(&mo->oe, q, qd, qdd, t, x + nq, x + nv + nq, x + 2 * nv + nq);
+    if (mo->sens) {
+        assert_int_equal(sens_eval(mo->sens, t, q, qd, qdd), MECHRT_OK);
+        sens_columns(mo->sens, mo->cols + (size_t)mo->n * (size_t)mo->ncol);
+    }
+    mo->n++;
+}
+
+/* The run over one period at the model's design, Newton to 1e-12. */
+static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
+{
+    const Model *m = mech->model;
+    memset(mo, 0, sizeof *mo);
+    mo->m = m;
+    mo->sens = sens;
+    mo->nv = m->nq + m->nout;
+    mo->ncol = sens ? sens_column_count(sens) : 0;
+    mo->x = xcalloc((size_t)(STEPS + 1) * 3 * (size_t)mo->nv, sizeof *mo->x);
+    mo->cols = xcalloc((size_t)(STEPS + 1) * (size_t)mo->ncol + 1, sizeof *mo->cols);
+    outputs_init(&mo->oe, m);
+    RunOptions o = run_default_options();
+    o.steps = STEPS;
+    o.mechrt.tol_phi = o.mechrt.tol_dq = 1e-12;
+    RunResult res;
+    if (run_analysis(m, engine_kernels(e), NULL, &o, on_state, mo, &res) != ANALYSIS_OK)
+        fail_msg("run: %s", res.message);
+    assert_int_equal(mo->n, STEPS + 1);
+    outputs_free(&mo->oe);
+}
+
+static void motion_free(Motion *mo)
+{
+    free(mo->x), free(mo->cols);
+}
+
+/* sens's columns against (run(p + h e_j) - run(p - h e_j)) / 2h at every
+   state, for every design parameter j: positions, velocities,
+   accelerations and outputs. */
+static void check_sensitivities(const char *text, const char *name)
+{
+    Mech *mech = load_text(text, name);
+    Model *m = mech->model;
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_JIT, mech));
+    Sens sens;
+    char why[256];
+    if (!sens_init(&sens, m, &mech->kin, &e, why, sizeof why))
+        fail_msg("sens_init: %s", why);
+    Motion base, plus, minus;
+    run_motion(mech, &e, &sens, &base);
+    int np = m->np, nv = base.nv;
+    assert_int_equal(base.ncol, 3 * nv * np);
+    double *p = xcalloc((size_t)np, sizeof *p), worst = 0;
+    memcpy(p, m->design_p0, (size_t)np * sizeof *p);
+    for (int j = 0; j < np; j++) {
+        double h = 1e-6 * fmax(1.0, fabs(p[j]));
+        p[j] += h;
+        model_set_design(m, p);
+        run_motion(mech, &e, NULL, &plus);
+        p[j] -= 2 * h;
+        model_set_design(m, p);
+        run_motion(mech, &e, NULL, &minus);
+        p[j] += h;
+        model_set_design(m, p);
+        for (int k = 0; k <= STEPS; k++)
+            for (int i = 0; i < 3 * nv; i++) {
+                size_t at = (size_t)k * 3 * (size_t)nv + (size_t)i;
+                double fd = (plus.x[at] - minus.x[at]) / (2 * h);
+                double got = base.cols[(size_t)k * (size_t)base.ncol + (size_t)i * (size_t)np
+                                       + (size_t)j];
+                double err = fabs(got - fd) / (1.0 + fabs(fd));
+                worst = fmax(worst, err);
+                if (!(err <= 1e-6))
+                    fail_msg("%s: state %d, value %d, d/d(%s): sensitivity %.12g, "
+                             "finite difference %.12g", name, k, i, m->design_names[j], got, fd);
+            }
+        motion_free(&plus), motion_free(&minus);
+    }
+    print_message("%s: %d states x %d values x %d parameters, worst relative error %.2g\n", name,
+                  STEPS + 1, 3 * nv, np, worst);
+    motion_free(&base);
+    free(p);
+    sens_free(&sens);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+static void test_sensitivities_planar(void **s)
+{
+    (void)s;
+    check_sensitivities(planar_text, "fbd.mech");
+}
+
+static void test_sensitivities_spatial(void **s)
+{
+    (void)s;
+    check_sensitivities(spatial_text, "rssr_design.mech");
+}
+
+/* The CSV names: d(NAME)/d(P), d(d(NAME))/d(P), d(dd(NAME))/d(P), in
+   sens_columns' order. */
+static void test_sensitivity_column_names(void **s)
+{
+    (void)s;
+    Mech *mech = load_text(planar_text, "fbd.mech");
+    Model *m = mech->model;
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_GENERIC, mech));
+    Sens sens;
+    char why[256];
+    assert_true(sens_init(&sens, m, &mech->kin, &e, why, sizeof why));
+    int nv = m->nq + m->nout, np = m->np;
+    const char **names = xcalloc((size_t)nv, sizeof *names);
+    for (int i = 0; i < m->nq; i++)
+        names[i] = m->coord_names[i];
+    for (int k = 0; k < m->nout; k++)
+        names[m->nq + k] = m->outputs[k].name;
+    assert_int_equal(sens_column_count(&sens), 3 * nv * np);
+    static const struct {
+        int column;
+        const char *name;
+    } want[] = {{0, "d(crank.x)/d(a)"}, {5, "d(crank.x)/d(L)"}, {6, "d(crank.y)/d(a)"},
+                {11 * 6 + 1, "d(P.x)/d(b)"}, {14 * 6 - 1, "d(r)/d(L)"},
+                {14 * 6 + 2, "d(d(crank.x))/d(c)"}, {2 * 14 * 6 + 13 * 6 + 4, "d(dd(r))/d(dx)"}};
+    for (size_t i = 0; i < sizeof want / sizeof *want; i++) {
+        char *got = sens_column_name(&sens, names, want[i].column);
+        assert_string_equal(got, want[i].name);
+        free(got);
+    }
+    free(names);
+    sens_free(&sens);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_parse_design_and_derived_param),
+        cmocka_unit_test(test_parse_refuses_design_in_constants),
+        cmocka_unit_test(test_emit_design_file),
+        cmocka_unit_test(test_emit_file_without_design),
+        cmocka_unit_test(test_engines_agree_planar),
+        cmocka_unit_test(test_engines_agree_spatial),
+        cmocka_unit_test(test_sensitivities_planar),
+        cmocka_unit_test(test_sensitivities_spatial),
+        cmocka_unit_test(test_sensitivity_column_names),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
