@@ -1,0 +1,429 @@
+/* test_fit.c - mechc fit as a library: Freudenstein's three precision positions, the CSV's errors with their line and column, and the inputs fit_run refuses.
+ *
+ * Freudenstein: the rocker angle psi of a four-bar of ground link d at
+ * crank angles theta satisfies K1 cos psi - K2 cos theta + K3 =
+ * cos(theta - psi), K1 = d/a, K2 = d/c, K3 = (a^2 - b^2 + c^2 + d^2)/(2ac),
+ * linear in the K's: three (theta, psi) pairs give a, b, c in closed form.
+ * The pairs come from a closed-form position solution of the "true"
+ * linkage (1.2, 2.8, 2.3); fit_run from (1, 3, 2.5) must land on the
+ * closed form's a, b, c to 1e-12. The CSVs are written into a folder of
+ * the suite's own, removed at the end.
+ */
+#include "testutil.h"
+#include "testload.h"
+
+#include "../generator/base/arena.h"
+#include "../generator/engine/engine.h"
+#include "../generator/fit/data.h"
+#include "../generator/fit/fit.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static char tmpdir[256];
+
+static int setup(void **state)
+{
+    (void)state;
+    const char *base = getenv("TMPDIR");
+    snprintf(tmpdir, sizeof tmpdir, "%s/mechc_test_fit_XXXXXX", base && *base ? base : "/tmp");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* Ground link d = 3 from O2 to O4, crank a, coupler b, rocker c, all
+   along their bodies' x axes: theta = crank.phi = t, psi = rocker.phi. */
+static const char four_bar_text[] =
+    "mechanism freudenstein\n"
+    "design a = 1\n"
+    "design b = 3\n"
+    "design c = 2.5\n"
+    "param d = 3\n"
+    "body crank   x = 0.44  y = 0.24  phi = 0.5\n"
+    "body coupler x = 1.9   y = 1.4   phi = 0.9\n"
+    "body rocker  x = 2.8   y = 1.24  phi = 1.7\n"
+    "revolute O2: ground(0, 0)     crank(-a/2, 0)\n"
+    "revolute A:  crank(a/2, 0)    coupler(-b/2, 0)\n"
+    "revolute B:  coupler(b/2, 0)  rocker(c/2, 0)\n"
+    "revolute O4: ground(d, 0)     rocker(-c/2, 0)\n"
+    "driver input: crank.phi = t\n";
+
+static const double D = 3.0;
+
+/* psi at theta for links a, b, c: A cos psi + B sin psi = C from
+   Freudenstein's equation, on the branch with the coupler above the
+   ground link (the file's initial values). */
+static double rocker_angle(double a, double b, double c, double theta)
+{
+    double k1 = D / a, k2 = D / c, k3 = (a * a - b * b + c * c + D * D) / (2 * a * c);
+    double A = k1 - cos(theta), B = -sin(theta), C = k2 * cos(theta) - k3;
+    return atan2(B, A) + acos(C / hypot(A, B));
+}
+
+/* The 3x3 system M k = r by Cramer's rule. */
+static void solve3(const double M[3][3], const double r[3], double k[3])
+{
+    double det = M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1])
+               - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0])
+               + M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
+    for (int c = 0; c < 3; c++) {
+        double A[3][3];
+        memcpy(A, M, sizeof A);
+        for (int i = 0; i < 3; i++)
+            A[i][c] = r[i];
+        k[c] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1])
+                - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0])
+                + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) / det;
+    }
+}
+
+static const char *write_csv(const char *name, const char *text)
+{
+    static char path[400];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        fail_msg("cannot write %s", path);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* fit_run's inputs for mech: every parameter varied, no bounds. */
+typedef struct Fit {
+    Mech *mech;
+    Engine e;
+    FitData data;
+    FitOptions o;
+    FitResult r;
+    bool vary[8];
+    double lo[8], hi[8];
+} Fit;
+
+static void fit_open(Fit *f, const char *text, const char *csv_name, const char *csv)
+{
+    memset(f, 0, sizeof *f);
+    f->mech = load_text(text, "freudenstein.mech");
+    Diag diag;
+    if (!engine_open(&f->e, ENGINE_JIT, f->mech, &diag))
+        fail_msg("jit: %s", diag.message);
+    if (!fit_data_read(write_csv(csv_name, csv), f->mech->model, &f->data, &diag))
+        fail_msg("%s: %d:%d: %s", csv_name, diag.line, diag.col, diag.message);
+    f->o = fit_default_options();
+    f->o.vary = f->vary, f->o.lo = f->lo, f->o.hi = f->hi;
+    for (int j = 0; j < 8; j++)
+        f->vary[j] = true, f->lo[j] = -INFINITY, f->hi[j] = INFINITY;
+}
+
+static FitStatus fit_go(Fit *f)
+{
+    Model *m = f->mech->model;
+    return fit_run(m, &f->mech->kin, &f->e, &f->data, &f->o, &f->r);
+}
+
+static void fit_close(Fit *f)
+{
+    fit_result_free(&f->r);
+    fit_data_free(&f->data);
+    engine_close(&f->e);
+    pipeline_free(f->mech);
+}
+
+/* The data of the true linkage at theta = 0.5, 1, 1.5, as a CSV. */
+static void freudenstein_csv(char *csv, size_t size, double psi[3])
+{
+    static const double theta[3] = {0.5, 1.0, 1.5};
+    int n = snprintf(csv, size, "t,rocker.phi\n");
+    for (int i = 0; i < 3; i++) {
+        psi[i] = rocker_angle(1.2, 2.8, 2.3, theta[i]);
+        n += snprintf(csv + n, size - (size_t)n, "%.17g,%.17g\n", theta[i], psi[i]);
+    }
+}
+
+static void test_freudenstein_three_positions(void **s)
+{
+    (void)s;
+    static const double theta[3] = {0.5, 1.0, 1.5};
+    double psi[3], M[3][3], r[3], k[3];
+    char csv[512];
+    freudenstein_csv(csv, sizeof csv, psi);
+    for (int i = 0; i < 3; i++) {
+        M[i][0] = cos(psi[i]), M[i][1] = -cos(theta[i]), M[i][2] = 1.0;
+        r[i] = cos(theta[i] - psi[i]);
+    }
+    solve3(M, r, k);
+    double a = D / k[0], c = D / k[1], b = sqrt(a * a + c * c + D * D - 2 * a * c * k[2]);
+    assert_near(a, 1.2, 0, 1e-12);      /* the closed form recovers the truth */
+    assert_near(b, 2.8, 0, 1e-12);
+    assert_near(c, 2.3, 0, 1e-12);
+
+    Fit f;
+    fit_open(&f, four_bar_text, "freudenstein.csv", csv);
+    assert_int_equal(f.data.nsamples, 3);
+    assert_int_equal(f.data.nmeasured, 3);
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    assert_int_equal(f.r.n, 3);
+    assert_int_equal(f.r.k, 3);
+    assert_near(f.r.p0[0], 1.0, 0, 0);
+    assert_near(f.r.p[0], a, 0, 1e-12);
+    assert_near(f.r.p[1], b, 0, 1e-12);
+    assert_near(f.r.p[2], c, 0, 1e-12);
+    assert_true(f.r.cost0 > 1e-3);
+    assert_true(f.r.cost < 1e-24);
+    for (int i = 0; i < 3; i++)
+        assert_near(f.r.model[i], psi[i], 0, 1e-12);
+    assert_true(f.r.cond > 1 && isfinite(f.r.cond));
+    assert_string_equal(f.r.warning, "");
+    for (int j = 0; j < 3; j++)     /* the design found is left set */
+        assert_near(f.mech->model->dag.param_values[j], f.r.p[j], 0, 0);
+    for (int a1 = 0; a1 < 3; a1++) {
+        assert_near(f.r.corr[a1 * 3 + a1], 1.0, 0, 1e-12);
+        for (int b1 = 0; b1 < 3; b1++)
+            assert_near(f.r.corr[a1 * 3 + b1], f.r.corr[b1 * 3 + a1], 0, 1e-12);
+    }
+    fit_close(&f);
+}
+
+/* Outputs measured: a coupler point at seven times, generated by the
+   sampler itself at a true design (1.1, 2.9, 2.4), weighted; the fit from
+   the file's design finds the truth. */
+static void test_fit_coupler_point(void **s)
+{
+    (void)s;
+    char text[1024], csv[2048];
+    snprintf(text, sizeof text, "%soutput P: coupler(0.5, 0.2)\n", four_bar_text);
+    Fit f;
+    fit_open(&f, text, "grid.csv", "t,P.x,P.y\n0.2,0,0\n0.4,0,0\n0.6,0,0\n0.8,0,0\n1,0,0\n"
+                                   "1.2,0,0\n1.4,0,0\n");
+    Model *m = f.mech->model;
+    static const double truth[3] = {1.1, 2.9, 2.4};
+    model_set_design(m, truth);
+    FitSampler smp;
+    char why[300];
+    assert_true(fit_sampler_init(&smp, m, &f.mech->kin, &f.e, &f.data, 100, 1e-13, why, sizeof why));
+    double value[14];
+    if (!fit_sample(&smp, value, NULL, why, sizeof why))
+        fail_msg("fit_sample: %s", why);
+    fit_sampler_free(&smp);
+    model_set_design(m, NULL);
+    int n = snprintf(csv, sizeof csv, "t,P.x,w(P.x),P.y\n");
+    for (int k = 0; k < 7; k++)
+        n += snprintf(csv + n, sizeof csv - (size_t)n, "%.17g,%.17g,4,%.17g\n", f.data.t[k],
+                      value[2 * k], value[2 * k + 1]);
+    fit_data_free(&f.data);
+    Diag diag;
+    assert_true(fit_data_read(write_csv("coupler.csv", csv), m, &f.data, &diag));
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    assert_int_equal(f.r.n, 14);
+    for (int j = 0; j < 3; j++)
+        assert_near(f.r.p[j], truth[j], 0, 1e-10);
+    assert_true(f.r.cost < 1e-20);
+    fit_close(&f);
+}
+
+/* ---- the CSV ------------------------------------------------------------ */
+
+/* A good file: comments, blank and CRLF lines, spaces around fields, an
+   empty field (not measured), weights defaulting to 1. */
+static void test_data_read(void **s)
+{
+    (void)s;
+    Mech *mech = load_text(four_bar_text, "freudenstein.mech");
+    FitData d;
+    Diag diag;
+    const char *path = write_csv("good.csv", "# measured\r\n"
+                                             " t , rocker.phi , w(rocker.phi), crank.x\r\n"
+                                             "\n"
+                                             "0.5, 1.45, 4, \r\n"
+                                             "  # a comment\n"
+                                             "1, , , 0.3\n"
+                                             "1, 1.5, , 0.2\n");
+    if (!fit_data_read(path, mech->model, &d, &diag))
+        fail_msg("%d:%d: %s", diag.line, diag.col, diag.message);
+    assert_int_equal(d.nsamples, 3);
+    assert_int_equal(d.ncols, 2);
+    assert_int_equal(d.nmeasured, 4);
+    assert_string_equal(d.names[0], "rocker.phi");
+    assert_string_equal(d.names[1], "crank.x");
+    assert_int_equal(d.var[0], 8);
+    assert_int_equal(d.var[1], 0);
+    static const int lines[3] = {4, 6, 7};
+    static const double t[3] = {0.5, 1, 1};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(d.line[k], lines[k]);
+        assert_near(d.t[k], t[k], 0, 0);
+    }
+    assert_near(d.value[0], 1.45, 0, 0);
+    assert_true(isnan(d.value[1]) && isnan(d.value[2]));
+    assert_near(d.value[3], 0.3, 0, 0);
+    assert_near(d.weight[0], 4, 0, 0);
+    assert_near(d.weight[1], 1, 0, 0);
+    assert_near(d.weight[4], 1, 0, 0);
+    fit_data_free(&d);
+    pipeline_free(mech);
+}
+
+static void test_data_errors(void **s)
+{
+    (void)s;
+    Mech *mech = load_text(four_bar_text, "freudenstein.mech");
+    static const struct {
+        const char *csv;
+        int line, col;
+        const char *message;
+    } cases[] = {
+        {"crank.phi,rocker.phi\n0.5,1\n", 1, 1, "the header has no column t"},
+        {"t,rocker.psi\n0.5,1\n", 1, 3, "'rocker.psi' is neither t, a coordinate, an output"},
+        {"t,rocker.phi\n0.5,1.4x\n", 2, 5, "'1.4x' is not a finite number"},
+        {"t,rocker.phi\n0.5,nan\n", 2, 5, "'nan' is not a finite number"},
+        {"t,rocker.phi\n0.5,1e999\n", 2, 5, "'1e999' is not a finite number"},
+        {"t,rocker.phi\n1,1.4\n0.5,1.5\n", 3, 1, "t = 0.5 comes after t = 1"},
+        {"t,rocker.phi\n0.5,1.4,2\n", 2, 9, "3 fields where the header has 2"},
+        {"t,rocker.phi,crank.x\n0.5,1.4\n", 2, 5, "2 fields where the header has 3"},
+        {"t,rocker.phi,w(crank.phi)\n0.5,1.4,1\n", 1, 14, "the weight 'w(crank.phi)' has no measured column"},
+        {"t,rocker.phi,w(rocker.phi)\n0.5,1.4,-1\n", 2, 9, "a weight must be positive, not -1"},
+        {"t,rocker.phi,w(rocker.phi)\n0.5,1.4,0\n", 2, 9, "a weight must be positive, not 0"},
+        {"t,rocker.phi,rocker.phi\n", 1, 14, "'rocker.phi' is measured in two columns"},
+        {"t,rocker.phi,t\n", 1, 14, "a second column t"},
+        {"t\n0.5\n", 1, 1, "the header names no measured coordinate or output"},
+        {"t,rocker.phi\n,1.4\n", 2, 1, "the sample has no time t"},
+        {"t,rocker.phi\n0.5,\n1,\n", 3, 3, "no measured value"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        FitData d;
+        Diag diag;
+        char name[32];
+        snprintf(name, sizeof name, "bad%zu.csv", i);
+        const char *path = write_csv(name, cases[i].csv);
+        bool ok = fit_data_read(path, mech->model, &d, &diag);
+        if (ok || !diag.has_pos || diag.line != cases[i].line || diag.col != cases[i].col
+            || !strstr(diag.message, cases[i].message) || strcmp(diag.file, path) != 0)
+            fail_msg("case %zu: got %s %d:%d \"%s\", expected %d:%d \"...%s...\"", i,
+                     ok ? "success" : "error", diag.line, diag.col, diag.message, cases[i].line,
+                     cases[i].col, cases[i].message);
+        fit_data_free(&d);
+    }
+    FitData d;
+    Diag diag;
+    char missing[400];
+    snprintf(missing, sizeof missing, "%s/none.csv", tmpdir);
+    assert_false(fit_data_read(missing, mech->model, &d, &diag));
+    assert_non_null(strstr(diag.message, "none.csv"));
+    fit_data_free(&d);
+    pipeline_free(mech);
+}
+
+/* ---- what fit_run refuses ----------------------------------------------- */
+
+static void test_too_few_values(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open(&f, four_bar_text, "two.csv", "t,rocker.phi\n0.5,1.45\n1,1.51\n");
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    assert_non_null(strstr(f.r.message, "2 measured values cannot determine 3 parameters"));
+    for (int j = 0; j < 3; j++)     /* the model keeps its design */
+        assert_near(f.mech->model->dag.param_values[j], f.mech->model->design_p0[j], 0, 0);
+    fit_close(&f);
+    /* with one parameter varied, two values are enough */
+    fit_open(&f, four_bar_text, "two.csv", "t,rocker.phi\n0.5,1.45\n1,1.51\n");
+    f.vary[0] = f.vary[1] = false;
+    assert_int_equal(fit_go(&f), FIT_OK);
+    assert_int_equal(f.r.k, 1);
+    assert_int_equal(f.r.index[0], 2);
+    assert_near(f.r.p[0], 1.0, 0, 0);
+    assert_near(f.r.p[1], 3.0, 0, 0);
+    assert_true(f.r.p[2] != 2.5);
+    fit_close(&f);
+    fit_open(&f, four_bar_text, "two.csv", "t,rocker.phi\n0.5,1.45\n1,1.51\n");
+    f.vary[0] = f.vary[1] = f.vary[2] = false;
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    assert_non_null(strstr(f.r.message, "no design parameter to estimate"));
+    fit_close(&f);
+}
+
+/* crank.x = (a/2) cos(theta) depends on a alone: b cannot be told. */
+static void test_unidentifiable(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open(&f, four_bar_text, "crank.csv", "t,crank.x\n0.5,0.5\n1,0.3\n1.5,0.05\n");
+    f.vary[2] = false;
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    if (!strstr(f.r.message, "do not identify the combination +1 b"))
+        fail_msg("message: %s", f.r.message);
+    assert_null(strstr(f.r.message, " a "));
+    fit_close(&f);
+    /* a alone is identified by it: a = 2 x / cos(theta) */
+    fit_open(&f, four_bar_text, "crank.csv", "t,crank.x\n0.5,0.5\n1,0.3\n1.5,0.05\n");
+    f.vary[1] = f.vary[2] = false;
+    assert_int_equal(fit_go(&f), FIT_OK);
+    double want = 2 * (0.5 * cos(0.5) + 0.3 * cos(1.0) + 0.05 * cos(1.5))
+                / (cos(0.5) * cos(0.5) + cos(1.0) * cos(1.0) + cos(1.5) * cos(1.5));
+    assert_near(f.r.p[0], want, 0, 1e-12);   /* linear least squares in a */
+    assert_true(f.r.std_error[0] > 0);
+    fit_close(&f);
+}
+
+/* The truth a = 1.2 lies outside [0.9, 1.1]: the fit stops on the bound;
+   a start outside its bounds is refused. */
+static void test_bounds(void **s)
+{
+    (void)s;
+    double psi[3];
+    char csv[512];
+    freudenstein_csv(csv, sizeof csv, psi);
+    Fit f;
+    fit_open(&f, four_bar_text, "bounded.csv", csv);
+    f.lo[0] = 0.9, f.hi[0] = 1.1;
+    f.lo[2] = 2.0, f.hi[2] = 2.6;
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    assert_true(f.r.p[0] >= 0.9 && f.r.p[0] <= 1.1);
+    assert_near(f.r.p[0], 1.1, 0, 1e-9);
+    assert_true(f.r.p[2] >= 2.0 && f.r.p[2] <= 2.6);
+    assert_true(f.r.cost < f.r.cost0);
+    fit_close(&f);
+    fit_open(&f, four_bar_text, "bounded.csv", csv);
+    f.lo[1] = 3.5, f.hi[1] = 4;
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    assert_non_null(strstr(f.r.message, "design parameter 'b' starts at 3, outside its bounds"));
+    fit_close(&f);
+}
+
+/* A file without design parameters has nothing to fit. */
+static void test_no_design(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open(&f, "body a x = 1 y = 0 phi = 0\nrevolute O: ground(0, 0) a(-1, 0)\n"
+                 "driver d: a.phi = t\n", "plain.csv", "t,a.x\n0,1\n");
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    assert_non_null(strstr(f.r.message, "no design parameters"));
+    fit_close(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_freudenstein_three_positions),
+        cmocka_unit_test(test_fit_coupler_point),
+        cmocka_unit_test(test_data_read),
+        cmocka_unit_test(test_data_errors),
+        cmocka_unit_test(test_too_few_values),
+        cmocka_unit_test(test_unidentifiable),
+        cmocka_unit_test(test_bounds),
+        cmocka_unit_test(test_no_design),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
