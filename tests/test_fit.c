@@ -363,6 +363,7 @@ static void test_unidentifiable(void **s)
     if (!strstr(f.r.message, "do not identify the combination +1 b"))
         fail_msg("message: %s", f.r.message);
     assert_null(strstr(f.r.message, " a "));
+    assert_non_null(strstr(f.r.message, "down to 0)"));     /* not -0 */
     fit_close(&f);
     /* a alone is identified by it: a = 2 x / cos(theta) */
     fit_open(&f, four_bar_text, "crank.csv", "t,crank.x\n0.5,0.5\n1,0.3\n1.5,0.05\n");

@@ -148,7 +148,8 @@ static double condition(const Problem *pr, const gsl_matrix *J, char *why, size_
     gsl_vector *s = gsl_vector_alloc(J->size2);
     gsl_matrix *V = gsl_matrix_alloc(J->size2, J->size2);
     singular_values(J, s, V);
-    double smax = gsl_vector_get(s, 0), smin = gsl_vector_get(s, J->size2 - 1);
+    /* fabs: a zero singular value can come back as -0 */
+    double smax = fabs(gsl_vector_get(s, 0)), smin = fabs(gsl_vector_get(s, J->size2 - 1));
     why[0] = '\0';
     if (!(smax > 0)) {
         size_t n = (size_t)snprintf(why, size, "the measured values do not depend on");
@@ -197,8 +198,8 @@ static FitStatus set_up(Problem *pr, FitResult *r, gsl_vector **x0)
     if (pr->k == 0)
         return fail(r, FIT_BAD_INPUT, "no design parameter to estimate");
     if (pr->n < pr->k)
-        return fail(r, FIT_BAD_INPUT, "%d measured values cannot determine %d parameters",
-                    pr->n, pr->k);
+        return fail(r, FIT_BAD_INPUT, "%d measured value%s cannot determine %d parameters",
+                    pr->n, pr->n == 1 ? "" : "s", pr->k);
     *x0 = gsl_vector_alloc((size_t)pr->k);
     for (int i = 0; i < pr->k; i++) {
         int j = pr->index[i];
