@@ -15,17 +15,6 @@ set -u
 . "$(dirname "$0")/lib.sh"
 suite_begin fit_cli "${1:-build/mechc}"
 
-# column NAME FILE: the 1-based index of a CSV column.
-column() {
-    head -1 "$2" | tr ',' '\n' | grep -n -x -F -- "$1" | cut -d: -f1
-}
-
-# value_at T NAME FILE: the value of column NAME in the row whose t is T.
-value_at() {
-    c=$(column "$2" "$3")
-    awk -F, -v t="$1" -v c="$c" 'NR > 1 && $1 == t && c { print $c }' "$3"
-}
-
 # near A B TOL: |A - B| <= TOL (1 + |B|); says the error on stderr when not.
 near() {
     awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN {
@@ -85,7 +74,7 @@ check "fit: the --design line" out_has "design: --design a="
 design=$(sed -n 's/^design: --design //p' "$tmp/out")
 run_mechc run "$fr" --design "$design" --t0 0.5 --t1 1.5 --steps 2 --tol 1e-13 --csv "$tmp/fitted.csv"
 check "fit's design, run: rocker.phi at t = 1" \
-    near "$(value_at 1 rocker.phi "$tmp/fitted.csv")" 1.5118730782920675 1e-12
+    near "$(csv_value_at 1 rocker.phi "$tmp/fitted.csv")" 1.5118730782920675 1e-12
 
 run_mechc fit "$fr" --data "$tmp/fr.csv" --max-iter 1
 check "fit, no convergence: exit 1" status_is 1
@@ -139,7 +128,7 @@ run_mechc run "$fr" --design a=1.2,b=2.8,c=2.3 --t0 0.5 --t1 1.5 --steps 2 --tol
 check "run --design: exit 0" status_is 0
 for pair in 0.5:1.4525472019214092 1:1.5118730782920675 1.5:1.7153735894075408; do
     check "run --design: rocker.phi at t = ${pair%%:*}" \
-        near "$(value_at "${pair%%:*}" rocker.phi "$tmp/true.csv")" "${pair#*:}" 1e-12
+        near "$(csv_value_at "${pair%%:*}" rocker.phi "$tmp/true.csv")" "${pair#*:}" 1e-12
 done
 
 # ---- run --sens ------------------------------------------------------------
@@ -163,9 +152,9 @@ for w in b=3.000001,b=2.999999 a=1.000001,a=0.999999; do
         *) col="dd(P.y)" sens="d(dd(P.y))/d(a)" ;;
     esac
     for t in 0.25 0.75; do
-        fd=$(awk -v p="$(value_at $t "$col" "$tmp/plus.csv")" -v m="$(value_at $t "$col" "$tmp/minus.csv")" \
+        fd=$(awk -v p="$(csv_value_at $t "$col" "$tmp/plus.csv")" -v m="$(csv_value_at $t "$col" "$tmp/minus.csv")" \
             'BEGIN { printf "%.17g", (p - m) / 2e-6 }')
-        check "run --sens: $sens at t = $t" near "$(value_at $t "$sens" "$tmp/sens.csv")" "$fd" 1e-6
+        check "run --sens: $sens at t = $t" near "$(csv_value_at $t "$sens" "$tmp/sens.csv")" "$fd" 1e-6
     done
 done
 

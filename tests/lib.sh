@@ -25,6 +25,8 @@
 #   status_is N, out_empty, out_has TEXT, out_lines N, err_empty,
 #   err_has TEXT (fixed string), err_matches REGEX (grep's basic regex):
 #                  predicates on the last run.
+#   csv_value_at T NAME FILE  the value of CSV column NAME in FILE's row
+#                  whose t (first column) is T; nothing when there is none.
 #   suite_end      prints "NAME: N passed, M failed" (CI reads these lines)
 #                  and fails when M is not 0: the script's last command.
 
@@ -93,6 +95,11 @@ out_lines() { [ "$(wc -l < "$tmp/out")" = "$1" ]; }
 err_empty() { [ ! -s "$tmp/err" ]; }
 err_has() { grep -F -q -- "$1" "$tmp/err"; }
 err_matches() { grep -q -- "$1" "$tmp/err"; }
+
+csv_value_at() {
+    awk -F, -v t="$1" -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
+                                    $1 == t && c { print $c }' "$3"
+}
 
 suite_end() {
     echo "$suite: $pass passed, $fail failed"
