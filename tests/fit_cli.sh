@@ -80,6 +80,14 @@ run_mechc fit "$fr" --data "$tmp/fr.csv" --max-iter 1
 check "fit, no convergence: exit 1" status_is 1
 check "fit, no convergence: said" err_has "no convergence in 1 iterations"
 
+run_mechc fit "$fr" --data "$tmp/fr.csv" --design b=0.1 --json
+check "fit from a design that does not close: exit 1" status_is 1
+check "fit from a design that does not close: JSON ok and error alone" \
+    grep -q '^{"ok": false, "error": "at the starting design: t = 0.5: could not assemble.*"}$' "$tmp/out"
+check "fit from a design that does not close: said" err_has "error: fit: at the starting design"
+run_mechc fit "$fr" --data "$tmp/fr.csv" --design b=0.1
+check "fit from a design that does not close: no report" out_empty
+
 run_mechc fit "$fr"
 check "fit without --data: exit 2" status_is 2
 check "fit without --data: said" err_has "--data FILE.csv is required"
@@ -111,8 +119,11 @@ check "fit, a alone: exit 0" status_is 0
 run_mechc fit "$fr" --data "$tmp/fr.csv" --vary a,zz
 check "fit --vary zz: exit 2" status_is 2
 check "fit --vary zz: said" err_has "'zz' is not a design parameter"
-run_mechc fit "$fr" --data "$tmp/fr.csv" --bound a=2:1
-check "fit --bound a=2:1: exit 2" status_is 2
+for b in a=2:1 a=:1 a=-1: a=x:1 a=0:1x zz=0:1; do
+    run_mechc fit "$fr" --data "$tmp/fr.csv" --bound "$b"
+    check "fit --bound $b: exit 2" status_is 2
+    check "fit --bound $b: said" err_has "--bound takes P=LO:HI"
+done
 run_mechc fit "$fr" --data "$tmp/fr.csv" --bound a=0.9:1.1 --json
 check "fit --bound a=0.9:1.1: exit 0" status_is 0
 a=$(sed -n 's/.*"name": "a", "start": [^,]*, "estimate": \([^,]*\),.*/\1/p' "$tmp/out")

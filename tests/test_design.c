@@ -10,9 +10,9 @@
  * central difference of Phi in p. Finally kin/sens.c's sensitivities of
  * positions, velocities, accelerations and outputs at every state of a run
  * are the central differences of whole runs at p +- h, for a planar
- * four-bar with a slider on a rod (designed lengths, pivots and a rod
- * length) and a spatial RSSR (designed crank offset, ground pivot and
- * rod length). The aot library cache goes to the run's (testcache.h).
+ * four-bar with a point on a rod (designed lengths, pivots, rod length,
+ * driver speed, a constraint's and an output's coefficient) and a spatial
+ * RSSR (designed crank offset, ground pivot and rod length). The aot library cache goes to the run's (testcache.h).
  */
 #include "testutil.h"
 #include "testcache.h"
@@ -43,10 +43,10 @@ static int teardown(void **state)
     return testcache_teardown(&cache);
 }
 
-/* A four-bar with designed link lengths (b through a derived param) and
-   ground pivots, and a point m on the ground line at a designed distance
-   L from a coupler point; a coupler point and an angle difference as
-   outputs. */
+/* A four-bar with designed link lengths (b through a derived param),
+   ground pivots and driver speed w, and a point m on the line y = e x (a
+   `constraint`) at a designed distance L from a coupler point; a coupler
+   point and an output of e as outputs. */
 static const char planar_text[] =
     "mechanism fbd\n"
     "design a  = 1\n"
@@ -55,21 +55,22 @@ static const char planar_text[] =
     "design ax = 0.1\n"
     "design dx = 3\n"
     "design L  = 2.5\n"
-    "param omega = 2*pi\n"
+    "design w  = 2*pi\n"
+    "design e  = 0.1\n"
     "param h = b/2\n"
     "body crank   x = 0.5     y = 0       phi = 0\n"
     "body coupler x = 1.8438  y = 1.2402  phi = 0.9734\n"
     "body rocker  x = 2.8438  y = 1.2402  phi = 1.6961\n"
-    "point m x = 3.9 y = 0\n"
+    "point m x = 3.9 y = 0.39\n"
     "revolute O2: ground(ax, 0)  crank(-a/2, 0)\n"
     "revolute A:  crank(a/2, 0)  coupler(-h, 0)\n"
     "revolute B:  coupler(h, 0)  rocker(c/2, 0)\n"
     "revolute O4: ground(dx, 0)  rocker(-c/2, 0)\n"
     "distance rod: coupler(0, 0.2) m length = L\n"
-    "driver drive: crank.phi = omega*t\n"
-    "driver slide: m.y = 0\n"
+    "driver drive: crank.phi = w*t\n"
+    "constraint slide: m.y - e*m.x = 0\n"
     "output P: coupler(0.5, 0.2)\n"
-    "output r = rocker.phi - crank.phi\n";
+    "output r = rocker.phi - e*crank.phi\n";
 
 /* examples/rssr.mech with its crank offset a, the rod's length L and the
    rocker's ground pivot gx designed; the rocker's angle and a point of it
@@ -208,7 +209,7 @@ static void test_emit_design_file(void **s)
     assert_non_null(phi);
     const char *eol = strchr(phi, '\n'), *p = strstr(phi, "const fbd_real *p");
     assert_true(p && p < eol);
-    assert_non_null(strstr(res.c_text, "#define FBD_NP   6"));
+    assert_non_null(strstr(res.c_text, "#define FBD_NP   8"));
     assert_non_null(strstr(res.c_text, "void fbd_phi_p(const fbd_real *q, fbd_real t, "
                                        "const fbd_real *p, fbd_real *phi_p)"));
     assert_non_null(strstr(res.c_text, "fbd_p0[FBD_NP]"));
@@ -325,7 +326,7 @@ static void check_engines(const char *text, const char *name, const double *dp)
 static void test_engines_agree_planar(void **s)
 {
     (void)s;
-    check_engines(planar_text, "fbd.mech", (double[]){0.07, -0.11, 0.05, 0.02, -0.08, 0.13});
+    check_engines(planar_text, "fbd.mech", (double[]){0.07, -0.11, 0.05, 0.02, -0.08, 0.13, 0.3, -0.04});
 }
 
 static void test_engines_agree_spatial(void **s)
@@ -478,9 +479,9 @@ static void test_sensitivity_column_names(void **s)
     static const struct {
         int column;
         const char *name;
-    } want[] = {{0, "d(crank.x)/d(a)"}, {5, "d(crank.x)/d(L)"}, {6, "d(crank.y)/d(a)"},
-                {11 * 6 + 1, "d(P.x)/d(b)"}, {14 * 6 - 1, "d(r)/d(L)"},
-                {14 * 6 + 2, "d(d(crank.x))/d(c)"}, {2 * 14 * 6 + 13 * 6 + 4, "d(dd(r))/d(dx)"}};
+    } want[] = {{0, "d(crank.x)/d(a)"}, {7, "d(crank.x)/d(e)"}, {8, "d(crank.y)/d(a)"},
+                {11 * 8 + 1, "d(P.x)/d(b)"}, {14 * 8 - 1, "d(r)/d(e)"},
+                {14 * 8 + 2, "d(d(crank.x))/d(c)"}, {2 * 14 * 8 + 13 * 8 + 4, "d(dd(r))/d(dx)"}};
     for (size_t i = 0; i < sizeof want / sizeof *want; i++) {
         char *got = sens_column_name(&sens, names, want[i].column);
         assert_string_equal(got, want[i].name);

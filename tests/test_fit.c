@@ -171,6 +171,7 @@ static void test_freudenstein_three_positions(void **s)
     assert_int_equal(f.data.nmeasured, 3);
     if (fit_go(&f) != FIT_OK)
         fail_msg("fit: %s", f.r.message);
+    assert_true(f.r.solved);
     assert_int_equal(f.r.n, 3);
     assert_int_equal(f.r.k, 3);
     assert_near(f.r.p0[0], 1.0, 0, 0);
@@ -402,6 +403,25 @@ static void test_bounds(void **s)
     fit_close(&f);
 }
 
+/* A start where the linkage does not close (b = 0.1): FIT_FAILED with the
+   time and the cause, and no estimates (solved false). */
+static void test_start_cannot_assemble(void **s)
+{
+    (void)s;
+    double psi[3];
+    char csv[512];
+    freudenstein_csv(csv, sizeof csv, psi);
+    Fit f;
+    fit_open(&f, four_bar_text, "apart.csv", csv);
+    model_set_design(f.mech->model, (double[]){1, 0.1, 2.5});
+    assert_int_equal(fit_go(&f), FIT_FAILED);
+    assert_false(f.r.solved);
+    if (!strstr(f.r.message, "at the starting design: t = 0.5: could not assemble"))
+        fail_msg("message: %s", f.r.message);
+    assert_near(f.r.p[1], 0.1, 0, 0);
+    fit_close(&f);
+}
+
 /* A file without design parameters has nothing to fit. */
 static void test_no_design(void **s)
 {
@@ -424,6 +444,7 @@ int main(void)
         cmocka_unit_test(test_too_few_values),
         cmocka_unit_test(test_unidentifiable),
         cmocka_unit_test(test_bounds),
+        cmocka_unit_test(test_start_cannot_assemble),
         cmocka_unit_test(test_no_design),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -64,7 +64,8 @@ static const CliOption options[] = {
     {"--json", CLI_FLAG_AT(FitCli, json),
      .help = "print JSON: \"ok\", \"parameters\" (name, start, estimate,\n"
              "std_error), \"correlation\", \"cost0\", \"cost\", \"iterations\",\n"
-             "\"residuals\", \"worst\", \"design\""},
+             "\"residuals\", \"worst\", \"design\" (a fit that could not\n"
+             "start or go on: \"ok\": false and \"error\" alone)"},
 };
 
 static const char epilogue[] =
@@ -103,8 +104,10 @@ static bool read_choices(const FitCli *c, const Model *m, FitOptions *o)
         int j = eq ? design_index(m, b, (size_t)(eq - b)) : -1;
         char *colon = NULL, *end = NULL;
         double lo = eq ? strtod(eq + 1, &colon) : NAN, hi = NAN;
-        if (colon && *colon == ':')
+        if (colon && colon != eq + 1 && *colon == ':')     /* LO not empty */
             hi = strtod(colon + 1, &end);
+        if (end == colon + 1)       /* HI empty */
+            end = NULL;
         if (j < 0 || !end || *end || !isfinite(lo) || !isfinite(hi) || !(lo < hi)) {
             fprintf(stderr, "mechc fit: error: --bound takes P=LO:HI with P a design parameter "
                     "and LO < HI, not '%s'\n", b);
@@ -314,6 +317,14 @@ static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         FitStatus st = fit_run(m, &mech->kin, &e, &d, &o, &r);
         if (st == FIT_BAD_INPUT) {
             fprintf(stderr, "mechc fit: error: %s: %s\n", m->file, r.message);
+        } else if (!r.solved) {     /* no estimates to show */
+            if (c->json) {
+                printf("{\"ok\": false, \"error\": ");
+                json_string(stdout, r.message);
+                printf("}\n");
+            }
+            fprintf(stderr, "%s: error: fit: %s\n", m->file, r.message);
+            status = EXIT_ANALYSIS;
         } else {
             if (c->json)
                 print_json(m, &d, &r, c->worst);

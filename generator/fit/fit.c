@@ -212,11 +212,14 @@ static FitStatus set_up(Problem *pr, FitResult *r, gsl_vector **x0)
     return FIT_OK;
 }
 
-/* The results at the solver's x: design, costs, errors and correlations. */
-static void finish(Problem *pr, FitResult *r, gsl_multifit_nlinear_workspace *w)
+/* The results at the solver's x: design, costs, errors and correlations;
+   false (r->solved too) when the motion cannot be followed there. */
+static bool finish(Problem *pr, FitResult *r, gsl_multifit_nlinear_workspace *w)
 {
     const Model *m = pr->m;
-    evaluate(pr, w->x, true);
+    if (!evaluate(pr, w->x, true))
+        return false;
+    r->solved = true;
     memcpy(r->p, m->dag.param_values, (size_t)m->np * sizeof *r->p);
     size_t entries = (size_t)pr->d->nsamples * (size_t)pr->d->ncols;
     memcpy(r->model, pr->value, entries * sizeof *r->model);
@@ -239,6 +242,7 @@ static void finish(Problem *pr, FitResult *r, gsl_multifit_nlinear_workspace *w)
     }
     gsl_matrix_free(J);
     gsl_matrix_free(covar);
+    return true;
 }
 
 /* The starting point's cost and identifiability; FIT_OK or why not. */
@@ -287,12 +291,13 @@ static FitStatus solve(Problem *pr, FitResult *r, gsl_vector *x0)
         st = gsl_multifit_nlinear_driver((size_t)pr->o->max_iter, pr->o->xtol, pr->o->gtol,
                                          pr->o->ftol, NULL, NULL, &info, w);
     r->reason = info == 1 ? "small step" : info == 2 ? "small gradient" : "";
-    if (st == GSL_SUCCESS || st == GSL_ENOPROG) {   /* no progress at a minimum: done */
-        finish(pr, r, w);
+    bool ended = st == GSL_SUCCESS || st == GSL_ENOPROG || st == GSL_EMAXITER;
+    if (ended && !finish(pr, r, w)) {
+        fail(r, FIT_FAILED, "at the solver's last design: %s", pr->why);
+    } else if (st == GSL_SUCCESS || st == GSL_ENOPROG) {   /* no progress at a minimum: done */
         if (st == GSL_ENOPROG)
             r->reason = "no further decrease";
     } else if (st == GSL_EMAXITER) {
-        finish(pr, r, w);
         fail(r, FIT_FAILED, "no convergence in %d iterations (cost %.6g from %.6g)",
              pr->o->max_iter, r->cost, r->cost0);
     } else {

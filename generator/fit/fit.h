@@ -41,6 +41,9 @@ typedef struct FitResult {
     double cond;            /* J's condition number (2-norm) at the solution */
     double cpu_seconds;     /* the process's CPU time in fit_run (clock()) */
     double *model;          /* the data's shape: model values at the solution */
+    bool solved;            /* the solver ran and the fields above are its end's;
+                               false: FIT_BAD_INPUT, or FIT_FAILED before it
+                               started or where the motion could not be followed */
 } FitResult;
 
 FitOptions fit_default_options(void);
