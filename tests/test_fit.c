@@ -148,13 +148,21 @@ static void freudenstein_csv(char *csv, size_t size, double psi[3])
     }
 }
 
+/* fit_open on that CSV (csv_name); psi gets the angles. */
+static void fit_open_freudenstein(Fit *f, const char *csv_name, double psi[3])
+{
+    char csv[512];
+    freudenstein_csv(csv, sizeof csv, psi);
+    fit_open(f, four_bar_text, csv_name, csv);
+}
+
 static void test_freudenstein_three_positions(void **s)
 {
     (void)s;
     static const double theta[3] = {0.5, 1.0, 1.5};
     double psi[3], M[3][3], r[3], k[3];
-    char csv[512];
-    freudenstein_csv(csv, sizeof csv, psi);
+    Fit f;
+    fit_open_freudenstein(&f, "freudenstein.csv", psi);
     for (int i = 0; i < 3; i++) {
         M[i][0] = cos(psi[i]), M[i][1] = -cos(theta[i]), M[i][2] = 1.0;
         r[i] = cos(theta[i] - psi[i]);
@@ -165,8 +173,6 @@ static void test_freudenstein_three_positions(void **s)
     assert_near(b, 2.8, 0, 1e-12);
     assert_near(c, 2.3, 0, 1e-12);
 
-    Fit f;
-    fit_open(&f, four_bar_text, "freudenstein.csv", csv);
     assert_int_equal(f.data.nsamples, 3);
     assert_int_equal(f.data.nmeasured, 3);
     if (fit_go(&f) != FIT_OK)
@@ -383,10 +389,8 @@ static void test_bounds(void **s)
 {
     (void)s;
     double psi[3];
-    char csv[512];
-    freudenstein_csv(csv, sizeof csv, psi);
     Fit f;
-    fit_open(&f, four_bar_text, "bounded.csv", csv);
+    fit_open_freudenstein(&f, "bounded.csv", psi);
     f.lo[0] = 0.9, f.hi[0] = 1.1;
     f.lo[2] = 2.0, f.hi[2] = 2.6;
     if (fit_go(&f) != FIT_OK)
@@ -396,7 +400,7 @@ static void test_bounds(void **s)
     assert_true(f.r.p[2] >= 2.0 && f.r.p[2] <= 2.6);
     assert_true(f.r.cost < f.r.cost0);
     fit_close(&f);
-    fit_open(&f, four_bar_text, "bounded.csv", csv);
+    fit_open_freudenstein(&f, "bounded.csv", psi);
     f.lo[1] = 3.5, f.hi[1] = 4;
     assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
     assert_non_null(strstr(f.r.message, "design parameter 'b' starts at 3, outside its bounds"));
@@ -409,10 +413,8 @@ static void test_start_cannot_assemble(void **s)
 {
     (void)s;
     double psi[3];
-    char csv[512];
-    freudenstein_csv(csv, sizeof csv, psi);
     Fit f;
-    fit_open(&f, four_bar_text, "apart.csv", csv);
+    fit_open_freudenstein(&f, "apart.csv", psi);
     model_set_design(f.mech->model, (double[]){1, 0.1, 2.5});
     assert_int_equal(fit_go(&f), FIT_FAILED);
     assert_false(f.r.solved);
