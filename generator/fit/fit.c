@@ -273,8 +273,10 @@ static void result_alloc(FitResult *r, const Model *m, const FitData *d)
     r->std_error = xcalloc(np, sizeof *r->std_error);
     r->corr = xcalloc(np * np, sizeof *r->corr);
     r->model = xcalloc((size_t)d->nsamples * (size_t)d->ncols, sizeof *r->model);
-    memcpy(r->p0, m->dag.param_values, np * sizeof *r->p0);
-    memcpy(r->p, r->p0, np * sizeof *r->p);
+    if (np) {   /* none: fit_sampler_init refuses the file */
+        memcpy(r->p0, m->dag.param_values, np * sizeof *r->p0);
+        memcpy(r->p, r->p0, np * sizeof *r->p);
+    }
     r->reason = "";
 }
 

@@ -672,6 +672,8 @@ void model_free(Model *model)
 
 void model_set_design(Model *model, const double *p)
 {
+    if (model->np == 0)     /* no arrays to copy between (memcpy of NULL) */
+        return;
     memcpy(model->dag.param_values, p ? p : model->design_p0, (size_t)model->np * sizeof *p);
 }
 
