@@ -92,6 +92,11 @@ static const char spatial_text[] =
     "output psi = angle(R2)\n"
     "output Q: rocker(c, 0, 0)\n";
 
+static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
+{
+    return testcache_open_engine(&cache, e, kind, mech);
+}
+
 static int row_index(const Model *m, const char *name)
 {
     for (int r = 0; r < m->nr; r++)
@@ -104,13 +109,13 @@ static int row_index(const Model *m, const char *name)
 /* ---- parsing ------------------------------------------------------------ */
 
 /* design declares p[0] = 2; h = L/2 is a folded param of it: the pin's row
-   moves by dh = 1/2 per unit of L. */
+   moves by dh = 1/2 per unit of L; the initial x = 2h is taken at L = 2. */
 static void test_parse_design_and_derived_param(void **s)
 {
     (void)s;
     Mech *mech = load_text("design L = 2\n"
                            "param h = L/2\n"
-                           "body a x = 1 y = 0 phi = 0\n"
+                           "body a x = 2*h y = 0 phi = 0\n"
                            "revolute O: ground(0, 0) a(-h, 0)\n"
                            "driver d: a.phi = t\n", "derived.mech");
     Model *m = mech->model;
@@ -118,10 +123,9 @@ static void test_parse_design_and_derived_param(void **s)
     assert_string_equal(m->design_names[0], "L");
     assert_near(m->design_p0[0], 2.0, 0, 0);
     assert_near(m->dag.param_values[0], 2.0, 0, 0);
+    assert_near(m->q0[0], 2.0, 0, 0);   /* initial values at the file's design */
     Engine e;
-    Diag diag;
-    if (!engine_open(&e, ENGINE_JIT, mech, &diag))
-        fail_msg("jit: %s", diag.message);
+    assert_true(open_kind(&e, ENGINE_JIT, mech));
     double q[3] = {1, 0, 0}, phi[3], phi3[3], phi_p[3];
     int ox = row_index(m, "O.x");
     engine_phi(&e, q, 0.0, phi);
@@ -258,11 +262,6 @@ static void test_emit_file_without_design(void **s)
 }
 
 /* ---- engines ------------------------------------------------------------ */
-
-static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
-{
-    return testcache_open_engine(&cache, e, kind, mech);
-}
 
 /* Phi and Phi_p of every engine at a design set after they were opened,
    the same to 1e-12; Phi_p the central difference of Phi (1e-7). */
