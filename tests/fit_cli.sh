@@ -135,6 +135,17 @@ check "fit, no design parameters: exit 2" status_is 2
 run_mechc eval "$fr" --design zz=1
 check "eval --design zz=1: exit 2" status_is 2
 check "eval --design zz=1: said" err_has "'zz' is not a design parameter of"
+run_mechc eval "$fr" --design a=nan
+check "eval --design a=nan: exit 2" status_is 2
+check "eval --design a=nan: said" err_has "the value of 'a' must be a finite number, not 'nan'"
+run_mechc eval "$fr" --design a
+check "eval --design a: exit 2" status_is 2
+run_mechc eval "$ex/four_bar.mech" --design a=1
+check "eval --design on a file without design parameters: exit 2" status_is 2
+check "eval --design on a file without design parameters: said" err_has "has no design parameters"
+run_mechc eval "$fr" --design c=2.25 --design a=1.5 --json
+check "eval --design twice: exit 0" status_is 0
+check "eval --design twice: p" out_has '"p": [1.5, 3, 2.25]'
 run_mechc run "$fr" --design a=1.2,b=2.8,c=2.3 --t0 0.5 --t1 1.5 --steps 2 --tol 1e-13 --csv "$tmp/true.csv"
 check "run --design: exit 0" status_is 0
 for pair in 0.5:1.4525472019214092 1:1.5118730782920675 1.5:1.7153735894075408; do
@@ -149,6 +160,12 @@ check "run --sens without design parameters: said" err_has "the file has no desi
 run_mechc run "$fr" --sens --json
 check "run --sens --json: exit 2" status_is 2
 check "run --sens --json: said" err_has "not with --json"
+
+printf 'design r = 0.5\nbody w x = 0 y = 0.5 phi = 0\ndriver h: w.y = r\nvelocity roll: der(w.x) + r*der(w.phi) = 0\ndriver s: w.phi = t\n' \
+    > "$tmp/wheel.mech"
+run_mechc run "$tmp/wheel.mech" --sens
+check "run --sens with a velocity-level row: exit 2" status_is 2
+check "run --sens with a velocity-level row: said" err_has "this one has 1 velocity-level row"
 
 # d(rocker.phi)/d(b) and d(dd(P.y))/d(a) against runs at b +- h, a +- h
 run_mechc run "$fr" --sens --steps 4 --tol 1e-13 --csv "$tmp/sens.csv"
@@ -174,6 +191,8 @@ run_mechc gen "$fr" -o "$tmp/fr.c"
 check "gen of a design file: exit 0" status_is 0
 check "gen: p in phi" grep -q -F 'void freudenstein_phi(const freudenstein_real *q, freudenstein_real t, const freudenstein_real *p, freudenstein_real *phi)' "$tmp/fr.c"
 check "gen: FREUDENSTEIN_NP" grep -q '^#define FREUDENSTEIN_NP  *3' "$tmp/fr.c"
+run_mechc gen "$fr" --design b=2.75
+check "gen --design b=2.75: p0" sh -c "grep -A3 'freudenstein_p0\[FREUDENSTEIN_NP\] = {' '$tmp/out' | grep -q -x '    2.75,'"
 if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
     skip "MECHC_SKIP_GCC_ONLY: compiling the generated C"
 elif have cc; then

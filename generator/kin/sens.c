@@ -32,7 +32,7 @@ bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *
         snprintf(why, size, "the file has no design parameters (`design NAME = value`)");
     else if (m->nv > 0)
         snprintf(why, size, "sensitivities cover holonomic mechanisms; this one has %d "
-                 "velocity-level rows", m->nv);
+                 "velocity-level row%s", m->nv, m->nv == 1 ? "" : "s");
     else if (m->nh != m->nq)
         snprintf(why, size, "%d rows for %d coordinates", m->nh, m->nq);
     else
