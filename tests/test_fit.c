@@ -379,7 +379,17 @@ static void test_unidentifiable(void **s)
     double want = 2 * (0.5 * cos(0.5) + 0.3 * cos(1.0) + 0.05 * cos(1.5))
                 / (cos(0.5) * cos(0.5) + cos(1.0) * cos(1.0) + cos(1.5) * cos(1.5));
     assert_near(f.r.p[0], want, 0, 1e-12);   /* linear least squares in a */
-    assert_true(f.r.std_error[0] > 0);
+    /* its cost and standard error: s^2 = cost / (n - 1), se^2 = s^2 / sum (cos/2)^2 */
+    static const double th[3] = {0.5, 1.0, 1.5}, x[3] = {0.5, 0.3, 0.05};
+    double cost = 0, sxx = 0;
+    for (int i = 0; i < 3; i++) {
+        double e = want / 2 * cos(th[i]) - x[i];
+        cost += e * e;
+        sxx += cos(th[i]) * cos(th[i]) / 4;
+    }
+    assert_near(f.r.cost, cost, 1e-9, 0);
+    assert_near(f.r.std_error[0], sqrt(cost / 2 / sxx), 1e-9, 0);
+    assert_near(f.r.corr[0], 1.0, 0, 1e-15);
     fit_close(&f);
 }
 
