@@ -239,4 +239,12 @@ else
     skip "no cc: compiling the generated C"
 fi
 
+# An engine's own error, not a stale one: emitting the aot engine's C once
+# recorded "more than N operations" on every success, and that was what a
+# missing compiler was reported as.
+mkdir "$tmp/cache"
+CC=mechc_no_such_cc XDG_CACHE_HOME=$tmp/cache run_mechc eval "$ex/four_bar.mech" --engine aot
+check "aot without a compiler: exit 2" status_is 2
+check "aot without a compiler: said" err_has "the aot engine needs a C compiler: 'mechc_no_such_cc'"
+
 suite_end
