@@ -1,4 +1,4 @@
-/* test_fit.c - mechc fit as a library: Freudenstein's three precision positions, the CSV's errors with their line and column, and the inputs fit_run refuses.
+/* test_fit.c - mechc fit as a library: Freudenstein's three precision positions, the three examples against references of their own, the CSV's errors with their line and column, and the inputs fit_run refuses.
  *
  * Freudenstein: the rocker angle psi of a four-bar of ground link d at
  * crank angles theta satisfies K1 cos psi - K2 cos theta + K3 =
@@ -6,8 +6,14 @@
  * linear in the K's: three (theta, psi) pairs give a, b, c in closed form.
  * The pairs come from a closed-form position solution of the "true"
  * linkage (1.2, 2.8, 2.3); fit_run from (1, 3, 2.5) must land on the
- * closed form's a, b, c to 1e-12. The CSVs are written into a folder of
- * the suite's own, removed at the end.
+ * closed form's a, b, c to 1e-12; so must the fit of
+ * examples/freudenstein.mech to its data. examples/coupler_synthesis.csv's
+ * points lie on the coupler curve (closed form) of the linkage its header
+ * names, which fit finds. The Stewart platform's 36 joint centres come
+ * back to 1e-9 from leg lengths computed here (|r + A(e) p_i - b_i|) for
+ * a geometry up to 5 mm off nominal, and the example's own lengths are
+ * those of the geometry fit finds from them. The CSVs are written into a
+ * folder of the suite's own, removed at the end.
  */
 #include "testutil.h"
 #include "testload.h"
@@ -98,29 +104,46 @@ static const char *write_csv(const char *name, const char *text)
 }
 
 /* fit_run's inputs for mech: every parameter varied, no bounds. */
+enum { MAX_P = 64 };
 typedef struct Fit {
     Mech *mech;
     Engine e;
     FitData data;
     FitOptions o;
     FitResult r;
-    bool vary[8];
-    double lo[8], hi[8];
+    bool vary[MAX_P];
+    double lo[MAX_P], hi[MAX_P];
 } Fit;
 
-static void fit_open(Fit *f, const char *text, const char *csv_name, const char *csv)
+static void fit_open_mech(Fit *f, Mech *mech, const char *csv_path)
 {
     memset(f, 0, sizeof *f);
-    f->mech = load_text(text, "freudenstein.mech");
+    f->mech = mech;
+    assert_true(mech->model->np <= MAX_P);
     Diag diag;
     if (!engine_open(&f->e, ENGINE_JIT, f->mech, &diag))
         fail_msg("jit: %s", diag.message);
-    if (!fit_data_read(write_csv(csv_name, csv), f->mech->model, &f->data, &diag))
-        fail_msg("%s: %d:%d: %s", csv_name, diag.line, diag.col, diag.message);
+    if (!fit_data_read(csv_path, f->mech->model, &f->data, &diag))
+        fail_msg("%s: %d:%d: %s", csv_path, diag.line, diag.col, diag.message);
     f->o = fit_default_options();
     f->o.vary = f->vary, f->o.lo = f->lo, f->o.hi = f->hi;
-    for (int j = 0; j < 8; j++)
+    for (int j = 0; j < MAX_P; j++)
         f->vary[j] = true, f->lo[j] = -INFINITY, f->hi[j] = INFINITY;
+}
+
+static void fit_open(Fit *f, const char *text, const char *csv_name, const char *csv)
+{
+    fit_open_mech(f, load_text(text, "freudenstein.mech"), write_csv(csv_name, csv));
+}
+
+/* examples/NAME.mech with its data examples/NAME.csv ($MECHC_EXAMPLES/...). */
+static void fit_open_example(Fit *f, const char *name)
+{
+    const char *dir = getenv("MECHC_EXAMPLES");
+    char mech[300], csv[300];
+    snprintf(mech, sizeof mech, "%s.mech", name);
+    snprintf(csv, sizeof csv, "%s/%s.csv", dir ? dir : "examples", name);
+    fit_open_mech(f, load_example(mech), csv);
 }
 
 static FitStatus fit_go(Fit *f)
@@ -156,19 +179,29 @@ static void fit_open_freudenstein(Fit *f, const char *csv_name, double psi[3])
     fit_open(f, four_bar_text, csv_name, csv);
 }
 
-static void test_freudenstein_three_positions(void **s)
+/* a, b, c from three (theta, psi) pairs: Freudenstein's equations, linear
+   in K1, K2, K3. */
+static void freudenstein_solve(const double theta[3], const double psi[3], double abc[3])
 {
-    (void)s;
-    static const double theta[3] = {0.5, 1.0, 1.5};
-    double psi[3], M[3][3], r[3], k[3];
-    Fit f;
-    fit_open_freudenstein(&f, "freudenstein.csv", psi);
+    double M[3][3], r[3], k[3];
     for (int i = 0; i < 3; i++) {
         M[i][0] = cos(psi[i]), M[i][1] = -cos(theta[i]), M[i][2] = 1.0;
         r[i] = cos(theta[i] - psi[i]);
     }
     solve3(M, r, k);
-    double a = D / k[0], c = D / k[1], b = sqrt(a * a + c * c + D * D - 2 * a * c * k[2]);
+    double a = D / k[0], c = D / k[1];
+    abc[0] = a, abc[1] = sqrt(a * a + c * c + D * D - 2 * a * c * k[2]), abc[2] = c;
+}
+
+static void test_freudenstein_three_positions(void **s)
+{
+    (void)s;
+    static const double theta[3] = {0.5, 1.0, 1.5};
+    double psi[3], abc[3];
+    Fit f;
+    fit_open_freudenstein(&f, "freudenstein.csv", psi);
+    freudenstein_solve(theta, psi, abc);
+    double a = abc[0], b = abc[1], c = abc[2];
     assert_near(a, 1.2, 0, 1e-12);      /* the closed form recovers the truth */
     assert_near(b, 2.8, 0, 1e-12);
     assert_near(c, 2.3, 0, 1e-12);
@@ -235,6 +268,155 @@ static void test_fit_coupler_point(void **s)
     for (int j = 0; j < 3; j++)
         assert_near(f.r.p[j], truth[j], 0, 1e-10);
     assert_true(f.r.cost < 1e-20);
+    fit_close(&f);
+}
+
+/* ---- the examples ------------------------------------------------------ */
+
+/* examples/freudenstein.mech with its three pairs: fit equals the closed
+   form of Freudenstein's equations through them. */
+static void test_freudenstein_example(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open_example(&f, "freudenstein");
+    assert_int_equal(f.data.nsamples, 3);
+    assert_int_equal(f.data.ncols, 1);
+    assert_string_equal(f.data.names[0], "rocker.phi");
+    double abc[3];
+    freudenstein_solve(f.data.t, f.data.value, abc);
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    for (int j = 0; j < 3; j++)
+        assert_near(f.r.p[j], abc[j], 0, 1e-12);
+    fit_close(&f);
+}
+
+/* The coupler point of the four-bar the example's header names (pivots
+   (0, 0) and (4, 0.5), links 1.2, 3.5, 3, P = (1.5, 1) in the coupler's
+   frame) at crank angle theta, on the branch nearer (x, y). */
+static void coupler_point(double theta, double x, double y, double P[2])
+{
+    const double a = 1.2, b = 3.5, c = 3, dx = 4, dy = 0.5, px = 1.5, py = 1;
+    double ax = a * cos(theta), ay = a * sin(theta);
+    double ex = dx - ax, ey = dy - ay, d = hypot(ex, ey);
+    double along = (b * b - c * c + d * d) / (2 * d), off = sqrt(b * b - along * along);
+    double best = INFINITY;
+    for (int side = -1; side <= 1; side += 2) {
+        double bx = ax + (along * ex - side * off * ey) / d, by = ay + (along * ey + side * off * ex) / d;
+        double ux = (bx - ax) / b, uy = (by - ay) / b;
+        double qx = ax + px * ux - py * uy, qy = ay + px * uy + py * ux;
+        if (hypot(qx - x, qy - y) < best)
+            best = hypot(qx - x, qy - y), P[0] = qx, P[1] = qy;
+    }
+}
+
+/* examples/coupler_synthesis.mech: its five points lie on the coupler
+   curve of the linkage its header names, and fit finds that linkage with
+   zero residual from the file's design. */
+static void test_coupler_synthesis_example(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open_example(&f, "coupler_synthesis");
+    assert_int_equal(f.data.nsamples, 5);
+    assert_string_equal(f.data.names[0], "P.x");
+    assert_string_equal(f.data.names[1], "P.y");
+    for (int k = 0; k < 5; k++) {
+        double P[2], *v = f.data.value + 2 * k;
+        coupler_point(f.data.t[k], v[0], v[1], P);
+        assert_near(v[0], P[0], 0, 1e-12);
+        assert_near(v[1], P[1], 0, 1e-12);
+    }
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    static const char *const names[9] = {"xa", "ya", "xd", "yd", "a", "b", "c", "px", "py"};
+    static const double linkage[9] = {0, 0, 4, 0.5, 1.2, 3.5, 3, 1.5, 1};
+    for (int j = 0; j < 9; j++) {
+        assert_string_equal(f.mech->model->design_names[j], names[j]);
+        assert_near(f.r.p[j], linkage[j], 0, 1e-9);
+    }
+    assert_true(f.r.cost < 1e-24);
+    fit_close(&f);
+}
+
+/* The leg lengths |r + A(e) p_i - b_i| of examples/stewart_calibration.mech
+   at t (its drivers' pose, e0 from the norm), for a design p of six
+   (b_i, p_i) in the file's order. */
+static void stewart_legs(const double *p, double t, double L[6])
+{
+    const double w = 2 * M_PI;
+    double r[3] = {0.1 * sin(w * t), 0.08 * sin(2 * w * t), 1 + 0.1 * (1 - cos(w * t))};
+    double e1 = 0.1 * sin(w * t), e2 = 0.08 * sin(2 * w * t + 1), e3 = 0.12 * cos(3 * w * t);
+    double e0 = sqrt(1 - e1 * e1 - e2 * e2 - e3 * e3);
+    double A[3][3] = {
+        {e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3, 2 * (e1 * e2 - e0 * e3), 2 * (e1 * e3 + e0 * e2)},
+        {2 * (e1 * e2 + e0 * e3), e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3, 2 * (e2 * e3 - e0 * e1)},
+        {2 * (e1 * e3 - e0 * e2), 2 * (e2 * e3 + e0 * e1), e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3}};
+    for (int i = 0; i < 6; i++) {
+        const double *b = p + 6 * i, *q = p + 6 * i + 3;
+        double sq = 0;
+        for (int k = 0; k < 3; k++) {
+            double d = r[k] + A[k][0] * q[0] + A[k][1] * q[1] + A[k][2] * q[2] - b[k];
+            sq += d * d;
+        }
+        L[i] = sqrt(sq);
+    }
+}
+
+/* The 36 joint centres of the Stewart platform from 32 poses: exact leg
+   lengths of a geometry up to 5 mm off nominal (computed here) give it
+   back to 1e-9 from the nominal start; the example's own data are the
+   lengths of the geometry fit finds there, to 1e-12. */
+static void test_stewart_calibration(void **s)
+{
+    (void)s;
+    Fit f;
+    fit_open_example(&f, "stewart_calibration");
+    const Model *m = f.mech->model;
+    assert_int_equal(m->np, 36);
+    assert_string_equal(m->design_names[0], "b1x");
+    assert_string_equal(m->design_names[3], "p1x");
+    assert_string_equal(m->design_names[35], "p6z");
+    assert_int_equal(f.data.nsamples, 32);
+    assert_int_equal(f.data.ncols, 6);
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    for (int k = 0; k < 32; k++) {
+        double L[6];
+        stewart_legs(f.r.p, f.data.t[k], L);
+        for (int i = 0; i < 6; i++)
+            assert_near(f.data.value[6 * k + i], L[i], 0, 1e-12);
+    }
+    for (int j = 0; j < 36; j++)
+        assert_true(fabs(f.r.p[j] - m->design_p0[j]) <= 0.0055);
+    double truth[36];
+    for (int j = 0; j < 36; j++)
+        truth[j] = m->design_p0[j] + 0.005 * sin(2.3 * j + 0.7);
+    fit_close(&f);
+
+    char *csv = xmalloc(32 * 200);
+    int n = snprintf(csv, 32 * 200, "t,L1,L2,L3,L4,L5,L6\n");
+    for (int k = 0; k < 32; k++) {
+        double L[6];
+        stewart_legs(truth, k / 32.0, L);
+        n += snprintf(csv + n, 32 * 200 - (size_t)n, "%.17g", k / 32.0);
+        for (int i = 0; i < 6; i++)
+            n += snprintf(csv + n, 32 * 200 - (size_t)n, ",%.17g", L[i]);
+        n += snprintf(csv + n, 32 * 200 - (size_t)n, "\n");
+    }
+    fit_open_mech(&f, load_example("stewart_calibration.mech"), write_csv("stewart.csv", csv));
+    free(csv);
+    if (fit_go(&f) != FIT_OK)
+        fail_msg("fit: %s", f.r.message);
+    double worst = 0;
+    for (int j = 0; j < 36; j++) {
+        assert_near(f.r.p[j], truth[j], 0, 1e-9);
+        worst = fmax(worst, fabs(f.r.p[j] - truth[j]));
+    }
+    print_message("stewart: 36 joint centres recovered to %.2g in %d iterations\n", worst,
+                  f.r.iterations);
+    assert_true(f.r.cost < 1e-24);
     fit_close(&f);
 }
 
@@ -451,6 +633,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_freudenstein_three_positions),
         cmocka_unit_test(test_fit_coupler_point),
+        cmocka_unit_test(test_freudenstein_example),
+        cmocka_unit_test(test_coupler_synthesis_example),
+        cmocka_unit_test(test_stewart_calibration),
         cmocka_unit_test(test_data_read),
         cmocka_unit_test(test_data_errors),
         cmocka_unit_test(test_too_few_values),
