@@ -1,7 +1,9 @@
 #!/bin/sh
 # tests/fit_cli.sh MECHC - design parameters from the outside: `mechc fit`
 # (exit statuses, the CSV's FILE:LINE:COL errors with their caret, the
-# Freudenstein case's JSON), `--design` on other commands, `run --sens`
+# Freudenstein case's JSON; the examples freudenstein, coupler_synthesis,
+# with its curve drawn, and stewart_calibration), `--design` on other
+# commands, `run --sens`
 # (its refusals, its columns against finite differences of runs at
 # --design p +- h), and `gen` of a design file built by cc -Werror and run:
 # PREFIX_phi_p against central differences of PREFIX_phi in p.
@@ -130,6 +132,36 @@ a=$(sed -n 's/.*"name": "a", "start": [^,]*, "estimate": \([^,]*\),.*/\1/p' "$tm
 check "fit --bound a=0.9:1.1: a on the bound" near "$a" 1.1 1e-9
 run_mechc fit "$ex/four_bar.mech" --data "$tmp/fr.csv"
 check "fit, no design parameters: exit 2" status_is 2
+
+# ---- the examples ----------------------------------------------------------
+# examples/freudenstein.mech: Freudenstein's linear equations through its
+# three pairs give a = 1.2, b = 2.8, c = 2.3 (tests/test_fit.c solves them).
+run_mechc fit "$ex/freudenstein.mech" --data "$ex/freudenstein.csv" --json
+check "freudenstein example: exit 0" status_is 0
+for pair in a:1.2 b:2.8 c:2.3; do
+    got=$(sed -n "s/.*\"name\": \"${pair%%:*}\", \"start\": [^,]*, \"estimate\": \([^,]*\),.*/\1/p" "$tmp/out")
+    check "freudenstein example: ${pair%%:*}" near "$got" "${pair#*:}" 1e-12
+done
+# examples/coupler_synthesis.mech: the linkage its header names, zero
+# residual, and the coupler curve of the result drawn with run --svg.
+run_mechc fit "$ex/coupler_synthesis.mech" --data "$ex/coupler_synthesis.csv"
+check "coupler_synthesis example: exit 0" status_is 0
+for pair in xa:0 ya:0 xd:4 yd:0.5 a:1.2 b:3.5 c:3 px:1.5 py:1; do
+    got=$(awk -v n="${pair%%:*}" '$1 == n && NF == 4 { print $3 }' "$tmp/out")
+    check "coupler_synthesis example: ${pair%%:*}" near "$got" "${pair#*:}" 1e-9
+done
+design=$(sed -n 's/^design: --design //p' "$tmp/out")
+run_mechc run "$ex/coupler_synthesis.mech" --design "$design" --t0 0.4 --t1 2 --steps 4 \
+    --tol 1e-13 --csv "$tmp/curve.csv" --svg "$tmp/curve.svg"
+check "coupler_synthesis example: run at the result" status_is 0
+check "coupler_synthesis example: P.x at t = 0.8" \
+    near "$(csv_value_at 0.8 P.x "$tmp/curve.csv")" 1.1409600883056423 1e-12
+check "coupler_synthesis example: P.y at t = 2" \
+    near "$(csv_value_at 2 P.y "$tmp/curve.csv")" 2.7574562416530224 1e-12
+check "coupler_synthesis example: the SVG" grep -q '</svg>' "$tmp/curve.svg"
+run_mechc fit "$ex/stewart_calibration.mech" --data "$ex/stewart_calibration.csv" --json
+check "stewart_calibration example: exit 0" status_is 0
+check "stewart_calibration example: ok" out_has '"ok": true'
 
 # ---- --design --------------------------------------------------------------
 run_mechc eval "$fr" --design zz=1
