@@ -3,10 +3,10 @@
 # (exit statuses, the CSV's FILE:LINE:COL errors with their caret, the
 # Freudenstein case's JSON; the examples freudenstein, coupler_synthesis,
 # with its curve drawn, and stewart_calibration), `--design` on other
-# commands, `run --sens`
-# (its refusals, its columns against finite differences of runs at
-# --design p +- h), and `gen` of a design file built by cc -Werror and run:
-# PREFIX_phi_p against central differences of PREFIX_phi in p.
+# commands, `run --sens` (its refusals, its columns against finite
+# differences of runs at --design p +- h), and `gen` of a design file built
+# by cc -Werror and run: PREFIX_phi_p against central differences of
+# PREFIX_phi in p.
 #
 #   sh tests/fit_cli.sh build/mechc
 #
