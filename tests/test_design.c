@@ -200,8 +200,9 @@ static void emit(const Mech *mech, const EmitOptions *opt, EmitResult *res)
     assert_false(diag.failed);
 }
 
-/* gen's file: p after q and t in phi, PREFIX_NP, p0, names and phi_p; it
-   compiles under libtcc. */
+/* gen's file: p after q and t in phi, PREFIX_NP, p0, names and phi_p; the
+   engines' (with the twins) compiles under libtcc and computes the
+   generic engine's Phi at the design it is bound to. */
 static void test_emit_design_file(void **s)
 {
     (void)s;
@@ -209,10 +210,10 @@ static void test_emit_design_file(void **s)
     EmitOptions opt = emit_default_options();
     EmitResult res;
     emit(mech, &opt, &res);
-    const char *phi = strstr(res.c_text, "void fbd_phi(");
-    assert_non_null(phi);
-    const char *eol = strchr(phi, '\n'), *p = strstr(phi, "const fbd_real *p");
-    assert_true(p && p < eol);
+    const char *sig = strstr(res.c_text, "void fbd_phi(");
+    assert_non_null(sig);
+    const char *eol = strchr(sig, '\n'), *arg = strstr(sig, "const fbd_real *p");
+    assert_true(arg && arg < eol);
     assert_non_null(strstr(res.c_text, "#define FBD_NP   8"));
     assert_non_null(strstr(res.c_text, "void fbd_phi_p(const fbd_real *q, fbd_real t, "
                                        "const fbd_real *p, fbd_real *phi_p)"));
@@ -221,20 +222,37 @@ static void test_emit_design_file(void **s)
     assert_null(strstr(res.c_text, "design_bind"));    /* the engines' twins only */
     emit_result_free(&res);
 
-    opt.declare_math = true;    /* libtcc has no system headers: as the jit */
-    opt.direct_jac = true;
+    /* libtcc has no system headers; its functions are bound through the
+       context-free twins, which read p from design_bind's pointer */
+    opt.declare_math = true, opt.direct_jac = true, opt.host_design = true;
     emit(mech, &opt, &res);
+    assert_non_null(strstr(res.c_text, "void fbd_design_bind(const fbd_real *p)"));
     Diag diag;
     diag_init(&diag, "test", "", 0);
     Jit *jit = jit_compile(res.c_text, res.prefix, &diag);
     if (!jit)
         fail_msg("jit_compile: %s", diag.message);
+    const Kernels *k = jit_kernels(jit);
+    assert_non_null(k->design_bind);
+    /* at a design of its own, the unit's phi is the generic engine's */
+    const Model *m = mech->model;
+    assert_int_equal(m->np, 8);
+    assert_int_equal(m->nq, 11);
+    double p[8], q[11], t = 0.3, phi[11], want[11];
+    for (int j = 0; j < m->np; j++)
+        p[j] = m->design_p0[j] * 1.05;
+    for (int i = 0; i < m->nq; i++)
+        q[i] = m->q0[i] + 0.01 * i;
+    k->design_bind(p);
+    k->phi(q, t, phi);
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_GENERIC, mech));
+    model_set_design(mech->model, p);
+    engine_phi(&e, q, t, want);
+    for (int r = 0; r < m->nh; r++)
+        assert_near(phi[r], want[r], 0, 1e-12);
+    engine_close(&e);
     jit_free(jit);
-    emit_result_free(&res);
-
-    opt.host_design = true;     /* what the engines compile */
-    emit(mech, &opt, &res);
-    assert_non_null(strstr(res.c_text, "void fbd_design_bind(const fbd_real *p)"));
     emit_result_free(&res);
     pipeline_free(mech);
 }
