@@ -189,9 +189,9 @@ done
 run_mechc run "$ex/four_bar.mech" --sens
 check "run --sens without design parameters: exit 2" status_is 2
 check "run --sens without design parameters: said" err_has "the file has no design parameters"
-run_mechc run "$fr" --sens --json
-check "run --sens --json: exit 2" status_is 2
-check "run --sens --json: said" err_has "not with --json"
+run_mechc run "$fr" --sens --forces
+check "run --sens --forces: exit 2" status_is 2
+check "run --sens --forces: said" err_has "--sens and --forces"
 
 printf 'design r = 0.5\nbody w x = 0 y = 0.5 phi = 0\ndriver h: w.y = r\nvelocity roll: der(w.x) + r*der(w.phi) = 0\ndriver s: w.phi = t\n' \
     > "$tmp/wheel.mech"
@@ -204,6 +204,15 @@ run_mechc run "$fr" --sens --steps 4 --tol 1e-13 --csv "$tmp/sens.csv"
 check "run --sens: exit 0" status_is 0
 check "run --sens: its columns" \
     sh -c "head -1 '$tmp/sens.csv' | grep -q -F 'd(rocker.phi)/d(b),d(rocker.phi)/d(c),d(P.x)/d(a)'"
+# --json: the same columns, "sens_columns", a row of "sens" per state
+run_mechc run "$fr" --sens --steps 4 --tol 1e-13 --json
+check "run --sens --json: exit 0" status_is 0
+at=$(sed -n 's/.*"sens_columns": \[\([^]]*\)\].*/\1/p' "$tmp/out" | tr ',' '\n' \
+     | grep -n -F '"d(rocker.phi)/d(b)"' | cut -d: -f1)
+got=$(tr -d '\n' < "$tmp/out" | sed 's/.*"sens": \[\[//' | awk -F'\\], *\\[' '{ print $2 }' \
+      | awk -F, -v c="$at" '{ print $c }' | tr -d ' ')
+check "run --sens --json: d(rocker.phi)/d(b) at t = 0.25 as in the CSV" \
+    near "$got" "$(csv_value_at 0.25 'd(rocker.phi)/d(b)' "$tmp/sens.csv")" 1e-15
 for w in b=3.000001,b=2.999999 a=1.000001,a=0.999999; do
     run_mechc run "$fr" --design "${w%%,*}" --steps 4 --tol 1e-13 --csv "$tmp/plus.csv"
     run_mechc run "$fr" --design "${w#*,}" --steps 4 --tol 1e-13 --csv "$tmp/minus.csv"

@@ -554,6 +554,13 @@ static void test_unidentifiable(void **s)
     assert_null(strstr(f.r.message, " a "));
     assert_non_null(strstr(f.r.message, "down to 0)"));     /* not -0 */
     fit_close(&f);
+    /* b and c alone: the data depend on neither */
+    fit_open(&f, four_bar_text, "crank.csv", "t,crank.x\n0.5,0.5\n1,0.3\n1.5,0.05\n");
+    f.vary[0] = false;
+    assert_int_equal(fit_go(&f), FIT_BAD_INPUT);
+    if (!strstr(f.r.message, "the measured values do not depend on b, c"))
+        fail_msg("message: %s", f.r.message);
+    fit_close(&f);
     /* a alone is identified by it: a = 2 x / cos(theta) */
     fit_open(&f, four_bar_text, "crank.csv", "t,crank.x\n0.5,0.5\n1,0.3\n1.5,0.05\n");
     f.vary[1] = f.vary[2] = false;
