@@ -142,6 +142,13 @@ for pair in a:1.2 b:2.8 c:2.3; do
     got=$(sed -n "s/.*\"name\": \"${pair%%:*}\", \"start\": [^,]*, \"estimate\": \([^,]*\),.*/\1/p" "$tmp/out")
     check "freudenstein example: ${pair%%:*}" near "$got" "${pair#*:}" 1e-12
 done
+# the same fit through the other engines
+for e in generic aot; do
+    if [ $e = aot ] && ! have cc; then skip "no cc: fit --engine aot"; continue; fi
+    run_mechc fit "$ex/freudenstein.mech" --data "$ex/freudenstein.csv" --json --engine $e
+    got=$(sed -n 's/.*"name": "b", "start": [^,]*, "estimate": \([^,]*\),.*/\1/p' "$tmp/out")
+    check "freudenstein example, --engine $e: b" near "$got" 2.8 1e-12
+done
 # examples/coupler_synthesis.mech: the linkage its header names, zero
 # residual, and the coupler curve of the result drawn with run --svg.
 run_mechc fit "$ex/coupler_synthesis.mech" --data "$ex/coupler_synthesis.csv"
