@@ -96,8 +96,9 @@ Entity *build_declare(Builder *b, EntityKind kind, const char *name, SrcPos pos)
     return e;
 }
 
-/* Rows x coordinates: the dense Jacobian every engine fills (run's sparse
-   path excepted: it asks for no check here, max_jac_entries 0). */
+/* Rows x coordinates of the whole model: the dense Jacobian every engine
+   fills (run's sparse path excepted: it asks for no check here,
+   max_jac_entries 0). */
 static void check_jacobian_size(Builder *b, long long nr, long long nq, SrcPos pos)
 {
     if (b->limits->max_jac_entries > 0 && nr * nq > b->limits->max_jac_entries)
@@ -113,7 +114,6 @@ static int add_coord(Builder *b, const char *owner, const char *suffix, double q
     Model *m = b->model;
     if (m->nq >= b->limits->max_coords)
         diag_fail(b->diag, pos, "too many coordinates (the limit is %d)", b->limits->max_coords);
-    check_jacobian_size(b, b->npos + b->nvel, m->nq + 1, pos);
     int cap = b->cap_coords;    /* q0 shares the capacity of coord_names */
     build_grow(&m->arena, (void **)&m->coord_names, &b->cap_coords, m->nq + 1, sizeof *m->coord_names);
     build_grow(&m->arena, (void **)&m->q0, &cap, m->nq + 1, sizeof *m->q0);
@@ -255,7 +255,6 @@ static void push_row(Builder *b, const Joint *j, int index, NodeId expr)
     const JointInfo *info = &joint_info[j->kind];
     if (b->npos + b->nvel >= b->limits->max_rows)
         diag_fail(b->diag, j->pos, "too many rows (the limit is %d)", b->limits->max_rows);
-    check_jacobian_size(b, b->npos + b->nvel + 1, m->nq, j->pos);
     const char *suffix = info->suffix[index];
     char *name = arena_alloc(&m->arena, strlen(j->name) + strlen(suffix) + 1);
     strcpy(name, j->name);
@@ -591,6 +590,8 @@ static void build(Builder *b, const Program *prog, const char *default_name)
     collect_bodies(b);
     SrcPos where = last ? last->pos : (SrcPos){0};
     m->last_pos = where;
+    /* on the whole model, at the statement about the mechanism as a whole */
+    check_jacobian_size(b, (long long)b->npos + b->nvel, m->nq, where);
     if (m->nq == 0)
         diag_fail(b->diag, where, "the mechanism has no coordinates: declare a body, point or coord");
     if (b->npos + b->nvel == 0)
