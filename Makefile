@@ -117,11 +117,12 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 # generated-C compile checks, as many at a time as make's -j says
 # (tests/run_all); a failing suite's output is shown at the end.
 # deps runs first and alone: under -j the objects would otherwise compile
-# before a fresh machine has the headers.
+# before a fresh machine has the headers. tests/firmware_rules.sh compiles
+# for the host here, for the Cortex-M boards under firmware-check.
 TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
 check: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
-	$(Q)sh tests/run_all $(BUILD) $(TEST_JOBS)
+	$(Q)FIRMWARE_RULES=host sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
 

@@ -45,8 +45,9 @@
 # Cortex-M3 (double, software floating point) and checked the same way;
 # there the compiler's floating-point helpers (__aeabi_*) are allowed too.
 #
-# FIRMWARE_RULES=cross (make firmware-check, after make check) runs the
-# Cortex-M builds only, not the host's again. MECHC_SKIP_GCC_ONLY=1 (make
+# FIRMWARE_RULES=cross (make firmware-check) runs the Cortex-M builds only,
+# FIRMWARE_RULES=host (make check) the host's only: each compile is done
+# once over the two targets. MECHC_SKIP_GCC_ONLY=1 (make
 # check-asan and check-valgrind, whose instruments cannot see inside the
 # compiler) keeps mechc gen and the source rules and skips what only
 # compiles and inspects the written C.
@@ -258,6 +259,8 @@ else
 fi
 if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
     :
+elif [ "${FIRMWARE_RULES:-}" = host ]; then
+    skip "FIRMWARE_RULES=host: the Cortex-M builds (make firmware-check runs them)"
 elif command -v arm-none-eabi-gcc > /dev/null 2>&1; then
     a=arm-none-eabi-
     toolchains="$toolchains
