@@ -24,7 +24,7 @@ CFLAGS_TOOL += $(KLU_CFLAGS)
 # The libraries are linked statically where Debian ships a static one:
 # shared, GSL and SuiteSparse's chain are 20 libraries that the loader maps
 # and relocates at every start of mechc, 7 ms of CPU, as much as a short
-# run's work (make check starts mechc some 2,000 times). libtcc.a is the
+# run's work (make check starts mechc some 1,100 times). libtcc.a is the
 # only libtcc there is (non-PIC, hence -no-pie). METIS has no static
 # library, and libgfortran's comes only with gfortran (the parts of LAPACK
 # used here do not call it: --as-needed drops it): those stay shared, named
