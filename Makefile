@@ -29,8 +29,8 @@ CFLAGS_TOOL += $(KLU_CFLAGS)
 # library, and libgfortran's comes only with gfortran (the parts of LAPACK
 # used here do not call it: --as-needed drops it): those stay shared, named
 # by soname, since their -dev links may be missing.
-# GSL's CBLAS comes right after GSL: CHOLMOD needs the system BLAS, which
-# has cblas_* too, and its would change the SVD's last digits.
+# GSL's CBLAS comes right after GSL: CHOLMOD needs the system BLAS, whose
+# cblas_* would otherwise be taken and change the SVD's last digits.
 # SuiteSparseQR (generator/structure/spqr_rank.c) is C++ inside, hence
 # libstdc++; CHOLMOD uses OpenMP, hence libgomp.
 SUITESPARSE_LIBS := -Wl,--start-group -lklu -lamd -lcolamd -lbtf -lspqr -lcholmod -lccolamd -lcamd \
