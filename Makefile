@@ -19,18 +19,26 @@ CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) -MMD -MP
 # SuiteSparse's KLU, the sparse LU of large Jacobians (runtime/host/sparse_klu.c).
 # Debian 12's libsuitesparse-dev has no pkg-config file (later ones do).
 KLU_CFLAGS := $(shell pkg-config --cflags klu 2>/dev/null || echo -I/usr/include/suitesparse)
-KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig)
 CFLAGS_TOOL += $(KLU_CFLAGS)
-# SuiteSparseQR, the sparse rank-revealing QR of `info` at scale
-# (generator/structure/spqr_rank.c): C++ inside, hence libstdc++. It goes
-# after -lgslcblas: CHOLMOD pulls in the system BLAS, whose cblas_* would
-# otherwise be found before GSL's and change the SVD's last digits.
-SPQR_LIBS  := $(shell pkg-config --libs spqr cholmod 2>/dev/null || echo -lspqr -lcholmod) -lstdc++
 
-# libtcc: Debian ships only a static, non-PIC libtcc.a, so the tool links it
-# statically and is itself linked without PIE.
+# The libraries are linked statically where Debian ships a static one:
+# shared, GSL and SuiteSparse's chain are 20 libraries that the loader maps
+# and relocates at every start of mechc, 7 ms of CPU, as much as a short
+# run's work (make check starts mechc some 1,100 times). libtcc.a is the
+# only libtcc there is (non-PIC, hence -no-pie). METIS has no static
+# library, and libgfortran's comes only with gfortran (the parts of LAPACK
+# used here do not call it: --as-needed drops it): those stay shared, named
+# by soname, since their -dev links may be missing.
+# GSL's CBLAS comes right after GSL: CHOLMOD needs the system BLAS, whose
+# cblas_* would otherwise be taken and change the SVD's last digits.
+# SuiteSparseQR (generator/structure/spqr_rank.c) is C++ inside, hence
+# libstdc++; CHOLMOD uses OpenMP, hence libgomp.
+SUITESPARSE_LIBS := -Wl,--start-group -lklu -lamd -lcolamd -lbtf -lspqr -lcholmod -lccolamd -lcamd \
+                    -lsuitesparseconfig -Wl,--end-group -llapack -lblas
 LDFLAGS_TOOL := -no-pie $(SAN)
-LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -Wl,-Bdynamic $(KLU_LIBS) -lgsl -lgslcblas $(SPQR_LIBS) -ldl -lm -lpthread
+LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -lgsl -lgslcblas $(SUITESPARSE_LIBS) -lstdc++ -lgomp \
+                -Wl,-Bdynamic -Wl,--as-needed -l:libgfortran.so.5 -Wl,--no-as-needed \
+                -l:libmetis.so.5 -ldl -lm -lpthread
 LDLIBS_TEST  := -lcmocka
 
 GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))
@@ -117,11 +125,12 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 # generated-C compile checks, as many at a time as make's -j says
 # (tests/run_all); a failing suite's output is shown at the end.
 # deps runs first and alone: under -j the objects would otherwise compile
-# before a fresh machine has the headers.
+# before a fresh machine has the headers. tests/firmware_rules.sh compiles
+# for the host here, for the Cortex-M boards under firmware-check.
 TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
 check: deps
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
-	$(Q)sh tests/run_all $(BUILD) $(TEST_JOBS)
+	$(Q)FIRMWARE_RULES=host sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
 

@@ -45,8 +45,9 @@
 # Cortex-M3 (double, software floating point) and checked the same way;
 # there the compiler's floating-point helpers (__aeabi_*) are allowed too.
 #
-# FIRMWARE_RULES=cross (make firmware-check, after make check) runs the
-# Cortex-M builds only, not the host's again. MECHC_SKIP_GCC_ONLY=1 (make
+# FIRMWARE_RULES=cross (make firmware-check) runs the Cortex-M builds only,
+# FIRMWARE_RULES=host (make check) the host's only: each compile is done
+# once over the two targets. MECHC_SKIP_GCC_ONLY=1 (make
 # check-asan and check-valgrind, whose instruments cannot see inside the
 # compiler) keeps mechc gen and the source rules and skips what only
 # compiles and inspects the written C.
@@ -98,32 +99,64 @@ done
 
 # ---- helpers over objects ---------------------------------------------------
 
-# The rules read one `nm OBJ` listing, OBJ.nm (symbols_of), where a
-# defined symbol has three fields and an undefined one two (no address).
-# nm is given the object's format (objdump -f says it): guessing it, nm
-# tries the linker plugins (LLVMgold among them), eight times slower.
+# The rules on one object OBJ read three listings that object_rules
+# writes: OBJ.nm (nm: a defined symbol has three fields, an undefined one
+# two), OBJ.size (size -A: the sections) and OBJ.dis (objdump -dr
+# --no-show-raw-insn). nm is given the object's format (the disassembly's
+# header says it): guessing it, nm tries the linker plugins (LLVMgold
+# among them), eight times slower. Then one awk (rules.awk, then
+# callgraph.awk) judges every rule and writes what breaks rule R to OBJ.R:
+#   undefined_only    every undefined symbol matches the regex ext;
+#   no_writable_data  no data/bss symbols, empty .data and .bss;
+#   defined_prefixed  every defined symbol matches the regex prefix (if set);
+#   call_graph        below.
+# One process per listing and one for the rules: this script runs them for
+# some 80 objects, and starting a process costs more than a rule.
+cat > "$tmp/rules.awk" <<'EOF'
+function broken(rule, why) { print why > (obj "." rule) }
+BEGIN {
+    # every verdict file, new and empty: a rule that writes nothing is kept
+    split("undefined_only no_writable_data defined_prefixed call_graph", rules)
+    for (r in rules) printf "" > (obj "." rules[r])
+}
+FILENAME == obj ".nm" {
+    if (NF == 2 && $2 !~ ext) broken("undefined_only", "undefined: " $2)
+    if (NF == 3 && $2 ~ /^[DdBbCGgSs]$/) broken("no_writable_data", "writable: " $0)
+    if (prefix != "" && NF == 3 && $2 ~ /^[TtRrDdBb]$/ && $3 !~ /^[.$]/ && $3 !~ prefix)
+        broken("defined_prefixed", "foreign name: " $3)
+    next
+}
+FILENAME == obj ".size" {
+    if ($1 ~ /^\.(data|bss)/ && $2 != 0) broken("no_writable_data", "section " $1 " has " $2 " bytes")
+    next
+}
+EOF
 
-# symbols_of OBJ NM OBJDUMP: OBJ's symbols into OBJ.nm.
-symbols_of() {
-    format=$("$3" -f "$1" | sed -n 's/.* file format //p')
-    "$2" ${format:+--target="$format"} "$1" > "$1.nm"
+# object_rules OBJ NM SIZE OBJDUMP EXT PREFIX ALLOW_INDIRECT: OBJ's
+# listings and verdicts; OBJ.judged when all were written.
+object_rules() {
+    "$4" -dr --no-show-raw-insn "$1" > "$1.dis" || return 1
+    { read -r line; read -r line; } < "$1.dis"
+    case $line in
+        *" file format "*) format=${line##* file format } ;;
+        *) format= ;;
+    esac
+    "$2" ${format:+--target="$format"} "$1" > "$1.nm" &&
+    "$3" -A "$1" > "$1.size" &&
+    awk -v obj="$1" -v ext="$5" -v prefix="$6" -v allow_indirect="$7" \
+        -f "$tmp/rules.awk" -f "$tmp/callgraph.awk" "$1.nm" "$1.size" "$1.dis" &&
+    : > "$1.judged"
 }
 
-# undefined_only OBJ REGEX: every undefined symbol matches REGEX.
-undefined_only() {
-    awk -v re="$2" 'NF == 2 && $2 !~ re { print "undefined: " $2; bad = 1 } END { exit bad }' "$1.nm"
-}
-
-# no_writable_data OBJ SIZE: no data/bss symbols, empty .data and .bss.
-no_writable_data() {
-    awk 'NF == 3 && $2 ~ /^[DdBbCGgSs]$/ { print "writable: " $0; bad = 1 } END { exit bad }' "$1.nm" &&
-    "$2" -A "$1" | awk '$1 ~ /^\.(data|bss)/ && $2 != 0 { print "section " $1 " has " $2 " bytes"; bad = 1 } END { exit bad }'
-}
-
-# defined_prefixed OBJ REGEX: every defined symbol matches REGEX.
-defined_prefixed() {
-    awk -v re="$2" 'NF == 3 && $2 ~ /^[TtRrDdBb]$/ && $3 !~ /^[.$]/ && $3 !~ re {
-        print "foreign name: " $3; bad = 1 } END { exit bad }' "$1.nm"
+# kept OBJ RULE: object_rules found OBJ keeping RULE; else prints why not.
+kept() {
+    if [ ! -f "$1.judged" ]; then
+        echo "not judged: objdump, nm, size or the rules failed on $1"
+        return 1
+    fi
+    [ -s "$1.$2" ] || return 0
+    while IFS= read -r line; do printf '%s\n' "$line"; done < "$1.$2"
+    return 1
 }
 
 # The call graph of one object from `objdump -dr --no-show-raw-insn`, x86-64
@@ -160,7 +193,7 @@ function edge(a, b) {
     ops = insn; sub(/^[^ \t]+[ \t]*/, "", ops)
     if (mnem ~ /^(call|jmp|j[a-z]+)/ || (mnem ~ /^(b[a-z]*(\.[nw])?|cbn?z)$/ && mnem !~ /^(bic|bics|bfi|bfc|bkpt)/)) {
         if (ops ~ /^\*/ || mnem ~ /^(blx|bx)/ && ops ~ /^(r[0-9]+|ip|sl|fp)$/) {
-            if (!allow_indirect) { print fn ": indirect branch: " insn; bad = 1 }
+            if (!allow_indirect) broken("call_graph", fn ": indirect branch: " insn)
             next
         }
         pending = 1
@@ -172,7 +205,7 @@ function edge(a, b) {
             else target = base(target)
         }
     } else if (mnem ~ /^(tbb|tbh)/ && !allow_indirect) {
-        print fn ": table branch: " insn; bad = 1
+        broken("call_graph", fn ": table branch: " insn)
     }
     next
 }
@@ -180,8 +213,8 @@ END {
     flush()
     for (i = 1; i <= ne; i++) {
         if (to[i] in defined) { out[from[i]]++; continue }
-        if (to[i] ~ /^\./) { print from[i] ": section-relative branch to " to[i]; bad = 1 }
-        else if (to[i] !~ ext) { print from[i] ": calls " to[i]; bad = 1 }
+        if (to[i] ~ /^\./) broken("call_graph", from[i] ": section-relative branch to " to[i])
+        else if (to[i] !~ ext) broken("call_graph", from[i] ": calls " to[i])
     }
     do {
         changed = 0
@@ -190,58 +223,61 @@ END {
             for (i = 1; i <= ne; i++) if (to[i] == f) out[from[i]]--
         }
     } while (changed)
-    for (f in defined) if (!(f in gone)) { print "on a call cycle: " f; bad = 1 }
+    for (f in defined) if (!(f in gone)) broken("call_graph", "on a call cycle: " f)
+}
+EOF
+
+# The source rules, one awk over the files named: each file's C text
+# without comments and with every string and character literal emptied
+# (names from the .mech file live in those), #include lines kept whole
+# (they name their file in quotes); then on that text: every #include
+# matches the regex includes, no forbidden name (allocation, stdio, exit
+# and the like), and with statics=1 `static` only as `static const` data,
+# in the PART or TRIG macro of helper functions or on the sincos2 helper.
+# Prints what breaks a rule; fails then, and on an empty file.
+cat > "$tmp/source_rules.awk" <<'EOF'
+function has_word(s, w) { return s ~ ("(^|[^A-Za-z0-9_])(" w ")([^A-Za-z0-9_]|$)") }
+BEGIN {
+    forbidden = "malloc|calloc|realloc|free|alloca|printf|fprintf|sprintf|snprintf|puts|putchar|" \
+                "fopen|FILE|stdio|stdlib|setjmp|longjmp|exit|abort|errno"
+}
+FNR == 1 { incomment = 0; lines[FILENAME] = 1 }
+{
+    out = ""; i = 1; n = length($0)
+    while (i <= n) {
+        c = substr($0, i, 1); d = substr($0, i, 2)
+        if (incomment) {
+            if (d == "*/") { incomment = 0; i += 2 } else i++
+        } else if (d == "/*") { incomment = 1; i += 2; out = out " "
+        } else if (d == "//") { break
+        } else if (c == "\"" || c == "'") {
+            # a literal: skip to its closing quote, past escapes
+            for (j = i + 1; j <= n && substr($0, j, 1) != c; j++)
+                if (substr($0, j, 1) == "\\") j++
+            out = out c c; i = j + 1
+        } else { out = out c; i++ }
+    }
+    if ($0 ~ /^[ \t]*#[ \t]*include/) {
+        out = $0
+        if (out !~ includes) { print FILENAME ": " out; bad = 1 }
+    }
+    if (has_word(out, forbidden)) { print FILENAME ":" FNR ": " out; bad = 1 }
+    if (statics && has_word(out, "static") &&
+        out !~ /static const|#define [A-Z0-9_]+_(PART|TRIG) static|static void [A-Za-z0-9_]+_sincos2_apart\(double/) {
+        print FILENAME ":" FNR ": " out; bad = 1
+    }
+}
+END {
+    for (k = 1; k < ARGC; k++)
+        if (!(ARGV[k] in lines)) { print ARGV[k] ": empty"; bad = 1 }
     exit bad
 }
 EOF
 
-# call_graph OBJ OBJDUMP EXT_REGEX ALLOW_INDIRECT
-call_graph() {
-    "$2" -dr --no-show-raw-insn "$1" > "$tmp/dis" &&
-    awk -v ext="$3" -v allow_indirect="$4" -f "$tmp/callgraph.awk" "$tmp/dis"
-}
-
-# code_of FILE: the C text of FILE without comments and with every string
-# and character literal emptied (names from the .mech file live in those);
-# lines and directives kept. Fails on an empty result.
-code_of() {
-    awk '
-    {
-        out = ""; i = 1; n = length($0)
-        while (i <= n) {
-            c = substr($0, i, 1); d = substr($0, i, 2)
-            if (incomment) {
-                if (d == "*/") { incomment = 0; i += 2 } else i++
-            } else if (d == "/*") { incomment = 1; i += 2; out = out " "
-            } else if (d == "//") { break
-            } else if (c == "\"" || c == "'\''") {
-                # a literal: skip to its closing quote, past escapes
-                for (j = i + 1; j <= n && substr($0, j, 1) != c; j++)
-                    if (substr($0, j, 1) == "\\") j++
-                out = out c c; i = j + 1
-            } else { out = out c; i++ }
-        }
-        print out
-    }
-    # an #include names its file in quotes: keep those lines whole
-    ' "$1" | awk -v f="$1" '
-        BEGIN { while ((getline l < f) > 0) raw[++nr] = l }
-        { print (raw[NR] ~ /^[ \t]*#[ \t]*include/ ? raw[NR] : $0); n++ }
-        END { exit n == 0 }'
-}
-
-FORBIDDEN='\b(malloc|calloc|realloc|free|alloca|printf|fprintf|sprintf|snprintf|puts|putchar|fopen|FILE|stdio|stdlib|setjmp|longjmp|exit|abort|errno)\b'
-
 # source_rules C H: includes, forbidden names, static.
 source_rules() {
-    for f in "$1" "$2"; do
-        code_of "$f" > "$tmp/code" || return 1
-        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|<string\.h>|"[A-Za-z0-9_]+\.h")$/ {
-            print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
-        ! grep -n -E "$FORBIDDEN" "$tmp/code" &&
-        ! grep -n -w static "$tmp/code" | grep -v -E 'static const|#define [A-Z0-9_]+_(PART|TRIG) static|static void [A-Za-z0-9_]+_sincos2_apart\(double' ||
-        return 1
-    done
+    awk -v statics=1 -v includes='^#include (<math[.]h>|<string[.]h>|"[A-Za-z0-9_]+[.]h")$' \
+        -f "$tmp/source_rules.awk" "$@"
 }
 
 # ---- the toolchains ---------------------------------------------------------
@@ -258,6 +294,8 @@ else
 fi
 if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
     :
+elif [ "${FIRMWARE_RULES:-}" = host ]; then
+    skip "FIRMWARE_RULES=host: the Cortex-M builds (make firmware-check runs them)"
 elif command -v arm-none-eabi-gcc > /dev/null 2>&1; then
     a=arm-none-eabi-
     toolchains="$toolchains
@@ -293,8 +331,12 @@ sh "$root/examples/chain.sh" 12 "$tmp/chain_sparse_only.mech"
 # ---- generated kernels --------------------------------------------------------
 for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolled.mech" \
             "$tmp/chain_sparse_only.mech"; do
-    name=$(basename "$mech" .mech)
-    prefix=$(echo "$name" | tr -c 'A-Za-z0-9_\n' '_')
+    name=${mech##*/}
+    name=${name%.mech}
+    case $name in
+        *[!A-Za-z0-9_]*) prefix=$(echo "$name" | tr -c 'A-Za-z0-9_\n' '_') ;;
+        *) prefix=$name ;;
+    esac
     roll=never
     only=
     case $name in
@@ -320,12 +362,9 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
             o=$d/$prefix-$tc.o
             try 10 "$name ($real, $tc): $cc $FLAGS $arch" \
                 $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" || continue
-            symbols_of "$o" "$nm_" "$objdump_"
-            for rule in "undefined_only $o $allowed" \
-                        "no_writable_data $o $size_" \
-                        "defined_prefixed $o ^${prefix}_" \
-                        "call_graph $o $objdump_ $allowed 0"; do
-                try 10 "$name ($real, $tc): ${rule%% *}" $rule
+            object_rules "$o" "$nm_" "$size_" "$objdump_" "$allowed" "^${prefix}_" 0
+            for rule in undefined_only no_writable_data defined_prefixed call_graph; do
+                try 10 "$name ($real, $tc): $rule" kept "$o" $rule
             done
         done <<EOF
 $toolchains
@@ -336,12 +375,8 @@ done
 # ---- the runtime core -----------------------------------------------------------
 rt_sources=$(ls "$root"/runtime/*.c)
 rt_src_rules() {
-    for f in "$@"; do
-        code_of "$f" > "$tmp/code" || return 1
-        awk -v f="$f" '/^[ \t]*#[ \t]*include/ && $0 !~ /^#include (<math\.h>|<stddef\.h>|<stdbool\.h>|"mechrt\.h")$/ {
-            print f ": " $0; bad = 1 } END { exit bad }' "$tmp/code" &&
-        ! grep -n -E "$FORBIDDEN" "$tmp/code" || return 1
-    done
+    awk -v statics=0 -v includes='^#include (<math[.]h>|<stddef[.]h>|<stdbool[.]h>|"mechrt[.]h")$' \
+        -f "$tmp/source_rules.awk" "$@"
 }
 # exported_only OBJ NM REGEX: every global defined symbol matches REGEX.
 exported_only() {
@@ -371,11 +406,9 @@ while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
         fi
         ok
         allowed="^($MEM${extra:+|$extra})\$"
-        symbols_of "$d/core.o" "$nm_" "$objdump_"
-        for rule in "undefined_only $d/core.o $allowed" \
-                    "no_writable_data $d/core.o $size_" \
-                    "call_graph $d/core.o $objdump_ $allowed 1"; do
-            try 10 "runtime ($real, $tc): ${rule%% *}" $rule
+        object_rules "$d/core.o" "$nm_" "$size_" "$objdump_" "$allowed" "" 1
+        for rule in undefined_only no_writable_data call_graph; do
+            try 10 "runtime ($real, $tc): $rule" kept "$d/core.o" $rule
         done
         try 10 "runtime ($real, $tc): exported names" exported_only "$d/core.o" "$nm_" "$exported"
     done
