@@ -9,9 +9,10 @@
  *   Qd_p  = -Phi_q^-1 (V_q Q_p + V_p)                          V at qd
  *   Qdd_p =  Phi_q^-1 (G_q Q_p + G_qd Qd_p + G_p - (Phi_q qdd)_q Q_p - (Phi_q qdd)_p)
  *
- * where Phi_q qdd = V(qd := qdd) - V(qd := 0), so its partials are V's at
- * those two velocities; an output f gives f_q Q_p + f_p, D f the same with
- * its qd partials on Qd_p, and D(D f) + f_q qdd likewise.
+ * where Phi_q qdd = V(qd := qdd) - V(qd := 0), and V being affine in qd,
+ * its partials are V's at qd + qdd less V's at qd; an output f gives
+ * f_q Q_p + f_p, D f the same with its qd partials on Qd_p, and
+ * D(D f) + f_q qdd likewise.
  */
 #include "sens.h"
 
@@ -21,8 +22,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Where the engine's functions write, per velocity they are taken at. */
-enum { AT_QD, AT_QDD, AT_ZERO, AT_COUNT };
+/* Where the engine's functions write, per velocity they are taken at:
+   qd, and qd + qdd. V and D f are affine in qd, so the partials of
+   Phi_q qdd = V(qdd) - V(0) are V's at qd + qdd less V's at qd. */
+enum { AT_QD, AT_QD_QDD, AT_COUNT };
 
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size)
 {
@@ -122,7 +125,7 @@ static MechrtStatus factor(Sens *s, double t, const double *q)
 static void outputs(Sens *s)
 {
     int n = s->nout, nq = s->nq, np = s->np;
-    double *const *y = s->y[AT_QD], *const *y2 = s->y[AT_QDD], *const *y0 = s->y[AT_ZERO];
+    double *const *y = s->y[AT_QD], *const *y2 = s->y[AT_QD_QDD], *const *y0 = s->y[AT_QD];
     size_t len = (size_t)n * (size_t)np;
     set_scaled(s->y_p, 1.0, y[1], len);                 /* f_q Q_p + f_p */
     add_product(s->y_p, 1.0, y[0], s->q_p, n, nq, np);
@@ -154,11 +157,11 @@ MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, con
         return st;
     int n = s->nq, np = s->np;
     size_t len = (size_t)n * (size_t)np;
-    double *zero = s->work;     /* nq zeros: the velocity of V(qd := 0) */
-    memset(zero, 0, (size_t)n * sizeof *zero);
+    double *both = s->work;     /* qd + qdd */
+    for (int i = 0; i < n; i++)
+        both[i] = qd[i] + qdd[i];
     partials_at(s, AT_QD, q, qd, t);
-    partials_at(s, AT_QDD, q, qdd, t);
-    partials_at(s, AT_ZERO, q, zero, t);
+    partials_at(s, AT_QD_QDD, q, both, t);
     engine_design(s->e, DESIGN_G, q, qd, t, s->g);
     set_scaled(s->q_p, -1.0, s->phi_p, len);
     solve_columns(s, s->q_p);
@@ -168,10 +171,10 @@ MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, con
     set_scaled(s->qdd_p, 1.0, s->g[2], len);
     add_product(s->qdd_p, 1.0, s->g[0], s->q_p, n, n, np);
     add_product(s->qdd_p, 1.0, s->g[1], s->qd_p, n, n, np);
-    add_product(s->qdd_p, -1.0, s->v[AT_QDD][0], s->q_p, n, n, np);
-    add_product(s->qdd_p, 1.0, s->v[AT_ZERO][0], s->q_p, n, n, np);
+    add_product(s->qdd_p, -1.0, s->v[AT_QD_QDD][0], s->q_p, n, n, np);
+    add_product(s->qdd_p, 1.0, s->v[AT_QD][0], s->q_p, n, n, np);
     for (size_t i = 0; i < len; i++)
-        s->qdd_p[i] -= s->v[AT_QDD][1][i] - s->v[AT_ZERO][1][i];
+        s->qdd_p[i] -= s->v[AT_QD_QDD][1][i] - s->v[AT_QD][1][i];
     solve_columns(s, s->qdd_p);
     if (s->nout)
         outputs(s);

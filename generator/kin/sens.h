@@ -26,10 +26,10 @@ typedef struct Sens {
     double *q_p, *qd_p, *qdd_p;     /* nq x np */
     double *y_p, *yd_p, *ydd_p;     /* nout x np: the outputs' */
     /* the rest is sens.c's: Phi_q's LU, Phi_p, the engine's partials at
-       qd, qdd and 0 (V's and the outputs'), gamma's, scratch */
+       qd and qd + qdd (V's and the outputs'), gamma's, scratch */
     double *jac, *piv, *phi_p, *col, *work;
-    double *v[3][2];
-    double *y[3][DESIGN_Y_COUNT];
+    double *v[2][2];
+    double *y[2][DESIGN_Y_COUNT];
     double *g[3];
 } Sens;
 
