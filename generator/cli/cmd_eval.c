@@ -38,24 +38,38 @@ static const CliOption options[] = {
 
 static const char *row_level(const Row *row) { return row->velocity ? "velocity" : "position"; }
 
-/* "M" and "Q" (a file with masses): after the spec's keys. */
-static void print_json_dynamics(const Model *m, const double *M, const double *Q)
+/* ,\n "KEY": [v0, v1, ...] */
+static void json_vector(const char *key, const double *v, int n)
 {
-    printf(",\n \"M\": [");
-    for (int r = 0; r < m->nq; r++) {
-        printf(r ? ",\n       [" : "[");
-        for (int c = 0; c < m->nq; c++) {
+    printf(",\n \"%s\": [", key);
+    for (int i = 0; i < n; i++) {
+        printf(i ? ", " : "");
+        json_number(stdout, v[i]);
+    }
+    printf("]");
+}
+
+/* ,\n "KEY": [[row 0], then each row on a line of its own under the first] */
+static void json_matrix(const char *key, const double *a, int rows, int cols)
+{
+    int indent = (int)strlen(key) + 6;     /* under the first row's '[' */
+    printf(",\n \"%s\": [", key);
+    for (int r = 0; r < rows; r++) {
+        printf(r ? ",\n%*s[" : "[", r ? indent : 0, "");
+        for (int c = 0; c < cols; c++) {
             printf(c ? ", " : "");
-            json_number(stdout, M[(size_t)r * (size_t)m->nq + (size_t)c]);
+            json_number(stdout, a[(size_t)r * (size_t)cols + (size_t)c]);
         }
         printf("]");
     }
-    printf("],\n \"Q\": [");
-    for (int i = 0; i < m->nq; i++) {
-        printf(i ? ", " : "");
-        json_number(stdout, Q[i]);
-    }
     printf("]");
+}
+
+/* "M" and "Q" (a file with masses): after the spec's keys. */
+static void print_json_dynamics(const Model *m, const double *M, const double *Q)
+{
+    json_matrix("M", M, m->nq, m->nq);
+    json_vector("Q", Q, m->nq);
 }
 
 /* "design", "p" and "phi_p" (a file with design parameters): after the others. */
@@ -63,21 +77,8 @@ static void print_json_design(const Model *m, const double *phi_p)
 {
     printf(",\n \"design\": ");
     json_string_list(stdout, m->design_names, m->np);
-    printf(",\n \"p\": [");
-    for (int j = 0; j < m->np; j++) {
-        printf(j ? ", " : "");
-        json_number(stdout, m->dag.param_values[j]);
-    }
-    printf("],\n \"phi_p\": [");
-    for (int r = 0; r < m->nh; r++) {
-        printf(r ? ",\n           [" : "[");
-        for (int j = 0; j < m->np; j++) {
-            printf(j ? ", " : "");
-            json_number(stdout, phi_p[(size_t)r * (size_t)m->np + (size_t)j]);
-        }
-        printf("]");
-    }
-    printf("]");
+    json_vector("p", m->dag.param_values, m->np);
+    json_matrix("phi_p", phi_p, m->nh, m->np);
 }
 
 /* The design and dPhi/dp's nonzero entries row by row. */
@@ -117,28 +118,12 @@ static void print_json(const Model *m, double t, const double *q, const double *
     }
     printf("],\n \"t\": ");
     json_number(stdout, t);
-    const struct { const char *key; const double *v; int n; } vecs[] = {
-        {"q", q, m->nq}, {"qd", qd, m->nq}, {"phi", phi, m->nh}, {"nu", nu, m->nr},
-        {"gamma", gamma, m->nr},
-    };
-    for (size_t k = 0; k < sizeof vecs / sizeof *vecs; k++) {
-        printf(",\n \"%s\": [", vecs[k].key);
-        for (int i = 0; i < vecs[k].n; i++) {
-            printf(i ? ", " : "");
-            json_number(stdout, vecs[k].v[i]);
-        }
-        printf("]");
-    }
-    printf(",\n \"jac\": [");
-    for (int r = 0; r < m->nr; r++) {
-        printf(r ? ",\n         [" : "[");
-        for (int c = 0; c < m->nq; c++) {
-            printf(c ? ", " : "");
-            json_number(stdout, jac[(size_t)r * (size_t)m->nq + (size_t)c]);
-        }
-        printf("]");
-    }
-    printf("]");
+    json_vector("q", q, m->nq);
+    json_vector("qd", qd, m->nq);
+    json_vector("phi", phi, m->nh);
+    json_vector("nu", nu, m->nr);
+    json_vector("gamma", gamma, m->nr);
+    json_matrix("jac", jac, m->nr, m->nq);
     if (M)
         print_json_dynamics(m, M, Q);
     if (phi_p)
