@@ -306,13 +306,13 @@ static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     if (c->tol > 0)
         o.xtol = o.gtol = c->tol;
     FitData d = {0};
-    Diag data_diag;
+    Diag data_diag = {0};     /* failed stays false unless the CSV was read */
     Engine e;
     int status = EXIT_USAGE;
-    if (!read_choices(c, m, &o)) {
-    } else if (!fit_data_read(c->data_path, m, &d, &data_diag)) {
+    bool data = read_choices(c, m, &o) && fit_data_read(c->data_path, m, &d, &data_diag);
+    if (!data && data_diag.failed)
         diag_print(&data_diag, stderr);
-    } else if (cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
+    if (data && cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
         FitResult r;
         FitStatus st = fit_run(m, &mech->kin, &e, &d, &o, &r);
         if (st == FIT_BAD_INPUT) {
