@@ -1,8 +1,9 @@
 /* test_design.c - design parameters: parsed and refused where they may not go, emitted as p, evaluated alike by every engine, and the sensitivities against finite differences of whole runs.
  *
  * `design NAME = value` makes NAME the graph leaf p[j]: a derived `param`
- * of it works, an axis, a mass, an inertia or gravity depending on it is
- * an error naming it (FILE:LINE:COL). The generated C of such a file takes
+ * of it works, a mass, an inertia or gravity depending on it is an error
+ * naming it (FILE:LINE:COL), and so is an axis that is zero at the file's
+ * design. The generated C of such a file takes
  * `const PREFIX_real *p`, defines PREFIX_NP and PREFIX_phi_p; a file
  * without design parameters emits what it did before. jit, aot (when a C
  * compiler is there) and generic give the same Phi and Phi_p at a design
@@ -11,8 +12,10 @@
  * positions, velocities, accelerations and outputs at every state of a run
  * are the central differences of whole runs at p +- h, for a planar
  * four-bar with a point on a rod (designed lengths, pivots, rod length,
- * driver speed, a constraint's and an output's coefficient) and a spatial
- * RSSR (designed crank offset, ground pivot and rod length). The aot library cache goes to the run's (testcache.h).
+ * driver speed, a constraint's and an output's coefficient), a spatial
+ * RSSR (designed crank offset, ground pivot and rod length) and the RSSR
+ * with both revolute axes designed. Spatial translational, cylindrical
+ * and universal joints with designed axes agree between engines. The aot library cache goes to the run's (testcache.h).
  */
 #include "testutil.h"
 #include "testcache.h"
@@ -92,6 +95,40 @@ static const char spatial_text[] =
     "output psi = angle(R2)\n"
     "output Q: rocker(c, 0, 0)\n";
 
+/* The RSSR with its revolutes' axes designed: R1's tilted by ty (the
+   crank's offset stays perpendicular to it), R2's (0, ay, az). */
+static const char spatial_axis_text[] =
+    "mechanism rssr_axes\n"
+    "spatial\n"
+    "design ty = 0.1\n"
+    "design ay = 1\n"
+    "design az = 1.2\n"
+    "param c     = 3\n"
+    "param omega = 2*pi\n"
+    "body crank  x = 0  y = 0  z = 0\n"
+    "body rocker x = 2  y = 0  z = 0  orient = axis(0, 1, 1, pi/2)\n"
+    "revolute R1: ground(0, 0, 0)  crank(0, 0, 0)   axis(0, ty, 1)\n"
+    "revolute R2: ground(2, 0, 0)  rocker(0, 0, 0)  axis(0, ay, az)\n"
+    "distance C:  crank(1, 0, 0)   rocker(c, 0, 0)  length = sqrt(10)\n"
+    "driver   D:  angle(R1) = omega*t\n"
+    "output psi = angle(R2)\n"
+    "output Q: rocker(c, 0, 0)\n";
+
+/* A translational, a cylindrical and a universal joint (B's axis given)
+   with designed axes, driven along the slide. */
+static const char spatial_slider_text[] =
+    "spatial\n"
+    "design tx = 1\n"
+    "design ty = 0.2\n"
+    "design tz = 0.1\n"
+    "design ux = 0.3\n"
+    "body s x = 0 y = 0 z = 0\n"
+    "body w x = 0 y = 0 z = 0\n"
+    "translational T: ground(0, 0, 0) s(0, 0, 0) axis(tx, ty, tz)\n"
+    "cylindrical C: s(0, 0, 0) w(0, 0, 0) axis(ux, 1, 0)\n"
+    "universal U: ground(0, 0, 0) w(0, 0, 0) axis(ux, 0, 1) axis(0, 1, ux)\n"
+    "driver D: slide(T) = t\n";
+
 static bool open_kind(Engine *e, EngineKind kind, const Mech *mech)
 {
     return testcache_open_engine(&cache, e, kind, mech);
@@ -161,9 +198,9 @@ static void expect_refused(const char *text, const char *where, const char *what
 static void test_parse_refuses_design_in_constants(void **s)
 {
     (void)s;
-    expect_refused("spatial\ndesign L = 1\nbody a x = 0 y = 0 z = 0\n"
-                   "revolute O: ground(0, 0, 0) a(0, 0, 0) axis(L, 0, 1)\n",
-                   "bad.mech:4:45: error: ", "an axis component cannot depend on design parameter 'L'");
+    expect_refused("spatial\ndesign L = 0\nbody a x = 0 y = 0 z = 0\n"
+                   "revolute O: ground(0, 0, 0) a(0, 0, 0) axis(L, 0, 2*L)\n",
+                   "bad.mech:4:40: error: ", "the axis of revolute 'O' is zero at the file's design");
     const char *pendulum = "design k = 2\nparam twice = 2*k\n"
                            "body rod x = 0.5 y = 0 phi = 0\nrevolute O: ground(0, 0) rod(-0.5, 0)\n";
     static const struct {
@@ -352,6 +389,13 @@ static void test_engines_agree_spatial(void **s)
     check_engines(spatial_text, "rssr_design.mech", (double[]){0.1, -0.2, 0.15});
 }
 
+static void test_engines_agree_spatial_axes(void **s)
+{
+    (void)s;
+    check_engines(spatial_axis_text, "rssr_axes.mech", (double[]){0.05, -0.2, 0.15});
+    check_engines(spatial_slider_text, "slider_axes.mech", (double[]){0.1, -0.05, 0.2, 0.1});
+}
+
 /* ---- sensitivities against whole runs ----------------------------------- */
 
 enum { STEPS = 24 };
@@ -474,6 +518,12 @@ static void test_sensitivities_spatial(void **s)
     check_sensitivities(spatial_text, "rssr_design.mech");
 }
 
+static void test_sensitivities_spatial_axes(void **s)
+{
+    (void)s;
+    check_sensitivities(spatial_axis_text, "rssr_axes.mech");
+}
+
 /* The CSV names: d(NAME)/d(P), d(d(NAME))/d(P), d(dd(NAME))/d(P), in
    sens_columns' order. */
 static void test_sensitivity_column_names(void **s)
@@ -521,6 +571,8 @@ int main(void)
         cmocka_unit_test(test_engines_agree_spatial),
         cmocka_unit_test(test_sensitivities_planar),
         cmocka_unit_test(test_sensitivities_spatial),
+        cmocka_unit_test(test_engines_agree_spatial_axes),
+        cmocka_unit_test(test_sensitivities_spatial_axes),
         cmocka_unit_test(test_sensitivity_column_names),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -222,7 +222,7 @@ double build_constant(Builder *b, const Ast *ast, const char *what)
     double v;
     if (!dag_is_const(dag, id, &v) && first_design(dag, id))
         diag_fail(b->diag, ast->pos, "%s cannot depend on design parameter '%s' (design "
-                  "parameters may set offsets, planar axes, lengths, drivers, constraints, "
+                  "parameters may set offsets, axes, lengths, drivers, constraints, "
                   "outputs and initial values)", what, first_design(dag, id));
     if (!dag_is_const(dag, id, &v) || !isfinite(v))
         diag_fail(b->diag, ast->pos, "%s is not a finite number", what);
@@ -237,7 +237,8 @@ NodeId build_design_value(Builder *b, const Ast *ast, const char *what, double *
         return id;
     *nominal = node_value_at(dag, id, NULL, NULL, 0.0);
     if (!isfinite(*nominal))
-        diag_fail(b->diag, ast->pos, "%s is not a finite number at the file's design", what);
+        diag_fail(b->diag, ast->pos, "%s is not a finite number%s", what,
+                  first_design(dag, id) ? " at the file's design" : "");
     return id;
 }
 

@@ -34,10 +34,13 @@ typedef struct Vec3 {
 } Vec3;
 
 /* A body-fixed vector s of a joint side, not yet turned: A(p) s is built
-   only where a product needs it (see axis_dot). */
+   only where a product needs it (see axis_dot). A vector of an axis of
+   design parameters is the nodes v instead. */
 typedef struct Axis3 {
     Attach at;
     double s[3];
+    bool designed;
+    Vec3 v;
 } Axis3;
 
 /* A joint side's axis and two perpendiculars, body-fixed. */
@@ -184,15 +187,22 @@ static Vec3 difference3(Dag *d, Attach p, Attach q)
     return v3_sub(d, pp, pq);
 }
 
+/* The coordinate axis e_k f starts from: the smallest |h_k|, the first of equals. */
+static int frame_start(const double h[3])
+{
+    int k = 0;
+    for (int i = 1; i < 3; i++)
+        if (fabs(h[i]) < fabs(h[k]))
+            k = i;
+    return k;
+}
+
 /* The unit axis h and its perpendiculars f, g (see the header), local. */
 void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f[3], double g[3])
 {
     double n = sqrt(ux * ux + uy * uy + uz * uz);
     h[0] = ux / n, h[1] = uy / n, h[2] = uz / n;
-    int k = 0;
-    for (int i = 1; i < 3; i++)
-        if (fabs(h[i]) < fabs(h[k]))
-            k = i;
+    int k = frame_start(h);
     double len = 0;
     for (int i = 0; i < 3; i++) {
         f[i] = (i == k) - h[k] * h[i];
@@ -206,21 +216,60 @@ void joints_spatial_frame(double ux, double uy, double uz, double h[3], double f
     g[2] = h[0] * f[1] - h[1] * f[0];
 }
 
-/* The h, f, g of side A (b false: the axis (ux, uy, uz)) or B. */
-static Frame3 frame3(const Joint *j, bool b)
+/* The frame of an axis u of design parameters, as nodes: h = u / |u|,
+   f = (e_k - h_k h) / sqrt(1 - h_k^2), g = h x f, with k the one of the
+   file's design (fr's numbers), so that the rows are smooth in p about it. */
+static void designed_frame3(Dag *d, Frame3 *fr, const NodeId u[3])
 {
-    Frame3 fr;
+    int k = frame_start(fr->h.s);
+    Vec3 uv = {u[0], u[1], u[2]};
+    NodeId uu = v3_dot(d, uv, uv);
+    NodeId n = dag_call(d, OP_SQRT, uu, DAG_NONE);
+    NodeId inv = dag_div(d, DAG_ONE, n);
+    Vec3 h = v3_scale(d, inv, uv);
+    NodeId hk = k == 0 ? h.x : k == 1 ? h.y : h.z;
+    Vec3 khh = v3_scale(d, hk, h);
+    Vec3 ek = {k == 0 ? DAG_ONE : DAG_ZERO, k == 1 ? DAG_ONE : DAG_ZERO, k == 2 ? DAG_ONE : DAG_ZERO};
+    Vec3 f0 = v3_sub(d, ek, khh);
+    NodeId hk2 = dag_mul(d, hk, hk);
+    NodeId rest = dag_sub(d, DAG_ONE, hk2);
+    NodeId len = dag_call(d, OP_SQRT, rest, DAG_NONE);
+    NodeId il = dag_div(d, DAG_ONE, len);
+    Vec3 f = v3_scale(d, il, f0);
+    Vec3 g = v3_cross(d, h, f);
+    fr->h.v = h, fr->f.v = f, fr->g.v = g;
+    fr->h.designed = fr->f.designed = fr->g.designed = true;
+}
+
+static bool nodes_constant(const Dag *d, const NodeId u[3])
+{
+    return dag_is_const(d, u[0], NULL) && dag_is_const(d, u[1], NULL) && dag_is_const(d, u[2], NULL);
+}
+
+/* The h, f, g of side A (b false: the axis (ux, uy, uz)) or B. */
+static Frame3 frame3(Dag *d, const Joint *j, bool b)
+{
+    Frame3 fr = {0};
     if (b)
         joints_spatial_frame(j->bx, j->by, j->bz, fr.h.s, fr.f.s, fr.g.s);
     else
         joints_spatial_frame(j->ux, j->uy, j->uz, fr.h.s, fr.f.s, fr.g.s);
     fr.h.at = fr.f.at = fr.g.at = b ? j->b : j->a;
+    const NodeId *u = b ? j->b_node : j->u_node;
+    if (j->axis_designed && !nodes_constant(d, u))
+        designed_frame3(d, &fr, u);
     return fr;
 }
 
 static Vec3 axis_global(Dag *d, Axis3 v)
 {
-    return rotate3(d, v.at, v.s);
+    if (!v.designed)
+        return rotate3(d, v.at, v.s);
+    if (!v.at.has_p)
+        return v.v;
+    NodeId two = dag_const(d, 2.0);
+    Vec3 s2 = v3_scale(d, two, v.v);
+    return rotate3_nodes(d, v.at, v.v, s2);
 }
 
 /* c^T A(p) s for a constant c, written so each factor is linear in p:
@@ -260,6 +309,11 @@ static NodeId fixed_dot(Dag *d, const double c[3], Axis3 v)
 /* (A(p_a) a)^T (A(p_b) b); one side fixed (ground or a point): fixed_dot. */
 static NodeId axis_dot(Dag *d, Axis3 a, Axis3 b)
 {
+    if (a.designed || b.designed) {
+        Vec3 ga = axis_global(d, a);
+        Vec3 gb = axis_global(d, b);
+        return v3_dot(d, ga, gb);
+    }
     if (!a.at.has_p && b.at.has_p)
         return fixed_dot(d, a.s, b);
     if (a.at.has_p && !b.at.has_p)
@@ -304,7 +358,7 @@ void lower_S_SPHERICAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 /* universal: spherical; .dot dot-1 hA^T hB = 0 */
 void lower_S_UNIVERSAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     spherical(d, j, rows);
     rows[3] = axis_dot(d, a.h, b.h);
 }
@@ -312,21 +366,21 @@ void lower_S_UNIVERSAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 /* revolute: spherical; .f, .g parallel axes */
 void lower_S_REVOLUTE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     spherical(d, j, rows);
     parallel(d, &a, &b, rows + 3);
 }
 
 void lower_S_CYLINDRICAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     cylindrical(d, j, &a, &b, rows);
 }
 
 /* translational: cylindrical; .rot dot-1 gA^T fB = 0 (no turning about h) */
 void lower_S_TRANSLATIONAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     cylindrical(d, j, &a, &b, rows);
     rows[4] = axis_dot(d, a.g, b.f);
 }
@@ -336,8 +390,9 @@ void lower_S_TRANSLATIONAL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 void lower_S_WELD(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
     spherical(d, j, rows);
-    Axis3 xa = {j->a, {1, 0, 0}}, ya = {j->a, {0, 1, 0}}, za = {j->a, {0, 0, 1}};
-    Axis3 xb = {j->b, {1, 0, 0}}, yb = {j->b, {0, 1, 0}}, zb = {j->b, {0, 0, 1}};
+    Axis3 xa = {.at = j->a, .s = {1, 0, 0}}, ya = {.at = j->a, .s = {0, 1, 0}};
+    Axis3 za = {.at = j->a, .s = {0, 0, 1}}, xb = {.at = j->b, .s = {1, 0, 0}};
+    Axis3 yb = {.at = j->b, .s = {0, 1, 0}}, zb = {.at = j->b, .s = {0, 0, 1}};
     rows[3] = axis_dot(d, xa, yb);
     rows[4] = axis_dot(d, ya, zb);
     rows[5] = axis_dot(d, za, xb);
@@ -359,7 +414,7 @@ void lower_S_DISTANCE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 /* pointplane: dot-2 hA^T (P_B - P_A) = 0 */
 void lower_S_POINTPLANE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false);
+    Frame3 a = frame3(d, j, false);
     Vec3 e = difference3(d, j->b, j->a);
     Vec3 ha = axis_global(d, a.h);
     rows[0] = v3_dot(d, ha, e);
@@ -367,14 +422,14 @@ void lower_S_POINTPLANE(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 
 void lower_S_PARALLEL(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     parallel(d, &a, &b, rows);
 }
 
 /* perpendicular: dot-1 hA^T hB = 0 */
 void lower_S_PERPENDICULAR(Dag *d, const Joint *j, NodeId rows[JOINT_MAX_ROWS])
 {
-    Frame3 a = frame3(j, false), b = frame3(j, true);
+    Frame3 a = frame3(d, j, false), b = frame3(d, j, true);
     rows[0] = axis_dot(d, a.h, b.h);
 }
 
@@ -411,7 +466,7 @@ static Vec3 contact_offset(Dag *d, const Joint *j, NodeId *s_out)
     double n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     for (int i = 0; i < 3; i++)
         u[i] /= n;
-    Vec3 a = rotate3(d, j->a, u);
+    Vec3 a = j->axis_designed ? axis_global(d, frame3(d, j, false).h) : rotate3(d, j->a, u);
     NodeId xx = dag_mul(d, a.x, a.x);
     NodeId yy = dag_mul(d, a.y, a.y);
     NodeId s2 = dag_add(d, xx, yy);
@@ -474,7 +529,7 @@ void joints_spatial_point(Model *model, Attach at, NodeId xyz[3])
 NodeId joints_spatial_slide(Model *model, const Joint *j)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(j, false);
+    Frame3 a = frame3(d, j, false);
     Vec3 e = difference3(d, j->b, j->a);
     Vec3 ha = axis_global(d, a.h);
     return v3_dot(d, ha, e);
@@ -485,8 +540,8 @@ NodeId joints_spatial_slide(Model *model, const Joint *j)
 NodeId joints_spatial_angle(Model *model, const Joint *j)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(j, false);
-    Frame3 b = frame3(j, true);
+    Frame3 a = frame3(d, j, false);
+    Frame3 b = frame3(d, j, true);
     NodeId c = axis_dot(d, a.f, b.f);
     NodeId s = axis_dot(d, a.g, b.f);
     return dag_call(d, OP_ATAN2, s, c);
@@ -497,8 +552,8 @@ NodeId joints_spatial_angle(Model *model, const Joint *j)
 NodeId joints_spatial_angle_row(Model *model, const Joint *j, NodeId theta)
 {
     Dag *d = &model->dag;
-    Frame3 a = frame3(j, false);
-    Frame3 b = frame3(j, true);
+    Frame3 a = frame3(d, j, false);
+    Frame3 b = frame3(d, j, true);
     NodeId c = axis_dot(d, a.f, b.f);
     NodeId s = axis_dot(d, a.g, b.f);
     NodeId ct = dag_call(d, OP_COS, theta, DAG_NONE);

@@ -331,18 +331,26 @@ static void check_normalisable(Builder *b, SrcPos pos, const double u[3])
                   n > 0 ? "0" : "NaN (0/0)");
 }
 
-/* A spatial joint's axes: A's (ux, uy, uz), B's (bx, by, bz), neither zero. */
+/* A spatial joint's axes: A's (ux, uy, uz), B's (bx, by, bz), neither zero
+   (at the file's design when design parameters give them: their nodes
+   then make the rows, joints_spatial.c). */
 static void spatial_axes(Builder *b, const Stmt *s, Joint *j)
 {
     const JointInfo *info = &joint_info[s->joint];
     double u[2][3];
+    NodeId *node[2] = {j->u_node, j->b_node};
     for (int k = 0; k < 2; k++) {
         Ast *const *ax = k == 0 || !s->axis_b[0] ? s->axis : s->axis_b;
         SrcPos pos = k == 0 || !s->axis_b[0] ? s->axis_pos : s->axis_b_pos;
-        for (int i = 0; i < 3; i++)
-            u[k][i] = build_constant(b, ax[i], "an axis component");
+        for (int i = 0; i < 3; i++) {
+            u[k][i] = 0.0;
+            node[k][i] = ax[i] ? build_design_value(b, ax[i], "an axis component", &u[k][i])
+                               : DAG_ZERO;
+            j->axis_designed |= !dag_is_const(&b->model->dag, node[k][i], NULL);
+        }
         if (u[k][0] == 0.0 && u[k][1] == 0.0 && u[k][2] == 0.0)
-            diag_fail(b->diag, pos, "the axis of %s '%s' is zero", info->keyword, s->name);
+            diag_fail(b->diag, pos, "the axis of %s '%s' is zero%s", info->keyword, s->name,
+                      j->axis_designed ? " at the file's design" : "");
         check_normalisable(b, pos, u[k]);
     }
     j->ux = u[0][0], j->uy = u[0][1], j->uz = u[0][2];

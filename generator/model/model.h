@@ -30,10 +30,11 @@ typedef struct Joint {
     SrcPos pos;
     Attach a, b;
     double ux, uy;      /* axis, as written (a designed one's at the file's design) */
-    bool axis_designed; /* a planar axis of design parameters: */
-    NodeId u_node[2];   /* its nodes */
     double uz;          /* spatial: A's axis is (ux, uy, uz) in A's frame, */
     double bx, by, bz;  /* and B's (bx, by, bz) in B's (A's vector unless given) */
+    bool axis_designed; /* an axis of design parameters (A's or B's): */
+    NodeId u_node[3];   /* A's components as nodes (planar: u_node[0], [1]), */
+    NodeId b_node[3];   /* B's (spatial) */
     NodeId option;      /* length, angle or radius (angle absent: 0); a
                            measuring driver's right side E (below) */
     int measures;       /* spatial `driver D: angle(R) = E`: 1 + R's index in
