@@ -88,6 +88,42 @@ static void accumulate(DynWork *w, NodeId *acc, int j, NodeId v)
     acc[j] = dag_add(w->dag, acc[j], v);
 }
 
+/* A mass's or force's constant as a node: the number, made as before
+   design parameters could set it (a file without them gets the same
+   nodes), or its expression of design parameters. */
+static NodeId dyn_node(Dag *d, double value, NodeId node)
+{
+    return dag_is_const(d, node, NULL) ? dag_const(d, value) : node;
+}
+
+/* sign m g_c of an element: one named constant, or a product of nodes. */
+static NodeId weight(DynWork *w, const MassElement *e, int c, double sign)
+{
+    Dag *d = w->dag;
+    NodeId g = w->m->gravity_node[c];
+    if (dag_is_const(d, e->m_node, NULL) && dag_is_const(d, g, NULL))
+        return dag_const_named(d, sign * e->m * w->m->gravity[c], DYN_WEIGHT);
+    NodeId mg = dag_mul(d, e->m_node, g);
+    return sign < 0 ? dag_neg(d, mg) : mg;
+}
+
+/* J + m s.s of a planar body: one named constant, or nodes. */
+static NodeId inertia_at_body(Dag *d, const MassElement *e)
+{
+    const NodeId parts[4] = {e->J_node, e->m_node, e->s_node[0], e->s_node[1]};
+    bool constant = true;
+    for (int i = 0; i < 4; i++)
+        constant = constant && dag_is_const(d, parts[i], NULL);
+    if (constant)
+        return dag_const_named(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy),
+                               DYN_INERTIA_AT_BODY);
+    NodeId xx = dag_mul(d, e->s_node[0], e->s_node[0]);
+    NodeId yy = dag_mul(d, e->s_node[1], e->s_node[1]);
+    NodeId ss = dag_add(d, xx, yy);
+    NodeId mss = dag_mul(d, e->m_node, ss);
+    return dag_add(d, e->J_node, mss);
+}
+
 /* a * b + c * d, each product in a statement of its own */
 static NodeId dot2(Dag *d, NodeId a, NodeId b, NodeId c, NodeId e)
 {
@@ -108,29 +144,28 @@ static void add_body(DynWork *w, const MassElement *e)
     int x = e->body, y = x + 1, phi = x + 2;
     NodeId c = dag_call(d, OP_COS, e->theta, DAG_NONE);     /* as joints.c's rotate */
     NodeId sn = dag_call(d, OP_SIN, e->theta, DAG_NONE);
-    NodeId vx = dag_const(d, e->sx), vy = dag_const(d, e->sy);
+    NodeId vx = dyn_node(d, e->sx, e->s_node[0]);
+    NodeId vy = dyn_node(d, e->sy, e->s_node[1]);
     NodeId sy = dag_mul(d, sn, vy), cx = dag_mul(d, c, vx);
     NodeId ux = dag_sub(d, cx, sy);
     NodeId cy = dag_mul(d, c, vy), sx = dag_mul(d, sn, vx);
     NodeId uy = dag_add(d, sx, cy);
-    NodeId m = dag_const(d, e->m);
+    NodeId m = dyn_node(d, e->m, e->m_node);
     add_mass(w, x, x, m);
     add_mass(w, y, y, m);
     NodeId muy = dag_mul(d, m, uy);
     add_mass(w, x, phi, dag_neg(d, muy));
     add_mass(w, y, phi, dag_mul(d, m, ux));
-    add_mass(w, phi, phi, dag_const_named(d, e->J + e->m * (e->sx * e->sx + e->sy * e->sy),
-                                          DYN_INERTIA_AT_BODY));
+    add_mass(w, phi, phi, inertia_at_body(d, e));
     NodeId rate = dag_vard(d, phi);
     NodeId w2 = dag_mul(d, rate, rate);
     NodeId mw2 = dag_mul(d, m, w2);
     accumulate(w, w->velocity, x, dag_mul(d, mw2, ux));
     accumulate(w, w->velocity, y, dag_mul(d, mw2, uy));
-    double gx = w->m->gravity[0], gy = w->m->gravity[1];
-    accumulate(w, w->applied, x, dag_const_named(d, e->m * gx, DYN_WEIGHT));
-    accumulate(w, w->applied, y, dag_const_named(d, e->m * gy, DYN_WEIGHT));
-    NodeId mgx = dag_const_named(d, -e->m * gx, DYN_WEIGHT);
-    NodeId mgy = dag_const_named(d, e->m * gy, DYN_WEIGHT);
+    accumulate(w, w->applied, x, weight(w, e, 0, 1.0));
+    accumulate(w, w->applied, y, weight(w, e, 1, 1.0));
+    NodeId mgx = weight(w, e, 0, -1.0);
+    NodeId mgy = weight(w, e, 1, 1.0);
     accumulate(w, w->applied, phi, dot2(d, uy, mgx, ux, mgy));
 }
 
@@ -165,21 +200,22 @@ static void euler_matrix(Dag *d, const EulerEntry table[3][4], const NodeId v[4]
         }
 }
 
-/* J' (xx, yy, zz, xy, xz, yz) entry (i, j). */
-static double tensor_at(const double t[6], int i, int j)
+/* The index of J' (i, j) in (xx, yy, zz, xy, xz, yz). */
+static int tensor_index(int i, int j)
 {
     static const int at[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
-    return t[at[i][j]];
+    return at[i][j];
 }
 
-/* sum_j c[j] v[j] over three constants and nodes, zeros left out */
-static NodeId weighted3(Dag *d, const double c[3], NodeId const v[3])
+/* sum_j c[j] v[j] over three coefficients (numbers c, nodes cn) and
+   nodes v; constant zeros left out */
+static NodeId weighted3(Dag *d, const double c[3], const NodeId cn[3], NodeId const v[3])
 {
     NodeId sum = DAG_ZERO;
     for (int j = 0; j < 3; j++) {
-        if (c[j] == 0)
+        if (dag_is_const(d, cn[j], NULL) && c[j] == 0)
             continue;
-        NodeId term = dag_mul(d, dag_const(d, c[j]), v[j]);
+        NodeId term = dag_mul(d, dyn_node(d, c[j], cn[j]), v[j]);
         sum = dag_add(d, sum, term);
     }
     return sum;
@@ -202,13 +238,16 @@ static void add_rotation(DynWork *w, const MassElement *e)
     euler_matrix(d, euler_G, p, G);
     euler_matrix(d, euler_G, pd, Gd);
     double J[3][3];
+    NodeId Jn[3][3];
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            J[i][j] = tensor_at(e->inertia, i, j);
+        for (int j = 0; j < 3; j++) {
+            J[i][j] = e->inertia[tensor_index(i, j)];
+            Jn[i][j] = e->inertia_node[tensor_index(i, j)];
+        }
     for (int b = 0; b < 4 && !d->overflow; b++) {
         NodeId col[3] = {G[0][b], G[1][b], G[2][b]}, jg[3];
         for (int i = 0; i < 3; i++)
-            jg[i] = weighted3(d, J[i], col);     /* (J' G)(i, b) */
+            jg[i] = weighted3(d, J[i], Jn[i], col);     /* (J' G)(i, b) */
         for (int a = 0; a <= b; a++) {
             NodeId ga[3] = {G[0][a], G[1][a], G[2][a]};
             NodeId sum = DAG_ZERO;
@@ -229,7 +268,7 @@ static void add_rotation(DynWork *w, const MassElement *e)
         omega[i] = dag_mul(d, dag_const(d, 2.0), sum);
     }
     for (int i = 0; i < 3; i++)
-        jw[i] = weighted3(d, J[i], omega);
+        jw[i] = weighted3(d, J[i], Jn[i], omega);
     for (int a = 0; a < 4 && !d->overflow; a++) {
         NodeId sum = DAG_ZERO;
         for (int i = 0; i < 3; i++) {
@@ -251,7 +290,7 @@ static void add_spatial_element(DynWork *w, const MassElement *e)
     for (int k = 0; k < n; k++)
         for (int c = 0; c < 3; c++)
             dp[3 * k + c] = diff_by_q(&w->df, parts[c], w->cols[k]);
-    NodeId m = dag_const(d, e->m);
+    NodeId m = dyn_node(d, e->m, e->m_node);
     for (int a = 0; a < n && !d->overflow; a++)
         for (int b = a; b < n; b++) {
             NodeId pp = dot2(d, dp[3 * a], dp[3 * b], dp[3 * a + 1], dp[3 * b + 1]);
@@ -266,7 +305,7 @@ static void add_spatial_element(DynWork *w, const MassElement *e)
     }
     NodeId g[3];
     for (int c = 0; c < 3; c++)
-        g[c] = dag_const_named(d, e->m * w->m->gravity[c], DYN_WEIGHT);
+        g[c] = weight(w, e, c, 1.0);
     for (int k = 0; k < n && !d->overflow; k++) {
         int j = w->cols[k];
         const NodeId *u = dp + 3 * k;
@@ -322,7 +361,8 @@ static void add_element(DynWork *w, const MassElement *e)
         dy[k] = diff_by_q(&w->df, e->py, w->cols[k]);
         dth[k] = diff_by_q(&w->df, e->theta, w->cols[k]);
     }
-    NodeId m = dag_const(d, e->m), J = dag_const(d, e->J);
+    NodeId m = dyn_node(d, e->m, e->m_node);
+    NodeId J = dyn_node(d, e->J, e->J_node);
     for (int a = 0; a < n && !d->overflow; a++)
         for (int b = a; b < n; b++) {
             NodeId pp = dot2(d, dx[a], dx[b], dy[a], dy[b]);
@@ -338,8 +378,8 @@ static void add_element(DynWork *w, const MassElement *e)
     NodeId ay = diff_total(&w->df, vy);
     NodeId vth = diff_total(&w->df, e->theta);
     NodeId ath = diff_total(&w->df, vth);
-    NodeId gx = dag_const_named(d, e->m * w->m->gravity[0], DYN_WEIGHT);
-    NodeId gy = dag_const_named(d, e->m * w->m->gravity[1], DYN_WEIGHT);
+    NodeId gx = weight(w, e, 0, 1.0);
+    NodeId gy = weight(w, e, 1, 1.0);
     for (int k = 0; k < n && !d->overflow; k++) {
         int j = w->cols[k];
         NodeId pa = dot2(d, dx[k], ax, dy[k], ay);
@@ -367,10 +407,10 @@ static void add_along(DynWork *w, NodeId e, NodeId coef)
 static NodeId spring_force(DynWork *w, const AppliedForce *f, NodeId s)
 {
     Dag *d = w->dag;
-    NodeId stretch = dag_sub(d, s, dag_const(d, f->free));
-    NodeId ks = dag_mul(d, dag_const(d, f->k), stretch);
+    NodeId stretch = dag_sub(d, s, dyn_node(d, f->free, f->free_node));
+    NodeId ks = dag_mul(d, dyn_node(d, f->k, f->k_node), stretch);
     NodeId rate = diff_total(&w->df, s);
-    NodeId cr = dag_mul(d, dag_const(d, f->c), rate);
+    NodeId cr = dag_mul(d, dyn_node(d, f->c, f->c_node), rate);
     NodeId sum = dag_add(d, ks, cr);
     NodeId total = dag_add(d, sum, f->fx);
     return dag_neg(d, total);

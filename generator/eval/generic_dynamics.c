@@ -24,6 +24,10 @@
  *   Q_e  += -(d/dt W)^T J' w' - W^T J' (d/dt W) ed + (d(W ed)/de)^T J' w',
  * so the two agree only if those identities hold: check compares them.
  * A body torque tau (global axes): Q_e += 2 E^T tau.
+ *
+ * Masses, inertias, gravity and spring constants of design parameters are
+ * the values of their nodes at the model's design, evaluated at each call
+ * into copies of the elements and forces (design_refresh).
  */
 #include "generic_impl.h"
 
@@ -47,7 +51,18 @@ struct GenericDyn {
        the pattern. NULL until generic_mass_pattern. */
     int *slot, *slot_at;
     int nnz;
+    /* The elements, forces and gravity the formulas read: the model's,
+       with their constants at the design now when the file has design
+       parameters (consts: their nodes, NCONST per element, then gravity,
+       then per force) */
+    MassElement *masses;
+    AppliedForce *forces;
+    double gravity[3];
+    NodeValues consts;
+    bool designed;
 };
+
+enum { MASS_CONSTS = 8, FORCE_CONSTS = 3 };
 
 enum { FORCE_ROOTS = 9 };
 
@@ -135,10 +150,71 @@ static void add_rotation_velocity(const MassElement *e, const double *q, const d
     }
 }
 
+/* The nodes of every element's m, J and tensor, gravity, and every
+   force's k, c and free length: design_refresh's roots, in its order. */
+static void design_open(GenericDyn *d)
+{
+    const Model *m = d->m;
+    size_t n = (size_t)m->nmasses * MASS_CONSTS + 3 + (size_t)m->nforces * FORCE_CONSTS, k = 0;
+    NodeId *roots = xmalloc(n * sizeof *roots);
+    for (int i = 0; i < m->nmasses; i++) {
+        const MassElement *e = &m->masses[i];
+        roots[k++] = e->m_node;
+        roots[k++] = e->J_node;
+        for (int j = 0; j < 6; j++)
+            roots[k++] = e->inertia_node[j];
+    }
+    for (int c = 0; c < 3; c++)
+        roots[k++] = m->gravity_node[c];
+    for (int i = 0; i < m->nforces; i++) {
+        const AppliedForce *f = &m->forces[i];
+        roots[k++] = f->k_node;
+        roots[k++] = f->c_node;
+        roots[k++] = f->free_node;
+    }
+    node_values_init(&d->consts, &m->dag, roots, (int)n);
+    free(roots);
+    d->designed = true;
+}
+
+/* The constants at the model's design now (model_set_design's). */
+static void design_refresh(GenericDyn *d)
+{
+    if (!d->designed)
+        return;
+    const Model *m = d->m;
+    node_values_run(&d->consts, NULL, NULL, 0.0);
+    int k = 0;
+    for (int i = 0; i < m->nmasses; i++) {
+        MassElement *e = &d->masses[i];
+        e->m = node_values_get(&d->consts, k++);
+        e->J = node_values_get(&d->consts, k++);
+        for (int j = 0; j < 6; j++)
+            e->inertia[j] = node_values_get(&d->consts, k++);
+    }
+    for (int c = 0; c < 3; c++)
+        d->gravity[c] = node_values_get(&d->consts, k++);
+    for (int i = 0; i < m->nforces; i++) {
+        AppliedForce *f = &d->forces[i];
+        f->k = node_values_get(&d->consts, k++);
+        f->c = node_values_get(&d->consts, k++);
+        f->free = node_values_get(&d->consts, k++);
+    }
+}
+
 GenericDyn *generic_dynamics_open(const Model *m)
 {
     GenericDyn *d = xcalloc(1, sizeof *d);
     d->m = m;
+    d->masses = xcalloc((size_t)m->nmasses + 1, sizeof *d->masses);
+    d->forces = xcalloc((size_t)m->nforces + 1, sizeof *d->forces);
+    if (m->nmasses > 0)
+        memcpy(d->masses, m->masses, (size_t)m->nmasses * sizeof *d->masses);
+    if (m->nforces > 0)
+        memcpy(d->forces, m->forces, (size_t)m->nforces * sizeof *d->forces);
+    memcpy(d->gravity, m->gravity, sizeof d->gravity);
+    if (m->np > 0)
+        design_open(d);
     d->mass_tapes = xcalloc((size_t)m->nmasses + 1, sizeof *d->mass_tapes);
     d->force_tapes = xcalloc((size_t)m->nforces + 1, sizeof *d->force_tapes);
     CompileScratch cs;
@@ -178,6 +254,10 @@ void generic_dynamics_free(GenericDyn *d)
     free(d->dp);
     free(d->slot);
     free(d->slot_at);
+    free(d->masses);
+    free(d->forces);
+    if (d->designed)
+        node_values_free(&d->consts);
     free(d);
 }
 
@@ -207,7 +287,7 @@ static void add_mass(GenericDyn *d, const double *q, const int *slot, double *ou
     const Model *m = d->m;
     size_t nq = (size_t)m->nq;
     for (int i = 0; i < m->nmasses; i++) {
-        const MassElement *e = &m->masses[i];
+        const MassElement *e = &d->masses[i];
         const Tape *p = &d->mass_tapes[i];
         const int *at = slot ? slot + d->slot_at[i] : NULL;
         int n = p->nqcols;
@@ -238,6 +318,7 @@ void generic_mass(Generic *g, const double *q, double *M)
 {
     size_t nq = (size_t)g->dyn->m->nq;
     memset(M, 0, nq * nq * sizeof *M);
+    design_refresh(g->dyn);
     add_mass(g->dyn, q, NULL, M);
 }
 
@@ -289,6 +370,7 @@ void generic_mass_nz(Generic *g, const double *q, double *vals)
 {
     GenericDyn *d = g->dyn;
     memset(vals, 0, (size_t)d->nnz * sizeof *vals);
+    design_refresh(d);
     add_mass(d, q, d->slot, vals);
 }
 
@@ -298,14 +380,14 @@ static void add_inertia(GenericDyn *d, const double *q, const double *qd, bool w
 {
     const Model *m = d->m;
     for (int i = 0; i < m->nmasses; i++) {
-        const MassElement *e = &m->masses[i];
+        const MassElement *e = &d->masses[i];
         const Tape *p = &d->mass_tapes[i];
         root_gradients(d, p, q, NULL, 0.0, 3, d->dp);
         Seed s = {.q = q, .dq = qd, .col_q = -1, .col_qd = -1};
         tape_jet(p, &s, 2, d->jreg);
         double ax = root_jet(d, p, 0).dd, ay = root_jet(d, p, 1).dd, ath = root_jet(d, p, 2).dd;
-        double gx = with_gravity ? m->gravity[0] : 0.0, gy = with_gravity ? m->gravity[1] : 0.0;
-        double gz = with_gravity ? m->gravity[2] : 0.0;
+        double gx = with_gravity ? d->gravity[0] : 0.0, gy = with_gravity ? d->gravity[1] : 0.0;
+        double gz = with_gravity ? d->gravity[2] : 0.0;
         for (int k = 0; k < p->nqcols; k++) {
             const double *u = d->dp + 3 * k;
             if (e->spatial)     /* the third root is pz */
@@ -444,7 +526,7 @@ static void add_applied(GenericDyn *d, const double *q, const double *qd, double
 {
     const Model *m = d->m;
     for (int i = 0; i < m->nforces; i++) {
-        const AppliedForce *f = &m->forces[i];
+        const AppliedForce *f = &d->forces[i];
         const Tape *p = &d->force_tapes[i];
         tape_run(p, q, qd, t, d->vreg);
         force_apply[f->kind](d, f, p, q, qd, t, Q);
@@ -454,6 +536,7 @@ static void add_applied(GenericDyn *d, const double *q, const double *qd, double
 void generic_force(Generic *g, const double *q, const double *qd, double t, double *Q)
 {
     memset(Q, 0, (size_t)g->nq * sizeof *Q);
+    design_refresh(g->dyn);
     add_inertia(g->dyn, q, qd, true, Q);
     add_applied(g->dyn, q, qd, t, Q);
 }
@@ -461,5 +544,6 @@ void generic_force(Generic *g, const double *q, const double *qd, double t, doub
 void generic_velocity_terms(Generic *g, const double *q, const double *qd, double *Qv)
 {
     memset(Qv, 0, (size_t)g->nq * sizeof *Qv);
+    design_refresh(g->dyn);
     add_inertia(g->dyn, q, qd, false, Qv);
 }

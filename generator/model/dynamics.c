@@ -17,14 +17,35 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A constant key's value (0 when absent), refused when negative. */
-static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *what, bool nonnegative)
+/* A constant or design parameters' value (0 when absent): its node, and
+   its number at the file's design. */
+static double dyn_value(Builder *b, const Ast *ast, const char *what, NodeId *node)
 {
-    double v = build_constant(b, s->key[key], what);
-    if (nonnegative && v < 0)
-        diag_fail(b->diag, s->key_pos[key], "%s of %s '%s' is negative (%g)", what,
-                  dyn_keyword(s), s->name, v);
+    double v = 0.0;
+    *node = ast ? build_design_value(b, ast, what, &v) : DAG_ZERO;
     return v;
+}
+
+/* A key's value (0 when absent), refused when negative (at the file's design). */
+static double dyn_constant(Builder *b, const Stmt *s, DynKey key, const char *what,
+                           bool nonnegative, NodeId *node)
+{
+    double v = dyn_value(b, s->key[key], what, node);
+    if (nonnegative && v < 0)
+        diag_fail(b->diag, s->key_pos[key], "%s of %s '%s' is negative (%g)%s", what,
+                  dyn_keyword(s), s->name, v,
+                  dag_is_const(&b->model->dag, *node, NULL) ? "" : " at the file's design");
+    return v;
+}
+
+/* com(sx, sy[, sz]) of a body's mass: at's offset, designed or not. */
+static void com_offset(Builder *b, const Stmt *s, Attach *at)
+{
+    double *value[3] = {&at->sx, &at->sy, &at->sz};
+    for (int k = 0; k < (b->spatial ? 3 : 2); k++) {
+        *value[k] = dyn_value(b, s->vec[k], "a centre-of-mass offset", &at->s_node[k]);
+        at->designed |= !dag_is_const(&b->model->dag, at->s_node[k], NULL);
+    }
 }
 
 /* A key's expression of q, der(q) and t (absent: 0). */
@@ -74,9 +95,9 @@ static MassElement *new_mass(Builder *b, const Stmt *s)
     MassElement *e = &m->masses[m->nmasses++];
     *e = (MassElement){.name = s->name, .pos = s->pos, .theta = DAG_ZERO, .body = -1,
                        .spatial = b->spatial, .pz = DAG_ZERO, .euler = -1};
-    e->m = dyn_constant(b, s, DKEY_M, "the mass m", true);
+    e->m = dyn_constant(b, s, DKEY_M, "the mass m", true, &e->m_node);
     if (!b->spatial)    /* a spatial J is a tensor: spatial_inertia */
-        e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true);
+        e->J = dyn_constant(b, s, DKEY_J, "the moment of inertia J", true, &e->J_node);
     return e;
 }
 
@@ -99,14 +120,14 @@ static void spatial_inertia(Builder *b, const Stmt *s, MassElement *e)
     }
     for (int i = 0; i < 3; i++) {
         snprintf(what, sizeof what, "the moment of inertia %s", diag_names[i]);
-        e->inertia[i] = build_constant(b, s->inertia[i], what);
+        e->inertia[i] = dyn_value(b, s->inertia[i], what, &e->inertia_node[i]);
         if (e->inertia[i] < 0)
             diag_fail(b->diag, s->inertia[i]->pos, "%s of mass '%s' is negative (%g)", what,
                       s->name, e->inertia[i]);
     }
     for (int i = 0; i < 3; i++) {
         snprintf(what, sizeof what, "the product of inertia %s", dyn_key_names[product[i]]);
-        e->inertia[3 + i] = dyn_constant(b, s, product[i], what, false);
+        e->inertia[3 + i] = dyn_constant(b, s, product[i], what, false, &e->inertia_node[3 + i]);
     }
     double ev[3];
     eigen3_symmetric(e->inertia, ev);
@@ -127,11 +148,8 @@ static void spatial_body_mass(Builder *b, const Stmt *s, const Entity *ent, Mass
 {
     bool body = ent->kind == ENT_BODY;
     Attach at = {.q = ent->q, .spatial = true, .has_p = body};
-    if (s->vec[0]) {
-        at.sx = build_constant(b, s->vec[0], "a centre-of-mass offset");
-        at.sy = build_constant(b, s->vec[1], "a centre-of-mass offset");
-        at.sz = build_constant(b, s->vec[2], "a centre-of-mass offset");
-    }
+    if (s->vec[0])
+        com_offset(b, s, &at);
     NodeId xyz[3];
     joints_spatial_point(b->model, at, xyz);
     e->px = xyz[0], e->py = xyz[1], e->pz = xyz[2];
@@ -164,10 +182,8 @@ static void build_body_mass(Builder *b, const Stmt *s)
         return;
     }
     Attach at = {.q = ent->q, .has_phi = body};
-    if (s->vec[0]) {
-        at.sx = build_constant(b, s->vec[0], "a centre-of-mass offset");
-        at.sy = build_constant(b, s->vec[1], "a centre-of-mass offset");
-    }
+    if (s->vec[0])
+        com_offset(b, s, &at);
     NodeId xy[2];
     joints_point(b->model, at, xy);
     e->px = xy[0], e->py = xy[1];
@@ -175,6 +191,7 @@ static void build_body_mass(Builder *b, const Stmt *s)
         e->theta = dag_var(&b->model->dag, ent->q + 2);
         e->body = ent->q;
         e->sx = at.sx, e->sy = at.sy;
+        e->s_node[0] = at.s_node[0], e->s_node[1] = at.s_node[1];
     }
     build_check_nodes(b);
 }
@@ -310,9 +327,9 @@ static void build_SPRING(Builder *b, const Stmt *s, AppliedForce *f)
 {
     const char *kw = dyn_keyword(s);
     NodeId xy[3];
-    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
-    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
-    f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true);
+    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true, &f->k_node);
+    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true, &f->c_node);
+    f->free = dyn_constant(b, s, DKEY_LENGTH, "the free length", true, &f->free_node);
     dyn_point(b, &s->attach[0], EXPR_HOLONOMIC, kw, xy);
     f->ax = xy[0], f->ay = xy[1], f->az = xy[2];
     dyn_point(b, &s->attach[1], EXPR_HOLONOMIC, kw, xy);
@@ -326,9 +343,9 @@ static void build_SPRING(Builder *b, const Stmt *s, AppliedForce *f)
    angle is angle(R), A's 0. */
 static void build_RSPRING(Builder *b, const Stmt *s, AppliedForce *f)
 {
-    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true);
-    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true);
-    f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false);
+    f->k = dyn_constant(b, s, DKEY_K, "the stiffness k", true, &f->k_node);
+    f->c = dyn_constant(b, s, DKEY_C, "the damping c", true, &f->c_node);
+    f->free = dyn_constant(b, s, DKEY_ANGLE, "the free angle", false, &f->free_node);
     if (b->spatial) {
         Entity *e = build_lookup(b, s->attach[0].name, s->attach[0].pos);
         const Joint *j = e->kind == ENT_JOINT ? &b->model->joints[e->q] : NULL;
@@ -391,10 +408,11 @@ void build_dynamics(Builder *b, const Stmt *s)
         diag_fail(b->diag, s->pos, "a second gravity statement (the first is on line %d)",
                   b->gravity_line);
     b->gravity_line = build_line(b, s->pos);
-    b->model->gravity[0] = build_constant(b, s->vec[0], "the gravity component gx");
-    b->model->gravity[1] = build_constant(b, s->vec[1], "the gravity component gy");
-    if (b->spatial)
-        b->model->gravity[2] = build_constant(b, s->vec[2], "the gravity component gz");
+    static const char *const what[3] = {"the gravity component gx", "the gravity component gy",
+                                        "the gravity component gz"};
+    Model *m = b->model;
+    for (int c = 0; c < (b->spatial ? 3 : 2); c++)
+        m->gravity[c] = dyn_value(b, s->vec[c], what[c], &m->gravity_node[c]);
 }
 
 /* After the statements: M is dense nq x nq in the engines and the

@@ -100,6 +100,10 @@ typedef struct MassElement {
     int euler;          /* a spatial body's own mass: the index of its e0
                            (e0..e3 at euler .. euler + 3); -1 otherwise */
     double inertia[6];  /* J' in body axes: xx, yy, zz, xy, xz, yz */
+    /* m, J, (sx, sy) and the tensor as nodes: constants, or expressions of
+       design parameters (the numbers above are then their values at the
+       file's design) */
+    NodeId m_node, J_node, s_node[2], inertia_node[6];
 } MassElement;
 
 /* An applied force, every kind by virtual work (its kind's maths:
@@ -116,6 +120,7 @@ typedef struct AppliedForce {
     NodeId fx, fy;      /* POINT: components; otherwise fx the value (the
                            actuator's force or torque for a spring) */
     double k, c, free;  /* SPRING, RSPRING: stiffness, damping, free length or angle */
+    NodeId k_node, c_node, free_node;   /* the same as nodes (as MassElement's) */
     int coord;          /* GENERAL: the coordinate; BODY_TORQUE: e0's */
     NodeId az, bz, fz;
 } AppliedForce;
@@ -145,6 +150,7 @@ typedef struct Model {
     int nforces;
     AppliedForce *forces;
     double gravity[3];  /* (0, 0, 0) without a gravity statement; gz spatial only */
+    NodeId gravity_node[3];     /* the same as nodes (as MassElement's) */
     /* Design parameters in statement order: names and the file's values.
        The design evaluated now is dag.param_values (model_set_design). */
     int np;
