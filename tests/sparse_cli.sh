@@ -69,6 +69,23 @@ check "chain 50: auto (sparse) equals dense to 1e-10" same_csv "$tmp/c.d.csv" "$
 run "$ex/slider_crank.mech" --steps 2 --stats --csv "$tmp/sc.csv"
 check "slider_crank auto: stays dense" sh -c "! grep -q KLU '$tmp/err'"
 
+# ---- run --sens on the sparse path: KLU of Phi_q, the dense path's numbers ----
+# a chain of 20 loops with the drive's amplitude, its speed and a ground
+# pivot designed (123 coordinates: auto is sparse)
+sh "$ex/chain.sh" 20 "$tmp/chain20.mech"
+sed 's/^param amp .*/design amp = 0.5/; s/^param omega .*/design omega = 2*pi\ndesign gx = 1/
+     s/^revolute g1: ground(1, 0)/revolute g1: ground(gx, 0)/' "$tmp/chain20.mech" > "$tmp/chain20d.mech"
+run "$tmp/chain20d.mech" --steps 10 --sens --linear dense --csv "$tmp/cs.d.csv" --stats
+check "chain 20 --sens dense: exit 0" status_is 0
+check "chain 20 --sens dense: the dense LU" sh -c "! grep -q 'KLU of Phi_q' '$tmp/err'"
+run "$tmp/chain20d.mech" --steps 10 --sens --csv "$tmp/cs.a.csv" --stats
+check "chain 20 --sens auto: exit 0" status_is 0
+check "chain 20 --sens auto: sensitivities by KLU" \
+    err_has "sensitivities to 3 design parameters (KLU of Phi_q)"
+check "chain 20 --sens: the columns are there" \
+    sh -c "head -1 '$tmp/cs.a.csv' | grep -q ',d(dd(rod20.phi))/d(gx)'"
+check "chain 20 --sens: sparse equals dense to 1e-9" same_csv "$tmp/cs.d.csv" "$tmp/cs.a.csv" 1e-9
+
 # ---- refusals ------------------------------------------------------------------
 run "$ex/slider_crank.mech" --linear banded
 check "--linear banded: exit 2" status_is 2

@@ -395,7 +395,7 @@ typedef struct Motion {
     OutputEval oe;
     Sens *sens;
     int n, nv, ncol;
-    double *x, *cols;
+    double *x, *cols, *t;
 } Motion;
 
 static void on_state(void *ctx, double t, const double *q, const double *qd, const double *qdd)
@@ -403,6 +403,7 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
     Motion *mo = ctx;
     int nq = mo->m->nq, nv = mo->nv;
     assert_true(mo->n <= STEPS);
+    mo->t[mo->n] = t;
     double *x = mo->x + (size_t)mo->n * 3 * (size_t)nv;
     memcpy(x, q, (size_t)nq * sizeof *x);
     memcpy(x + nv, qd, (size_t)nq * sizeof *x);
@@ -415,8 +416,9 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
     mo->n++;
 }
 
-/* The run over one period at the model's design, Newton to 1e-12. */
-static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
+/* The run over one period at the model's design, Newton to 1e-12, on the
+   dense path; on the sparse one (KLU, the sensitivities' too) with sparse. */
+static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse)
 {
     const Model *m = mech->model;
     memset(mo, 0, sizeof *mo);
@@ -426,20 +428,29 @@ static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
     mo->ncol = sens ? sens_column_count(sens) : 0;
     mo->x = xcalloc((size_t)(STEPS + 1) * 3 * (size_t)mo->nv, sizeof *mo->x);
     mo->cols = xcalloc((size_t)(STEPS + 1) * (size_t)mo->ncol + 1, sizeof *mo->cols);
+    mo->t = xcalloc(STEPS + 1, sizeof *mo->t);
     outputs_init(&mo->oe, m);
     RunOptions o = run_default_options();
     o.steps = STEPS;
     o.mechrt.tol_phi = o.mechrt.tol_dq = 1e-12;
+    o.linear = sparse ? ANALYSIS_LINEAR_SPARSE : ANALYSIS_LINEAR_DENSE;
+    if (sparse && sens)
+        assert_true(sens_use_sparse(sens, engine_jac_nz(e)));
     RunResult res;
-    if (run_analysis(m, engine_kernels(e), NULL, &o, on_state, mo, &res) != ANALYSIS_OK)
+    if (run_analysis(m, engine_kernels(e), engine_jac_nz(e), &o, on_state, mo, &res) != ANALYSIS_OK)
         fail_msg("run: %s", res.message);
     assert_int_equal(mo->n, STEPS + 1);
     outputs_free(&mo->oe);
 }
 
+static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
+{
+    run_motion_on(mech, e, sens, mo, false);
+}
+
 static void motion_free(Motion *mo)
 {
-    free(mo->x), free(mo->cols);
+    free(mo->x), free(mo->cols), free(mo->t);
 }
 
 /* sens's columns against (run(p + h e_j) - run(p - h e_j)) / 2h at every
@@ -510,6 +521,56 @@ static void test_sensitivities_spatial_axes(void **s)
 {
     (void)s;
     check_sensitivities(spatial_axis_text, "rssr_axes.mech");
+}
+
+/* The sensitivities with KLU of Phi_q are the dense LU's: at the states
+   of a dense run to 1e-13 relative, every column; along a run on the
+   sparse path (whose states differ from the dense run's by its Newton
+   iterations, 1e-12) to 1e-10. */
+static void check_sparse_sensitivities(const char *text, const char *name)
+{
+    Mech *mech = load_text(text, name);
+    Model *m = mech->model;
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_JIT, mech));
+    assert_non_null(engine_jac_nz(&e));
+    Sens dense, sparse;
+    char why[256];
+    assert_true(sens_init(&dense, m, &mech->kin, &e, why, sizeof why));
+    assert_true(sens_init(&sparse, m, &mech->kin, &e, why, sizeof why));
+    Motion a, b;
+    run_motion_on(mech, &e, &dense, &a, false);
+    run_motion_on(mech, &e, &sparse, &b, true);
+    assert_non_null(sparse.klu);
+    assert_null(dense.klu);
+    int ncol = a.ncol, nv = a.nv;
+    double *cols = xcalloc((size_t)ncol, sizeof *cols), same = 0, along = 0;
+    for (int k = 0; k <= STEPS; k++) {
+        const double *x = a.x + (size_t)k * 3 * (size_t)nv, *ca = a.cols + (size_t)k * (size_t)ncol;
+        assert_int_equal(sens_eval(&sparse, a.t[k], x, x + nv, x + 2 * nv), MECHRT_OK);
+        sens_columns(&sparse, cols);
+        for (int i = 0; i < ncol; i++) {
+            same = fmax(same, fabs(cols[i] - ca[i]) / (1.0 + fabs(ca[i])));
+            along = fmax(along, fabs(b.cols[(size_t)k * (size_t)ncol + (size_t)i] - ca[i])
+                                / (1.0 + fabs(ca[i])));
+        }
+    }
+    print_message("%s: KLU against dense LU sensitivities: %.2g at the same states, %.2g along "
+                  "a sparse run\n", name, same, along);
+    assert_true(same <= 1e-12);
+    assert_true(along <= 1e-10);
+    free(cols);
+    motion_free(&a), motion_free(&b);
+    sens_free(&dense), sens_free(&sparse);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+static void test_sensitivities_sparse(void **s)
+{
+    (void)s;
+    check_sparse_sensitivities(planar_text, "fbd.mech");
+    check_sparse_sensitivities(spatial_axis_text, "rssr_axes.mech");
 }
 
 /* The CSV names: d(NAME)/d(P), d(d(NAME))/d(P), d(dd(NAME))/d(P), in
@@ -715,6 +776,7 @@ int main(void)
         cmocka_unit_test(test_engines_agree_spatial_axes),
         cmocka_unit_test(test_sensitivities_spatial_axes),
         cmocka_unit_test(test_sensitivity_column_names),
+        cmocka_unit_test(test_sensitivities_sparse),
         cmocka_unit_test(test_designed_masses_planar),
         cmocka_unit_test(test_designed_masses_spatial),
     };

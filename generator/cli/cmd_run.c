@@ -494,6 +494,8 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
     c->ro.notes = stderr;
     c->ro.source = source;
     c->ro.linear = (AnalysisLinear)c->linear;
+    if (sc && run_linear_is_sparse(m, jnz, &c->ro))
+        sens_use_sparse(&sc->sens, jnz);    /* KLU as the run; else the dense LU */
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
@@ -532,8 +534,9 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     }
     int status = analyse(c, mech->model, &e, &pics, diag, c->sens ? &sc : NULL);
     if (c->sens && c->stats && sc.states > 0)
-        fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters: %.6g ms of "
-                "CPU time, %.0f ns per state\n", sc.sens.np, 1e3 * sc.cpu_seconds,
+        fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters%s: %.6g ms of "
+                "CPU time, %.0f ns per state\n", sc.sens.np,
+                sc.sens.klu ? " (KLU of Phi_q)" : "", 1e3 * sc.cpu_seconds,
                 1e9 * sc.cpu_seconds / (double)sc.states);
     if (c->sens)
         sens_free(&sc.sens);

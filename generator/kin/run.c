@@ -333,6 +333,13 @@ static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunO
     return true;
 }
 
+bool run_linear_is_sparse(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o)
+{
+    bool sparse;
+    char why[8];
+    return choose_linear(m, jnz, o, &sparse, why, sizeof why) && sparse;
+}
+
 /* The dense path's factorisation: the pattern LU on the kernels' sparse
    Jacobian (same results as lu.c's, replayed over the nonzeros), when
    there is one, the mechanism is stepped (no velocity rows) and its

@@ -128,6 +128,10 @@ typedef void (*RunForcesFn)(void *ctx, double t, const double *q, const double *
    or how many rows are too many. */
 bool run_rows_match(const Model *m, char *why, size_t size);
 
+/* Whether a run of m with options o takes the sparse path (jnz: the
+   engine's sparse Jacobian, or NULL). */
+bool run_linear_is_sparse(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o);
+
 /* The run. m gives sizes, names and initial values; k evaluates m's rows;
    jnz is their sparse Jacobian (engine_jac_nz), or NULL: dense only.
    Needs k->nh + k->nv == k->nq, otherwise ANALYSIS_BAD_INPUT saying how many

@@ -3,7 +3,8 @@
  * Every partial derivative comes from the engine's sensitivity functions
  * (the generated PREFIX_phi_p, _sens_v, _sens_g, _sens_y, or the graph
  * interpreted by the generic engine), and the sensitivities of all design
- * parameters at once are dense products and solves with one LU of Phi_q:
+ * parameters at once are products and solves with one LU of Phi_q (dense,
+ * or KLU on the sparse path):
  *
  *   Q_p   = -Phi_q^-1 Phi_p
  *   Qd_p  = -Phi_q^-1 (V_q Q_p + V_p)                          V at qd
@@ -12,7 +13,10 @@
  * where Phi_q qdd = V(qd := qdd) - V(qd := 0), and V being affine in qd,
  * its partials are V's at qd + qdd less V's at qd; an output f gives
  * f_q Q_p + f_p, D f the same with its qd partials on Qd_p, and
- * D(D f) + f_q qdd likewise.
+ * D(D f) + f_q qdd likewise. The n x n partials V_q, G_q and G_qd are
+ * multiplied over their structural nonzeros (the graph's entries other
+ * than DAG_ZERO, a subset of Phi_q's pattern), in the dense walk's order,
+ * so both give the same sums.
  */
 #include "sens.h"
 
@@ -27,10 +31,31 @@
    Phi_q qdd = V(qdd) - V(0) are V's at qd + qdd less V's at qd. */
 enum { AT_QD, AT_QD_QDD, AT_COUNT };
 
+/* The structural nonzeros of V_q, G_q and G_qd (kin's nodes). */
+static void collect_nonzeros(Sens *s, const Kinematics *kin)
+{
+    const NodeId *of[3] = {kin->design.v_q, kin->design.g_q, kin->design.g_qd};
+    size_t nn = (size_t)s->nq * (size_t)s->nq, n = 0;
+    for (int k = 0; k < 3; k++)
+        for (size_t i = 0; i < nn; i++)
+            n += of[k][i] != DAG_ZERO;
+    s->nz_rc = xcalloc(2 * n + 1, sizeof *s->nz_rc);
+    int at = 0;
+    for (int k = 0; k < 3; k++) {
+        s->nz_at[k] = at;
+        for (size_t i = 0; i < nn; i++)
+            if (of[k][i] != DAG_ZERO) {
+                s->nz_rc[2 * at] = (int)(i / (size_t)s->nq);
+                s->nz_rc[2 * at + 1] = (int)(i % (size_t)s->nq);
+                at++;
+            }
+    }
+    s->nz_at[3] = at;
+}
+
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size)
 {
     memset(s, 0, sizeof *s);
-    (void)kin;
     if (m->np == 0)
         snprintf(why, size, "the file has no design parameters (`design NAME = value`)");
     else if (m->nv > 0)
@@ -59,6 +84,17 @@ bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *
     for (int k = 0; k < 3; k++)
         s->g[k] = xcalloc(k == 2 ? qp : qq, sizeof(double));
     s->work = xcalloc(qp + yp, sizeof(double));
+    collect_nonzeros(s, kin);
+    return true;
+}
+
+bool sens_use_sparse(Sens *s, const MechrtHostJacNz *jnz)
+{
+    s->klu = jnz ? mechrt_host_sparse_new(s->nq, jnz) : NULL;
+    if (!s->klu)
+        return false;
+    free(s->jac), free(s->piv);     /* nq x nq: not needed */
+    s->jac = s->piv = NULL;
     return true;
 }
 
@@ -73,6 +109,9 @@ void sens_free(Sens *s)
     }
     for (int k = 0; k < 3; k++)
         free(s->g[k]);
+    free(s->nz_rc);
+    if (s->klu)
+        mechrt_host_sparse_free(s->klu);
     memset(s, 0, sizeof *s);
 }
 
@@ -92,6 +131,26 @@ static void add_product(double *c, double sign, const double *a, const double *b
         }
 }
 
+/* c (nq x np) += sign * a (nq x nq) b (nq x np) over a's structural
+   nonzeros (the k-th list of collect_nonzeros): add_product's sums. */
+static void add_product_nz(const Sens *s, int k, double *c, double sign, const double *a,
+                           const double *b)
+{
+    size_t nq = (size_t)s->nq, np = (size_t)s->np;
+    for (int e = s->nz_at[k]; e < s->nz_at[k + 1]; e++) {
+        size_t r = (size_t)s->nz_rc[2 * e], col = (size_t)s->nz_rc[2 * e + 1];
+        double f = sign * a[r * nq + col];
+        if (f == 0.0)
+            continue;
+        const double *bk = b + col * np;
+        double *cr = c + r * np;
+        for (size_t j = 0; j < np; j++)
+            cr[j] += f * bk[j];
+    }
+}
+
+enum { NZ_V, NZ_GQ, NZ_GQD };
+
 /* c (n x np) = sign * a, element by element. */
 static void set_scaled(double *c, double sign, const double *a, size_t n)
 {
@@ -106,7 +165,10 @@ static void solve_columns(Sens *s, double *x)
     for (int j = 0; j < s->np; j++) {
         for (int i = 0; i < s->nq; i++)
             s->col[i] = x[(size_t)i * np + (size_t)j];
-        mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
+        if (s->klu)
+            mechrt_host_sparse_solve(s->klu, s->col);   /* as lu_solve: NaN stays NaN */
+        else
+            mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
         for (int i = 0; i < s->nq; i++)
             x[(size_t)i * np + (size_t)j] = s->col[i];
     }
@@ -116,9 +178,15 @@ static void solve_columns(Sens *s, double *x)
 static MechrtStatus factor(Sens *s, double t, const double *q)
 {
     int n = s->nq;
+    double tol = mechrt_default_options().pivot_tol;
+    if (s->klu) {
+        engine_phi_p(s->e, q, t, s->phi_p);
+        mechrt_host_sparse_eval(s->klu, q, t);
+        return mechrt_host_sparse_factor(s->klu, tol);
+    }
     engine_jac(s->e, q, t, s->jac);
     engine_phi_p(s->e, q, t, s->phi_p);
-    return mechrt_lu_factor(n, s->jac, n, s->piv, mechrt_default_options().pivot_tol, NULL);
+    return mechrt_lu_factor(n, s->jac, n, s->piv, tol, NULL);
 }
 
 /* The outputs' sensitivities from the coordinates' (y partials taken). */
@@ -166,13 +234,13 @@ MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, con
     set_scaled(s->q_p, -1.0, s->phi_p, len);
     solve_columns(s, s->q_p);
     set_scaled(s->qd_p, -1.0, s->v[AT_QD][1], len);
-    add_product(s->qd_p, -1.0, s->v[AT_QD][0], s->q_p, n, n, np);
+    add_product_nz(s, NZ_V, s->qd_p, -1.0, s->v[AT_QD][0], s->q_p);
     solve_columns(s, s->qd_p);
     set_scaled(s->qdd_p, 1.0, s->g[2], len);
-    add_product(s->qdd_p, 1.0, s->g[0], s->q_p, n, n, np);
-    add_product(s->qdd_p, 1.0, s->g[1], s->qd_p, n, n, np);
-    add_product(s->qdd_p, -1.0, s->v[AT_QD_QDD][0], s->q_p, n, n, np);
-    add_product(s->qdd_p, 1.0, s->v[AT_QD][0], s->q_p, n, n, np);
+    add_product_nz(s, NZ_GQ, s->qdd_p, 1.0, s->g[0], s->q_p);
+    add_product_nz(s, NZ_GQD, s->qdd_p, 1.0, s->g[1], s->qd_p);
+    add_product_nz(s, NZ_V, s->qdd_p, -1.0, s->v[AT_QD_QDD][0], s->q_p);
+    add_product_nz(s, NZ_V, s->qdd_p, 1.0, s->v[AT_QD][0], s->q_p);
     for (size_t i = 0; i < len; i++)
         s->qdd_p[i] -= s->v[AT_QD_QDD][1][i] - s->v[AT_QD][1][i];
     solve_columns(s, s->qdd_p);

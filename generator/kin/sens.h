@@ -7,10 +7,12 @@
  *   Phi_q qd_pj  = -(V_q q_pj + V_pj),       V = Phi_q qd + Phi_t
  *   Phi_q qdd_pj = -(W_q q_pj + W_qd qd_pj + W_pj),  W = Phi_q qdd - gamma
  *
- * one LU of Phi_q per state serving every right-hand side. The partial
- * derivatives come from the engine's sensitivity functions (generated:
- * PREFIX_phi_p, _sens_v, _sens_g, _sens_y; generic: interpreted), and all
- * design parameters are handled at once by dense products (sens.c).
+ * one LU of Phi_q per state serving every right-hand side: dense, or on
+ * the sparse path KLU on the Jacobian's nonzeros (sens_use_sparse). The
+ * partial derivatives come from the engine's sensitivity functions
+ * (generated: PREFIX_phi_p, _sens_v, _sens_g, _sens_y; generic:
+ * interpreted), and all design parameters are handled at once by products
+ * over the partials' structural nonzeros (sens.c).
  */
 #ifndef MECHC_SENS_H
 #define MECHC_SENS_H
@@ -31,6 +33,10 @@ typedef struct Sens {
     double *v[2][2];
     double *y[2][DESIGN_Y_COUNT];
     double *g[3];
+    /* the structural nonzeros of V_q, G_q and G_qd: (row, col) pairs in
+       row-major order, nz_at[k] .. nz_at[k + 1] - 1 those of the k-th */
+    int *nz_rc, nz_at[4];
+    MechrtHostSparse *klu;      /* the sparse path's factorisation, or NULL */
 } Sens;
 
 /* Prepares s for the motion of m through e (np > 0, no velocity-level
@@ -38,6 +44,10 @@ typedef struct Sens {
    bytes) when m is not such a mechanism. */
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size);
 void sens_free(Sens *s);
+/* Factors Phi_q by KLU on the Jacobian's nonzeros jnz (the engine's)
+   instead of the dense LU: the run's sparse path. false, the dense LU
+   kept, when the pattern cannot be analysed. */
+bool sens_use_sparse(Sens *s, const MechrtHostJacNz *jnz);
 
 /* The sensitivities at the state (t, q, qd, qdd) of the motion, at the
    model's design. MECHRT_OK, or the LU's status when Phi_q is singular
