@@ -18,7 +18,9 @@
  * and universal joints with designed axes agree between engines. Masses,
  * inertias, centres of mass, gravity and spring constants of design
  * parameters: every engine's M and Q at a design set after opening equal
- * those of the file with the constants written in, and so does a sim. The aot library cache goes to the run's (testcache.h).
+ * those of the file with the constants written in, and so does a sim;
+ * check_mechanism passes on these files. Sensitivities with KLU of Phi_q
+ * (the sparse path) are the dense LU's. The aot library cache goes to the run's (testcache.h).
  */
 #include "testutil.h"
 #include "testcache.h"
@@ -32,6 +34,7 @@
 #include "../generator/kin/run.h"
 #include "../generator/kin/sens.h"
 #include "../generator/dyn/sim.h"
+#include "../generator/verify/check.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -748,6 +751,41 @@ static void check_designed_dynamics(const DynCase *c, const double *nominal, con
     free(dtext), free(ctext);
 }
 
+/* mechc check of text: ok, with every quantity compared between jit and
+   generic (and M, Q with masses), Phi_p against finite differences. */
+static void expect_check_ok(const char *text, const char *name, bool masses)
+{
+    Mech *mech = load_text(text, name);
+    CheckOptions opt = check_default_options();
+    opt.samples = 4;
+    opt.use_aot = false;
+    CheckReport rep;
+    Diag diag;
+    assert_true(check_mechanism(mech, &opt, &rep, &diag));
+    for (int w = 0; w < CHECK_WHAT_COUNT; w++)
+        if (rep.items[w].checked && !(rep.items[w].error <= rep.items[w].tol))
+            fail_msg("%s: check %s: %g over %g", name, rep.items[w].what, rep.items[w].error,
+                     rep.items[w].tol);
+    assert_true(rep.ok);
+    assert_true(rep.items[CHECK_PHI_P_FD].checked);
+    for (int w = CHECK_PAIR_FIRST; w < CHECK_DYN_FIRST + (masses ? 2 : 0); w++)
+        if (strstr(rep.items[w].what, "jit/generic"))
+            assert_true(rep.items[w].checked);
+    pipeline_free(mech);
+}
+
+static void test_check_designed(void **s)
+{
+    (void)s;
+    expect_check_ok(spatial_axis_text, "rssr_axes.mech", false);
+    expect_check_ok(spatial_slider_text, "slider_axes.mech", false);
+    char *pendulum = dyn_text(&pendulum_case, "design", (double[]){1, 1.5, 0.1, 9.81, 20, 0.3});
+    char *top = dyn_text(&top_case, "design", (double[]){1, 0.002, 0.004, 9.81, 0.02});
+    expect_check_ok(pendulum, "pendulum_masses.mech", true);
+    expect_check_ok(top, "top_masses.mech", true);
+    free(pendulum), free(top);
+}
+
 static void test_designed_masses_planar(void **s)
 {
     (void)s;
@@ -779,6 +817,7 @@ int main(void)
         cmocka_unit_test(test_sensitivities_sparse),
         cmocka_unit_test(test_designed_masses_planar),
         cmocka_unit_test(test_designed_masses_spatial),
+        cmocka_unit_test(test_check_designed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
