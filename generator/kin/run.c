@@ -97,18 +97,41 @@ RunOptions run_default_options(void)
 static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
 {
     run_watch_condition(r, t, rep);
-    if (r->fstate)
+    if (r->fstate && r->red) {
+        redundant_expand(r->red, r->inv.lambda, r->lambda);
+        r->fstate(ctx, t, r->q, r->qd, r->qdd, r->lambda);
+    } else if (r->fstate)
         r->fstate(ctx, t, r->q, r->qd, r->qdd, r->inv.lambda);
     else
         state(ctx, t, r->q, r->qd, r->qdd);
     r->res->states++;
 }
 
+/* The redundant rows left out of the run (r->red) at the state just
+   computed: false, with the failure in r->res, when one is violated. */
+static bool redundant_at(Run *r, double t)
+{
+    int row;
+    const char *level;
+    if (redundant_check(r->red, r->q, r->qd, r->qdd, t, r->o->mechrt.tol_phi, &row,
+                        &level) <= 1)
+        return true;
+    r->res->status = ANALYSIS_FAILED;
+    r->res->cause = MECHRT_EMAXITER;
+    r->res->t_fail = t;
+    redundant_explain(r->red, r->q, r->qd, r->qdd, t, r->o->mechrt.tol_phi, r->res->message,
+                      sizeof r->res->message);
+    return false;
+}
+
 /* Inverse dynamics at the state just computed (t, r->q, r->qd, r->qdd),
    into r->lambda; nothing without run_analysis_forces. False, with the
-   failure in r->res, when the solve fails. */
+   failure in r->res, when the solve fails. First, with redundant rows,
+   their check. */
 static bool inverse_at(Run *r, double t)
 {
+    if (r->red && !redundant_at(r, t))
+        return false;
     if (!r->fstate)
         return true;
     MechrtStatus st = inverse_solve(&r->inv, r->k, r->q, r->qd, r->qdd, t);
@@ -355,6 +378,10 @@ static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *jnz)
     return f;
 }
 
+/* Beyond this many Jacobian entries the redundant rows are not looked for
+   (the SVD at t0 is dense): info's limit (AnalysisOptions.max_dense). */
+#define RUN_REDUNDANT_MAX_ENTRIES 5e5
+
 bool run_rows_match(const Model *m, char *why, size_t size)
 {
     if (m->nr < m->nq) {
@@ -365,6 +392,8 @@ bool run_rows_match(const Model *m, char *why, size_t size)
                  dof == 1 ? "" : " (one per degree of freedom)");
         return false;
     }
+    if (m->nr > m->nq && m->nv == 0 && (double)m->nr * m->nq <= RUN_REDUNDANT_MAX_ENTRIES)
+        return true;    /* the redundant rows are found at t0 (open_redundant) */
     if (m->nr > m->nq) {
         int extra = m->nr - m->nq;
         snprintf(why, size, "the mechanism has %d more %s than coordinates (%d rows, %d "
@@ -376,34 +405,45 @@ bool run_rows_match(const Model *m, char *why, size_t size)
     return true;
 }
 
-/* run_analysis and run_analysis_forces: one of state and fstate. */
-static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
-                              const RunOptions *o, RunStateFn state, RunForcesFn fstate,
-                              void *state_ctx, RunResult *res)
+/* More rows than coordinates: the redundant rows found at t0 and red
+   opened on the others, said once in the notes; false with why when the
+   others do not drive every degree of freedom or the Jacobian is not
+   finite. */
+static bool open_redundant(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                           const RunOptions *o, Redundant *red, char *why, size_t size)
 {
-    memset(res, 0, sizeof *res);
-    res->t_fail = NAN;
-    if (o->steps < 0)
-        return bad_input(res, "the number of steps must be at least 0, not %d", o->steps);
-    /* steps = 0 is the analysis at one instant, t0: t1 plays no part */
-    if (!(isfinite(o->t0) && (o->steps == 0 || isfinite(o->t1)))
-        || (o->steps > 0 && o->t0 == o->t1))
-        return bad_input(res, "the time interval must be finite and not empty (t0 = %g, t1 = %g)",
-                         o->t0, o->t1);
-    if (o->max_substeps < 1)
-        return bad_input(res, "the number of substeps must be at least 1, not %d",
-                         o->max_substeps);
-    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
-        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
-                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    char why[sizeof res->message];
-    if (!run_rows_match(m, why, sizeof why))
-        return bad_input(res, "%s", why);
-    bool sparse;
-    if (!choose_linear(m, jnz, o, &sparse, why, sizeof why))
-        return bad_input(res, "%s", why);
+    bool *drop = xcalloc((size_t)m->nr + 1, sizeof *drop);
+    int n = redundant_find(m, k, o->t0, drop);
+    if (n >= 0)
+        redundant_open(red, m, k, jnz, drop);
+    free(drop);
+    if (n < 0) {
+        snprintf(why, size, "t = %.10g: NaN or Inf in the Jacobian where the redundant rows "
+                 "are looked for (the configuration assembled on all rows)", o->t0);
+        return false;
+    }
+    if (red->nkeep < m->nq) {
+        int dof = m->nq - red->nkeep;
+        snprintf(why, size, "%d degree%s of freedom %s not driven (%d coordinates, %d rows of "
+                 "which %d %s redundant: ", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are",
+                 m->nq, m->nr, red->ndrop, red->ndrop == 1 ? "is" : "are");
+        redundant_names(red, why, size);
+        analysis_msgf(why, size, "): add %s", dof == 1 ? "a driver" : "drivers");
+        redundant_close(red);
+        return false;
+    }
+    redundant_note(o->notes, red);
+    return true;
+}
 
+/* The run of analyse, its input checked; red: the redundant rows left out
+   (m, k and jnz are then its kept rows'), or NULL. */
+static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             bool sparse, Redundant *red, const RunOptions *o, RunStateFn state,
+                             RunForcesFn fstate, void *state_ctx, RunResult *res)
+{
     Run r = {0};
+    r.red = red;
     r.m = m;
     r.k = k;
     r.jnz = jnz;
@@ -432,6 +472,10 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const Mech
     if (fstate) {
         r.fstate = fstate;
         inverse_init(&r.inv, m->nq, m->nr);
+        if (red) {
+            r.lambda = xcalloc((size_t)red->nr, sizeof *r.lambda);
+            redundant_note_reactions(o->notes, red);
+        }
     }
 
     AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
@@ -450,9 +494,47 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const Mech
         run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
-    free(r.q), free(r.work);
+    free(r.q), free(r.work), free(r.lambda);
     inverse_free(&r.inv);
     return status;
+}
+
+/* run_analysis and run_analysis_forces: one of state and fstate. */
+static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                              const RunOptions *o, RunStateFn state, RunForcesFn fstate,
+                              void *state_ctx, RunResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    if (o->steps < 0)
+        return bad_input(res, "the number of steps must be at least 0, not %d", o->steps);
+    /* steps = 0 is the analysis at one instant, t0: t1 plays no part */
+    if (!(isfinite(o->t0) && (o->steps == 0 || isfinite(o->t1)))
+        || (o->steps > 0 && o->t0 == o->t1))
+        return bad_input(res, "the time interval must be finite and not empty (t0 = %g, t1 = %g)",
+                         o->t0, o->t1);
+    if (o->max_substeps < 1)
+        return bad_input(res, "the number of substeps must be at least 1, not %d",
+                         o->max_substeps);
+    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
+        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
+                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
+    char why[sizeof res->message];
+    if (!run_rows_match(m, why, sizeof why))
+        return bad_input(res, "%s", why);
+    bool sparse;
+    if (!choose_linear(m, jnz, o, &sparse, why, sizeof why))
+        return bad_input(res, "%s", why);
+    if (m->nr > m->nq) {
+        Redundant red;
+        if (!open_redundant(m, k, jnz, o, &red, why, sizeof why))
+            return bad_input(res, "%s", why);
+        AnalysisStatus st = run_on(&red.view, &red.k, jnz ? &red.jnz : NULL, sparse, &red, o,
+                                   state, fstate, state_ctx, res);
+        redundant_close(&red);
+        return st;
+    }
+    return run_on(m, k, jnz, sparse, NULL, o, state, fstate, state_ctx, res);
 }
 
 AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
