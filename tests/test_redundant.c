@@ -283,6 +283,72 @@ static void test_four_bar_forces(void **state)
     free(tp), free(ts);
 }
 
+/* text with its line starting with `start` replaced by line (in place:
+   text has room). */
+static void replace_line(char *text, const char *start, const char *line)
+{
+    char *at = strstr(text, start);
+    assert_non_null(at);
+    char *end = strchr(at, '\n');
+    assert_non_null(end);
+    size_t tail = strlen(end) + 1;
+    memmove(at + strlen(line), end, tail);
+    memcpy(at, line, strlen(line));
+}
+
+/* sim: the z-revolute four-bar without its driver, released under gravity
+   from the assembled configuration, moves as the planar one (the rows it
+   drops leave the motion alone); dense and sparse. */
+static void test_four_bar_sim(void **state)
+{
+    (void)state;
+    char *tp = example_plus("four_bar.mech", planar_masses);
+    char *ts = example_plus("four_bar_spatial_redundant.mech", spatial_masses);
+    replace_line(tp, "driver drive", "");
+    replace_line(ts, "driver drive", "");
+    replace_line(tp, "body coupler", "body coupler x = 1.84375  y = 1.2401959270615268  "
+                 "phi = 0.9733899101495463");
+    replace_line(tp, "body rocker", "body rocker x = 2.84375  y = 1.2401959270615268  "
+                 "phi = 1.696124157962962");
+    replace_line(ts, "body coupler", "body coupler x = 1.84375  y = 1.2401959270615268  z = 0  "
+                 "orient = axis(0, 0, 1, 0.9733899101495463)");
+    replace_line(ts, "body rocker", "body rocker x = 2.84375  y = 1.2401959270615268  z = 0  "
+                 "orient = axis(0, 0, 1, 1.696124157962962)");
+    Mech *planar = load_text(tp, "planar.mech"), *spatial = load_text(ts, "spatial.mech");
+    const Model *mp = planar->model, *ms = spatial->model;
+    assert_int_equal(ms->nh, 23);
+    Collected p, s;
+    analyse(planar, SIM, ANALYSIS_LINEAR_DENSE, 1, 20, &p);
+    assert_int_equal(p.status, ANALYSIS_OK);
+    int px = coord(mp, "coupler.x"), py = coord(mp, "coupler.y"), pphi = coord(mp, "rocker.phi");
+    int sx = coord(ms, "coupler.x"), sy = coord(ms, "coupler.y");
+    int se0 = coord(ms, "rocker.e0"), se3 = coord(ms, "rocker.e3");
+    for (int lin = ANALYSIS_LINEAR_DENSE; lin <= ANALYSIS_LINEAR_SPARSE; lin++) {
+        analyse(spatial, SIM, (AnalysisLinear)lin, 1, 20, &s);
+        if (s.status != ANALYSIS_OK)
+            fail_msg("%s", s.sres.message);
+        assert_non_null(strstr(s.notes, "spatial.mech: note: 23 holonomic rows for 21 "
+                                        "coordinates: redundant rows: O4.z (joint O4), O4.f "
+                                        "(joint O4), O4.g (joint O4); solved on the other 20 rows"));
+        assert_non_null(strstr(s.notes, "reactions of the redundant rows"));
+        for (int i = 0; i <= 20; i++) {
+            const double *a = state_at(&p, (size_t)i), *b = state_at(&s, (size_t)i);
+            const double *qa = a + 1, *qb = b + 1;
+            assert_near(b[0], a[0], 0, 0);
+            assert_near(qb[sx], qa[px], 1e-9, 1e-9);
+            assert_near(qb[sy], qa[py], 1e-9, 1e-9);
+            assert_near(rocker_angle(qb, se0, se3, qa[pphi]), qa[pphi], 1e-9, 1e-9);
+        }
+        assert_near(s.lambda[row(ms, "O4.z")], 0, 0, 0);
+        assert_near(s.lambda[row(ms, "O4.x")], p.lambda[row(mp, "O4.x")], 1e-6, 1e-6);
+        collected_free(&s);
+    }
+    collected_free(&p);
+    pipeline_free(planar);
+    pipeline_free(spatial);
+    free(tp), free(ts);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -290,6 +356,7 @@ int main(void)
         cmocka_unit_test(test_bricard_driven_to_its_limit),
         cmocka_unit_test(test_inconsistent_redundancy),
         cmocka_unit_test(test_four_bar_forces),
+        cmocka_unit_test(test_four_bar_sim),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -114,6 +114,11 @@ static void red_all_nz(void *ctx, const double *q, const double *qd, double t, d
     gather(r, r->gamma, gamma);
 }
 
+bool redundant_applies(const Model *m)
+{
+    return m->nh > m->nq && m->nv == 0 && (double)m->nr * m->nq <= REDUNDANT_MAX_ENTRIES;
+}
+
 int redundant_find(const Model *m, const MechrtKernels *k, double t0, bool *red)
 {
     int nq = m->nq, nr = m->nr;
@@ -191,6 +196,7 @@ void redundant_open(Redundant *r, const Model *m, const MechrtKernels *k,
     r->phi = xmalloc(nr * sizeof *r->phi);
     r->nu = xmalloc(nr * sizeof *r->nu);
     r->gamma = xmalloc(nr * sizeof *r->gamma);
+    r->lambda = xcalloc(nr, sizeof *r->lambda);
     r->jac = xmalloc(nr * nq * sizeof *r->jac);
     Row *rows = xmalloc(nr * sizeof *rows);
     for (int i = 0; i < r->nkeep; i++)
@@ -214,10 +220,38 @@ void redundant_open(Redundant *r, const Model *m, const MechrtKernels *k,
         open_pattern(r, jnz);
 }
 
+bool redundant_start(Redundant *r, const Model *m, const MechrtKernels *k,
+                     const MechrtHostJacNz *jnz, double t0, bool driven, FILE *notes,
+                     char *why, size_t size)
+{
+    bool *drop = xcalloc((size_t)m->nr + 1, sizeof *drop);
+    int n = redundant_find(m, k, t0, drop);
+    if (n >= 0)
+        redundant_open(r, m, k, jnz, drop);
+    free(drop);
+    if (n < 0) {
+        snprintf(why, size, "t = %.10g: NaN or Inf in the Jacobian where the redundant rows "
+                 "are looked for (the configuration assembled on all rows)", t0);
+        return false;
+    }
+    if (driven && r->nkeep < m->nq) {
+        int dof = m->nq - r->nkeep;
+        snprintf(why, size, "%d degree%s of freedom %s not driven (%d coordinates, %d rows of "
+                 "which %d %s redundant: ", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are",
+                 m->nq, m->nr, r->ndrop, r->ndrop == 1 ? "is" : "are");
+        redundant_names(r, why, size);
+        analysis_msgf(why, size, "): add %s", dof == 1 ? "a driver" : "drivers");
+        redundant_close(r);
+        return false;
+    }
+    redundant_note(notes, r);
+    return true;
+}
+
 void redundant_close(Redundant *r)
 {
     free(r->keep), free(r->drop);
-    free(r->phi), free(r->nu), free(r->gamma), free(r->jac);
+    free(r->phi), free(r->nu), free(r->gamma), free(r->jac), free(r->lambda);
     free(r->nz_keep), free(r->nz_row), free(r->nz_col), free(r->vals);
     free(r->view.rows);
     memset(r, 0, sizeof *r);
@@ -333,10 +367,11 @@ void redundant_explain(Redundant *r, const double *q, const double *qd, const do
     redundant_names(r, msg, size);
 }
 
-void redundant_expand(const Redundant *r, const double *kept, double *all)
+const double *redundant_expand(Redundant *r, const double *kept)
 {
     for (int i = 0; i < r->ndrop; i++)
-        all[r->drop[i]] = 0;
+        r->lambda[r->drop[i]] = 0;
     for (int i = 0; i < r->nkeep; i++)
-        all[r->keep[i]] = kept[i];
+        r->lambda[r->keep[i]] = kept[i];
+    return r->lambda;
 }

@@ -29,7 +29,17 @@ typedef struct Redundant {
     Model view;
     MechrtKernels k;
     MechrtHostJacNz jnz;
+    double *lambda;             /* nr: redundant_expand's */
 } Redundant;
+
+/* Beyond this many Jacobian entries the redundant rows are not looked for
+   (the SVD at t0 is dense): info's limit (AnalysisOptions.max_dense). */
+#define REDUNDANT_MAX_ENTRIES 5e5
+
+/* m has more holonomic rows than coordinates, no velocity-level rows and
+   a Jacobian small enough for the SVD: run, sim and check leave its
+   redundant rows out. */
+bool redundant_applies(const Model *m);
 
 /* The rows to drop (nr flags into red; their count returned): the model
    assembled at t0 from its file's values on all its rows (minimum-norm
@@ -45,6 +55,14 @@ int redundant_find(const Model *m, const MechrtKernels *k, double t0, bool *red)
 void redundant_open(Redundant *r, const Model *m, const MechrtKernels *k,
                     const MechrtHostJacNz *jnz, const bool *red);
 void redundant_close(Redundant *r);
+
+/* redundant_find, then redundant_open on the other rows, said once in
+   notes (redundant_note); false with why (size bytes) when the Jacobian
+   is not finite there or, with driven (run, which needs one row per
+   coordinate), the rows kept do not drive every degree of freedom. */
+bool redundant_start(Redundant *r, const Model *m, const MechrtKernels *k,
+                     const MechrtHostJacNz *jnz, double t0, bool driven, FILE *notes,
+                     char *why, size_t size);
 
 /* The rows dropped, "O4.z (joint O4), O4.f (joint O4)" (info's wording),
    appended to msg. */
@@ -79,7 +97,8 @@ void redundant_explain(Redundant *r, const double *q, const double *qd, const do
                        double t, double tol_phi, char *msg, size_t size);
 
 /* The multipliers of the kept rows (nkeep) spread over the model's rows
-   (nr): the dropped rows' reactions are 0 (the basis solution). */
-void redundant_expand(const Redundant *r, const double *kept, double *all);
+   (r->lambda, nr, returned): the dropped rows' reactions are 0 (the basis
+   solution). */
+const double *redundant_expand(Redundant *r, const double *kept);
 
 #endif

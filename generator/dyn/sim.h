@@ -20,6 +20,7 @@
 #include "../engine/engine.h"
 #include "../model/model.h"
 #include "../analysis/common.h"
+#include "../analysis/redundant.h"
 
 /* The integrators: explicit embedded Runge-Kutta pairs, and two implicit
    methods for stiff mechanisms (stiff springs, large damping) that take
@@ -73,6 +74,10 @@ typedef struct SimOptions {
        column; NULL: no element named, its name alone */
     const Model *model;
     const Diag *source;
+    /* sim_run with more holonomic rows than coordinates: the redundant
+       rows it leaves out (the kernels are the other rows'), checked at
+       every output state, their multipliers reported as 0; NULL: none */
+    Redundant *redundant;
 } SimOptions;
 
 SimOptions sim_default_options(void);

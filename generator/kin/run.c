@@ -97,10 +97,9 @@ RunOptions run_default_options(void)
 static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
 {
     run_watch_condition(r, t, rep);
-    if (r->fstate && r->red) {
-        redundant_expand(r->red, r->inv.lambda, r->lambda);
-        r->fstate(ctx, t, r->q, r->qd, r->qdd, r->lambda);
-    } else if (r->fstate)
+    if (r->fstate && r->red)
+        r->fstate(ctx, t, r->q, r->qd, r->qdd, redundant_expand(r->red, r->inv.lambda));
+    else if (r->fstate)
         r->fstate(ctx, t, r->q, r->qd, r->qdd, r->inv.lambda);
     else
         state(ctx, t, r->q, r->qd, r->qdd);
@@ -378,10 +377,6 @@ static MechrtLup *run_lup_new(const Model *m, const MechrtHostJacNz *jnz)
     return f;
 }
 
-/* Beyond this many Jacobian entries the redundant rows are not looked for
-   (the SVD at t0 is dense): info's limit (AnalysisOptions.max_dense). */
-#define RUN_REDUNDANT_MAX_ENTRIES 5e5
-
 bool run_rows_match(const Model *m, char *why, size_t size)
 {
     if (m->nr < m->nq) {
@@ -392,8 +387,8 @@ bool run_rows_match(const Model *m, char *why, size_t size)
                  dof == 1 ? "" : " (one per degree of freedom)");
         return false;
     }
-    if (m->nr > m->nq && m->nv == 0 && (double)m->nr * m->nq <= RUN_REDUNDANT_MAX_ENTRIES)
-        return true;    /* the redundant rows are found at t0 (open_redundant) */
+    if (redundant_applies(m))
+        return true;    /* the redundant rows are found at t0 (redundant_start) */
     if (m->nr > m->nq) {
         int extra = m->nr - m->nq;
         snprintf(why, size, "the mechanism has %d more %s than coordinates (%d rows, %d "
@@ -402,37 +397,6 @@ bool run_rows_match(const Model *m, char *why, size_t size)
                  m->nr, m->nq);
         return false;
     }
-    return true;
-}
-
-/* More rows than coordinates: the redundant rows found at t0 and red
-   opened on the others, said once in the notes; false with why when the
-   others do not drive every degree of freedom or the Jacobian is not
-   finite. */
-static bool open_redundant(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
-                           const RunOptions *o, Redundant *red, char *why, size_t size)
-{
-    bool *drop = xcalloc((size_t)m->nr + 1, sizeof *drop);
-    int n = redundant_find(m, k, o->t0, drop);
-    if (n >= 0)
-        redundant_open(red, m, k, jnz, drop);
-    free(drop);
-    if (n < 0) {
-        snprintf(why, size, "t = %.10g: NaN or Inf in the Jacobian where the redundant rows "
-                 "are looked for (the configuration assembled on all rows)", o->t0);
-        return false;
-    }
-    if (red->nkeep < m->nq) {
-        int dof = m->nq - red->nkeep;
-        snprintf(why, size, "%d degree%s of freedom %s not driven (%d coordinates, %d rows of "
-                 "which %d %s redundant: ", dof, dof == 1 ? "" : "s", dof == 1 ? "is" : "are",
-                 m->nq, m->nr, red->ndrop, red->ndrop == 1 ? "is" : "are");
-        redundant_names(red, why, size);
-        analysis_msgf(why, size, "): add %s", dof == 1 ? "a driver" : "drivers");
-        redundant_close(red);
-        return false;
-    }
-    redundant_note(o->notes, red);
     return true;
 }
 
@@ -472,10 +436,8 @@ static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const Mechr
     if (fstate) {
         r.fstate = fstate;
         inverse_init(&r.inv, m->nq, m->nr);
-        if (red) {
-            r.lambda = xcalloc((size_t)red->nr, sizeof *r.lambda);
+        if (red)
             redundant_note_reactions(o->notes, red);
-        }
     }
 
     AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
@@ -494,7 +456,7 @@ static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const Mechr
         run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
               "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
     res->status = status;
-    free(r.q), free(r.work), free(r.lambda);
+    free(r.q), free(r.work);
     inverse_free(&r.inv);
     return status;
 }
@@ -527,7 +489,7 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const Mech
         return bad_input(res, "%s", why);
     if (m->nr > m->nq) {
         Redundant red;
-        if (!open_redundant(m, k, jnz, o, &red, why, sizeof why))
+        if (!redundant_start(&red, m, k, jnz, o->t0, true, o->notes, why, sizeof why))
             return bad_input(res, "%s", why);
         AnalysisStatus st = run_on(&red.view, &red.k, jnz ? &red.jnz : NULL, sparse, &red, o,
                                    state, fstate, state_ctx, res);

@@ -44,10 +44,8 @@ typedef struct Run {
     RunForcesFn fstate;
     Inverse inv;
     /* more rows than coordinates: the run is on red's kept rows (m, k,
-       jnz are its), red checks the others at every state; lambda: the
-       multipliers spread over the model's rows for fstate */
+       jnz are its), red checks the others at every state */
     Redundant *red;
-    double *lambda;
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;
