@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "../generator/dyn/sim.h"
+#include "../generator/verify/check.h"
 #include "../generator/kin/run.h"
 #include "../generator/pipeline/pipeline.h"
 #include "../runtime/host/mechrt_host.h"
@@ -349,6 +350,38 @@ static void test_four_bar_sim(void **state)
     free(tp), free(ts);
 }
 
+/* check: the base state assembled on the rows kept (the note once), every
+   comparison within tolerance; where the redundant rows contradict, the
+   initial values, not assembled. */
+static void test_check(void **state)
+{
+    (void)state;
+    const char *names[] = {"four_bar_spatial_redundant.mech", "O4 1 mm above the plane"};
+    for (int i = 0; i < 2; i++) {
+        char *text = example_plus("four_bar_spatial_redundant.mech", "");
+        if (i == 1)
+            replace_line(text, "revolute O4", "revolute O4: ground(d, 0, 1e-3) rocker(-c/2, 0, 0) "
+                         "axis(0, 0, 1)");
+        Mech *mech = load_text(text, "fb.mech");
+        CheckOptions opt = check_default_options();
+        opt.use_aot = false;
+        opt.samples = 3;
+        char notes[2048] = "";
+        opt.notes = fmemopen(notes, sizeof notes - 1, "w");
+        CheckReport rep;
+        Diag diag;
+        assert_true(check_mechanism(mech, &opt, &rep, &diag));
+        fclose(opt.notes);
+        if (rep.assembled != (i == 0) || !rep.ok)
+            fail_msg("%s: assembled %d, ok %d", names[i], rep.assembled, rep.ok);
+        assert_non_null(strstr(notes, "fb.mech: note: 24 holonomic rows for 21 coordinates: "
+                                      "redundant rows: O4.z (joint O4), O4.f (joint O4), O4.g "
+                                      "(joint O4);"));
+        pipeline_free(mech);
+        free(text);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -357,6 +390,7 @@ int main(void)
         cmocka_unit_test(test_inconsistent_redundancy),
         cmocka_unit_test(test_four_bar_forces),
         cmocka_unit_test(test_four_bar_sim),
+        cmocka_unit_test(test_check),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
