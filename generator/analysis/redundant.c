@@ -43,31 +43,82 @@ static void gather_jac(const Redundant *r, const double *full, double *out)
         memcpy(out + (size_t)i * nq, full + (size_t)r->keep[i] * nq, nq * sizeof *out);
 }
 
+/* The model's kernels into the scratch arrays, each stamped with the
+   state it was evaluated at. */
+static void stamp(const Redundant *r, RedundantAt *at, const double *q, const double *qd,
+                  double t)
+{
+    size_t bytes = (size_t)r->nq * sizeof *q;
+    memcpy(at->q, q, bytes);
+    if (qd)
+        memcpy(at->qd, qd, bytes);
+    at->t = t;
+    at->valid = true;
+}
+
+static bool fresh(const Redundant *r, const RedundantAt *at, const double *q, const double *qd,
+                  double t)
+{
+    size_t bytes = (size_t)r->nq * sizeof *q;
+    return at->valid && at->t == t && memcmp(at->q, q, bytes) == 0
+           && (!qd || memcmp(at->qd, qd, bytes) == 0);
+}
+
+static void eval_phi(Redundant *r, const double *q, double t)
+{
+    r->full->phi(r->full->ctx, q, t, r->phi);
+    stamp(r, &r->at_phi, q, NULL, t);
+}
+
+static void eval_jac(Redundant *r, const double *q, double t)
+{
+    r->full->jac(r->full->ctx, q, t, r->jac);
+    stamp(r, &r->at_jac, q, NULL, t);
+}
+
+static void eval_jac_nz(Redundant *r, const double *q, double t)
+{
+    r->full_jnz->jac.jac_nz(r->full_jnz->jac.ctx, q, t, r->vals);
+    stamp(r, &r->at_vals, q, NULL, t);
+}
+
+static void eval_nu(Redundant *r, const double *q, double t)
+{
+    r->full->nu(r->full->ctx, q, t, r->nu);
+    stamp(r, &r->at_nu, q, NULL, t);
+}
+
+static void eval_gamma(Redundant *r, const double *q, const double *qd, double t)
+{
+    r->full->gamma(r->full->ctx, q, qd, t, r->gamma);
+    stamp(r, &r->at_gamma, q, qd, t);
+}
+
 static void red_phi(void *ctx, const double *q, double t, double *phi)
 {
     Redundant *r = ctx;
-    r->full->phi(r->full->ctx, q, t, r->phi);
+    eval_phi(r, q, t);
     gather(r, r->phi, phi);
 }
 
 static void red_jac(void *ctx, const double *q, double t, double *jac)
 {
     Redundant *r = ctx;
-    r->full->jac(r->full->ctx, q, t, r->jac);
+    eval_jac(r, q, t);
     gather_jac(r, r->jac, jac);
 }
 
 static void red_nu(void *ctx, const double *q, double t, double *nu)
 {
     Redundant *r = ctx;
-    r->full->nu(r->full->ctx, q, t, r->nu);
+    eval_nu(r, q, t);
     gather(r, r->nu, nu);
 }
 
 static void red_gamma(void *ctx, const double *q, const double *qd, double t, double *gamma)
 {
     Redundant *r = ctx;
-    r->full->gamma(r->full->ctx, q, qd, t, r->gamma);
+    eval_gamma(r, q, qd, t);
     gather(r, r->gamma, gamma);
 }
 
@@ -76,6 +127,10 @@ static void red_all(void *ctx, const double *q, const double *qd, double t, doub
 {
     Redundant *r = ctx;
     r->full->all(r->full->ctx, q, qd, t, r->phi, r->jac, r->nu, r->gamma);
+    stamp(r, &r->at_phi, q, NULL, t);
+    stamp(r, &r->at_jac, q, NULL, t);
+    stamp(r, &r->at_nu, q, NULL, t);
+    stamp(r, &r->at_gamma, q, qd, t);
     gather(r, r->phi, phi);
     gather_jac(r, r->jac, jac);
     gather(r, r->nu, nu);
@@ -97,7 +152,7 @@ static void red_force(void *ctx, const double *q, const double *qd, double t, do
 static void red_jac_nz(void *ctx, const double *q, double t, double *vals)
 {
     Redundant *r = ctx;
-    r->full_jnz->jac.jac_nz(r->full_jnz->jac.ctx, q, t, r->vals);
+    eval_jac_nz(r, q, t);
     for (int e = 0; e < r->jnz.jac.nnz; e++)
         vals[e] = r->vals[r->nz_keep[e]];
 }
@@ -107,6 +162,10 @@ static void red_all_nz(void *ctx, const double *q, const double *qd, double t, d
 {
     Redundant *r = ctx;
     r->full_jnz->all_nz(r->full_jnz->jac.ctx, q, qd, t, r->phi, r->vals, r->nu, r->gamma);
+    stamp(r, &r->at_phi, q, NULL, t);
+    stamp(r, &r->at_vals, q, NULL, t);
+    stamp(r, &r->at_nu, q, NULL, t);
+    stamp(r, &r->at_gamma, q, qd, t);
     for (int e = 0; e < r->jnz.jac.nnz; e++)
         vals[e] = r->vals[r->nz_keep[e]];
     gather(r, r->phi, phi);
@@ -161,6 +220,7 @@ static void open_pattern(Redundant *r, const MechrtHostJacNz *jnz)
     r->nz_keep = xmalloc(nnz * sizeof *r->nz_keep);
     r->nz_row = xmalloc(nnz * sizeof *r->nz_row);
     r->nz_col = xmalloc(nnz * sizeof *r->nz_col);
+    r->nz_drop = xmalloc(nnz * sizeof *r->nz_drop);
     r->vals = xmalloc(nnz * sizeof *r->vals);
     int n = 0;
     for (int e = 0; e < jnz->jac.nnz; e++)
@@ -168,6 +228,8 @@ static void open_pattern(Redundant *r, const MechrtHostJacNz *jnz)
             r->nz_keep[n] = e;
             r->nz_row[n] = newrow[jnz->jac.row[e]];
             r->nz_col[n++] = jnz->jac.col[e];
+        } else {
+            r->nz_drop[r->ndrop_nz++] = e;
         }
     free(newrow);
     r->jnz = (MechrtHostJacNz){.jac = {.nnz = n, .row = r->nz_row, .col = r->nz_col, .ctx = r,
@@ -197,6 +259,13 @@ void redundant_open(Redundant *r, const Model *m, const MechrtKernels *k,
     r->nu = xmalloc(nr * sizeof *r->nu);
     r->gamma = xmalloc(nr * sizeof *r->gamma);
     r->lambda = xcalloc(nr, sizeof *r->lambda);
+    r->acc = xmalloc(2 * nr * sizeof *r->acc);
+    RedundantAt *at[] = {&r->at_phi, &r->at_jac, &r->at_vals, &r->at_nu, &r->at_gamma};
+    r->at_block = xmalloc(2 * nq * (sizeof at / sizeof *at) * sizeof *r->at_block + 1);
+    for (size_t i = 0; i < sizeof at / sizeof *at; i++) {
+        at[i]->q = r->at_block + 2 * nq * i;
+        at[i]->qd = at[i]->q + nq;
+    }
     r->jac = xmalloc(nr * nq * sizeof *r->jac);
     Row *rows = xmalloc(nr * sizeof *rows);
     for (int i = 0; i < r->nkeep; i++)
@@ -252,7 +321,8 @@ void redundant_close(Redundant *r)
 {
     free(r->keep), free(r->drop);
     free(r->phi), free(r->nu), free(r->gamma), free(r->jac), free(r->lambda);
-    free(r->nz_keep), free(r->nz_row), free(r->nz_col), free(r->vals);
+    free(r->acc), free(r->at_block);
+    free(r->nz_keep), free(r->nz_row), free(r->nz_col), free(r->nz_drop), free(r->vals);
     free(r->view.rows);
     memset(r, 0, sizeof *r);
 }
@@ -288,20 +358,34 @@ void redundant_note_reactions(FILE *notes, const Redundant *r)
 }
 
 /* The dropped rows' residuals of Phi_q x = rhs relative to their
-   tolerance, the worst into *worst (its row in *row) when it is larger. */
-static void check_rate(const Redundant *r, const double *x, const double *rhs, double *worst,
-                       int *row, bool *this_level)
+   tolerance, from the dense Jacobian (r->jac) or the model's nonzeros
+   (r->vals, sparse); the worst into *worst (its row in *row) when it is
+   larger. */
+static void check_rate(Redundant *r, bool sparse, const double *x, const double *rhs,
+                       double *worst, int *row, bool *this_level)
 {
-    size_t nq = (size_t)r->nq;
+    double *ax = r->acc, *scale = r->acc + r->nr;
     for (int d = 0; d < r->ndrop; d++) {
         int i = r->drop[d];
-        const double *a = r->jac + (size_t)i * nq;
-        double ax = 0, scale = fabs(rhs[i]);
-        for (size_t j = 0; j < nq; j++) {
-            ax += a[j] * x[j];
-            scale += fabs(a[j] * x[j]);
+        ax[i] = 0;
+        scale[i] = fabs(rhs[i]);
+        if (sparse)
+            continue;
+        const double *a = r->jac + (size_t)i * (size_t)r->nq;
+        for (int j = 0; j < r->nq; j++) {
+            ax[i] += a[j] * x[j];
+            scale[i] += fabs(a[j] * x[j]);
         }
-        double v = fabs(ax - rhs[i]) / (REDUNDANT_RATE_SHARE * scale + 1e-12);
+    }
+    for (int n = 0; sparse && n < r->ndrop_nz; n++) {
+        int e = r->nz_drop[n], i = r->full_jnz->jac.row[e];
+        double v = r->vals[e] * x[r->full_jnz->jac.col[e]];
+        ax[i] += v;
+        scale[i] += fabs(v);
+    }
+    for (int d = 0; d < r->ndrop; d++) {
+        int i = r->drop[d];
+        double v = fabs(ax[i] - rhs[i]) / (REDUNDANT_RATE_SHARE * scale[i] + 1e-12);
         if (!(v <= *worst)) {
             *worst = v;
             *row = i;
@@ -310,17 +394,29 @@ static void check_rate(const Redundant *r, const double *x, const double *rhs, d
     }
 }
 
+/* The dropped rows' Jacobian at (q, t), from the step that ended there
+   when it left one; true when it is the nonzeros (r->vals). */
+static bool jac_at(Redundant *r, const double *q, double t)
+{
+    if (r->full_jnz && fresh(r, &r->at_vals, q, NULL, t))
+        return true;
+    if (fresh(r, &r->at_jac, q, NULL, t))
+        return false;
+    if (r->full_jnz)
+        eval_jac_nz(r, q, t);
+    else
+        eval_jac(r, q, t);
+    return r->full_jnz != NULL;
+}
+
 double redundant_check(Redundant *r, const double *q, const double *qd, const double *qdd,
                        double t, double tol_phi, int *row, const char **level)
 {
-    const MechrtKernels *k = r->full;
     double worst = 0;
     *row = -1;
     *level = "position";
-    if (qd && k->all)
-        k->all(k->ctx, q, qd, t, r->phi, r->jac, r->nu, r->gamma);
-    else
-        k->phi(k->ctx, q, t, r->phi);
+    if (!fresh(r, &r->at_phi, q, NULL, t))
+        eval_phi(r, q, t);
     for (int d = 0; d < r->ndrop; d++) {
         double v = fabs(r->phi[r->drop[d]]) / (REDUNDANT_PHI_SHARE * tol_phi);
         if (!(v <= worst))
@@ -328,19 +424,18 @@ double redundant_check(Redundant *r, const double *q, const double *qd, const do
     }
     if (!qd)
         return worst;
-    if (!k->all) {
-        k->jac(k->ctx, q, t, r->jac);
-        k->nu(k->ctx, q, t, r->nu);
-        if (qdd)
-            k->gamma(k->ctx, q, qd, t, r->gamma);
-    }
-    bool at = false;
-    check_rate(r, qd, r->nu, &worst, row, &at);
+    bool sparse = jac_at(r, q, t), at = false;
+    if (!fresh(r, &r->at_nu, q, NULL, t))
+        eval_nu(r, q, t);
+    check_rate(r, sparse, qd, r->nu, &worst, row, &at);
     if (at)
         *level = "velocity";
+    if (!qdd)
+        return worst;
+    if (!fresh(r, &r->at_gamma, q, qd, t))
+        eval_gamma(r, q, qd, t);
     at = false;
-    if (qdd)
-        check_rate(r, qdd, r->gamma, &worst, row, &at);
+    check_rate(r, sparse, qdd, r->gamma, &worst, row, &at);
     if (at)
         *level = "acceleration";
     return worst;

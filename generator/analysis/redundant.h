@@ -10,6 +10,13 @@
 #include <stddef.h>
 #include <stdio.h>
 
+/* The state a kernel's values belong to: (q, t), and qd for gamma. */
+typedef struct RedundantAt {
+    bool valid;
+    double t;
+    double *q, *qd;             /* nq each */
+} RedundantAt;
+
 /* A mechanism with nh > nq holonomic rows (no velocity-level rows) as the
    square system of its independent rows: `view` is the model with those
    rows alone (the same names, joints and positions; everything else
@@ -24,8 +31,13 @@ typedef struct Redundant {
     int nq, nr, nkeep, ndrop;
     int *keep, *drop;           /* row indices of the model, ascending */
     double *phi, *jac, *nu, *gamma, *vals;     /* the model's rows, scratch */
+    /* where each was last evaluated (the kernels below keep them), so
+       that redundant_check takes them from the step that just ended */
+    RedundantAt at_phi, at_jac, at_vals, at_nu, at_gamma;
     int *nz_keep;               /* jnz entry e: the model's entry nz_keep[e] */
     int *nz_row, *nz_col;
+    int ndrop_nz, *nz_drop;     /* the model's entries in the dropped rows */
+    double *acc, *at_block;     /* redundant_check's sums (2 nr); the stamps' states */
     Model view;
     MechrtKernels k;
     MechrtHostJacNz jnz;

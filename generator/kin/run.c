@@ -333,13 +333,16 @@ static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...)
 
 
 /* Dense or sparse for this run (RunOptions.linear); false with why when
-   the choice cannot be honoured. */
+   the choice cannot be honoured. auto takes KLU for redundant rows at any
+   size: the rows kept have no unrolled LU of their own, and KLU's kept
+   pivot order costs half the dense LU's work there (bench/redundant.sh). */
 static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o,
                           bool *sparse, char *why, size_t size)
 {
     bool can = jnz != NULL;
     *sparse = o->linear == ANALYSIS_LINEAR_SPARSE
-              || (o->linear == ANALYSIS_LINEAR_AUTO && can && m->nq > ANALYSIS_DENSE_MAX_NQ);
+              || (o->linear == ANALYSIS_LINEAR_AUTO && can
+                  && (m->nq > ANALYSIS_DENSE_MAX_NQ || redundant_applies(m)));
     if (*sparse && !jnz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -428,7 +431,10 @@ static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const Mechr
                          jnz->jac.nnz, m->nq, m->nq);
     }
     res->sparse = sparse;
-    if (!sparse)
+    /* without the kernels' unrolled LU (written for all the rows) the
+       pattern LU keeps its pivot order for only half the steps of a
+       turning crank: lu.c's LU costs less there (bench/redundant.sh) */
+    if (!sparse && !red)
         r.lup = run_lup_new(m, jnz);
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
