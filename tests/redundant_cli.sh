@@ -50,6 +50,12 @@ check "driven Bricard: its redundant row" err_has "note: 36 holonomic rows for 3
 check "driven Bricard: the limit" err_has "error: t = 2.75625: the mechanism cannot reach the driven position: driver 'D' pushes it past a limit position"
 check "driven Bricard: the states before it" err_has "note: the 28 states before t = 2.75625 are written"
 
+# ---- parallelogram_redundant.mech with a driver (13 rows for 12) runs ----
+{ cat "$ex/parallelogram_redundant.mech"; echo "driver drive: c1.phi = pi/3 + t"; } > "$tmp/par.mech"
+run run "$tmp/par.mech" --steps 10
+check "driven parallelogram: exit 0" status_is 0
+check "driven parallelogram: A2.y redundant" err_has "note: 13 holonomic rows for 12 coordinates: redundant row: A2.y (joint A2);"
+
 # ---- contradicting redundancies: exit 1, named, with the time ----
 sed 's/ground(d, 0, 0)/ground(d, 0, 1e-3)/' "$fb" > "$tmp/lifted.mech"
 run run "$tmp/lifted.mech"
