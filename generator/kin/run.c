@@ -47,6 +47,12 @@
  * condition estimate exceeds MechrtOptions.cond_warn are warned about once,
  * when they begin, with a note when they end.
  *
+ * More holonomic rows than coordinates (a four-bar written in 3D with
+ * four revolutes about z): the redundant rows are found once at t0 and
+ * the run is the one of the other rows (analysis/redundant.c: their
+ * kernels and pattern, a view of the model with their names), with every
+ * state checked on the redundant rows too (redundant_at).
+ *
  * run_analysis_forces adds inverse dynamics (`run --forces`): at every
  * state, lambda from Phi_q^T lambda = Q - M qdd by the runtime's
  * mechrt_inverse_dynamics, inside the step's timing so that --stats
