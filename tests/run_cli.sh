@@ -469,9 +469,17 @@ constraint b: p.y = 0
 driver c: p.x = t
 EOF
 run "$tmp/over.mech"
-check "one row too many: exit 2" status_is 2
-check "one row too many: says so" err_has "1 more row than coordinates"
-check "one row too many: points at the last statement" err_has "over.mech:4:1: error:"
+check "a redundant driver that contradicts: exit 1" status_is 1
+check "a redundant driver that contradicts: named once" \
+    err_has "over.mech: note: 3 holonomic rows for 2 coordinates: redundant row: c (joint c);"
+check "a redundant driver that contradicts: says where, when and why" \
+    err_has "over.mech: error: t = 0: the redundant rows contradict the others: row c (joint c) is violated at the velocity level"
+printf 'velocity v: der(p.y) = 0\n' >> "$tmp/over.mech"
+run "$tmp/over.mech"
+check "one row too many with a velocity-level row: exit 2" status_is 2
+check "one row too many with a velocity-level row: says so" err_has "2 more rows than coordinates"
+check "one row too many with a velocity-level row: points at the last statement" \
+    err_has "over.mech:5:1: error:"
 
 # ---- every example runs, or fails as its header says -----------------------
 for f in "$ex"/*.mech; do

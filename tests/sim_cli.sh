@@ -400,10 +400,19 @@ constraint b: p.y = 0
 constraint c: p.x + p.y = 1
 mass p m = 1
 EOF
+run "$tmp/over.mech" --steps 2
+check "a redundant row: exit 0" status_is 0
+check "a redundant row: named once" \
+    err_has "over.mech: note: 3 holonomic rows for 2 coordinates: redundant row: c (joint c);"
+check "a redundant row: its reaction said not unique" \
+    err_has "over.mech: note: the reactions of the redundant rows and of the rows they repeat are not unique"
+check "a redundant row: the states" out_lines 4
+printf 'velocity v: der(p.x) = 0\n' >> "$tmp/over.mech"
 run "$tmp/over.mech"
-check "more rows than coordinates: exit 2" status_is 2
-check "more rows than coordinates: FILE:LINE:COL" err_matches "over\.mech:4:1: error: 3 holonomic rows for 2 coordinates"
-check "more rows than coordinates: nothing on stdout" out_lines 0
+check "more holonomic rows than coordinates, and velocity-level rows: exit 2" status_is 2
+check "more holonomic rows than coordinates, and velocity-level rows: FILE:LINE:COL" \
+    err_matches "over\.mech:6:1: error: 3 holonomic rows for 2 coordinates"
+check "more holonomic rows than coordinates, and velocity-level rows: nothing on stdout" out_lines 0
 # --interpolate's degree, as generator/dyn/hermite.c has it (3 nodes: 9
 # conditions, degree 8; 2 on the first step: the quintic), in --help and doc
 run --help

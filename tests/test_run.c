@@ -913,13 +913,16 @@ static void test_row_count(void **state)
     mech = load_text("point p x = 0 y = 0\nconstraint a: p.x = 0\nconstraint b: p.y = 0\n"
                      "driver c: p.x = t\ndriver d: p.y = t\n", "over.mech");
     run_with(mech, ENGINE_JIT, run_default_options(), &c);
-    assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
-    assert_non_null(strstr(c.res.message, "the mechanism has 2 more rows than coordinates"));
+    /* rows c and d repeat a and b (redundant, test_redundant.c) but
+       contradict them: a failure at t0, at the velocity level */
+    assert_int_equal(c.status, ANALYSIS_FAILED);
+    assert_int_equal(c.res.states, 0);
+    assert_non_null(strstr(c.res.message, "t = 0: the redundant rows contradict the others"));
     collected_free(&c);
 
     /* bad options are bad input too */
     RunOptions o = run_default_options();
-    o.steps = 0;
+    o.steps = -1;
     run_with(mech, ENGINE_JIT, o, &c);
     assert_int_equal(c.status, ANALYSIS_BAD_INPUT);
     collected_free(&c);

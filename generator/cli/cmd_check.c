@@ -296,6 +296,7 @@ static const CliCommand command = {
 int cmd_check(int argc, char **argv)
 {
     CheckCli c = {.opt = check_default_options(), .limits = mech_default_limits()};
+    c.opt.notes = stderr;
     c.seed = (int)c.opt.seed;
     return cli_main(&command, argc, argv, &c);
 }

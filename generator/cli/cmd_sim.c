@@ -343,7 +343,8 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         diag_error(diag, m->last_pos, "the mechanism has no masses: `mechc sim` needs `mass` "
                    "statements (with `gravity`, forces or springs) to simulate its dynamics");
         diag_print(diag, stderr);
-    } else if (m->nh > m->nq) {     /* before any output: sim_run would refuse it later */
+    } else if (m->nh > m->nq && !redundant_applies(m)) {   /* before any output: sim_run
+                                                              would refuse it later */
         diag_error(diag, m->last_pos, "%d holonomic rows for %d coordinates: sim's position "
                    "projection needs at most one row per coordinate", m->nh, m->nq);
         diag_print(diag, stderr);

@@ -120,6 +120,33 @@ bool sim_has_masses(const MechrtKernels *k)
     return k && k->mass && k->force;
 }
 
+/* The callback with the state y at t, its accelerations in s->f0 and
+   multipliers in s->lambda; with redundant rows left out, first their
+   check (false, the failure in s->res, when one is violated), and the
+   multipliers spread over every row. */
+static bool deliver(Sim *s, const double *y, double t, SimStateFn state, void *ctx)
+{
+    Redundant *red = s->o->redundant;
+    int n = s->nq;
+    if (!red) {
+        state(ctx, t, y, y + n, s->f0, s->lambda);
+        s->res->states++;
+        return true;
+    }
+    int row;
+    const char *level;
+    double tol = s->o->mechrt.tol_phi;
+    if (redundant_check(red, y, y + n, s->f0, t, tol, &row, &level) > 1) {
+        sim_fail(s, MECHRT_EMAXITER, t, "the check of the redundant rows");
+        redundant_explain(red, y, y + n, s->f0, t, tol, s->res->message,
+                          sizeof s->res->message);
+        return false;
+    }
+    state(ctx, t, y, y + n, s->f0, redundant_expand(red, s->lambda));
+    s->res->states++;
+    return true;
+}
+
 /* The state y at t out: its accelerations and multipliers, then the
    callback; with cache, the right side there is kept for the next step. */
 static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void *ctx,
@@ -139,9 +166,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
                                + sim_half_mdot(s, y, y + n);
             sim_cache_store(s, t, y, s->f1);
         }
-        state(ctx, t, y, y + n, s->f0, s->lambda);
-        s->res->states++;
-        return true;
+        return deliver(s, y, t, state, ctx);
     }
     MechrtStatus st = !sim_dense_ready(s) ? MECHRT_EINVAL
                       : mechrt_forward_dynamics(&s->kc, &s->o->dyn, y, y + n, t, s->f0,
@@ -151,9 +176,7 @@ static bool put_state(Sim *s, const double *y, double t, SimStateFn state, void 
         sim_explain_dynamics(s, st, &rep, y);
         return false;
     }
-    state(ctx, t, y, y + n, s->f0, s->lambda);
-    s->res->states++;
-    return true;
+    return deliver(s, y, t, state, ctx);
 }
 
 /* --interpolate: steps towards t1 across the output times, settling
@@ -338,17 +361,12 @@ static bool start_at_t0(const Model *m, const MechrtKernels *k, const MechrtHost
     return ok;
 }
 
-AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
-                       const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
-                       void *state_ctx, SimResult *res)
+/* sim_run on m and its kernels, input checked: o->redundant set when m
+   and k are the rows kept of a model with redundant rows. */
+static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
+                             void *state_ctx, SimResult *res)
 {
-    memset(res, 0, sizeof *res);
-    res->t_fail = NAN;
-    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
-        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
-                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
-    if (check_input(k, jnz, mnz, o, res) != ANALYSIS_OK)
-        return ANALYSIS_BAD_INPUT;
     double *q = xmalloc((size_t)m->nq * sizeof *q);
     memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
     SimResult pre = {0};
@@ -373,5 +391,34 @@ AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJ
     res->assembled_robustly = pre.assembled_robustly;
     res->assembly_move = move;
     free(q);
+    return st;
+}
+
+AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                       const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
+                       void *state_ctx, SimResult *res)
+{
+    memset(res, 0, sizeof *res);
+    res->t_fail = NAN;
+    if (k->nq != m->nq || k->nh != m->nh || k->nv != m->nv)
+        return bad_input(res, "internal error: kernels for %d/%d/%d coordinates/rows, "
+                         "model with %d/%d/%d", k->nq, k->nh, k->nv, m->nq, m->nh, m->nv);
+    if (!redundant_applies(m)) {
+        if (check_input(k, jnz, mnz, o, res) != ANALYSIS_OK)
+            return ANALYSIS_BAD_INPUT;
+        return run_on(m, k, jnz, mnz, o, state, state_ctx, res);
+    }
+    Redundant red;
+    char why[SIM_MESSAGE_MAX];
+    if (!redundant_start(&red, m, k, jnz, o->t0, false, o->notes, why, sizeof why))
+        return bad_input(res, "%s", why);
+    SimOptions ro = *o;
+    ro.redundant = &red;
+    AnalysisStatus st = check_input(&red.k, jnz ? &red.jnz : NULL, mnz, &ro, res);
+    if (st == ANALYSIS_OK) {
+        redundant_note_reactions(o->notes, &red);
+        st = run_on(&red.view, &red.k, jnz ? &red.jnz : NULL, mnz, &ro, state, state_ctx, res);
+    }
+    redundant_close(&red);
     return st;
 }

@@ -20,6 +20,7 @@
 #include "../engine/engine.h"
 #include "../model/model.h"
 #include "../analysis/common.h"
+#include "../analysis/redundant.h"
 
 /* The integrators: explicit embedded Runge-Kutta pairs, and two implicit
    methods for stiff mechanisms (stiff springs, large damping) that take
@@ -73,6 +74,10 @@ typedef struct SimOptions {
        column; NULL: no element named, its name alone */
     const Model *model;
     const Diag *source;
+    /* sim_run with more holonomic rows than coordinates: the redundant
+       rows it leaves out (the kernels are the other rows'), checked at
+       every output state, their multipliers reported as 0; NULL: none */
+    Redundant *redundant;
 } SimOptions;
 
 SimOptions sim_default_options(void);
@@ -127,7 +132,10 @@ typedef void (*SimStateFn)(void *ctx, double t, const double *q, const double *q
 bool sim_has_masses(const MechrtKernels *k);
 
 /* From the file's initial values: construction and assembly at t0 (as
-   run), then sim_integrate. */
+   run), then sim_integrate. More holonomic rows than coordinates (no
+   velocity-level rows): the redundant rows found at t0 and left out
+   (SimOptions.redundant, notes on the rows and on their reactions), the
+   states checked on them and their lambda reported as 0. */
 AnalysisStatus sim_run(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
                        const MechrtHostMassNz *mnz, const SimOptions *o, SimStateFn state,
                        void *state_ctx, SimResult *res);

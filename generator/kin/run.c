@@ -47,6 +47,12 @@
  * condition estimate exceeds MechrtOptions.cond_warn are warned about once,
  * when they begin, with a note when they end.
  *
+ * More holonomic rows than coordinates (a four-bar written in 3D with
+ * four revolutes about z): the redundant rows are found once at t0 and
+ * the run is the one of the other rows (analysis/redundant.c: their
+ * kernels and pattern, a view of the model with their names), with every
+ * state checked on the redundant rows too (redundant_at).
+ *
  * run_analysis_forces adds inverse dynamics (`run --forces`): at every
  * state, lambda from Phi_q^T lambda = Q - M qdd by the runtime's
  * mechrt_inverse_dynamics, inside the step's timing so that --stats
@@ -97,18 +103,40 @@ RunOptions run_default_options(void)
 static void put_state(Run *r, double t, const MechrtReport *rep, RunStateFn state, void *ctx)
 {
     run_watch_condition(r, t, rep);
-    if (r->fstate)
+    if (r->fstate && r->red)
+        r->fstate(ctx, t, r->q, r->qd, r->qdd, redundant_expand(r->red, r->inv.lambda));
+    else if (r->fstate)
         r->fstate(ctx, t, r->q, r->qd, r->qdd, r->inv.lambda);
     else
         state(ctx, t, r->q, r->qd, r->qdd);
     r->res->states++;
 }
 
+/* The redundant rows left out of the run (r->red) at the state just
+   computed: false, with the failure in r->res, when one is violated. */
+static bool redundant_at(Run *r, double t)
+{
+    int row;
+    const char *level;
+    if (redundant_check(r->red, r->q, r->qd, r->qdd, t, r->o->mechrt.tol_phi, &row,
+                        &level) <= 1)
+        return true;
+    r->res->status = ANALYSIS_FAILED;
+    r->res->cause = MECHRT_EMAXITER;
+    r->res->t_fail = t;
+    redundant_explain(r->red, r->q, r->qd, r->qdd, t, r->o->mechrt.tol_phi, r->res->message,
+                      sizeof r->res->message);
+    return false;
+}
+
 /* Inverse dynamics at the state just computed (t, r->q, r->qd, r->qdd),
    into r->lambda; nothing without run_analysis_forces. False, with the
-   failure in r->res, when the solve fails. */
+   failure in r->res, when the solve fails. First, with redundant rows,
+   their check. */
 static bool inverse_at(Run *r, double t)
 {
+    if (r->red && !redundant_at(r, t))
+        return false;
     if (!r->fstate)
         return true;
     MechrtStatus st = inverse_solve(&r->inv, r->k, r->q, r->qd, r->qdd, t);
@@ -311,13 +339,16 @@ static AnalysisStatus bad_input(RunResult *res, const char *fmt, ...)
 
 
 /* Dense or sparse for this run (RunOptions.linear); false with why when
-   the choice cannot be honoured. */
+   the choice cannot be honoured. auto takes KLU for redundant rows at any
+   size: the rows kept have no unrolled LU of their own, and KLU's kept
+   pivot order costs half the dense LU's work there (bench/redundant.sh). */
 static bool choose_linear(const Model *m, const MechrtHostJacNz *jnz, const RunOptions *o,
                           bool *sparse, char *why, size_t size)
 {
     bool can = jnz != NULL;
     *sparse = o->linear == ANALYSIS_LINEAR_SPARSE
-              || (o->linear == ANALYSIS_LINEAR_AUTO && can && m->nq > ANALYSIS_DENSE_MAX_NQ);
+              || (o->linear == ANALYSIS_LINEAR_AUTO && can
+                  && (m->nq > ANALYSIS_DENSE_MAX_NQ || redundant_applies(m)));
     if (*sparse && !jnz) {
         snprintf(why, size, "--linear sparse needs the generated kernels' sparse Jacobian, "
                  "which the generic engine does not have: use --engine jit or aot");
@@ -372,6 +403,8 @@ bool run_rows_match(const Model *m, char *why, size_t size)
                  dof == 1 ? "" : " (one per degree of freedom)");
         return false;
     }
+    if (redundant_applies(m))
+        return true;    /* the redundant rows are found at t0 (redundant_start) */
     if (m->nr > m->nq) {
         int extra = m->nr - m->nq;
         snprintf(why, size, "the mechanism has %d more %s than coordinates (%d rows, %d "
@@ -381,6 +414,70 @@ bool run_rows_match(const Model *m, char *why, size_t size)
         return false;
     }
     return true;
+}
+
+/* The run of analyse, its input checked; red: the redundant rows left out
+   (m, k and jnz are then its kept rows'), or NULL. */
+static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
+                             bool sparse, Redundant *red, const RunOptions *o, RunStateFn state,
+                             RunForcesFn fstate, void *state_ctx, RunResult *res)
+{
+    Run r = {0};
+    r.red = red;
+    r.m = m;
+    r.k = k;
+    r.jnz = jnz;
+    r.o = o;
+    r.res = res;
+    r.nq = m->nq;
+    r.nr = m->nr;
+    size_t nq = (size_t)m->nq;
+    /* one block, q | qd | qdd, so that a step's start is saved in one copy */
+    r.q = xcalloc(3 * nq, sizeof *r.q);
+    r.qd = r.q + nq;
+    r.qdd = r.q + 2 * nq;
+    r.sparse = sparse;
+    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, jnz))) {
+        free(r.q);
+        return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
+                         "entries) is not a valid %d x %d pattern, or out of memory",
+                         jnz->jac.nnz, m->nq, m->nq);
+    }
+    res->sparse = sparse;
+    /* without the kernels' unrolled LU (written for all the rows) the
+       pattern LU keeps its pivot order for only half the steps of a
+       turning crank: lu.c's LU costs less there (bench/redundant.sh) */
+    if (!sparse && !red)
+        r.lup = run_lup_new(m, jnz);
+    r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
+    r.work = xcalloc(r.lwork, sizeof *r.work);
+    memcpy(r.q, m->q0, nq * sizeof *r.q);
+    if (fstate) {
+        r.fstate = fstate;
+        inverse_init(&r.inv, m->nq, m->nr);
+        if (red)
+            redundant_note_reactions(o->notes, red);
+    }
+
+    AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
+                                  : run_integrated(&r, state, state_ctx);
+    if (r.sp) {
+        mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
+        mechrt_host_sparse_free(r.sp);
+    }
+    if (r.lup) {
+        res->fresh_factorisations = r.lup->analyses;
+        res->refactorisations = r.lup->replays;
+        res->generated_factorisations = r.lup->gen_factors;
+        free(r.lup);
+    }
+    if (status == ANALYSIS_OK && r.episode)
+        run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
+              "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
+    res->status = status;
+    free(r.q), free(r.work);
+    inverse_free(&r.inv);
+    return status;
 }
 
 /* run_analysis and run_analysis_forces: one of state and fstate. */
@@ -409,57 +506,16 @@ static AnalysisStatus analyse(const Model *m, const MechrtKernels *k, const Mech
     bool sparse;
     if (!choose_linear(m, jnz, o, &sparse, why, sizeof why))
         return bad_input(res, "%s", why);
-
-    Run r = {0};
-    r.m = m;
-    r.k = k;
-    r.jnz = jnz;
-    r.o = o;
-    r.res = res;
-    r.nq = m->nq;
-    r.nr = m->nr;
-    size_t nq = (size_t)m->nq;
-    /* one block, q | qd | qdd, so that a step's start is saved in one copy */
-    r.q = xcalloc(3 * nq, sizeof *r.q);
-    r.qd = r.q + nq;
-    r.qdd = r.q + 2 * nq;
-    r.sparse = sparse;
-    if (sparse && m->nv == 0 && !(r.sp = mechrt_host_sparse_new(m->nq, jnz))) {
-        free(r.q);
-        return bad_input(res, "internal error: the kernels' sparse Jacobian pattern (%d "
-                         "entries) is not a valid %d x %d pattern, or out of memory",
-                         jnz->jac.nnz, m->nq, m->nq);
+    if (m->nr > m->nq) {
+        Redundant red;
+        if (!redundant_start(&red, m, k, jnz, o->t0, true, o->notes, why, sizeof why))
+            return bad_input(res, "%s", why);
+        AnalysisStatus st = run_on(&red.view, &red.k, jnz ? &red.jnz : NULL, sparse, &red, o,
+                                   state, fstate, state_ctx, res);
+        redundant_close(&red);
+        return st;
     }
-    res->sparse = sparse;
-    if (!sparse)
-        r.lup = run_lup_new(m, jnz);
-    r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
-    r.work = xcalloc(r.lwork, sizeof *r.work);
-    memcpy(r.q, m->q0, nq * sizeof *r.q);
-    if (fstate) {
-        r.fstate = fstate;
-        inverse_init(&r.inv, m->nq, m->nr);
-    }
-
-    AnalysisStatus status = m->nv == 0 ? run_holonomic(&r, state, state_ctx)
-                                  : run_integrated(&r, state, state_ctx);
-    if (r.sp) {
-        mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
-        mechrt_host_sparse_free(r.sp);
-    }
-    if (r.lup) {
-        res->fresh_factorisations = r.lup->analyses;
-        res->refactorisations = r.lup->replays;
-        res->generated_factorisations = r.lup->gen_factors;
-        free(r.lup);
-    }
-    if (status == ANALYSIS_OK && r.episode)
-        run_notef(&r, "note", "nearly singular from t = %.10g to the end (worst condition estimate "
-              "%.3g at t = %.10g)", r.ep_start, r.ep_worst, r.ep_worst_t);
-    res->status = status;
-    free(r.q), free(r.work);
-    inverse_free(&r.inv);
-    return status;
+    return run_on(m, k, jnz, sparse, NULL, o, state, fstate, state_ctx, res);
 }
 
 AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,

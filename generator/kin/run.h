@@ -123,9 +123,11 @@ typedef void (*RunStateFn)(void *ctx, double t, const double *q, const double *q
 typedef void (*RunForcesFn)(void *ctx, double t, const double *q, const double *qd,
                             const double *qdd, const double *lambda);
 
-/* True when m has one row per coordinate, as a run needs; otherwise false
-   with why (size bytes) saying how many degrees of freedom are not driven
-   or how many rows are too many. */
+/* True when m has one row per coordinate, as a run needs, or more
+   holonomic rows and no velocity-level ones (the redundant rows are left
+   out at t0, redundant.h); otherwise false with why (size bytes) saying
+   how many degrees of freedom are not driven or how many rows are too
+   many. */
 bool run_rows_match(const Model *m, char *why, size_t size);
 
 /* Whether a run of m with options o takes the sparse path (jnz: the
@@ -135,7 +137,11 @@ bool run_linear_is_sparse(const Model *m, const MechrtHostJacNz *jnz, const RunO
 /* The run. m gives sizes, names and initial values; k evaluates m's rows;
    jnz is their sparse Jacobian (engine_jac_nz), or NULL: dense only.
    Needs k->nh + k->nv == k->nq, otherwise ANALYSIS_BAD_INPUT saying how many
-   degrees of freedom are not driven (or how many rows are too many). */
+   degrees of freedom are not driven (or how many rows are too many); or
+   more holonomic rows than coordinates (k->nv == 0): the redundant rows
+   found at t0 (a note), the run on the others, every state checked on
+   the redundant ones (ANALYSIS_FAILED where they contradict the others),
+   and ANALYSIS_BAD_INPUT when the others drive too few coordinates. */
 AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const MechrtHostJacNz *jnz,
                             const RunOptions *o, RunStateFn state, void *state_ctx,
                             RunResult *res);
@@ -143,7 +149,9 @@ AnalysisStatus run_analysis(const Model *m, const MechrtKernels *k, const Mechrt
 /* run_analysis with inverse dynamics at every state: lambda from
    Phi_q^T lambda = Q(q, qd, t) - M(q) qdd (mechrt_inverse_dynamics,
    minimum-norm where rows are dependent), computed inside each step's
-   timing, handed to state with the state. Needs k->mass and k->force (a
+   timing, handed to state with the state (with redundant rows: the rows
+   kept carry the reactions, the redundant rows' lambda is 0, a note says
+   they are not unique). Needs k->mass and k->force (a
    file with masses): ANALYSIS_BAD_INPUT otherwise. A failed solve (NaN in M or
    Q) fails the run at that time. */
 AnalysisStatus run_analysis_forces(const Model *m, const MechrtKernels *k,

@@ -5,6 +5,7 @@
 #include "run.h"
 
 #include "../analysis/common.h"
+#include "../analysis/redundant.h"
 #include "../dyn/inverse.h"
 
 /* States before the current one that the rank corrector's predictor
@@ -42,6 +43,9 @@ typedef struct Run {
        dynamics' workspace and multipliers */
     RunForcesFn fstate;
     Inverse inv;
+    /* more rows than coordinates: the run is on red's kept rows (m, k,
+       jnz are its), red checks the others at every state */
+    Redundant *red;
     /* a nearly singular stretch in progress */
     bool episode;
     double ep_start, ep_end, ep_worst, ep_worst_t;

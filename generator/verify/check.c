@@ -68,6 +68,7 @@
 
 #include "../../runtime/mechrt.h"
 #include "../analysis/assemble_t0.h"
+#include "../analysis/redundant.h"
 #include "../base/arena.h"
 #include "../base/rng.h"
 #include "../kin/run.h"
@@ -106,6 +107,7 @@ static const char *const dyn_names[CHECK_WHAT_COUNT - CHECK_DYN_FIRST] = {
 typedef struct BaseNewton {
     Checker *c;
     const MechrtKernels *k;
+    const MechrtHostJacNz *jnz;     /* the sparse path's pattern */
 } BaseNewton;
 
 static MechrtStatus base_newton(void *ctx, double *q, MechrtReport *rep)
@@ -113,13 +115,13 @@ static MechrtStatus base_newton(void *ctx, double *q, MechrtReport *rep)
     const BaseNewton *b = ctx;
     size_t nq = (size_t)b->c->nq;
     if (!b->c->sparse) {
-        size_t lwork = mechrt_workspace_size(b->c->nq, b->c->nr);
+        size_t lwork = mechrt_workspace_size(b->c->nq, b->k->nh + b->k->nv);
         double *work = xmalloc(lwork * sizeof *work);
         MechrtStatus st = mechrt_assemble(b->k, NULL, q, 0.0, work, lwork, rep);
         free(work);
         return st;
     }
-    MechrtHostSparse *s = mechrt_host_sparse_new(b->c->nq, b->c->jnz[ENGINE_JIT]);
+    MechrtHostSparse *s = mechrt_host_sparse_new(b->c->nq, b->jnz);
     double *work = xcalloc(MECHRT_HOST_SPARSE_WORK_LEN(nq) + 2 * nq, sizeof *work);
     double *qd = work + MECHRT_HOST_SPARSE_WORK_LEN(nq), *qdd = qd + nq;
     MechrtStatus st = !s ? MECHRT_EINVAL
@@ -130,24 +132,52 @@ static MechrtStatus base_newton(void *ctx, double *q, MechrtReport *rep)
     return st;
 }
 
-/* The base state: assembled at t = 0 from the initial values when the
-   holonomic rows are square (dense: with the robust restarts from rough
-   initial values, as run; sparse: none, they are dense), else the initial
-   values. */
-static bool assemble(Checker *c, double *q)
+/* assemble's Newton on the holonomic rows of m, square, with kernels k0
+   and pattern jnz. */
+static bool assemble_square(Checker *c, const Model *m, const MechrtKernels *k0,
+                            const MechrtHostJacNz *jnz, double *q)
 {
-    memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
-    if (c->nh != c->nq)
-        return false;
-    MechrtKernels k = c->eng[ENGINE_JIT].k;
+    MechrtKernels k = *k0;
     if (!c->sparse)
         k.all = NULL;
-    BaseNewton b = {c, &k};
+    BaseNewton b = {c, &k, jnz};
     AssembleT0Options ao = {.t0 = 0.0, .newton = base_newton, .newton_ctx = &b,
                             .robust = !c->sparse, .again = true,
                             .rough = analysis_default_options()};
     AssembleT0Report rep;
-    bool ok = assemble_at_t0(c->m, &k, NULL, &ao, q, &rep);
+    return assemble_at_t0(m, &k, NULL, &ao, q, &rep);
+}
+
+/* More holonomic rows than coordinates: assembled on the rows that are
+   not redundant (redundant.c, as run), which must drive every coordinate,
+   and only where the redundant rows hold there too. */
+static bool assemble_redundant(Checker *c, double *q)
+{
+    Redundant red;
+    char why[300];
+    const MechrtHostJacNz *jnz = c->jnz[ENGINE_JIT];
+    if (!redundant_start(&red, c->m, &c->eng[ENGINE_JIT].k, jnz, 0.0, true, c->opt->notes, why,
+                         sizeof why))
+        return false;
+    int row;
+    const char *level;
+    bool ok = assemble_square(c, &red.view, &red.k, jnz ? &red.jnz : NULL, q)
+              && redundant_check(&red, q, NULL, NULL, 0.0, mechrt_default_options().tol_phi,
+                                 &row, &level) <= 1;
+    redundant_close(&red);
+    return ok;
+}
+
+/* The base state: assembled at t = 0 from the initial values when the
+   holonomic rows are square (dense: with the robust restarts from rough
+   initial values, as run; sparse: none, they are dense) or redundant rows
+   make them so, else the initial values. */
+static bool assemble(Checker *c, double *q)
+{
+    memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
+    bool ok = redundant_applies(c->m) ? assemble_redundant(c, q)
+              : c->nh == c->nq && assemble_square(c, c->m, &c->eng[ENGINE_JIT].k,
+                                                   c->jnz[ENGINE_JIT], q);
     if (!ok)
         memcpy(q, c->m->q0, (size_t)c->nq * sizeof *q);
     return ok;

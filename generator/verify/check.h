@@ -47,6 +47,10 @@ typedef struct CheckOptions {
        ANALYSIS_DENSE_MAX_NQ coordinates (default auto) */
     AnalysisLinear linear;
     CheckFault fault;       /* tests only (default none) */
+    /* notes ("FILE: note: ...": the redundant rows of a mechanism with
+       more holonomic rows than coordinates, said once); NULL: none
+       (default) */
+    FILE *notes;
 } CheckOptions;
 
 CheckOptions check_default_options(void);
