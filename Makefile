@@ -264,15 +264,26 @@ bench: deps
 	$(Q)sh bench/dynamics.sh $(MECHC)
 	$(Q)sh bench/design.sh $(MECHC)
 
-install: $(MECHC) $(SO)
+# The library: include/mechc/mechc.h, lib/libmechc.a and .so, and
+# lib/pkgconfig/mechc.pc for `cc prog.c $$(pkg-config --cflags --libs mechc)`
+# (--static: libmechc.a with what it needs).
+install: $(MECHC) $(LIB) $(SO)
 	install -d $(DESTDIR)$(PREFIX)/bin
 	install -m 755 $(MECHC) $(DESTDIR)$(PREFIX)/bin/mechc
 	install -d $(DESTDIR)$(PREFIX)/include/mechc $(DESTDIR)$(PREFIX)/share/mechc/runtime
-	install -m 644 runtime/mechrt.h $(DESTDIR)$(PREFIX)/include/mechc/
+	install -m 644 runtime/mechrt.h generator/lib/mechc.h $(DESTDIR)$(PREFIX)/include/mechc/
 	install -m 644 runtime/*.h runtime/*.c $(DESTDIR)$(PREFIX)/share/mechc/runtime/
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/libmechc.a
+	install -m 755 $(SO) $(DESTDIR)$(PREFIX)/lib/libmechc.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' \
+	  -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|' generator/lib/mechc.pc.in \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/mechc.pc
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
+	rm -f $(DESTDIR)$(PREFIX)/lib/libmechc.a $(DESTDIR)$(PREFIX)/lib/libmechc.so \
+	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/mechc.pc
 	rm -rf $(DESTDIR)$(PREFIX)/share/mechc $(DESTDIR)$(PREFIX)/include/mechc
 
 clean:
