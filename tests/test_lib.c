@@ -9,6 +9,7 @@
 
 #include "../generator/lib/mechc.h"
 
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -336,6 +337,38 @@ static void info(void **state)
     mechc_model_free(m);
 }
 
+/* One thread's work on a model of its own: load, jit, run; rocker.phi at t = 1. */
+static void *run_alone(void *out)
+{
+    mechc_model *m = mechc_load_file("examples/four_bar.mech", NULL);
+    mechc_kernels *k = m ? mechc_compile(m, "jit", NULL) : NULL;
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 50;
+    mechc_result *r = k ? mechc_run(k, &o, NULL) : NULL;
+    *(double *)out = r ? mechc_result_q(r)[50 * 9 + 8] : NAN;
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+    return NULL;
+}
+
+/* Distinct models in threads at the same time give what one alone gives. */
+static void threads(void **state)
+{
+    (void)state;
+    enum { T = 4 };
+    double alone, got[T];
+    run_alone(&alone);
+    assert_near(alone, 1.696124157962962, 1e-12, 0);
+    pthread_t th[T];
+    for (int i = 0; i < T; i++)
+        assert_int_equal(pthread_create(&th[i], NULL, run_alone, &got[i]), 0);
+    for (int i = 0; i < T; i++) {
+        pthread_join(th[i], NULL);
+        assert_true(got[i] == alone);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -349,6 +382,7 @@ int main(void)
         cmocka_unit_test(design_without_recompiling),
         cmocka_unit_test(sim_matches_cli),
         cmocka_unit_test(info),
+        cmocka_unit_test(threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
