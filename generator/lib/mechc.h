@@ -18,6 +18,9 @@
  * keep scratch memory in the handle). A kernels handle keeps a pointer to
  * its model: free the kernels first.
  *
+ * The first load turns GSL's error handler off (gsl_set_error_handler_off:
+ * its default aborts; the library checks every status), for good.
+ *
  * The library never prints and never exits on bad input or a failed
  * analysis: every failure is a status (mechc_status) and, where a
  * mechc_diag pointer is taken (it may be NULL), a message. Out of memory
