@@ -144,10 +144,10 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
 /* ---- compiling ---- */
 
 /* Compiles m's kernels with an engine: "jit" (default when NULL: generated
-   C compiled in process; in libmechc.so by the tcc program into a shared
-   object loaded with dlopen, in libmechc.a by libtcc), "aot" (generated
-   C built by $CC, default cc, -O2, cached in ~/.cache/mechc) or "generic"
-   (formulas interpreted, nothing compiled). NULL with diag filled:
+   C compiled in memory by libtcc, about 2 ms for a four-bar; one jit
+   compile at a time in the process), "aot" (generated C built by $CC,
+   default cc, -O2, cached in $XDG_CACHE_HOME/mechc or ~/.cache/mechc) or
+   "generic" (formulas interpreted, nothing compiled). NULL with diag filled:
    MECHC_EARG for an unknown engine, MECHC_ECOMPILE when it cannot compile. */
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
