@@ -195,6 +195,16 @@ mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, doub
 /* dPhi/dp at the current design: MECHC_ENOTAVAIL when np == 0. */
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t,
                          double *phi_p /* nh x np */);
+/* The sensitivities of a state of the motion (q, qd, qdd at t, as a run
+   gives them) to the design parameters, what `run --sens` writes:
+   variable-major, [i * np + j] = d(variable i)/d(p_j); q_p, qd_p, qdd_p
+   nq x np, y_p, yd_p, ydd_p (the outputs'; may be NULL) nout x np.
+   MECHC_ENOTAVAIL without design parameters, with velocity-level rows or
+   without as many rows as coordinates; MECHC_EANALYSIS where Phi_q is
+   singular. */
+mechc_status mechc_sensitivities(mechc_kernels *k, const double *q, const double *qd,
+                                 const double *qdd, double t, double *q_p, double *qd_p,
+                                 double *qdd_p, double *y_p, double *yd_p, double *ydd_p);
 /* The `output` statements' values, velocities and accelerations; yd, ydd
    (and qd, qdd with them) may be NULL. */
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
