@@ -247,6 +247,23 @@ static void errors(void **state)
     assert_null(mechc_run(k, NULL, &d));
     assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
     mechc_kernels_free(k);
+    mechc_model_free(m);    /* a driver past a limit position: the states before it, the status and the message */
+    m = mechc_load_string("point p x = 0 y = 1\ndistance D: ground(0, 0) p length = 1\n"
+                          "driver d: p.x = 2*t\n", "reach.mech", &d);
+    assert_non_null(m);
+    k = compile(m, "jit");
+    mechc_run_options o10 = mechc_run_defaults();
+    o10.steps = 10;
+    mechc_result *r = mechc_run(k, &o10, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_EANALYSIS);
+    assert_int_equal(d.status, MECHC_EANALYSIS);
+    assert_int_equal(mechc_result_states(r), 5);
+    assert_near(mechc_result_t_fail(r), 0.5, 0, 1e-15);
+    assert_non_null(strstr(mechc_result_message(r), "t = 0.5: the mechanism cannot reach"));
+    assert_string_equal(d.message, mechc_result_message(r));
+    mechc_result_free(r);
+    mechc_kernels_free(k);
     mechc_model_free(m);
 }
 
