@@ -197,6 +197,43 @@ static void engines_agree(void **state)
     mechc_model_free(m);
 }
 
+/* The outputs of examples/rssr.mech at a run's states, one by one and in one call. */
+static void outputs(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/rssr.mech");
+    int nq = mechc_nq(m), no = mechc_nout(m);
+    assert_true(no > 0);
+    mechc_kernels *k = compile(m, "jit");
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 6;
+    mechc_result *r = mechc_run(k, &o, NULL);
+    assert_non_null(r);
+    int n = mechc_result_states(r);
+    double *y = malloc((size_t)(3 * n * no) * sizeof *y), one[3][64];
+    assert_true(no <= 64);
+    assert_int_equal(mechc_outputs_batch(k, (size_t)n, mechc_result_q(r), mechc_result_qd(r),
+                                         mechc_result_qdd(r), mechc_result_time(r), (size_t)n,
+                                         y, y + n * no, y + 2 * n * no),
+                     MECHC_OK);
+    for (int i = 0; i < n; i++) {
+        mechc_outputs(k, mechc_result_q(r) + i * nq, mechc_result_qd(r) + i * nq,
+                      mechc_result_qdd(r) + i * nq, mechc_result_time(r)[i], one[0], one[1],
+                      one[2]);
+        for (int j = 0; j < no; j++) {
+            assert_true(y[i * no + j] == mechc_result_y(r)[i * no + j]);
+            assert_true(y[i * no + j] == one[0][j]);
+            assert_true(y[(n + i) * no + j] == mechc_result_yd(r)[i * no + j]);
+            assert_true(y[(2 * n + i) * no + j] == one[2][j]);
+        }
+    }
+    assert_non_null(mechc_output_name(m, 0));
+    free(y);
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 /* The diagnostic of a broken text as a value: file, line, column, message. */
 static void diagnostics(void **state)
 {
@@ -498,6 +535,7 @@ int main(void)
         cmocka_unit_test(jacobian),
         cmocka_unit_test(batches),
         cmocka_unit_test(engines_agree),
+        cmocka_unit_test(outputs),
         cmocka_unit_test(diagnostics),
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
