@@ -165,7 +165,7 @@ static void print_stats(const SimResult *r, int nr)
     if (nr > 0 && r->sparse)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; largest pivot spread of "
                 "[I Phi_q^T; Phi_q 0] with every row %.3g (about (sigma_max / sigma_min)^2 of "
-                "Phi_q; above 1e6 the dense elimination chose the rows)\n", r->max_redundant,
+                "Phi_q; above 1e4 the dense elimination chose the rows)\n", r->max_redundant,
                 r->max_redundant == 1 ? "row" : "rows", r->max_screen_spread);
     else if (nr > 0)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; smallest pivot ratio of "

@@ -14,15 +14,18 @@
    largest entry, as the dense LU's), and the pivot spread of [I Phi_q^T;
    Phi_q 0] with every row above which the rows are chosen by the dense
    rank-revealing elimination. Its small eigenvalues are -sigma_i^2 of
-   Phi_q, so 1e6 is a singular value ratio near 1e-3, ten times above
-   row_tol's 1e-4 (pivots in the elimination track the singular values
-   within modest factors): far from a rank drop every row is kept without
-   the dense elimination, near one it decides. */
+   Phi_q, so 1e4 is a singular value ratio near 1e-2, a hundred times
+   above row_tol's 1e-4: far from a rank drop every row is kept without
+   the dense elimination, near one it decides. (At 1e6 the rows near a
+   flat position of A02, N = 2, stayed until 4e-6 rad from it, where the
+   elimination's pivots, 30 times below the singular values, had dropped
+   them at 7e-5 on the dense path: the stages' error over the small
+   singular value went into the velocities, 6e-5 of error at rtol 1e-10.) */
 #define SIM_KKT_PIVOT_TOL 1e-12
+#define SIM_KKT_SPREAD_MAX 1e4
 /* A projection that moves a coordinate or rate by more than this share
    of its tolerance (atol + rtol |y|) has the next step take f afresh. */
 #define SIM_FRESH_F_SHARE 0.1
-#define SIM_KKT_SPREAD_MAX 1e6
 
 /* The rows' tolerance of both projections (row_tol): redundant rows, and
    near a rank drop the row becoming dependent, are left alone; a small
