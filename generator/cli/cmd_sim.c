@@ -73,7 +73,10 @@ static const CliOption options[] = {
              "the generated kernels' nonzeros; jit, aot); default auto:\n"
              "sparse above 100 coordinates"},
     {"--rtol", CLI_REAL_AT(SimCli, so.rtol), NONNEGATIVE, .metavar = "X",
-     .help = "relative error per step (default 1e-10)"},
+     .help = "relative error per step, as GSL's and SUNDIALS' rtol:\n"
+             "|err_i| <= atol + rtol |y_i| on every position and rate\n"
+             "(default 1e-10: the errors of the steps add up, and\n"
+             "IFToMM A01's 2000 s need it to end within 1e-5)"},
     {"--atol", CLI_REAL_AT(SimCli, so.atol), NONNEGATIVE, .metavar = "X",
      .help = "absolute error per step, coordinate units (default 1e-10)"},
     {"--qd", CLI_STRING_AT(SimCli, qd_text), .metavar = "V1,V2,...",
