@@ -174,6 +174,10 @@ static void print_stats(const SimResult *r, int nr)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; smallest pivot ratio of "
                 "Phi_q %.3g (near 0: a singular position)\n", r->max_redundant,
                 r->max_redundant == 1 ? "row" : "rows", r->min_pivot_ratio);
+    if (r->fold_steps > 0)
+        fprintf(stderr, "mechc sim: stats: %ld steps near a rank drop left rows out, with the "
+                "accelerations those rows impose held from where they went out\n",
+                r->fold_steps);
     fprintf(stderr, "mechc sim: stats: %.6g ms of integration (%.6g ms CPU)\n",
             1e3 * r->seconds, 1e3 * r->cpu_seconds);
 }

@@ -61,8 +61,10 @@ bool sim_fold_prepare(Sim *s, const double *y, double t)
     /* the same rows out as in the step before: the difference from where
        they went out is held (nearer the rank drop the solve with every row
        has the residuals of the projections over an ever smaller pivot) */
-    if (s->fold_on && out > 0 && memcmp(s->active0, s->active, (size_t)s->nr) == 0)
+    if (s->fold_on && out > 0 && memcmp(s->active0, s->active, (size_t)s->nr) == 0) {
+        s->res->fold_steps++;
         return true;
+    }
     s->fold_on = false;
     if (out == 0 || s->o->method == SIM_MSBDF || !sim_dense_ready(s) || !fold_needed(s, y, t, out))
         return true;    /* msbdf: its rows stay from one output time to the next */
