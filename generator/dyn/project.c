@@ -377,16 +377,34 @@ static bool sparse_rows(Sim *s, const double *y, double t)
     return true;
 }
 
+/* Rows the step before left out are back (s->active0: its rows). */
+static bool rows_returned(const Sim *s)
+{
+    for (int i = 0; i < s->nr; i++)
+        if (!s->active0[i] && s->active[i])
+            return true;
+    return false;
+}
+
 /* After a step (or at the start): projection when on, then the rows; the
    sparse path chooses the rows before the velocity projection, which
-   uses them. */
+   uses them, and projects the positions with the rows of the step before
+   (its factors), again with the new ones where rows came back (the
+   velocities of rows that were out, projected at positions off them,
+   took their residual over a small pivot). */
 static bool settle(Sim *s, double *y, double t, bool project)
 {
     if (!s->kkt)
         return (!project || (settle_positions(s, y, t) && settle_velocities(s, y, t)))
                && choose_rows(s, y, t, NULL);
-    return (!project || settle_positions(s, y, t)) && sparse_rows(s, y, t)
-           && (!project || settle_velocities(s, y, t));
+    if ((project && !settle_positions(s, y, t)) || !sparse_rows(s, y, t))
+        return false;
+    if (project && rows_returned(s)) {
+        if (!settle_positions(s, y, t))
+            return false;
+        s->vel_ready = s->vel_ready && sim_sparse_eval(s, y, y + s->nq, t, false) == MECHRT_OK;
+    }
+    return !project || settle_velocities(s, y, t);
 }
 
 /* The settled state differs from s->ys (before) by more than
