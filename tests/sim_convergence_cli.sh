@@ -4,11 +4,11 @@
 #   sh tests/sim_convergence_cli.sh build/mechc
 #
 # IFToMM A01 (simple pendulum, examples/a01_pendulum.mech) and A02 (the N
-# four-bar, sh examples/a02_four_bar.sh 2: 15 coordinates, the dense path,
-# through 14 flat positions where Phi_q loses two ranks) over 20 s with 20
-# output steps (the integrator's steps then follow its tolerance, not the
-# outputs), rk8pd at --rtol = --atol = 1e-4, 1e-5, ..., 1e-9: the largest
-# error of P1 (A01: Jacobi elliptic functions) and of B0's position and
+# four-bar, sh examples/a02_four_bar.sh 2: 15 coordinates, the dense path
+# and the sparse one, through 14 flat positions where Phi_q loses two
+# ranks) over 20 s with 20 output steps (the integrator's steps then
+# follow its tolerance, not the outputs), rk8pd at --rtol = --atol =
+# 1e-4, 1e-5, ..., 1e-9: the largest error of P1 (A01: Jacobi elliptic functions) and of B0's position and
 # velocity (A02: the one-angle equation of the parallelogram branch,
 # sh examples/a02_four_bar.sh --error) over the 21 states must fall at least
 # fivefold per decade. Before the fix of doc/dynamics.md, "Step control near
@@ -81,6 +81,8 @@ errors() {
 falls "a01" $(errors a01 "$ex/a01_pendulum.mech")
 
 sh "$ex/a02_four_bar.sh" 2 "$tmp/a02.mech"
-falls "a02, N = 2" $(errors 2 "$tmp/a02.mech" --qd "$(sh "$ex/a02_four_bar.sh" --qd 2)")
+qd=$(sh "$ex/a02_four_bar.sh" --qd 2)
+falls "a02, N = 2" $(errors 2 "$tmp/a02.mech" --qd "$qd")
+falls "a02, N = 2, --linear sparse" $(errors 2 "$tmp/a02.mech" --qd "$qd" --linear sparse)
 
 suite_end
