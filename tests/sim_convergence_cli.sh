@@ -8,12 +8,13 @@
 # and the sparse one, through 14 flat positions where Phi_q loses two
 # ranks) over 20 s with 20 output steps (the integrator's steps then
 # follow its tolerance, not the outputs), rk8pd at --rtol = --atol =
-# 1e-4, 1e-5, ..., 1e-9: the largest error of P1 (A01: Jacobi elliptic functions) and of B0's position and
-# velocity (A02: the one-angle equation of the parallelogram branch,
-# sh examples/a02_four_bar.sh --error) over the 21 states must fall at least
-# fivefold per decade. Before the fix of doc/dynamics.md, "Step control near
-# singular positions", A02's rose past 1e-8. The benchmarks' own spans and
-# output counts (A01 2000 s, A02 N = 40) and CPU times are bench/dynamics.sh's.
+# 1e-4, 1e-5, ..., 1e-9: the largest error of P1 (A01: Jacobi elliptic
+# functions) and of B0's position and velocity (A02: the one-angle
+# equation of the parallelogram branch, sh examples/a02_four_bar.sh
+# --error) over the 21 states must fall at least fivefold per decade.
+# Before the fix of doc/dynamics.md, "Step control near singular
+# positions", A02's rose past 1e-8. The benchmarks' own spans and output
+# counts (A01 2000 s, A02 N = 40) and CPU times are bench/dynamics.sh's.
 # The last line is "sim_convergence_cli: N passed, M failed".
 set -u
 # shellcheck source=tests/lib.sh
