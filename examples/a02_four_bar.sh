@@ -3,6 +3,9 @@
 #
 #   sh examples/a02_four_bar.sh N [OUTFILE]   the .mech (stdout without OUTFILE)
 #   sh examples/a02_four_bar.sh --qd N        the --qd list for `mechc sim`
+#   sh examples/a02_four_bar.sh --error N CSV the largest error of B0's position
+#                                             and velocity in sim's CSV against
+#                                             the exact solution (below; RK4 at 1e-4 s)
 #
 #   sh examples/a02_four_bar.sh 40 a02.mech
 #   mechc sim a02.mech --t1 20 --steps 400 --qd "$(sh examples/a02_four_bar.sh --qd 40)"
@@ -37,18 +40,46 @@
 
 . "$(dirname "$0")/size_arg.sh"
 
-qd=false
-if [ "${1:-}" = --qd ]; then
-    qd=true
-    shift
-    if [ $# -ne 1 ]; then
-        echo "usage: sh $0 N [OUTFILE] | --qd N   (N a positive integer)" >&2
-        exit 2
-    fi
+mode=gen
+case ${1:-} in
+    --qd | --error)
+        mode=${1#--}
+        shift
+        if [ $# -ne "$([ "$mode" = qd ] && echo 1 || echo 2)" ]; then
+            echo "usage: sh $0 N [OUTFILE] | --qd N | --error N CSV   (N a positive integer)" >&2
+            exit 2
+        fi ;;
+esac
+if [ "$mode" = gen ]; then
+    size_arg 6 3 "$@"  # NQ = 6N + 3
+else
+    size_arg 6 3 "$1"
 fi
-size_arg 6 3 "$@"      # NQ = 6N + 3
 
-if $qd; then
+# The exact solution at each row's t (I th'' = -K cos th by RK4, h = 1e-4,
+# to 1e-12), B0's position and velocity against the CSV's columns.
+if [ "$mode" = error ]; then
+    awk -F, -v n="$n" '
+    BEGIN { pi = atan2(0, -1); ii = (n + 1) / 3 + n; k = 9.81 * ((n + 1) / 2 + n)
+            th = pi / 2; w = -1; tt = 0; h = 1e-4 }
+    function acc(a) { return -k * cos(a) / ii }
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    {
+        while (tt < $1 - 1e-12) {
+            hh = ($1 - tt < h) ? $1 - tt : h
+            k1 = w; l1 = acc(th); k2 = w + hh / 2 * l1; l2 = acc(th + hh / 2 * k1)
+            k3 = w + hh / 2 * l2; l3 = acc(th + hh / 2 * k2); k4 = w + hh * l3; l4 = acc(th + hh * k3)
+            th += hh / 6 * (k1 + 2 * k2 + 2 * k3 + k4); w += hh / 6 * (l1 + 2 * l2 + 2 * l3 + l4); tt += hh
+        }
+        e[1] = $(c["B0.x"]) - cos(th); e[2] = $(c["B0.y"]) - sin(th)
+        e[3] = $(c["d(B0.x)"]) + sin(th) * w; e[4] = $(c["d(B0.y)"]) - cos(th) * w
+        for (j = 1; j <= 4; j++) { d = e[j] < 0 ? -e[j] : e[j]; if (d > worst) worst = d }
+    }
+    END { printf "%.3g\n", worst }' "$2"
+    exit
+fi
+
+if [ "$mode" = qd ]; then
     # one piece at a time: growing one string is quadratic (N = 33332: 18 s)
     awk -v n="$n" 'BEGIN { printf "0.5,0,-1"; for (i = 0; i < n; i++) printf ",1,0,0,0.5,0,-1"; print "" }'
     exit 0

@@ -73,7 +73,10 @@ static const CliOption options[] = {
              "the generated kernels' nonzeros; jit, aot); default auto:\n"
              "sparse above 100 coordinates"},
     {"--rtol", CLI_REAL_AT(SimCli, so.rtol), NONNEGATIVE, .metavar = "X",
-     .help = "relative error per step (default 1e-10)"},
+     .help = "relative error per step, as GSL's and SUNDIALS' rtol:\n"
+             "|err_i| <= atol + rtol |y_i| on every position and rate\n"
+             "(default 1e-10: the errors of the steps add up, and\n"
+             "IFToMM A01's 2000 s need it to end within 1e-5)"},
     {"--atol", CLI_REAL_AT(SimCli, so.atol), NONNEGATIVE, .metavar = "X",
      .help = "absolute error per step, coordinate units (default 1e-10)"},
     {"--qd", CLI_STRING_AT(SimCli, qd_text), .metavar = "V1,V2,...",
@@ -165,12 +168,16 @@ static void print_stats(const SimResult *r, int nr)
     if (nr > 0 && r->sparse)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; largest pivot spread of "
                 "[I Phi_q^T; Phi_q 0] with every row %.3g (about (sigma_max / sigma_min)^2 of "
-                "Phi_q; above 1e6 the dense elimination chose the rows)\n", r->max_redundant,
+                "Phi_q; above 1e4 the dense elimination chose the rows)\n", r->max_redundant,
                 r->max_redundant == 1 ? "row" : "rows", r->max_screen_spread);
     else if (nr > 0)
         fprintf(stderr, "mechc sim: stats: up to %d dependent %s; smallest pivot ratio of "
                 "Phi_q %.3g (near 0: a singular position)\n", r->max_redundant,
                 r->max_redundant == 1 ? "row" : "rows", r->min_pivot_ratio);
+    if (r->fold_steps > 0)
+        fprintf(stderr, "mechc sim: stats: %ld steps near a rank drop left rows out, with the "
+                "accelerations those rows impose held from where they went out\n",
+                r->fold_steps);
     fprintf(stderr, "mechc sim: stats: %.6g ms of integration (%.6g ms CPU)\n",
             1e3 * r->seconds, 1e3 * r->cpu_seconds);
 }

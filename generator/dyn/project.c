@@ -1,6 +1,7 @@
 /* project.c - the projections of sim: positions onto Phi = 0, velocities onto Phi_q qd = nu, the rows of the next step. */
 #include "project.h"
 
+#include "fold.h"
 #include "kkt.h"
 
 #include <math.h>
@@ -13,12 +14,18 @@
    largest entry, as the dense LU's), and the pivot spread of [I Phi_q^T;
    Phi_q 0] with every row above which the rows are chosen by the dense
    rank-revealing elimination. Its small eigenvalues are -sigma_i^2 of
-   Phi_q, so 1e6 is a singular value ratio near 1e-3, ten times above
-   row_tol's 1e-4 (pivots in the elimination track the singular values
-   within modest factors): far from a rank drop every row is kept without
-   the dense elimination, near one it decides. */
+   Phi_q, so 1e4 is a singular value ratio near 1e-2, a hundred times
+   above row_tol's 1e-4: far from a rank drop every row is kept without
+   the dense elimination, near one it decides. (At 1e6 the rows near a
+   flat position of A02, N = 2, stayed until 4e-6 rad from it, where the
+   elimination's pivots, 30 times below the singular values, had dropped
+   them at 7e-5 on the dense path: the stages' error over the small
+   singular value went into the velocities, 6e-5 of error at rtol 1e-10.) */
 #define SIM_KKT_PIVOT_TOL 1e-12
-#define SIM_KKT_SPREAD_MAX 1e6
+#define SIM_KKT_SPREAD_MAX 1e4
+/* A projection that moves a coordinate or rate by more than this share
+   of its tolerance (atol + rtol |y|) has the next step take f afresh. */
+#define SIM_FRESH_F_SHARE 0.1
 
 /* The rows' tolerance of both projections (row_tol): redundant rows, and
    near a rank drop the row becoming dependent, are left alone; a small
@@ -64,7 +71,55 @@ static MechrtStatus min_norm_solve(Sim *s, int m, double tol, const double *b, d
     return MECHRT_OK;
 }
 
-/* qd <- qd - pinv(Phi_q) (Phi_q qd - nu): the nearest velocities the rows allow. */
+/* M = L L^T in place in the n x n array a (lower triangle; the upper
+   left as it was); false where M is not positive definite (a coordinate
+   without mass or inertia, Euler parameters' singular M). */
+static bool cholesky(int n, double *a)
+{
+    for (int j = 0; j < n; j++) {
+        double *rj = a + (size_t)j * (size_t)n;
+        double d = rj[j];
+        for (int k = 0; k < j; k++)
+            d -= rj[k] * rj[k];
+        if (!(d > 0))
+            return false;
+        rj[j] = sqrt(d);
+        for (int i = j + 1; i < n; i++) {
+            double *ri = a + (size_t)i * (size_t)n, v = ri[j];
+            for (int k = 0; k < j; k++)
+                v -= ri[k] * rj[k];
+            ri[j] = v / rj[j];
+        }
+    }
+    return true;
+}
+
+/* x <- L^-1 x (trans false) or L^-T x (true), L the lower triangle of l. */
+static void tri_solve(int n, const double *l, double *x, bool trans)
+{
+    if (!trans) {
+        for (int i = 0; i < n; i++) {
+            const double *ri = l + (size_t)i * (size_t)n;
+            double v = x[i];
+            for (int k = 0; k < i; k++)
+                v -= ri[k] * x[k];
+            x[i] = v / ri[i];
+        }
+        return;
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        double v = x[i];
+        for (int k = i + 1; k < n; k++)
+            v -= l[(size_t)k * (size_t)n + (size_t)i] * x[k];
+        x[i] = v / l[(size_t)i * (size_t)n + (size_t)i];
+    }
+}
+
+/* qd <- qd - dqd with Phi_q dqd = Phi_q qd - nu and the least dqd^T M dqd
+   (mass-orthogonal, as the sparse path's: see sparse_project_velocities),
+   singular values of Phi_q L^-T below the projections' tolerance left
+   alone, M = L L^T; at t0 (the given rates) and with M not positive
+   definite the least |dqd|. */
 static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, double t)
 {
     int n = s->nq, m = s->nr;
@@ -81,9 +136,19 @@ static MechrtStatus project_velocities(Sim *s, const double *q, double *qd, doub
             a += s->jac[(size_t)i * (size_t)n + (size_t)j] * qd[j];
         s->resid[i] = a;
     }
+    bool weighted = false;
+    if (s->res->steps > 0) {   /* at t0 the file's or --qd's rates: the nearest, as ever */
+        s->kc.mass(s->kc.ctx, q, s->mass);
+        weighted = sim_all_finite(n * n, s->mass) && cholesky(n, s->mass);
+    }
+    if (weighted)   /* rows of Phi_q L^-T: L^-1 times each row */
+        for (int i = 0; i < m; i++)
+            tri_solve(n, s->mass, s->jac + (size_t)i * (size_t)n, false);
     MechrtStatus st = min_norm_solve(s, m, project_tol(s), s->resid, s->dqd, &zero);
     if (st != MECHRT_OK || zero)
         return st;   /* Phi_q = 0: nothing constrains the velocities */
+    if (weighted)
+        tri_solve(n, s->mass, s->dqd, true);
     for (int j = 0; j < n; j++) {
         qd[j] -= s->dqd[j];
         if (!isfinite(qd[j]))
@@ -312,16 +377,57 @@ static bool sparse_rows(Sim *s, const double *y, double t)
     return true;
 }
 
+/* Rows the step before left out are back (s->active0: its rows). */
+static bool rows_returned(const Sim *s)
+{
+    for (int i = 0; i < s->nr; i++)
+        if (!s->active0[i] && s->active[i])
+            return true;
+    return false;
+}
+
 /* After a step (or at the start): projection when on, then the rows; the
    sparse path chooses the rows before the velocity projection, which
-   uses them. */
-bool sim_settle(Sim *s, double *y, double t, bool project)
+   uses them, and projects the positions with the rows of the step before
+   (its factors), again with the new ones where rows came back (the
+   velocities of rows that were out, projected at positions off them,
+   took their residual over a small pivot). */
+static bool settle(Sim *s, double *y, double t, bool project)
 {
-    s->cache_ok = false;    /* y and the rows change */
     if (!s->kkt)
         return (!project || (settle_positions(s, y, t) && settle_velocities(s, y, t)))
                && choose_rows(s, y, t, NULL);
-    return (!project || settle_positions(s, y, t)) && sparse_rows(s, y, t)
-           && (!project || settle_velocities(s, y, t));
+    if ((project && !settle_positions(s, y, t)) || !sparse_rows(s, y, t))
+        return false;
+    if (project && rows_returned(s)) {
+        if (!settle_positions(s, y, t))
+            return false;
+        s->vel_ready = s->vel_ready && sim_sparse_eval(s, y, y + s->nq, t, false) == MECHRT_OK;
+    }
+    return !project || settle_velocities(s, y, t);
+}
+
+/* The settled state differs from s->ys (before) by more than
+   SIM_FRESH_F_SHARE of the error allowed per step, or the rows changed. */
+static bool settle_moved(const Sim *s, const double *y)
+{
+    const SimOptions *o = s->o;
+    if (memcmp(s->active0, s->active, (size_t)s->nr) != 0)
+        return true;
+    for (int i = 0; i < 2 * s->nq; i++)
+        if (fabs(y[i] - s->ys[i]) > SIM_FRESH_F_SHARE * (o->atol + o->rtol * fabs(y[i])))
+            return true;
+    return false;
+}
+
+bool sim_settle(Sim *s, double *y, double t, bool project)
+{
+    s->cache_ok = false;    /* y and the rows change */
+    memcpy(s->ys, y, 2 * (size_t)s->nq * sizeof *y);
+    memcpy(s->active0, s->active, (size_t)s->nr);
+    if (!settle(s, y, t, project))
+        return false;
+    s->fresh_f = settle_moved(s, y);
+    return !project || sim_fold_prepare(s, y, t);
 }
 

@@ -2,6 +2,7 @@
 #include "rhs.h"
 
 #include "energy.h"
+#include "fold.h"
 #include "kkt.h"
 
 #include <math.h>
@@ -58,6 +59,7 @@ static int sim_rhs_solve(Sim *s, double t, const double y[], double f[])
         if (sim_sparse_accel(s, q, qd, t, s->all_active ? NULL : s->active, f + n, NULL)
             == MECHRT_OK) {
             memcpy(f, qd, (size_t)n * sizeof *f);
+            sim_fold_apply(s, f + n);
             if (s->o->energy)
                 f[2 * n] = sim_sparse_mass_form(s, mechrt_host_kkt_mass(s->kkt), qd, f + n)
                            + sim_half_mdot(s, q, qd);
@@ -74,6 +76,7 @@ static int sim_rhs_solve(Sim *s, double t, const double y[], double f[])
                                               s->work, s->lwork, &rep);
     if (st == MECHRT_OK) {
         memcpy(f, qd, (size_t)n * sizeof *f);
+        sim_fold_apply(s, f + n);
         if (rep.redundant > s->res->max_redundant)
             s->res->max_redundant = rep.redundant;
         if (s->nr > 0 && rep.pivot_ratio < s->res->min_pivot_ratio)

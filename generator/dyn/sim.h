@@ -114,6 +114,8 @@ typedef struct SimResult {
     double max_screen_spread;    /* largest pivot spread of [I Phi_q^T; Phi_q 0] with
                                     every row, where it factored (sparse path) */
     long projection_iterations;  /* Newton iterations in the position ones */
+    long fold_steps;             /* steps near a rank drop that left rows out with their
+                                    accelerations held (fold.c) */
     SimKernelCalls calls;
     int max_redundant;           /* most rows found dependent at once */
     double min_pivot_ratio;      /* nearest approach to a rank drop (1: none) */

@@ -127,6 +127,11 @@ bool sim_open(Sim *s, const MechrtKernels *k, const MechrtHostJacNz *jnz,
     s->fb = xcalloc((size_t)s->dim, sizeof *s->fb);
     s->active = xcalloc(m + 1, sizeof *s->active);
     memset(s->active, 1, m + 1);
+    s->active0 = xcalloc(m + 1, sizeof *s->active0);
+    s->ys = xcalloc((size_t)s->dim, sizeof *s->ys);
+    s->fold = xcalloc(n, sizeof *s->fold);
+    s->fold2 = xcalloc(n, sizeof *s->fold2);
+    s->fold_rows = xcalloc(m + 1, sizeof *s->fold_rows);
     s->dyn = o->dyn;
     s->dyn.active = s->active;
     if (sim_sparse_wanted(k, jnz, mnz, o)) {
@@ -170,7 +175,8 @@ void sim_close(Sim *s)
 {
     free(s->work), free(s->jac), free(s->nu), free(s->resid), free(s->lambda);
     free(s->dqd), free(s->mass), free(s->mass2), free(s->qs), free(s->f0), free(s->f1);
-    free(s->y), free(s->fail_y), free(s->active);
+    free(s->y), free(s->fail_y), free(s->active), free(s->active0), free(s->ys);
+    free(s->fold), free(s->fold2), free(s->fold_rows);
     free(s->cy), free(s->cf), free(s->ya), free(s->fa), free(s->fb), free(s->yi), free(s->yc), free(s->fc);
     free(s->qrw);
     free(s->wjac), free(s->wjac0), free(s->wturn);

@@ -30,6 +30,18 @@ typedef struct Sim {
     double e0;                   /* E at t0 */
     MechrtDynOptions dyn;        /* the caller's, with the rows of this step */
     unsigned char *active;       /* nr: the rows kept during this step */
+    /* sim_settle: the state and rows before it; fresh_f: it moved the
+       state beyond SIM_FRESH_F_SHARE of the tolerance or changed the rows,
+       so the next step's first stage takes f there, not GSL's f at the
+       unprojected end of the last step */
+    double *ys;
+    unsigned char *active0;
+    bool fresh_f;
+    /* fold.c: qdd with every row minus with the step's rows at its start,
+       added at its stages (fold_on); the scratch of its solves */
+    double *fold, *fold2;
+    unsigned char *fold_rows;
+    bool fold_on;
     /* the sparse path (kkt NULL: dense) */
     MechrtHostKkt *kkt;
     const MechrtHostJacNz *jnz;

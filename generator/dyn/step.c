@@ -72,9 +72,14 @@ bool sim_one_step(Sim *s, double *y, double *t, double tn, double *h)
        unprojected end with the old rows; where f at the projected state
        is at hand (an output state or the interpolant's end solved it
        there), count = 0 makes it evaluate f there instead, which the
-       cache answers */
-    if (sim_cache_has(s, *t, y))
+       cache answers; so too where the projection moved the state beyond
+       the tolerance's scale or changed the rows (fresh_f): the stale f
+       was taken elsewhere, and the pair's error estimate would see the
+       difference as error (near a flat position of IFToMM A02 a velocity
+       correction of 1e-4 made rk8pd cut its step to 5e-9 s) */
+    if (sim_cache_has(s, *t, y) || s->fresh_f)
         d->e->count = 0;
+    s->fresh_f = false;
     bool explicit_rk = s->o->method == SIM_RK8PD || s->o->method == SIM_RKF45;
     int gs = s->o->interpolate && explicit_rk ? step_without_end_f(s, t, tn, h, y)
                                               : gsl_odeiv2_evolve_apply(d->e, d->c, d->s,
