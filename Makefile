@@ -12,9 +12,14 @@ WARN    := -Wall -Wextra -Wshadow -Wpointer-arith -Wwrite-strings -Wundef \
            -Wmissing-prototypes -Wstrict-prototypes -Wformat=2 -Werror=switch
 OPT     ?= -O2 -g
 SAN     ?=
-CFLAGS_TOOL    := -std=c11 $(OPT) $(WARN) $(SAN) -D_DEFAULT_SOURCE \
+# One set of objects serves the mechc program (linked -no-pie) and
+# libmechc.so, hence -fPIC everywhere; -fno-semantic-interposition keeps
+# the calls inside a file direct and inlinable, as without it (the .so
+# exports only mechc_*, so nothing interposes).
+PIC     := -fPIC -fno-semantic-interposition
+CFLAGS_TOOL    := -std=c11 $(OPT) $(WARN) $(SAN) $(PIC) -D_DEFAULT_SOURCE \
                   -DMECHC_VERSION='"$(VERSION)"' -MMD -MP
-CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) -MMD -MP
+CFLAGS_RUNTIME := -std=c99 -pedantic $(OPT) $(WARN) $(SAN) $(PIC) -MMD -MP
 
 # SuiteSparse's KLU, the sparse LU of large Jacobians (runtime/host/sparse_klu.c).
 # Debian 12's libsuitesparse-dev has no pkg-config file (later ones do).
@@ -52,17 +57,16 @@ GEN_OBJ   := $(GEN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/gen/templates.o $(BUILD)/gen/s
 RT_OBJ    := $(RT_SRC:%.c=$(BUILD)/%.o)
 HOST_OBJ  := $(HOST_SRC:%.c=$(BUILD)/%.o)
 LIB       := $(BUILD)/libmechc.a
-# libmechc.so (generator/lib/mechc.h, doc/library.md): every object again
-# with -fPIC under $(BUILD)/pic, linked against the shared GSL and
-# SuiteSparse; it exports mechc_* alone (generator/lib/mechc.map). Its jit
-# is libtcc, as the tool's: Debian's libtcc.a is position-independent
+# libmechc.so (generator/lib/mechc.h, doc/library.md): the same objects as
+# libmechc.a, all compiled -fPIC (PIC below), linked against the shared GSL
+# and SuiteSparse; it exports mechc_* alone (generator/lib/mechc.map). Its
+# jit is libtcc, as the tool's: Debian's libtcc.a is position-independent
 # executable code whose only references a shared object cannot take are
 # to libc's stdout, stderr and environ; in a copy of the archive
 # ($(BUILD)/pic/libtcc.a) they are renamed to the library's own
 # (generator/jit/libtcc_data.c), set when it is loaded.
-PIC_OBJ   := $(patsubst $(BUILD)/%,$(BUILD)/pic/%,$(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ))
+PIC_OBJ   := $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)
 SO        := $(BUILD)/libmechc.so
-CFLAGS_PIC = -fPIC -DMECHC_SHARED
 LIBTCC_PIC := $(BUILD)/pic/libtcc.a
 LDLIBS_SO := -lgsl -lgslcblas -lklu -lamd -lcolamd -lbtf -lspqr -lcholmod -lccolamd -lcamd \
              -lsuitesparseconfig -llapack -lblas -lstdc++ -lgomp -ldl -lm -lpthread
@@ -128,15 +132,6 @@ $(BUILD)/gen/sincos.o: $(BUILD)/gen/sincos.c
 $(LIB): $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)
 	@$(if $(filter 1,$(V)),,echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
-
-$(BUILD)/pic/gen/%.o: $(BUILD)/gen/%.c
-	@mkdir -p $(dir $@)
-	$(Q)$(CC) $(CFLAGS_TOOL) $(CFLAGS_PIC) -I. -c $< -o $@
-
-$(BUILD)/pic/%.o: %.c
-	@mkdir -p $(dir $@)
-	@$(if $(filter 1,$(V)),,echo "  CC-PIC  $<")
-	$(Q)$(CC) $(if $(filter runtime/%,$(filter-out runtime/host/%,$<)),$(CFLAGS_RUNTIME),$(CFLAGS_TOOL)) $(CFLAGS_PIC) -c $< -o $@
 
 $(LIBTCC_PIC):
 	@mkdir -p $(dir $@)

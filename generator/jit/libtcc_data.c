@@ -6,9 +6,9 @@
  * copy relocations). The Makefile links libmechc.so with a copy of the
  * archive whose references to them are renamed to these, which are
  * local to the library (generator/lib/mechc.map) and set from libc's
- * when it is loaded. Only in the .so's objects (MECHC_SHARED).
+ * when it is loaded. In libmechc.a too, where nothing refers to them
+ * (the mechc program links the unrenamed libtcc.a).
  */
-#ifdef MECHC_SHARED
 #include <stdio.h>
 extern char **environ;
 
@@ -23,4 +23,3 @@ __attribute__((constructor)) static void libtcc_data_init(void)
     libtcc_stderr = stderr;
     libtcc_environ = environ;
 }
-#endif
