@@ -40,6 +40,9 @@ LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -lgsl -lgslcblas $(SUITESPARSE_LIBS) -lstdc++
                 -Wl,-Bdynamic -Wl,--as-needed -l:libgfortran.so.5 -Wl,--no-as-needed \
                 -l:libmetis.so.5 -ldl -lm -lpthread
 LDLIBS_TEST  := -lcmocka
+# Debian's interpreter, which sees Debian's python3-numpy, -cffi and -pytest
+# (.ci/deps python); another one on the PATH may not.
+PYTHON       ?= /usr/bin/python3
 
 GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))
 CLI_SRC   := generator/cli/main.c
@@ -128,9 +131,13 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 # before a fresh machine has the headers. tests/firmware_rules.sh compiles
 # for the host here, for the Cortex-M boards under firmware-check.
 TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
+# The Python module's suite (tests/python.sh) needs Debian's NumPy, cffi and
+# pytest: installed here when possible; without them that suite says so and
+# is skipped, the rest runs.
 check: deps
+	$(Q)sh .ci/deps python || echo "mechc: no NumPy, cffi or pytest for $(PYTHON): tests/python.sh will be skipped"
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
-	$(Q)FIRMWARE_RULES=host sh tests/run_all $(BUILD) $(TEST_JOBS)
+	$(Q)FIRMWARE_RULES=host MECHC_PYTHON=$(PYTHON) sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
 
