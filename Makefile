@@ -234,6 +234,7 @@ bench: deps
 	$(Q)sh bench/sympy_time.sh $(MECHC)
 	$(Q)sh bench/dynamics.sh $(MECHC)
 	$(Q)sh bench/design.sh $(MECHC)
+	$(Q)sh bench/python.sh $(MECHC)
 
 install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/bin
@@ -241,6 +242,22 @@ install: $(MECHC)
 	install -d $(DESTDIR)$(PREFIX)/include/mechc $(DESTDIR)$(PREFIX)/share/mechc/runtime
 	install -m 644 runtime/mechrt.h $(DESTDIR)$(PREFIX)/include/mechc/
 	install -m 644 runtime/*.h runtime/*.c $(DESTDIR)$(PREFIX)/share/mechc/runtime/
+
+# The Python module (doc/python.md) into $(PYTHON_DIR), Debian's folder of
+# site packages under PREFIX for $(PYTHON), with the installed library's
+# path written into it (mechc/_libpath.py).
+PYTHON_DIR ?= $(PREFIX)/lib/python$(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null || echo 3)/dist-packages
+.PHONY: install-python uninstall-python
+install: install-python
+install-python:
+	install -d $(DESTDIR)$(PYTHON_DIR)/mechc
+	install -m 644 python/mechc/*.py $(DESTDIR)$(PYTHON_DIR)/mechc/
+	printf '# _libpath.py - written by make install: the libmechc.so this package opens.\nLIBRARY = "%s"\n' \
+	  '$(PREFIX)/lib/libmechc.so' > $(DESTDIR)$(PYTHON_DIR)/mechc/_libpath.py
+
+uninstall: uninstall-python
+uninstall-python:
+	rm -rf $(DESTDIR)$(PYTHON_DIR)/mechc
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
