@@ -47,7 +47,7 @@ build/libmechc.so of the source tree (PYTHONPATH=python after `make`),
 else the system's. doc/python.md has the whole guide and the figures.
 """
 
-from ._ffi import (ffi as _ffi, lib as _lib, MechcError, InputError, NotAvailableError,
+from ._ffi import (ffi as _cffi, lib as _lib, MechcError, InputError, NotAvailableError,
                    AnalysisError, error_from_diag as _error_from_diag)
 from ._model import Model, Design, Kinematics, Dynamics
 from ._result import Trajectory
@@ -58,7 +58,7 @@ __all__ = ["load", "loads", "version", "Model", "Design", "Trajectory", "Kinemat
 
 def version():
     """The version of the mechc that libmechc was built from, e.g. "0.1.0"."""
-    return _ffi.string(_lib.mechc_version()).decode()
+    return _cffi.string(_lib.mechc_version()).decode()
 
 
 def load(path, engine="jit"):
@@ -68,9 +68,9 @@ def load(path, engine="jit"):
     (a MechcError) with the file, line and column of a mistake in the file.
     """
     path = str(path)
-    diag = _ffi.new("mechc_diag *")
+    diag = _cffi.new("mechc_diag *")
     m = _lib.mechc_load_file(path.encode(), diag)
-    if m == _ffi.NULL:
+    if m == _cffi.NULL:
         raise _error_from_diag(diag)
     return Model(m, engine, path)
 
@@ -82,9 +82,9 @@ def loads(text, name=None, engine="jit"):
     also gives the mechanism's name when the text has no `mechanism`
     statement.
     """
-    diag = _ffi.new("mechc_diag *")
-    cname = _ffi.NULL if name is None else str(name).encode()
+    diag = _cffi.new("mechc_diag *")
+    cname = _cffi.NULL if name is None else str(name).encode()
     m = _lib.mechc_load_string(text.encode(), cname, diag)
-    if m == _ffi.NULL:
+    if m == _cffi.NULL:
         raise _error_from_diag(diag)
     return Model(m, engine, "<string>" if name is None else str(name))

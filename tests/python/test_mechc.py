@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import mechc
-from mechc import _ffi
+import mechc._ffi as _ffi
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EX = os.path.join(ROOT, "examples")
