@@ -23,17 +23,25 @@ Dynamics = collections.namedtuple("Dynamics", "M Q jac gamma")
 Dynamics.__doc__ = """What Model.eom returns: M (nq x nq), Q (nq), Phi_q (nr x nq), gamma (nr)."""
 
 
+_DOUBLES = ffi.typeof("double[]")
+_from_buffer = ffi.from_buffer
+_contiguous = np.ascontiguousarray
+
+
 def _buf(a):
     """A double * over a float64 C-contiguous array, without a copy."""
-    return ffi.from_buffer("double[]", a)
+    return _from_buffer(_DOUBLES, a)
 
 
 def _out(out, shape, name):
     """out when it fits (float64, C-contiguous, shape), a new array when None."""
     if out is None:
         return np.empty(shape, _F64)
-    if (not isinstance(out, np.ndarray) or out.dtype != _F64 or out.shape != shape
-            or not out.flags.c_contiguous or not out.flags.writeable):
+    if not isinstance(out, np.ndarray) or out.dtype != _F64 or out.shape != shape:
+        flags = None
+    else:
+        flags = out.flags
+    if flags is None or not (flags.c_contiguous and flags.writeable):
         raise ValueError("mechc: %s: out must be a writable C-contiguous float64 array of "
                          "shape %s" % (name, shape))
     return out
@@ -129,6 +137,7 @@ class Model:
         self._k = k
         m = handle
         self.nq = lib.mechc_nq(m)
+        self._one = (self.nq,)
         self.nh = lib.mechc_nh(m)
         self.nv = lib.mechc_nv(m)
         self.nr = lib.mechc_nr(m)
@@ -227,11 +236,13 @@ class Model:
 
     def _states(self, q, name="q"):
         """q as float64 C-contiguous, and n: None for one state, else the count."""
-        a = np.ascontiguousarray(q, dtype=_F64)
-        if a.ndim == 1 and a.shape[0] == self.nq:
-            return a, None
-        if a.ndim == 2 and a.shape[1] == self.nq:
-            return a, a.shape[0]
+        a = _contiguous(q, dtype=_F64)
+        shape = a.shape
+        if len(shape) == 1:
+            if shape[0] == self.nq:
+                return a, None
+        elif len(shape) == 2 and shape[1] == self.nq:
+            return a, shape[0]
         raise ValueError("mechc: %s must have shape (%d,) or (n, %d), not %s"
                          % (name, self.nq, self.nq, a.shape))
 
@@ -254,16 +265,23 @@ class Model:
 
     # ---- kinematic kernels --------------------------------------------------
 
+    # One state takes the short path first: the fewest Python operations
+    # between the caller and the library (doc/python.md has its cost).
+
     def phi(self, q, t=0.0, out=None):
         """Phi(q, t), the holonomic rows' residuals: (nh,), or (n, nh) for (n, nq) states."""
-        q, n = self._states(q)
-        if n is None:
+        q = _contiguous(q, dtype=_F64)
+        if q.shape == self._one:
             out = _out(out, (self.nh,), "phi")
-            check(lib.mechc_phi(self._k, _buf(q), t, _buf(out)))
-            return out
-        t = self._times(t, n)
-        out = _out(out, (n, self.nh), "phi")
-        check(lib.mechc_phi_batch(self._k, n, _buf(q), _buf(t), t.shape[0], _buf(out)))
+            status = lib.mechc_phi(self._k, _from_buffer(_DOUBLES, q), t,
+                                   _from_buffer(_DOUBLES, out))
+        else:
+            q, n = self._states(q)
+            t = self._times(t, n)
+            out = _out(out, (n, self.nh), "phi")
+            status = lib.mechc_phi_batch(self._k, n, _buf(q), _buf(t), t.shape[0], _buf(out))
+        if status:
+            check(status)
         return out
 
     def jacobian(self, q, t=0.0, sparse=False, out=None):
@@ -281,11 +299,15 @@ class Model:
             return self._jacobian_sparse(q, n, t, out)
         if n is None:
             out = _out(out, (self.nr, self.nq), "jacobian")
-            check(lib.mechc_jacobian(self._k, _buf(q), t, _buf(out)))
-            return out
-        t = self._times(t, n)
-        out = _out(out, (n, self.nr, self.nq), "jacobian")
-        check(lib.mechc_jacobian_batch(self._k, n, _buf(q), _buf(t), t.shape[0], _buf(out)))
+            status = lib.mechc_jacobian(self._k, _from_buffer(_DOUBLES, q), t,
+                                        _from_buffer(_DOUBLES, out))
+        else:
+            t = self._times(t, n)
+            out = _out(out, (n, self.nr, self.nq), "jacobian")
+            status = lib.mechc_jacobian_batch(self._k, n, _buf(q), _buf(t), t.shape[0],
+                                              _buf(out))
+        if status:
+            check(status)
         return out
 
     def jacobian_pattern(self):
@@ -320,27 +342,36 @@ class Model:
 
     def nu(self, q, t=0.0, out=None):
         """nu(q, t), the right side of Phi_q qd = nu: (nr,), or (n, nr) for n states."""
-        q, n = self._states(q)
-        if n is None:
+        q = _contiguous(q, dtype=_F64)
+        if q.shape == self._one:
             out = _out(out, (self.nr,), "nu")
-            check(lib.mechc_nu(self._k, _buf(q), t, _buf(out)))
-            return out
-        t = self._times(t, n)
-        out = _out(out, (n, self.nr), "nu")
-        check(lib.mechc_nu_batch(self._k, n, _buf(q), _buf(t), t.shape[0], _buf(out)))
+            status = lib.mechc_nu(self._k, _from_buffer(_DOUBLES, q), t,
+                                  _from_buffer(_DOUBLES, out))
+        else:
+            q, n = self._states(q)
+            t = self._times(t, n)
+            out = _out(out, (n, self.nr), "nu")
+            status = lib.mechc_nu_batch(self._k, n, _buf(q), _buf(t), t.shape[0], _buf(out))
+        if status:
+            check(status)
         return out
 
     def gamma(self, q, qd, t=0.0, out=None):
         """gamma(q, qd, t), the right side of Phi_q qdd = gamma: (nr,), or (n, nr)."""
-        q, qd, n = self._pair(q, qd)
-        if n is None:
+        q = _contiguous(q, dtype=_F64)
+        qd = _contiguous(qd, dtype=_F64)
+        if q.shape == self._one and qd.shape == self._one:
             out = _out(out, (self.nr,), "gamma")
-            check(lib.mechc_gamma(self._k, _buf(q), _buf(qd), t, _buf(out)))
-            return out
-        t = self._times(t, n)
-        out = _out(out, (n, self.nr), "gamma")
-        check(lib.mechc_gamma_batch(self._k, n, _buf(q), _buf(qd), _buf(t), t.shape[0],
-                                    _buf(out)))
+            status = lib.mechc_gamma(self._k, _from_buffer(_DOUBLES, q),
+                                     _from_buffer(_DOUBLES, qd), t, _from_buffer(_DOUBLES, out))
+        else:
+            q, qd, n = self._pair(q, qd)
+            t = self._times(t, n)
+            out = _out(out, (n, self.nr), "gamma")
+            status = lib.mechc_gamma_batch(self._k, n, _buf(q), _buf(qd), _buf(t), t.shape[0],
+                                           _buf(out))
+        if status:
+            check(status)
         return out
 
     def all(self, q, qd, t=0.0, out=None):
