@@ -6,11 +6,14 @@ CPU time (time.process_time; loading also counts the children the JIT
 starts, os.times), the best of several repeats, each figure printed with
 the command that measured it and the target:
 1. gamma of the four-bar over 10^6 states from NumPy, one batch call
-   into a preallocated out= array (target < 50 ms), and the fused all();
+   into a preallocated out= array (target < 50 ms), and the fused all(),
+   with each engine (jit: tcc's code; aot: gcc -O2's; generic: interpreted);
 2. one Python call at one state, m.gamma(q, qd, t, out=g): its whole
    cost, the library's kernel included (target < 2 us), beside a bare
    cffi call of mechc_gamma with the pointers made once;
-3. mechc.load + the JIT compile of the four-bar (target < 5 ms);
+3. mechc.load + the compile of the four-bar (target < 5 ms): jit (in
+   libmechc.so the tcc program, a child process), aot (a cached library:
+   the first load warms the cache) and generic;
 4. whether the GIL is released: a Python thread counts while the main
    thread is inside a batch call.
 """
@@ -46,19 +49,24 @@ def best(fn, repeat):
 
 
 def show(what, value, unit, target):
-    print("  %-52s %9.3f %-3s (target %s)" % (what, value, unit, target))
+    print("  %-66s %9.3f %-3s (target %s)" % (what, value, unit, target))
 
 
-def batch_figures(m, n):
+def batch_figures(n):
     rng = np.random.default_rng(1)
-    Q = m.q0 + 0.1 * rng.standard_normal((n, m.nq))
-    QD = rng.standard_normal((n, m.nq))
-    g = np.empty((n, m.nr))
-    s = best(lambda: m.gamma(Q, QD, 0.25, out=g), 5)
-    show("gamma, 10^6 states, one call (m.gamma(Q, QD, t, out=g))", 1e3 * s, "ms", "< 50 ms")
-    outs = (np.empty((n, m.nh)), np.empty((n, m.nr, m.nq)), np.empty((n, m.nr)), g)
-    s = best(lambda: m.all(Q, QD, 0.25, out=outs), 3)
-    show("all (phi, jac, nu, gamma), 10^6 states, one call", 1e3 * s, "ms", "none")
+    for engine in ("jit", "aot", "generic"):
+        m = mechc.load(FOUR_BAR, engine=engine)
+        Q = m.q0 + 0.1 * rng.standard_normal((n, m.nq))
+        QD = rng.standard_normal((n, m.nq))
+        g = np.empty((n, m.nr))
+        s = best(lambda: m.gamma(Q, QD, 0.25, out=g), 5)
+        show("gamma, 10^6 states, one call, %s: m.gamma(Q, QD, t, out=g)" % engine, 1e3 * s,
+             "ms", "< 50 ms")
+        outs = (np.empty((n, m.nh)), np.empty((n, m.nr, m.nq)), np.empty((n, m.nr)), g)
+        s = best(lambda: m.all(Q, QD, 0.25, out=outs), 3)
+        show("  all (phi, jac, nu, gamma), 10^6 states, one call, %s" % engine, 1e3 * s, "ms",
+             "none")
+        m.close()
     return Q, QD
 
 
@@ -86,18 +94,16 @@ def single_figures(m):
 
 
 def load_figures():
-    def one():
-        mechc.load(FOUR_BAR, engine="jit").close()
-    one()
-    show("mechc.load + jit compile, four-bar (children's CPU too)", 1e3 * best(one, 20), "ms",
-         "< 5 ms")
-    m = mechc.load(FOUR_BAR, engine="jit")
-    show("  the library's own compile_seconds (wall)", 1e3 * m.compile_seconds, "ms", "none")
-    m.close()
-
-    def generic():
-        mechc.load(FOUR_BAR, engine="generic").close()
-    show("mechc.load, generic engine (nothing compiled)", 1e3 * best(generic, 20), "ms", "none")
+    for engine in ("jit", "aot", "generic"):
+        def one():
+            mechc.load(FOUR_BAR, engine=engine).close()
+        one()
+        show("mechc.load + compile, four-bar, %s (children's CPU too)" % engine,
+             1e3 * best(one, 20), "ms", "< 5 ms")
+        m = mechc.load(FOUR_BAR, engine=engine)
+        show("  its compile_seconds (wall, the library's own figure)", 1e3 * m.compile_seconds,
+             "ms", "none")
+        m.close()
 
 
 def gil_figure(m, Q, QD):
@@ -126,8 +132,8 @@ def main():
     os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir))
     print("Python module (%s, NumPy %s, mechc %s): %s"
           % (sys.executable, np.__version__, mechc.version(), CMD))
+    Q, QD = batch_figures(1000000)
     m = mechc.load(FOUR_BAR, engine="jit")
-    Q, QD = batch_figures(m, 1000000)
     single_figures(m)
     load_figures()
     gil_figure(m, Q, QD)
