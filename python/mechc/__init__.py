@@ -2,23 +2,22 @@
 
 A thin layer over libmechc (the mechanism compiler as a C library, opened
 with cffi in ABI mode: nothing to compile, no network). Load a mechanism,
-compile its kernels (engine "jit": generated C compiled in process, "aot":
+compile its kernels (engine "jit": generated C compiled by tcc, "aot":
 by the system compiler, cached; "generic": interpreted), then evaluate
 them at one state or at many states in one call:
 
-    >>> import numpy as np, mechc
-    >>> m = mechc.load("examples/four_bar.mech", engine="jit")
-    >>> m.coords[:3], m.nq, m.nr
-    (('crank.x', 'crank.y', 'crank.phi'), 9, 9)
-    >>> q = m.q0                       # the file's initial values, (9,)
-    >>> m.phi(q, t=0.0)                # Phi(q, t), (nh,)
-    >>> m.jacobian(q)                  # Phi_q, dense (nr, nq)
-    >>> vals, rows, cols = m.jacobian(q, sparse=True)   # scipy.sparse.coo_matrix-ready
-    >>> Q = np.tile(q, (1000000, 1))   # 10^6 states, (n, nq)
-    >>> G = m.gamma(Q, np.ones_like(Q), t=0.0)   # (10^6, nr) in one C call
-    >>> traj = m.run(steps=360)        # kinematic analysis: a dict of named columns
-    >>> traj["rocker.phi"].max(), traj.q.shape
-    >>> m.info()["dof"]                # mechc info --json as a dict
+    import numpy as np, mechc
+    m = mechc.load("examples/four_bar.mech", engine="jit")
+    m.coords[:3], m.nq, m.nr          # ('crank.x', 'crank.y', 'crank.phi'), 9, 9
+    q = m.q0                          # the file's initial values, (9,)
+    m.phi(q, t=0.0)                   # Phi(q, t), (nh,)
+    m.jacobian(q)                     # Phi_q, dense (nr, nq)
+    vals, rows, cols = m.jacobian(q, sparse=True)   # scipy.sparse.coo_matrix-ready
+    Q = np.tile(q, (1000000, 1))      # 10^6 states, (n, nq)
+    G = m.gamma(Q, np.ones_like(Q), t=0.0)          # (10^6, nr) in one C call
+    traj = m.run(steps=360)           # kinematic analysis: a dict of named columns
+    traj["rocker.phi"].max(), traj.q.shape          # 2.4189, (361, 9)
+    m.info()["dof"]                   # mechc info --json as a dict: 0
 
 Kernels: phi, jacobian, nu, gamma, all (fused), and with masses in the
 file mass, force, eom; phi_p with design parameters; output_values.
