@@ -55,11 +55,28 @@ GEN_OBJ   := $(GEN_SRC:%.c=$(BUILD)/%.o) $(BUILD)/gen/templates.o $(BUILD)/gen/s
 RT_OBJ    := $(RT_SRC:%.c=$(BUILD)/%.o)
 HOST_OBJ  := $(HOST_SRC:%.c=$(BUILD)/%.o)
 LIB       := $(BUILD)/libmechc.a
+# libmechc.so (generator/lib/mechc.h, doc/library.md): every object again
+# with -fPIC under $(BUILD)/pic, linked against the shared GSL and
+# SuiteSparse; it exports mechc_* alone (generator/lib/mechc.map). Its jit
+# is libtcc, as the tool's: Debian's libtcc.a is position-independent
+# executable code whose only references a shared object cannot take are
+# to libc's stdout, stderr and environ; in a copy of the archive
+# ($(BUILD)/pic/libtcc.a) they are renamed to the library's own
+# (generator/jit/libtcc_data.c), set when it is loaded.
+PIC_OBJ   := $(patsubst $(BUILD)/%,$(BUILD)/pic/%,$(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ))
+SO        := $(BUILD)/libmechc.so
+CFLAGS_PIC = -fPIC -DMECHC_SHARED
+LIBTCC_PIC := $(BUILD)/pic/libtcc.a
+LDLIBS_SO := -lgsl -lgslcblas -lklu -lamd -lcolamd -lbtf -lspqr -lcholmod -lccolamd -lcamd \
+             -lsuitesparseconfig -llapack -lblas -lstdc++ -lgomp -ldl -lm -lpthread
+# What a program linking libmechc.a needs after it (mechc.pc's Libs.private).
+LIBS_PRIVATE := -no-pie -ltcc -lgsl -lgslcblas -lklu -lamd -lcolamd -lbtf -lspqr -lcholmod \
+                -lccolamd -lcamd -lsuitesparseconfig -llapack -lblas -lstdc++ -lgomp -ldl -lm -lpthread
 MECHC     := $(BUILD)/mechc
 TESTS     := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 
 .PHONY: all deps check test demo bench check-asan check-ubsan check-valgrind fuzz sanitize install uninstall clean help examples-check
-all: $(MECHC)
+all: $(MECHC) $(SO)
 
 help:
 	@echo "make            build $(MECHC)"
@@ -115,6 +132,25 @@ $(LIB): $(GEN_OBJ) $(RT_OBJ) $(HOST_OBJ)
 	@$(if $(filter 1,$(V)),,echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
+$(BUILD)/pic/gen/%.o: $(BUILD)/gen/%.c
+	@mkdir -p $(dir $@)
+	$(Q)$(CC) $(CFLAGS_TOOL) $(CFLAGS_PIC) -I. -c $< -o $@
+
+$(BUILD)/pic/%.o: %.c
+	@mkdir -p $(dir $@)
+	@$(if $(filter 1,$(V)),,echo "  CC-PIC  $<")
+	$(Q)$(CC) $(if $(filter runtime/%,$(filter-out runtime/host/%,$<)),$(CFLAGS_RUNTIME),$(CFLAGS_TOOL)) $(CFLAGS_PIC) -c $< -o $@
+
+$(LIBTCC_PIC):
+	@mkdir -p $(dir $@)
+	$(Q)objcopy --redefine-sym stdout=libtcc_stdout --redefine-sym stderr=libtcc_stderr \
+	  --redefine-sym environ=libtcc_environ $$($(CC) -print-file-name=libtcc.a) $@
+
+$(SO): $(PIC_OBJ) $(LIBTCC_PIC) generator/lib/mechc.map
+	@$(if $(filter 1,$(V)),,echo "  LD      $@")
+	$(Q)$(CC) -shared $(SAN) -Wl,-soname,libmechc.so -Wl,--version-script=generator/lib/mechc.map \
+	  -Wl,-z,defs $(PIC_OBJ) $(LIBTCC_PIC) $(LDLIBS_SO) -o $@
+
 $(MECHC): $(BUILD)/generator/cli/main.o $(LIB)
 	@$(if $(filter 1,$(V)),,echo "  LD      $@")
 	$(Q)$(CC) $(LDFLAGS_TOOL) $^ $(LDLIBS_TOOL) -o $@
@@ -136,7 +172,7 @@ TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$
 # is skipped, the rest runs.
 check: deps
 	$(Q)sh .ci/deps python || echo "mechc: no NumPy, cffi or pytest for $(PYTHON): tests/python.sh will be skipped"
-	$(Q)$(MAKE) --no-print-directory $(MECHC) $(TESTS)
+	$(Q)$(MAKE) --no-print-directory $(MECHC) $(SO) $(TESTS)
 	$(Q)FIRMWARE_RULES=host MECHC_PYTHON=$(PYTHON) sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
@@ -236,12 +272,21 @@ bench: deps
 	$(Q)sh bench/design.sh $(MECHC)
 	$(Q)sh bench/python.sh $(MECHC)
 
-install: $(MECHC)
+# The library: include/mechc/mechc.h, lib/libmechc.a and .so, and
+# lib/pkgconfig/mechc.pc for `cc prog.c $$(pkg-config --cflags --libs mechc)`
+# (--static: libmechc.a with what it needs).
+install: $(MECHC) $(LIB) $(SO)
 	install -d $(DESTDIR)$(PREFIX)/bin
 	install -m 755 $(MECHC) $(DESTDIR)$(PREFIX)/bin/mechc
 	install -d $(DESTDIR)$(PREFIX)/include/mechc $(DESTDIR)$(PREFIX)/share/mechc/runtime
-	install -m 644 runtime/mechrt.h $(DESTDIR)$(PREFIX)/include/mechc/
+	install -m 644 runtime/mechrt.h generator/lib/mechc.h $(DESTDIR)$(PREFIX)/include/mechc/
 	install -m 644 runtime/*.h runtime/*.c $(DESTDIR)$(PREFIX)/share/mechc/runtime/
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/libmechc.a
+	install -m 755 $(SO) $(DESTDIR)$(PREFIX)/lib/libmechc.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' \
+	  -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|' generator/lib/mechc.pc.in \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/mechc.pc
 
 # The Python module (doc/python.md) into $(PYTHON_DIR), Debian's folder of
 # site packages under PREFIX for $(PYTHON), with the installed library's
@@ -261,6 +306,8 @@ uninstall-python:
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
+	rm -f $(DESTDIR)$(PREFIX)/lib/libmechc.a $(DESTDIR)$(PREFIX)/lib/libmechc.so \
+	  $(DESTDIR)$(PREFIX)/lib/pkgconfig/mechc.pc
 	rm -rf $(DESTDIR)$(PREFIX)/share/mechc $(DESTDIR)$(PREFIX)/include/mechc
 
 clean:

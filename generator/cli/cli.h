@@ -160,6 +160,10 @@ int cmd_info(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 int cmd_fit(int argc, char **argv);
 
+/* What `info --json` prints (cmd_info.c), to out; libmechc's mechc_info_json too. */
+struct InfoReport;
+void info_print_json(FILE *out, const struct InfoReport *rep);
+
 /* ---- JSON (json.c) ---- */
 
 /* JSON number: %.17g, or null for NaN and infinities (JSON has neither). */

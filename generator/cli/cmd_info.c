@@ -90,81 +90,81 @@ static const char *evidence(const Integrability *it)
 
 /* ---- JSON ---- */
 
-static void json_names(const char *key, const InfoReport *rep, bool velocity)
+static void json_names(FILE *out, const char *key, const InfoReport *rep, bool velocity)
 {
     const Model *m = rep->model;
-    printf(",\n \"%s\": [", key);
+    fprintf(out, ",\n \"%s\": [", key);
     int n = 0;
     for (int r = velocity ? m->nh : 0; r < (velocity ? m->nr : m->nh); r++)
         if (rep->rows[r].redundant) {
-            printf(n++ ? ", " : "");
-            json_string(stdout, m->rows[r].name);
+            fprintf(out, n++ ? ", " : "");
+            json_string(out, m->rows[r].name);
         }
-    printf("]");
+    fprintf(out, "]");
 }
 
-static void json_int_or_null(const char *key, int v)
+static void json_int_or_null(FILE *out, const char *key, int v)
 {
     if (v >= 0)
-        printf(",\n \"%s\": %d", key, v);
+        fprintf(out, ",\n \"%s\": %d", key, v);
     else
-        printf(",\n \"%s\": null", key);
+        fprintf(out, ",\n \"%s\": null", key);
 }
 
-static void json_num(const char *key, double v)
+static void json_num(FILE *out, const char *key, double v)
 {
-    printf(",\n \"%s\": ", key);
-    json_number(stdout, v);
+    fprintf(out, ",\n \"%s\": ", key);
+    json_number(out, v);
 }
 
 /* "rows": every row with its joint, kind, level and verdicts. */
-static void json_rows(const InfoReport *rep)
+static void json_rows(FILE *out, const InfoReport *rep)
 {
     const Model *m = rep->model;
-    printf(",\n \"rows\": [");
+    fprintf(out, ",\n \"rows\": [");
     for (int r = 0; r < m->nr; r++) {
         const Row *row = &m->rows[r];
         const InfoRow *ir = &rep->rows[r];
-        printf(r ? ",\n   {\"name\": " : "{\"name\": ");
-        json_string(stdout, row->name);
-        printf(", \"kind\": \"%s\", \"level\": \"%s\", \"joint\": ", joint_info[row->kind].keyword,
+        fprintf(out, r ? ",\n   {\"name\": " : "{\"name\": ");
+        json_string(out, row->name);
+        fprintf(out, ", \"kind\": \"%s\", \"level\": \"%s\", \"joint\": ", joint_info[row->kind].keyword,
                level_name(row));
-        json_string(stdout, m->joints[row->joint].name);
-        printf(", \"driver\": %s, \"redundant\": %s", ir->driver ? "true" : "false",
+        json_string(out, m->joints[row->joint].name);
+        fprintf(out, ", \"driver\": %s, \"redundant\": %s", ir->driver ? "true" : "false",
                ir->redundant ? "true" : "false");
         if (row->velocity) {
             const Integrability *it = &ir->integ;
-            printf(", \"integrable\": %s", it->integrable ? "true" : "false");
+            fprintf(out, ", \"integrable\": %s", it->integrable ? "true" : "false");
             if (it->integrable) {
                 /* "law" is the law itself or absent: never a sentence */
                 if (it->law) {
-                    printf(", \"law\": ");
-                    json_string(stdout, it->law);
+                    fprintf(out, ", \"law\": ");
+                    json_string(out, it->law);
                 }
-                printf(", \"law_found\": %s", it->law ? "true" : "false");
+                fprintf(out, ", \"law_found\": %s", it->law ? "true" : "false");
             }
-            printf(", \"evidence\": \"%s\", \"note\": ", evidence(it));
-            json_string(stdout, it->note ? it->note : "");
+            fprintf(out, ", \"evidence\": \"%s\", \"note\": ", evidence(it));
+            json_string(out, it->note ? it->note : "");
         }
-        printf("}");
+        fprintf(out, "}");
     }
-    printf("]");
+    fprintf(out, "]");
 }
 
 /* "joints": rows of each joint against the textbook table. */
-static void json_joints(const Model *m)
+static void json_joints(FILE *out, const Model *m)
 {
-    printf(",\n \"joints\": [");
+    fprintf(out, ",\n \"joints\": [");
     for (int j = 0; j < m->njoints; j++) {
         const Joint *jt = &m->joints[j];
         bool vel;
         int table = info_textbook_rows(jt->kind, &vel);
-        printf(j ? ",\n   {\"name\": " : "{\"name\": ");
-        json_string(stdout, jt->name);
-        printf(", \"kind\": \"%s\", \"rows\": %d, \"table_rows\": %d}", joint_info[jt->kind].keyword,
+        fprintf(out, j ? ",\n   {\"name\": " : "{\"name\": ");
+        json_string(out, jt->name);
+        fprintf(out, ", \"kind\": \"%s\", \"rows\": %d, \"table_rows\": %d}", joint_info[jt->kind].keyword,
                jt->nrows, table);
     }
-    printf("]");
+    fprintf(out, "]");
 }
 
 /* A direction's components are rates against its free coordinate (which
@@ -202,94 +202,94 @@ enum { TOP_COMPONENTS = 6 };
 
 /* --at / --state: "state" with the drop, the rows that became dependent
    and the null-space directions. */
-static void json_state(const InfoReport *rep)
+static void json_state(FILE *out, const InfoReport *rep)
 {
     const Model *m = rep->model;
     const InfoState *st = &rep->state;
-    printf(",\n \"state\": {\"source\": \"%s\"", st->given ? "csv" : "followed");
+    fprintf(out, ",\n \"state\": {\"source\": \"%s\"", st->given ? "csv" : "followed");
     if (!st->given)
-        printf(", \"steps\": %d", st->steps);
-    json_num("residual", st->residual);
-    json_int_or_null("rank", rep->rank);
-    json_int_or_null("generic_rank", st->ref_rank);
-    json_int_or_null("drop", st->drop);
-    json_num("tol", rep->rank_tol);
-    printf(",\n   \"dependent\": [");
+        fprintf(out, ", \"steps\": %d", st->steps);
+    json_num(out, "residual", st->residual);
+    json_int_or_null(out, "rank", rep->rank);
+    json_int_or_null(out, "generic_rank", st->ref_rank);
+    json_int_or_null(out, "drop", st->drop);
+    json_num(out, "tol", rep->rank_tol);
+    fprintf(out, ",\n   \"dependent\": [");
     for (int k = 0; k < st->ndependent; k++) {
-        printf(k ? ", " : "");
-        json_string(stdout, m->rows[st->dependent[k]].name);
+        fprintf(out, k ? ", " : "");
+        json_string(out, m->rows[st->dependent[k]].name);
     }
-    printf("]");
-    json_int_or_null("null_dim", st->nnull);
-    printf(",\n   \"directions\": [");
+    fprintf(out, "]");
+    json_int_or_null(out, "null_dim", st->nnull);
+    fprintf(out, ",\n   \"directions\": [");
     for (int k = 0; k < st->nshown; k++) {
         const double *v = st->null + (size_t)k * (size_t)m->nq;
         int idx[TOP_COMPONENTS];
         int n = top_components(v, m->nq, TOP_COMPONENTS, idx);
-        printf(k ? ",\n     {\"free\": " : "{\"free\": ");
-        json_string(stdout, m->coord_names[st->free_coord[k]]);
-        printf(", \"largest\": {");
+        fprintf(out, k ? ",\n     {\"free\": " : "{\"free\": ");
+        json_string(out, m->coord_names[st->free_coord[k]]);
+        fprintf(out, ", \"largest\": {");
         for (int i = 0; i < n; i++) {
-            printf(i ? ", " : "");
-            json_string(stdout, m->coord_names[idx[i]]);
-            printf(": ");
-            json_number(stdout, v[idx[i]]);
+            fprintf(out, i ? ", " : "");
+            json_string(out, m->coord_names[idx[i]]);
+            fprintf(out, ": ");
+            json_number(out, v[idx[i]]);
         }
-        printf("}}");
+        fprintf(out, "}}");
     }
-    printf("]}");
+    fprintf(out, "]}");
 }
 
-static void print_json(const InfoReport *rep)
+void info_print_json(FILE *out, const InfoReport *rep)
 {
     const Model *m = rep->model;
-    printf("{\"mechanism\": ");
-    json_string(stdout, m->name);
-    printf(",\n \"coords\": ");
-    json_string_list(stdout, m->coord_names, m->nq);
-    json_rows(rep);
-    json_joints(m);
-    printf(",\n \"nq\": %d, \"nh\": %d, \"nv\": %d, \"nr\": %d", rep->nq, rep->nh, rep->nv, rep->nr);
-    printf(",\n \"dof\": %d", rep->dof);
-    json_int_or_null("rank", rep->rank);
-    json_names("redundant", rep, false);
-    printf(",\n \"drivers\": %d, \"mobility\": %d", rep->nh_drivers + rep->nv_drivers, rep->mobility);
+    fprintf(out, "{\"mechanism\": ");
+    json_string(out, m->name);
+    fprintf(out, ",\n \"coords\": ");
+    json_string_list(out, m->coord_names, m->nq);
+    json_rows(out, rep);
+    json_joints(out, m);
+    fprintf(out, ",\n \"nq\": %d, \"nh\": %d, \"nv\": %d, \"nr\": %d", rep->nq, rep->nh, rep->nv, rep->nr);
+    fprintf(out, ",\n \"dof\": %d", rep->dof);
+    json_int_or_null(out, "rank", rep->rank);
+    json_names(out, "redundant", rep, false);
+    fprintf(out, ",\n \"drivers\": %d, \"mobility\": %d", rep->nh_drivers + rep->nv_drivers, rep->mobility);
     if (rep->rank_all >= 0) {
-        printf(",\n \"dof_rank\": %d, \"mobility_rank\": %d", rep->dof_rank, rep->mobility_rank);
+        fprintf(out, ",\n \"dof_rank\": %d, \"mobility_rank\": %d", rep->dof_rank, rep->mobility_rank);
     } else {
-        printf(",\n \"dof_rank\": null, \"mobility_rank\": null");
+        fprintf(out, ",\n \"dof_rank\": null, \"mobility_rank\": null");
     }
-    json_int_or_null("rank_all", rep->rank_all);
-    json_names("redundant_velocity", rep, true);
-    json_int_or_null("generic_rank", rep->generic_rank);
-    printf(",\n \"dense\": %s", rep->dense ? "true" : "false");
+    json_int_or_null(out, "rank_all", rep->rank_all);
+    json_names(out, "redundant_velocity", rep, true);
+    json_int_or_null(out, "generic_rank", rep->generic_rank);
+    fprintf(out, ",\n \"dense\": %s", rep->dense ? "true" : "false");
     if (rep->rank >= 0) {
-        json_num("rank_tol", rep->rank_tol);
-        json_num("sigma_max", rep->sigma_max);
-        json_num("sigma_min", rep->sigma_min);
-        json_num("cond", rep->cond);        /* null when infinite */
+        json_num(out, "rank_tol", rep->rank_tol);
+        json_num(out, "sigma_max", rep->sigma_max);
+        json_num(out, "sigma_min", rep->sigma_min);
+        json_num(out, "cond", rep->cond);        /* null when infinite */
     }
-    json_num("t", rep->t);
-    printf(",\n \"assembled\": %s, \"iterations\": %d", rep->assembled ? "true" : "false",
+    json_num(out, "t", rep->t);
+    fprintf(out, ",\n \"assembled\": %s, \"iterations\": %d", rep->assembled ? "true" : "false",
            rep->assembly.iterations);
-    json_num("residual", rep->assembly.residual);
-    printf(",\n \"q\": [");
+    json_num(out, "residual", rep->assembly.residual);
+    fprintf(out, ",\n \"q\": [");
     for (int i = 0; i < m->nq; i++) {
-        printf(i ? ", " : "");
-        json_number(stdout, rep->q[i]);
+        fprintf(out, i ? ", " : "");
+        json_number(out, rep->q[i]);
     }
-    printf("],\n \"system_integrable\": %s",
+    fprintf(out, "],\n \"system_integrable\": %s",
            !rep->system.tested ? "null" : rep->system.involutive ? "true" : "false");
-    printf(",\n \"system_note\": ");
-    json_string(stdout, rep->system.note ? rep->system.note : "");
+    fprintf(out, ",\n \"system_note\": ");
+    json_string(out, rep->system.note ? rep->system.note : "");
     if (rep->state.asked)
-        json_state(rep);
-    printf(",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
-    printf(",\n \"singular\": ");
-    json_string(stdout, rep->singular);
-    printf(",\n \"verdict\": ");
-    json_string(stdout, rep->verdict);
-    printf("}\n");
+        json_state(out, rep);
+    fprintf(out, ",\n \"singularity\": \"%s\"", info_singularity_names[rep->singularity]);
+    fprintf(out, ",\n \"singular\": ");
+    json_string(out, rep->singular);
+    fprintf(out, ",\n \"verdict\": ");
+    json_string(out, rep->verdict);
+    fprintf(out, "}\n");
 }
 
 /* ---- text ---- */
@@ -558,7 +558,7 @@ static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
     }
     free(q);
     if (c->json)
-        print_json(&rep);
+        info_print_json(stdout, &rep);
     else
         print_text(&rep);
     int status = EXIT_OK;

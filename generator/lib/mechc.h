@@ -201,8 +201,9 @@ mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
 /* ---- kernels over n states at once ----
    q and qd are n x nq (state i in row i), the outputs n times the single
    call's size, state i's block at i * size. t holds nt values: nt == 1,
-   one time for every state, or nt == n, one each (MECHC_EARG otherwise).
-   n == 0 does nothing. */
+   one time for every state, or nt == n, one each (MECHC_EARG otherwise);
+   t NULL with nt 0: t = 0 for every state. n == 0 does nothing. The
+   results are those of the single calls, state by state. */
 
 mechc_status mechc_phi_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                              size_t nt, double *phi /* n x nh */);

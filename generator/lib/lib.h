@@ -1,0 +1,59 @@
+/* lib.h - libmechc's handles as the library's own files see them (the public API: mechc.h). */
+#ifndef MECHC_LIB_H
+#define MECHC_LIB_H
+
+#include "mechc.h"
+
+#include "../engine/engine.h"
+#include "../kin/outputs.h"
+#include "../pipeline/pipeline.h"
+
+#include <stdbool.h>
+
+struct mechc_model {
+    Mech *mech;
+    char *name;             /* the file name as given, owned: diag.file points here */
+    Diag diag;              /* outlives mech (pipeline_load wants it) */
+};
+
+/* The batch calls, one pointer per kernel: n states, q n x nq, t nt
+   values (1 or n). batch.c fills them with loops over the single-state
+   kernel; generated P_*_batch kernels replace a slot where the engine's
+   compiled unit has one (lib_batch_bind). */
+typedef void (*LibBatchPhi)(mechc_kernels *k, size_t n, const double *q, const double *t,
+                            size_t nt, double *out);
+typedef void (*LibBatchGamma)(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                              const double *t, size_t nt, double *out);
+typedef void (*LibBatchAll)(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                            const double *t, size_t nt, double *phi, double *jac, double *nu,
+                            double *gamma);
+typedef void (*LibBatchMass)(mechc_kernels *k, size_t n, const double *q, double *M);
+
+typedef struct LibBatch {
+    LibBatchPhi phi, jac, nu;
+    LibBatchGamma gamma, force;
+    LibBatchAll all;
+    LibBatchMass mass;
+} LibBatch;
+
+struct mechc_kernels {
+    mechc_model *model;
+    Engine engine;
+    OutputEval outputs;     /* the `output` statements, interpreted */
+    double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs) */
+    LibBatch batch;
+};
+
+/* Fills d (may be NULL) with status and a message, no position. Returns status. */
+mechc_status lib_fail(mechc_diag *d, mechc_status status, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* Fills d (may be NULL) from a stage's Diag. Returns status. */
+mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from);
+/* Clears d (may be NULL): status MECHC_OK, nothing else. */
+void lib_ok(mechc_diag *d);
+
+/* The loops behind the batch calls (batch.c); then what the engine's
+   compiled unit has of its own. */
+void lib_batch_bind(mechc_kernels *k);
+
+#endif

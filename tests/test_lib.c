@@ -1,0 +1,388 @@
+/* test_lib.c - libmechc's public API (generator/lib/mechc.h): loading, names, kernels, batches, run, sim, info, errors.
+ *
+ * Uses mechc.h alone, as a program embedding the library would. Runs from
+ * the repository root (examples/ relative), like `make check`. The
+ * reference values are what `mechc run` and `mechc sim` print for the
+ * same files (their JSON, 17 digits).
+ */
+#include "testutil.h"
+
+#include "../generator/lib/mechc.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+static mechc_model *load(const char *path)
+{
+    mechc_diag d;
+    mechc_model *m = mechc_load_file(path, &d);
+    if (!m)
+        fail_msg("%s:%d:%d: %s", d.file, d.line, d.column, d.message);
+    assert_int_equal(d.status, MECHC_OK);
+    return m;
+}
+
+static mechc_kernels *compile(mechc_model *m, const char *engine)
+{
+    mechc_diag d;
+    mechc_kernels *k = mechc_compile(m, engine, &d);
+    if (!k)
+        fail_msg("%s: %s", engine, d.message);
+    return k;
+}
+
+static void sizes_and_names(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    assert_int_equal(mechc_nq(m), 9);
+    assert_int_equal(mechc_nh(m), 9);
+    assert_int_equal(mechc_nv(m), 0);
+    assert_int_equal(mechc_nr(m), 9);
+    assert_int_equal(mechc_nout(m), 0);
+    assert_int_equal(mechc_nbodies(m), 3);
+    assert_int_equal(mechc_np(m), 0);
+    assert_int_equal(mechc_has_dynamics(m), 0);
+    assert_string_equal(mechc_model_name(m), "four_bar");
+    assert_string_equal(mechc_coord_name(m, 2), "crank.phi");
+    assert_string_equal(mechc_coord_name(m, 8), "rocker.phi");
+    assert_null(mechc_coord_name(m, 9));
+    assert_null(mechc_coord_name(m, -1));
+    assert_string_equal(mechc_row_name(m, 0), "O2.x");
+    assert_string_equal(mechc_row_name(m, 8), "drive");
+    assert_string_equal(mechc_body_name(m, 1), "coupler");
+    assert_int_equal(mechc_coord_index(m, "coupler.phi"), 5);
+    assert_int_equal(mechc_coord_index(m, "nothing"), -1);
+    int first, count;
+    assert_int_equal(mechc_body_coords(m, 2, &first, &count), MECHC_OK);
+    assert_int_equal(first, 6);
+    assert_int_equal(count, 3);
+    assert_near(mechc_q0(m)[4], 1.2402, 0, 0);
+    mechc_model_free(m);
+}
+
+/* Phi vanishes at the file's initial values to their 4 decimals, on every engine. */
+static void phi_at_q0(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    const char *engines[] = {"jit", "generic", NULL};
+    for (int e = 0; engines[e]; e++) {
+        mechc_kernels *k = compile(m, engines[e]);
+        assert_string_equal(mechc_kernels_engine(k), engines[e]);
+        double phi[9];
+        assert_int_equal(mechc_phi(k, mechc_q0(m), 0, phi), MECHC_OK);
+        for (int i = 0; i < 9; i++)
+            assert_near(phi[i], 0, 0, 2e-4);
+        mechc_kernels_free(k);
+    }
+    mechc_model_free(m);
+}
+
+/* The Jacobian against central differences of phi, and its nonzeros against the dense one. */
+static void jacobian(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_kernels *k = compile(m, "jit");
+    double q[9], jac[81], pp[9], pm[9];
+    memcpy(q, mechc_q0(m), sizeof q);
+    q[2] = 0.3;
+    double t = 0.1;
+    assert_int_equal(mechc_jacobian(k, q, t, jac), MECHC_OK);
+    for (int j = 0; j < 9; j++) {
+        double h = 1e-6, keep = q[j];
+        q[j] = keep + h;
+        mechc_phi(k, q, t, pp);
+        q[j] = keep - h;
+        mechc_phi(k, q, t, pm);
+        q[j] = keep;
+        for (int i = 0; i < 9; i++)
+            assert_near(jac[i * 9 + j], (pp[i] - pm[i]) / (2 * h), 0, 1e-8);
+    }
+    int nnz = mechc_jacobian_nz(k);
+    assert_true(nnz > 9 && nnz < 81);
+    int *rows = malloc((size_t)nnz * sizeof *rows), *cols = malloc((size_t)nnz * sizeof *cols);
+    double *vals = malloc((size_t)nnz * sizeof *vals);
+    assert_int_equal(mechc_jacobian_pattern(k, rows, cols), MECHC_OK);
+    assert_int_equal(mechc_jacobian_values(k, q, t, vals), MECHC_OK);
+    double sum = 0;
+    for (int i = 0; i < nnz; i++) {
+        assert_near(vals[i], jac[rows[i] * 9 + cols[i]], 1e-15, 0);
+        sum += fabs(vals[i]);
+    }
+    double dense = 0;
+    for (int i = 0; i < 81; i++)
+        dense += fabs(jac[i]);
+    assert_near(sum, dense, 1e-14, 0);      /* no nonzero outside the pattern */
+    free(rows), free(cols), free(vals);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* A batch call equals the single calls, with one time for all or one each. */
+static void batches(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_kernels *k = compile(m, "jit");
+    enum { N = 5 };
+    double q[N * 9], qd[N * 9], t[N], g[N * 9], g1[9], jac[N * 81], j1[81], phi[N * 9];
+    for (int i = 0; i < N; i++) {
+        t[i] = 0.1 * i;
+        for (int j = 0; j < 9; j++) {
+            q[i * 9 + j] = mechc_q0(m)[j] + 0.01 * i * j;
+            qd[i * 9 + j] = 0.5 + 0.1 * j - 0.2 * i;
+        }
+    }
+    assert_int_equal(mechc_gamma_batch(k, N, q, qd, t, N, g), MECHC_OK);
+    assert_int_equal(mechc_all_batch(k, N, q, qd, t, 1, phi, jac, NULL, NULL), MECHC_OK);
+    for (int i = 0; i < N; i++) {
+        mechc_gamma(k, q + i * 9, qd + i * 9, t[i], g1);
+        for (int r = 0; r < 9; r++)
+            assert_true(g[i * 9 + r] == g1[r]);
+        mechc_jacobian(k, q + i * 9, t[0], j1);
+        for (int r = 0; r < 81; r++)
+            assert_true(jac[i * 81 + r] == j1[r]);
+    }
+    assert_int_equal(mechc_gamma_batch(k, N, q, qd, t, 3, g), MECHC_EARG);
+    assert_int_equal(mechc_phi_batch(k, 0, NULL, NULL, 0, NULL), MECHC_OK);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* The diagnostic of a broken text as a value: file, line, column, message. */
+static void diagnostics(void **state)
+{
+    (void)state;
+    mechc_diag d;
+    mechc_model *m = mechc_load_string("mechanism m\nbody b x = 0 y = 0 phi = 0\n"
+                                       "revolute R: ground(0, 0) b(0 0)\n", "bad.mech", &d);
+    assert_null(m);
+    assert_int_equal(d.status, MECHC_EINPUT);
+    assert_string_equal(d.file, "bad.mech");
+    assert_int_equal(d.line, 3);
+    assert_int_equal(d.column, 30);
+    assert_non_null(strstr(d.message, "expected ','"));
+    assert_null(mechc_load_file("examples/no_such_file.mech", &d));
+    assert_int_equal(d.status, MECHC_EINPUT);
+    assert_true(d.message[0] != '\0');
+    assert_null(mechc_load_file(NULL, NULL));
+}
+
+/* Failures come back as statuses, never as an exit. */
+static void errors(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_diag d;
+    assert_null(mechc_compile(m, "fast", &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels *k = compile(m, "generic");
+    double M[81], q[9] = {0};
+    assert_int_equal(mechc_mass(k, q, M), MECHC_ENOTAVAIL);
+    assert_int_equal(mechc_phi_p(k, q, 0, M), MECHC_ENOTAVAIL);
+    assert_int_equal(mechc_phi(k, NULL, 0, M), MECHC_EARG);
+    assert_null(mechc_sim(k, NULL, &d));
+    assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
+    assert_non_null(strstr(d.message, "no masses"));
+    assert_int_equal(mechc_set_design(m, "a", 2), MECHC_ENOTAVAIL);
+    mechc_run_options o = mechc_run_defaults();
+    o.t1 = o.t0;
+    assert_null(mechc_run(k, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+    /* an undriven mechanism cannot run */
+    m = mechc_load_string("body b x = 1 y = 0 phi = 0\nrevolute R: ground(0, 0) b(-1, 0)\n",
+                          "free.mech", &d);
+    assert_non_null(m);
+    k = compile(m, "generic");
+    assert_null(mechc_run(k, NULL, &d));
+    assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+static int states_seen;
+static void count_state(void *ctx, double t, const double *q, const double *qd,
+                        const double *qdd, const double *lambda)
+{
+    (void)t, (void)q, (void)qd, (void)qdd, (void)lambda;
+    *(int *)ctx += 1;
+}
+
+/* The run's last state is what `mechc run --steps 4 --json` prints. */
+static void run_matches_cli(void **state)
+{
+    (void)state;
+    static const double q1[9] = {0.5, -1.224646799076922e-16, 6.283185307179586, 1.84375,
+                                 1.2401959270615266, 0.9733899101495465, 2.84375,
+                                 1.2401959270615268, 1.696124157962962};
+    static const double qdd1[9] = {-19.739208802178716, 4.834711775179833e-15, 0,
+                                   -43.17951925476592, -15.387734283352568,
+                                   -3.730359826267303, -23.44031045258721,
+                                   -15.387734283352573, 20.14394306184335};
+    mechc_model *m = load("examples/four_bar.mech");
+    const char *engines[] = {"jit", "generic", NULL};
+    for (int e = 0; engines[e]; e++) {
+        mechc_kernels *k = compile(m, engines[e]);
+        mechc_run_options o = mechc_run_defaults();
+        o.steps = 4;
+        states_seen = 0;
+        o.on_state = count_state;
+        o.ctx = &states_seen;
+        mechc_diag d;
+        mechc_result *r = mechc_run(k, &o, &d);
+        assert_non_null(r);
+        assert_int_equal(mechc_result_status(r), MECHC_OK);
+        assert_int_equal(mechc_result_states(r), 5);
+        assert_int_equal(states_seen, 5);
+        assert_near(mechc_result_time(r)[4], 1, 0, 0);
+        assert_null(mechc_result_lambda(r));
+        const double *q = mechc_result_q(r) + 4 * 9, *qdd = mechc_result_qdd(r) + 4 * 9;
+        for (int i = 0; i < 9; i++) {
+            assert_near(q[i], q1[i], 1e-12, 1e-12);
+            assert_near(qdd[i], qdd1[i], 1e-9, 1e-9);
+        }
+        /* the file's check: theta4(0.25) = 1.725386 */
+        assert_near(mechc_result_q(r)[9 + 8], 1.725386, 0, 1e-6);
+        mechc_result_free(r);
+        mechc_kernels_free(k);
+    }
+    mechc_model_free(m);
+}
+
+/* A design parameter changed without recompiling: `mechc run --design a=1.1`'s last state. */
+static void design_without_recompiling(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/freudenstein.mech");
+    assert_int_equal(mechc_np(m), 3);
+    assert_string_equal(mechc_design_name(m, 0), "a");
+    mechc_kernels *k = compile(m, "jit");
+    double p[3];
+    assert_int_equal(mechc_set_design(m, "a", 1.1), MECHC_OK);
+    assert_int_equal(mechc_set_design(m, "zz", 1.1), MECHC_EARG);
+    assert_int_equal(mechc_design(m, p), MECHC_OK);
+    assert_near(p[0], 1.1, 0, 0);
+    assert_near(p[1], 3, 0, 0);
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 4;
+    mechc_result *r = mechc_run(k, &o, NULL);
+    assert_non_null(r);
+    const double *q = mechc_result_q(r) + 4 * 9;
+    assert_near(q[0], 0.2971662682274769, 1e-12, 1e-12);
+    assert_near(q[8], 1.510430815824577, 1e-12, 1e-12);
+    mechc_result_free(r);
+    double phi_p[9 * 3];
+    assert_int_equal(mechc_phi_p(k, mechc_q0(m), 0, phi_p), MECHC_OK);
+    assert_int_equal(mechc_set_design_vector(m, NULL), MECHC_OK);
+    assert_int_equal(mechc_design(m, p), MECHC_OK);
+    assert_near(p[0], 1, 0, 0);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* Forward dynamics: `mechc sim examples/pendulum_dynamics.mech --steps 10 --json`. */
+static void sim_matches_cli(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/pendulum_dynamics.mech");
+    assert_int_equal(mechc_has_dynamics(m), 1);
+    mechc_kernels *k = compile(m, "jit");
+    double M[9];
+    assert_int_equal(mechc_mass(k, mechc_q0(m), M), MECHC_OK);
+    assert_true(M[0] > 0);
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 10;
+    mechc_diag d;
+    mechc_result *r = mechc_sim(k, &o, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_OK);
+    assert_int_equal(mechc_result_states(r), 11);
+    assert_non_null(mechc_result_lambda(r));
+    assert_near(mechc_result_q(r)[10 * 3 + 2], -1.995101304134083, 1e-10, 0);
+    assert_near(mechc_result_qd(r)[10 * 3 + 2], 1.1546296476978104, 1e-9, 0);
+    mechc_result_free(r);
+    o.method = "euler";
+    assert_null(mechc_sim(k, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* mechc info's figures: as a struct and as its JSON. */
+static void info(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/parallelogram_redundant.mech");
+    mechc_info in;
+    int redundant[64] = {0};
+    mechc_diag d;
+    assert_int_equal(mechc_info_at(m, 0, &in, redundant, NULL, &d), MECHC_OK);
+    assert_int_equal(in.assembled, 1);
+    assert_true(in.nredundant >= 1);
+    assert_int_equal(in.rank, in.nh - in.nredundant);
+    int flagged = 0;
+    for (int i = 0; i < in.nr; i++)
+        flagged += redundant[i];
+    assert_int_equal(flagged, in.nredundant);
+    char *json = mechc_info_json(m, &d);
+    assert_non_null(json);
+    assert_non_null(strstr(json, "\"redundant\": ["));
+    assert_true(json[0] == '{' && json[strlen(json) - 2] == '}');
+    mechc_free(json);
+    mechc_model_free(m);
+}
+
+/* One thread's work on a model of its own: load, jit, run; rocker.phi at t = 1. */
+static void *run_alone(void *out)
+{
+    mechc_model *m = mechc_load_file("examples/four_bar.mech", NULL);
+    mechc_kernels *k = m ? mechc_compile(m, "jit", NULL) : NULL;
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 50;
+    mechc_result *r = k ? mechc_run(k, &o, NULL) : NULL;
+    *(double *)out = r ? mechc_result_q(r)[50 * 9 + 8] : NAN;
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+    return NULL;
+}
+
+/* Distinct models in threads at the same time give what one alone gives. */
+static void threads(void **state)
+{
+    (void)state;
+    enum { T = 4 };
+    double alone, got[T];
+    run_alone(&alone);
+    assert_near(alone, 1.696124157962962, 1e-12, 0);
+    pthread_t th[T];
+    for (int i = 0; i < T; i++)
+        assert_int_equal(pthread_create(&th[i], NULL, run_alone, &got[i]), 0);
+    for (int i = 0; i < T; i++) {
+        pthread_join(th[i], NULL);
+        assert_true(got[i] == alone);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(sizes_and_names),
+        cmocka_unit_test(phi_at_q0),
+        cmocka_unit_test(jacobian),
+        cmocka_unit_test(batches),
+        cmocka_unit_test(diagnostics),
+        cmocka_unit_test(errors),
+        cmocka_unit_test(run_matches_cli),
+        cmocka_unit_test(design_without_recompiling),
+        cmocka_unit_test(sim_matches_cli),
+        cmocka_unit_test(info),
+        cmocka_unit_test(threads),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
