@@ -43,15 +43,15 @@ failed compile, run or simulation (.result: the states before it).
 
 The library: $MECHC_LIBRARY, else the one `make install` recorded, else
 build/libmechc.so of the source tree (PYTHONPATH=python after `make`),
-else the system's. doc/python.md has the whole guide and the figures.
+else the system's; mechc.library_path says which was opened. doc/python.md has the whole guide and the figures.
 """
 
-from ._ffi import (ffi as _cffi, lib as _lib, MechcError, InputError, NotAvailableError,
-                   AnalysisError, error_from_diag as _error_from_diag)
+from ._ffi import (ffi as _cffi, lib as _lib, library_path, MechcError, InputError,
+                   NotAvailableError, AnalysisError, error_from_diag as _error_from_diag)
 from ._model import Model, Design, Kinematics, Dynamics
 from ._result import Trajectory
 
-__all__ = ["load", "loads", "version", "Model", "Design", "Trajectory", "Kinematics",
+__all__ = ["load", "loads", "version", "library_path", "Model", "Design", "Trajectory", "Kinematics",
            "Dynamics", "MechcError", "InputError", "NotAvailableError", "AnalysisError"]
 
 

@@ -184,7 +184,7 @@ def _open():
             tried.append(path + " (missing)")
             continue
         try:
-            return ffi.dlopen(path)
+            return ffi.dlopen(path), path
         except OSError as e:
             tried.append("%s (%s)" % (path, e))
     raise ImportError("mechc: libmechc.so not found; build it with `make` in the source tree, "
@@ -192,7 +192,7 @@ def _open():
                       + "; ".join(tried))
 
 
-lib = _open()
+lib, library_path = _open()
 
 
 class MechcError(Exception):

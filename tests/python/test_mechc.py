@@ -367,3 +367,38 @@ def test_threads_share_nothing():
     assert all(np.array_equal(g, want) for g in got)
     for m in ms:
         m.close()
+
+
+def test_sim_initial_velocities(pendulum, tmp_path):
+    qd0 = np.array([0.0, 0.0, 1.5])
+    traj = pendulum.sim(t1=0.2, steps=4, qd0=qd0)
+    cli("sim", ex("pendulum_dynamics.mech"), "--t1", 0.2, "--steps", 4, "--qd", vec(qd0),
+        "--csv", tmp_path / "s.csv")
+    header, table = read_csv((tmp_path / "s.csv").read_text())
+    for j, name in enumerate(header):
+        assert np.array_equal(traj[name], table[:, j]), name
+    assert traj["d(rod.phi)"][0] == 1.5
+
+
+def test_installed_package_finds_installed_library(tmp_path):
+    """make install-python: the package, with the installed library's path written in."""
+    import shutil
+    import sys
+    prefix = tmp_path / "prefix"
+    quiet = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
+    p = subprocess.run(["make", "-s", "-C", ROOT, "install-python", "PREFIX=%s" % prefix,
+                        "PYTHON=%s" % sys.executable], capture_output=True, text=True, env=quiet)
+    assert p.returncode == 0, p.stderr
+    (prefix / "lib").mkdir(exist_ok=True)
+    shutil.copy(mechc.library_path, prefix / "lib" / "libmechc.so")
+    site = next((prefix / "lib").glob("python3*/dist-packages"))
+    env = {k: v for k, v in os.environ.items() if k not in ("MECHC_LIBRARY", "PYTHONPATH")}
+    env["PYTHONPATH"] = str(site)
+    code = ("import mechc; m = mechc.load(%r); print(mechc.library_path, m.nq, mechc.__file__)"
+            % ex("four_bar.mech"))
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                       cwd=str(tmp_path))
+    assert p.returncode == 0, p.stderr
+    lib, nq, where = p.stdout.split()
+    assert lib == str(prefix / "lib" / "libmechc.so") and nq == "9"
+    assert where.startswith(str(site))
