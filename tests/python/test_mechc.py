@@ -402,3 +402,17 @@ def test_installed_package_finds_installed_library(tmp_path):
     lib, nq, where = p.stdout.split()
     assert lib == str(prefix / "lib" / "libmechc.so") and nq == "9"
     assert where.startswith(str(site))
+
+
+def test_failed_run_keeps_its_states():
+    """A run that fails part-way: AnalysisError with the command's message and the states before."""
+    rc, _, err = cli("run", ex("textbook_four_bar.mech"), "--steps", 2, "--csv", os.devnull,
+                     ok=False)
+    line = next(x for x in err.splitlines() if ": error: " in x)
+    m = mechc.load(ex("textbook_four_bar.mech"))
+    with pytest.raises(mechc.AnalysisError) as e:
+        m.run(steps=2)
+    assert rc == 1 and isinstance(e.value, RuntimeError)
+    assert str(e.value) == line.replace(": error: ", ": ", 1)
+    assert len(e.value.result.t) == 1 and e.value.t_fail == 0.0078125
+    m.close()
