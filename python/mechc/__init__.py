@@ -1,4 +1,4 @@
-"""mechc - mechanisms from .mech files, compiled to C kernels, called with NumPy arrays.
+"""Mechanisms from .mech files, compiled to C kernels, called with NumPy arrays.
 
 A thin layer over libmechc (the mechanism compiler as a C library, opened
 with cffi in ABI mode: nothing to compile, no network). Load a mechanism,
