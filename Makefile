@@ -146,10 +146,12 @@ $(LIBTCC_PIC):
 	$(Q)objcopy --redefine-sym stdout=libtcc_stdout --redefine-sym stderr=libtcc_stderr \
 	  --redefine-sym environ=libtcc_environ $$($(CC) -print-file-name=libtcc.a) $@
 
+# -z defs: every symbol resolved (not under sanitizers: clang's leave
+# their runtime to the program).
 $(SO): $(PIC_OBJ) $(LIBTCC_PIC) generator/lib/mechc.map
 	@$(if $(filter 1,$(V)),,echo "  LD      $@")
 	$(Q)$(CC) -shared $(SAN) -Wl,-soname,libmechc.so -Wl,--version-script=generator/lib/mechc.map \
-	  -Wl,-z,defs $(PIC_OBJ) $(LIBTCC_PIC) $(LDLIBS_SO) -o $@
+	  $(if $(SAN),,-Wl,-z,defs) $(PIC_OBJ) $(LIBTCC_PIC) $(LDLIBS_SO) -o $@
 
 $(MECHC): $(BUILD)/generator/cli/main.o $(LIB)
 	@$(if $(filter 1,$(V)),,echo "  LD      $@")

@@ -285,6 +285,48 @@ static void design_without_recompiling(void **state)
     mechc_model_free(m);
 }
 
+/* rocker.phi at t = 1 (4 steps) with the design parameter a at a. */
+static double rocker_at(mechc_kernels *k, double a, double *q, double *qd, double *qdd)
+{
+    mechc_set_design(mechc_kernels_model(k), "a", a);
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 4;
+    mechc_result *r = mechc_run(k, &o, NULL);
+    assert_non_null(r);
+    if (q) {
+        memcpy(q, mechc_result_q(r) + 4 * 9, 9 * sizeof *q);
+        memcpy(qd, mechc_result_qd(r) + 4 * 9, 9 * sizeof *q);
+        memcpy(qdd, mechc_result_qdd(r) + 4 * 9, 9 * sizeof *q);
+    }
+    double v = mechc_result_q(r)[4 * 9 + 8];
+    mechc_result_free(r);
+    return v;
+}
+
+/* d(rocker.phi)/d(a) at t = 1 against central differences of two runs. */
+static void sensitivities(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/freudenstein.mech");
+    mechc_kernels *k = compile(m, "jit");
+    double q[9], qd[9], qdd[9], q_p[27], qd_p[27], qdd_p[27], h = 1e-6;
+    rocker_at(k, 1, q, qd, qdd);
+    assert_int_equal(mechc_sensitivities(k, q, qd, qdd, 1, q_p, qd_p, qdd_p, NULL, NULL, NULL),
+                     MECHC_OK);
+    double fd = (rocker_at(k, 1 + h, NULL, NULL, NULL) - rocker_at(k, 1 - h, NULL, NULL, NULL))
+                / (2 * h);
+    assert_near(q_p[8 * 3 + 0], fd, 1e-6, 1e-8);
+    assert_true(fabs(fd) > 0.01);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+    m = load("examples/four_bar.mech");
+    k = compile(m, "generic");
+    assert_int_equal(mechc_sensitivities(k, q, qd, qdd, 1, q_p, qd_p, qdd_p, NULL, NULL, NULL),
+                     MECHC_ENOTAVAIL);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 /* Forward dynamics: `mechc sim examples/pendulum_dynamics.mech --steps 10 --json`. */
 static void sim_matches_cli(void **state)
 {
@@ -352,20 +394,37 @@ static void *run_alone(void *out)
     return NULL;
 }
 
+/* The same with a simulation (GSL's integrator): rod.phi at t = 1. */
+static void *sim_alone(void *out)
+{
+    mechc_model *m = mechc_load_file("examples/pendulum_dynamics.mech", NULL);
+    mechc_kernels *k = m ? mechc_compile(m, "generic", NULL) : NULL;
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 10;
+    mechc_result *r = k ? mechc_sim(k, &o, NULL) : NULL;
+    *(double *)out = r ? mechc_result_q(r)[10 * 3 + 2] : NAN;
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+    return NULL;
+}
+
 /* Distinct models in threads at the same time give what one alone gives. */
 static void threads(void **state)
 {
     (void)state;
     enum { T = 4 };
-    double alone, got[T];
-    run_alone(&alone);
-    assert_near(alone, 1.696124157962962, 1e-12, 0);
+    double alone[2], got[T];
+    run_alone(&alone[0]);
+    sim_alone(&alone[1]);
+    assert_near(alone[0], 1.696124157962962, 1e-12, 0);
+    assert_near(alone[1], -1.995101304134083, 1e-10, 0);
     pthread_t th[T];
     for (int i = 0; i < T; i++)
-        assert_int_equal(pthread_create(&th[i], NULL, run_alone, &got[i]), 0);
+        assert_int_equal(pthread_create(&th[i], NULL, i % 2 ? sim_alone : run_alone, &got[i]), 0);
     for (int i = 0; i < T; i++) {
         pthread_join(th[i], NULL);
-        assert_true(got[i] == alone);
+        assert_true(got[i] == alone[i % 2]);
     }
 }
 
@@ -380,6 +439,7 @@ int main(void)
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
         cmocka_unit_test(design_without_recompiling),
+        cmocka_unit_test(sensitivities),
         cmocka_unit_test(sim_matches_cli),
         cmocka_unit_test(info),
         cmocka_unit_test(threads),

@@ -56,6 +56,8 @@ void mechc_kernels_free(mechc_kernels *k)
 {
     if (!k)
         return;
+    if (k->sens_state > 0)
+        sens_free(&k->sens);
     engine_close(&k->engine);
     outputs_free(&k->outputs);
     free(k->scratch);

@@ -6,6 +6,7 @@
 
 #include "../engine/engine.h"
 #include "../kin/outputs.h"
+#include "../kin/sens.h"
 #include "../pipeline/pipeline.h"
 
 #include <stdbool.h>
@@ -41,6 +42,8 @@ struct mechc_kernels {
     Engine engine;
     OutputEval outputs;     /* the `output` statements, interpreted */
     double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs) */
+    Sens sens;              /* mechc_sensitivities', made at its first call */
+    int sens_state;         /* 0 not made, 1 made, -1 the model has none */
     LibBatch batch;
 };
 

@@ -18,6 +18,9 @@
  * keep scratch memory in the handle). A kernels handle keeps a pointer to
  * its model: free the kernels first.
  *
+ * The first load turns GSL's error handler off (gsl_set_error_handler_off:
+ * its default aborts; the library checks every status), for good.
+ *
  * The library never prints and never exits on bad input or a failed
  * analysis: every failure is a status (mechc_status) and, where a
  * mechc_diag pointer is taken (it may be NULL), a message. Out of memory
@@ -141,10 +144,10 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
 /* ---- compiling ---- */
 
 /* Compiles m's kernels with an engine: "jit" (default when NULL: generated
-   C compiled in process; in libmechc.so by the tcc program into a shared
-   object loaded with dlopen, in libmechc.a by libtcc), "aot" (generated
-   C built by $CC, default cc, -O2, cached in ~/.cache/mechc) or "generic"
-   (formulas interpreted, nothing compiled). NULL with diag filled:
+   C compiled in memory by libtcc, about 2 ms for a four-bar; one jit
+   compile at a time in the process), "aot" (generated C built by $CC,
+   default cc, -O2, cached in $XDG_CACHE_HOME/mechc or ~/.cache/mechc) or
+   "generic" (formulas interpreted, nothing compiled). NULL with diag filled:
    MECHC_EARG for an unknown engine, MECHC_ECOMPILE when it cannot compile. */
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
@@ -192,6 +195,16 @@ mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, doub
 /* dPhi/dp at the current design: MECHC_ENOTAVAIL when np == 0. */
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t,
                          double *phi_p /* nh x np */);
+/* The sensitivities of a state of the motion (q, qd, qdd at t, as a run
+   gives them) to the design parameters, what `run --sens` writes:
+   variable-major, [i * np + j] = d(variable i)/d(p_j); q_p, qd_p, qdd_p
+   nq x np, y_p, yd_p, ydd_p (the outputs'; may be NULL) nout x np.
+   MECHC_ENOTAVAIL without design parameters, with velocity-level rows or
+   without as many rows as coordinates; MECHC_EANALYSIS where Phi_q is
+   singular. */
+mechc_status mechc_sensitivities(mechc_kernels *k, const double *q, const double *qd,
+                                 const double *qdd, double t, double *q_p, double *qd_p,
+                                 double *qdd_p, double *y_p, double *yd_p, double *ydd_p);
 /* The `output` statements' values, velocities and accelerations; yd, ydd
    (and qd, qdd with them) may be NULL. */
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,

@@ -3,7 +3,9 @@
 
 #include "../base/arena.h"
 
+#include <gsl/gsl_errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,9 +62,18 @@ mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from)
     return status;
 }
 
+/* GSL's error handler is the process's: the drivers turn it off around
+   their calls and restore it, which threads running analyses at once
+   would interleave, restoring GSL's default (abort) under another's
+   feet. Off once and for all, before the first model, every save and
+   restore keeps it off (the drivers check every status). */
+static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
+static void gsl_quiet(void) { gsl_set_error_handler_off(); }
+
 /* pipeline_load or pipeline_load_text into a new model; NULL with d filled. */
 static mechc_model *load(const char *path, const char *text, const char *name, mechc_diag *d)
 {
+    pthread_once(&gsl_once, gsl_quiet);
     mechc_model *m = xcalloc(1, sizeof *m);
     const char *given = path ? path : name;
     size_t len = strlen(given) + 1;
