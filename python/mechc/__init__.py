@@ -20,7 +20,8 @@ them at one state or at many states in one call:
     m.info()["dof"]                   # mechc info --json as a dict: 0
 
 Kernels: phi, jacobian, nu, gamma, all (fused), and with masses in the
-file mass, force, eom; phi_p with design parameters; output_values.
+file mass, force, eom; phi_p and sensitivities with design parameters;
+output_values.
 Each takes q of shape (nq,) (and qd) or (n, nq) for n states, t a number
 or (for n states) an array of n times, and out= a preallocated result.
 The GIL is released during every library call (cffi does that for every
@@ -48,11 +49,12 @@ else the system's; mechc.library_path says which was opened. doc/python.md has t
 
 from ._ffi import (ffi as _cffi, lib as _lib, library_path, MechcError, InputError,
                    NotAvailableError, AnalysisError, error_from_diag as _error_from_diag)
-from ._model import Model, Design, Kinematics, Dynamics
+from ._model import Model, Design, Kinematics, Dynamics, Sensitivities
 from ._result import Trajectory
 
-__all__ = ["load", "loads", "version", "library_path", "Model", "Design", "Trajectory", "Kinematics",
-           "Dynamics", "MechcError", "InputError", "NotAvailableError", "AnalysisError"]
+__all__ = ["load", "loads", "version", "library_path", "Model", "Design", "Trajectory",
+           "Kinematics", "Dynamics", "Sensitivities", "MechcError", "InputError",
+           "NotAvailableError", "AnalysisError"]
 
 
 def version():

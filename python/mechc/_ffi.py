@@ -86,6 +86,9 @@ mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *M, double *Q, double *jac, double *gamma);
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *phi_p);
+mechc_status mechc_sensitivities(mechc_kernels *k, const double *q, const double *qd,
+                                 const double *qdd, double t, double *q_p, double *qd_p,
+                                 double *qdd_p, double *y_p, double *yd_p, double *ydd_p);
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
                            const double *qdd, double t, double *y, double *yd, double *ydd);
 

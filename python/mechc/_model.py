@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from ._ffi import ffi, lib, check, error_from, error_from_diag, InputError
-from ._result import trajectory_from_result
+from ._result import trajectory_from_result, add_sensitivities
 
 _F64 = np.float64
 _ENGINES = ("jit", "aot", "generic")
@@ -19,6 +19,9 @@ _SPARSE_CHUNK = 1024
 Kinematics = collections.namedtuple("Kinematics", "phi jac nu gamma")
 Kinematics.__doc__ = """What Model.all returns: Phi (nh), Phi_q (nr x nq), nu (nr), gamma (nr)
 (each with a leading n for n states)."""
+Sensitivities = collections.namedtuple("Sensitivities", "q_p qd_p qdd_p y_p yd_p ydd_p")
+Sensitivities.__doc__ = """What Model.sensitivities returns: d(q)/d(p), d(qd)/d(p), d(qdd)/d(p)
+(nq x np each) and the outputs' d(y)/d(p), d(yd)/d(p), d(ydd)/d(p) (nout x np)."""
 Dynamics = collections.namedtuple("Dynamics", "M Q jac gamma")
 Dynamics.__doc__ = """What Model.eom returns: M (nq x nq), Q (nq), Phi_q (nr x nq), gamma (nr)."""
 
@@ -448,6 +451,29 @@ class Model:
         check(lib.mechc_phi_p(self._k, _buf(q), t, _buf(out)))
         return out
 
+    def sensitivities(self, q, qd, qdd, t=0.0):
+        """The sensitivities of a state of the motion to the design parameters (run --sens).
+
+        q, qd, qdd at t as a run gives them (traj.q[i], ...): a
+        Sensitivities(q_p, qd_p, qdd_p, y_p, yd_p, ydd_p), [i, j] =
+        d(variable i)/d(p_j), p in the order of m.design. NotAvailableError
+        without design parameters, with velocity-level rows or when not
+        driven; AnalysisError where Phi_q is singular.
+        """
+        arrays = []
+        for a, name in ((q, "q"), (qd, "qd"), (qdd, "qdd")):
+            a, n = self._states(a, name)
+            if n is not None:
+                raise ValueError("mechc: sensitivities take one state")
+            arrays.append(a)
+        res = Sensitivities(*(np.empty((rows, self.np), _F64)
+                              for rows in (self.nq,) * 3 + (self.nout,) * 3))
+        status = lib.mechc_sensitivities(self._k, *(_buf(a) for a in arrays), t,
+                                         *(_buf(r) for r in res))
+        if status:
+            check(status)
+        return res
+
     def output_values(self, q, qd=None, qdd=None, t=0.0):
         """The `output` statements' values at one state: y (nout,), or (y, yd, ydd) with qd and qdd.
 
@@ -476,13 +502,17 @@ class Model:
 
     # ---- analyses ---------------------------------------------------------------------
 
-    def run(self, steps=100, t0=0.0, t1=1.0, tol=None, max_iter=None, forces=False):
+    def run(self, steps=100, t0=0.0, t1=1.0, tol=None, max_iter=None, forces=False,
+            sens=False):
         """Kinematic analysis (mechc run): assembles at t0, then steps+1 states to t1.
 
         Returns a Trajectory: a dict of named columns as `mechc run --csv`
         writes them ("t", the coordinates, the outputs, "d(NAME)",
-        "dd(NAME)", with forces=True "lambda(ROW)"), each an (steps+1,)
-        array, plus the arrays .t, .q, .qd, .qdd, .y, .yd, .ydd, .lam.
+        "dd(NAME)", with forces=True "lambda(ROW)", with sens=True the
+        sensitivities "d(NAME)/d(P)", "d(d(NAME))/d(P)", "d(dd(NAME))/d(P)"
+        as run --sens), each an (steps+1,) array, plus the arrays .t, .q,
+        .qd, .qdd, .y, .yd, .ydd, .lam (and .sens, a Sensitivities of
+        (steps+1, ...) arrays).
         A failure part-way raises AnalysisError, whose .result holds the
         states before it. tol and max_iter default to the command's.
         """
@@ -493,7 +523,10 @@ class Model:
         if max_iter is not None:
             o.max_iter = int(max_iter)
         diag = ffi.new("mechc_diag *")
-        return self._result(lib.mechc_run(self._k, o, diag), diag)
+        traj = self._result(lib.mechc_run(self._k, o, diag), diag)
+        if sens:
+            add_sensitivities(traj, self)
+        return traj
 
     def sim(self, t1=1.0, steps=100, t0=0.0, qd0=None, method="rk8pd", rtol=None, atol=None):
         """Forward dynamics (mechc sim) of a file with masses, steps+1 states from t0 to t1.

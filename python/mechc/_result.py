@@ -26,7 +26,7 @@ class Trajectory(dict):
     ``numpy.column_stack(list(traj.values()))`` is the CSV's table.
     """
 
-    t = q = qd = qdd = y = yd = ydd = lam = None
+    t = q = qd = qdd = y = yd = ydd = lam = sens = None
 
     def __repr__(self):
         return "<mechc.Trajectory: %d states, %d columns>" % (len(self.t), len(self))
@@ -64,3 +64,20 @@ def trajectory_from_result(model, r):
         for j, name in enumerate(model.rows):
             tr["lambda(" + name + ")"] = tr.lam[:, j]
     return tr
+
+
+def add_sensitivities(tr, model):
+    """The columns of run --sens, state by state (the library has one state per call)."""
+    per_state = [model.sensitivities(tr.q[i], tr.qd[i], tr.qdd[i], tr.t[i])
+                 for i in range(len(tr.t))]
+    tr.sens = type(per_state[0])(*(np.array(a) for a in zip(*per_state))) if per_state else None
+    if tr.sens is None:
+        return
+    params = list(model.design)
+    for wrap, qa, ya in ((("d(", ")"), tr.sens.q_p, tr.sens.y_p),
+                         (("d(d(", "))"), tr.sens.qd_p, tr.sens.yd_p),
+                         (("d(dd(", "))"), tr.sens.qdd_p, tr.sens.ydd_p)):
+        for names, a in ((model.coords, qa), (model.outputs, ya)):
+            for i, name in enumerate(names):
+                for j, p in enumerate(params):
+                    tr[wrap[0] + name + wrap[1] + "/d(" + p + ")"] = a[:, i, j]

@@ -416,3 +416,18 @@ def test_failed_run_keeps_its_states():
     assert str(e.value) == line.replace(": error: ", ": ", 1)
     assert len(e.value.result.t) == 1 and e.value.t_fail == 0.0078125
     m.close()
+
+
+def test_run_sensitivities_equal_cli(tmp_path):
+    m = mechc.load(ex("coupler_synthesis.mech"))
+    traj = m.run(steps=8, sens=True)
+    cli("run", ex("coupler_synthesis.mech"), "--steps", 8, "--sens", "--csv", tmp_path / "s.csv")
+    header, table = read_csv((tmp_path / "s.csv").read_text())
+    assert list(traj.keys()) == header
+    for j, name in enumerate(header):
+        assert np.array_equal(traj[name], table[:, j]), name
+    assert traj.sens.q_p.shape == (9, m.nq, m.np)
+    with pytest.raises(mechc.NotAvailableError):
+        fb = mechc.load(ex("four_bar.mech"))
+        fb.sensitivities(fb.q0, fb.qd0, fb.qd0)
+    m.close()
