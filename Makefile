@@ -89,8 +89,8 @@ help:
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
-	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh)"
-	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
+	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh), the Python module (bench/python.sh)"
+	@echo "make install    install mechc, libmechc and the Python module under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
 	$(Q)sh .ci/deps
