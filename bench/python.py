@@ -48,8 +48,9 @@ def best(fn, repeat):
     return min(times)
 
 
-def show(what, value, unit, target):
-    print("  %-66s %9.3f %-3s (target %s)" % (what, value, unit, target))
+def show(what, value, unit, target=None):
+    line = "  %-66s %9.3f %-3s" % (what, value, unit)
+    print(line + (" (target %s)" % target if target else ""))
 
 
 def batch_figures(n):
@@ -64,8 +65,7 @@ def batch_figures(n):
              "ms", "< 50 ms")
         outs = (np.empty((n, m.nh)), np.empty((n, m.nr, m.nq)), np.empty((n, m.nr)), g)
         s = best(lambda: m.all(Q, QD, 0.25, out=outs), 3)
-        show("  all (phi, jac, nu, gamma), 10^6 states, one call, %s" % engine, 1e3 * s, "ms",
-             "none")
+        show("  all (phi, jac, nu, gamma), 10^6 states, one call, %s" % engine, 1e3 * s, "ms")
         m.close()
     return Q, QD
 
@@ -90,7 +90,7 @@ def single_figures(m):
         for _ in range(calls):
             f(k, pq, pqd, 0.25, pg)
     show("  the bare cffi call of mechc_gamma, pointers made once", 1e6 * best(bare, 5) / calls,
-         "us", "none")
+         "us")
 
 
 def load_figures():
@@ -102,7 +102,7 @@ def load_figures():
              1e3 * best(one, 20), "ms", "< 5 ms")
         m = mechc.load(FOUR_BAR, engine=engine)
         show("  its compile_seconds (wall, the library's own figure)", 1e3 * m.compile_seconds,
-             "ms", "none")
+             "ms")
         m.close()
 
 
