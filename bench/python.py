@@ -49,8 +49,8 @@ def best(fn, repeat):
 
 
 def show(what, value, unit, target=None):
-    line = "  %-66s %9.3f %-3s" % (what, value, unit)
-    print(line + (" (target %s)" % target if target else ""))
+    line = "  %-66s %9.3f %s" % (what, value, unit)
+    print(line + (" %s(target %s)" % (" " * (3 - len(unit)), target) if target else ""))
 
 
 def batch_figures(n):
