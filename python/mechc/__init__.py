@@ -44,7 +44,8 @@ failed compile, run or simulation (.result: the states before it).
 
 The library: $MECHC_LIBRARY, else the one `make install` recorded, else
 build/libmechc.so of the source tree (PYTHONPATH=python after `make`),
-else the system's; mechc.library_path says which was opened. doc/python.md has the whole guide and the figures.
+else the system's; mechc.library_path says which was opened.
+doc/python.md has the whole guide and the figures.
 """
 
 from ._ffi import (ffi as _cffi, lib as _lib, library_path, MechcError, InputError,

@@ -225,7 +225,7 @@ class Model:
         return None if s == ffi.NULL else ffi.string(s).decode()
 
     def info(self):
-        """The structure analysis of `mechc info --json` as a dict (rank, DOF, redundant rows...)."""
+        """The structure analysis of `mechc info --json` as a dict (rank, DOF, redundant rows)."""
         diag = ffi.new("mechc_diag *")
         s = lib.mechc_info_json(self._m, diag)
         if s == ffi.NULL:
@@ -414,7 +414,7 @@ class Model:
         return out
 
     def force(self, q, qd, t=0.0, out=None):
-        """Q(q, qd, t), the applied and velocity forces of M qdd + Phi_q^T lambda = Q: (nq,), or (n, nq)."""
+        """Q(q, qd, t) of M qdd + Phi_q^T lambda = Q, applied and velocity forces: (nq,), or (n, nq)."""
         q, qd, n = self._pair(q, qd)
         if n is None:
             out = _out(out, (self.nq,), "force")
