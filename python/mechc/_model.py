@@ -414,7 +414,7 @@ class Model:
         return out
 
     def force(self, q, qd, t=0.0, out=None):
-        """Q(q, qd, t) of M qdd + Phi_q^T lambda = Q, applied and velocity forces: (nq,), or (n, nq)."""
+        """Q(q, qd, t) of M qdd + Phi_q^T lambda = Q, the forces: (nq,), or (n, nq) for n states."""
         q, qd, n = self._pair(q, qd)
         if n is None:
             out = _out(out, (self.nq,), "force")
