@@ -380,8 +380,10 @@ class Model:
     def all(self, q, qd, t=0.0, out=None):
         """Phi, Phi_q, nu and gamma in one fused call: a Kinematics(phi, jac, nu, gamma).
 
-        out, when given, is a sequence of four arrays (or None for one to
-        allocate), filled in place.
+        out, when given, is a sequence of four: an array to fill in place,
+        None for one to allocate, or False for a part not to compute (it is
+        None in the result: ``m.all(q, qd, out=(None, False, None, None))``
+        leaves the Jacobian out, which a sparse-only model has not).
         """
         q, qd, n = self._pair(q, qd)
         lead = () if n is None else (n,)
@@ -390,15 +392,14 @@ class Model:
         out = (None,) * 4 if out is None else tuple(out)
         if len(out) != 4:
             raise ValueError("mechc: all: out holds four arrays (phi, jac, nu, gamma)")
-        phi, jac, nu, gamma = (_out(o, s, "all") for o, s in zip(out, shapes))
+        parts = [None if o is False else _out(o, s, "all") for o, s in zip(out, shapes)]
+        ptrs = [ffi.NULL if a is None else _buf(a) for a in parts]
         if n is None:
-            check(lib.mechc_all(self._k, _buf(q), _buf(qd), t, _buf(phi), _buf(jac), _buf(nu),
-                                _buf(gamma)))
+            check(lib.mechc_all(self._k, _buf(q), _buf(qd), t, *ptrs))
         else:
             t = self._times(t, n)
-            check(lib.mechc_all_batch(self._k, n, _buf(q), _buf(qd), _buf(t), t.shape[0],
-                                      _buf(phi), _buf(jac), _buf(nu), _buf(gamma)))
-        return Kinematics(phi, jac, nu, gamma)
+            check(lib.mechc_all_batch(self._k, n, _buf(q), _buf(qd), _buf(t), t.shape[0], *ptrs))
+        return Kinematics(*parts)
 
     # ---- dynamics (files with masses) ----------------------------------------
 

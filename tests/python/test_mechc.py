@@ -431,3 +431,14 @@ def test_run_sensitivities_equal_cli(tmp_path):
         fb = mechc.load(ex("four_bar.mech"))
         fb.sensitivities(fb.q0, fb.qd0, fb.qd0)
     m.close()
+
+
+def test_all_leaves_parts_out(four_bar):
+    m = four_bar
+    q, qd = a_state(m, 4)
+    k = m.all(q, qd, 0.3, out=(None, False, None, False))
+    assert k.jac is None and k.gamma is None
+    assert np.array_equal(k.phi, m.phi(q, 0.3)) and np.array_equal(k.nu, m.nu(q, 0.3))
+    Q = np.stack([q, q])
+    k = m.all(Q, Q, 0.3, out=(False, False, False, None))
+    assert k.phi is None and np.array_equal(k.gamma, m.gamma(Q, Q, 0.3))
