@@ -1,6 +1,7 @@
 /* test_lib.c - libmechc's public API (generator/lib/mechc.h): loading, names, kernels, batches, run, sim, info, errors.
  *
- * Uses mechc.h alone, as a program embedding the library would. Runs from
+ * Uses mechc.h, as a program embedding the library would (and
+ * testcache.h for the aot engine's cache, run_all's). Runs from
  * the repository root (examples/ relative), like `make check`. The
  * reference values are what `mechc run` and `mechc sim` print for the
  * same files (their JSON, 17 digits).
@@ -8,6 +9,7 @@
 #include "testutil.h"
 
 #include "../generator/lib/mechc.h"
+#include "testcache.h"
 
 #include <pthread.h>
 #include <stdlib.h>
@@ -152,6 +154,86 @@ static void batches(void **state)
     mechc_model_free(m);
 }
 
+static TestCache cache;
+static int setup(void **state) { (void)state; return testcache_setup(&cache, "lib"); }
+static int teardown(void **state) { (void)state; return testcache_teardown(&cache); }
+
+/* The three engines agree: jit and aot to the last bits of their
+   arithmetic, the interpreter to rounding. */
+static void engines_agree(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/slider_crank_dynamics.mech");
+    int nq = mechc_nq(m), nr = mechc_nr(m);
+    const char *engines[] = {"jit", "generic", "aot"};
+    /* one block per engine: phi, jac, nu, gamma, Q */
+    enum { PHI = 0, JAC = 16, NU = JAC + 16 * 16, GAMMA = NU + 16, FORCE = GAMMA + 16,
+           SIZE = FORCE + 16 };
+    double q[16], qd[16], out[3][SIZE];
+    assert_true(nq <= 16 && nr <= 16);
+    for (int j = 0; j < nq; j++)
+        q[j] = mechc_q0(m)[j] + 0.01 * j, qd[j] = 0.3 - 0.1 * j;
+    int n = cache.have_cc && !getenv("MECHC_SKIP_GCC_ONLY") ? 3 : 2;
+    for (int e = 0; e < n; e++) {
+        mechc_kernels *k = compile(m, engines[e]);
+        double *o = out[e];
+        assert_int_equal(mechc_all(k, q, qd, 0.2, o + PHI, o + JAC, o + NU, NULL), MECHC_OK);
+        assert_int_equal(mechc_gamma(k, q, qd, 0.2, o + GAMMA), MECHC_OK);
+        assert_int_equal(mechc_force(k, q, qd, 0.2, o + FORCE), MECHC_OK);
+        mechc_kernels_free(k);
+    }
+    for (int e = 1; e < n; e++) {
+        for (int i = 0; i < mechc_nh(m); i++)
+            assert_near(out[e][PHI + i], out[0][PHI + i], 1e-12, 1e-14);
+        for (int i = 0; i < nr * nq; i++)
+            assert_near(out[e][JAC + i], out[0][JAC + i], 1e-12, 1e-14);
+        for (int i = 0; i < nr; i++) {
+            assert_near(out[e][NU + i], out[0][NU + i], 1e-12, 1e-14);
+            assert_near(out[e][GAMMA + i], out[0][GAMMA + i], 1e-12, 1e-12);
+        }
+        for (int i = 0; i < nq; i++)
+            assert_near(out[e][FORCE + i], out[0][FORCE + i], 1e-12, 1e-12);
+    }
+    mechc_model_free(m);
+}
+
+/* The outputs of examples/rssr.mech at a run's states, one by one and in one call. */
+static void outputs(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/rssr.mech");
+    int nq = mechc_nq(m), no = mechc_nout(m);
+    assert_true(no > 0);
+    mechc_kernels *k = compile(m, "jit");
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 6;
+    mechc_result *r = mechc_run(k, &o, NULL);
+    assert_non_null(r);
+    int n = mechc_result_states(r);
+    double *y = malloc((size_t)(3 * n * no) * sizeof *y), one[3][64];
+    assert_true(no <= 64);
+    assert_int_equal(mechc_outputs_batch(k, (size_t)n, mechc_result_q(r), mechc_result_qd(r),
+                                         mechc_result_qdd(r), mechc_result_time(r), (size_t)n,
+                                         y, y + n * no, y + 2 * n * no),
+                     MECHC_OK);
+    for (int i = 0; i < n; i++) {
+        mechc_outputs(k, mechc_result_q(r) + i * nq, mechc_result_qd(r) + i * nq,
+                      mechc_result_qdd(r) + i * nq, mechc_result_time(r)[i], one[0], one[1],
+                      one[2]);
+        for (int j = 0; j < no; j++) {
+            assert_true(y[i * no + j] == mechc_result_y(r)[i * no + j]);
+            assert_true(y[i * no + j] == one[0][j]);
+            assert_true(y[(n + i) * no + j] == mechc_result_yd(r)[i * no + j]);
+            assert_true(y[(2 * n + i) * no + j] == one[2][j]);
+        }
+    }
+    assert_non_null(mechc_output_name(m, 0));
+    free(y);
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 /* The diagnostic of a broken text as a value: file, line, column, message. */
 static void diagnostics(void **state)
 {
@@ -201,6 +283,23 @@ static void errors(void **state)
     k = compile(m, "generic");
     assert_null(mechc_run(k, NULL, &d));
     assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
+    mechc_kernels_free(k);
+    mechc_model_free(m);    /* a driver past a limit position: the states before it, the status and the message */
+    m = mechc_load_string("point p x = 0 y = 1\ndistance D: ground(0, 0) p length = 1\n"
+                          "driver d: p.x = 2*t\n", "reach.mech", &d);
+    assert_non_null(m);
+    k = compile(m, "jit");
+    mechc_run_options o10 = mechc_run_defaults();
+    o10.steps = 10;
+    mechc_result *r = mechc_run(k, &o10, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_EANALYSIS);
+    assert_int_equal(d.status, MECHC_EANALYSIS);
+    assert_int_equal(mechc_result_states(r), 5);
+    assert_near(mechc_result_t_fail(r), 0.5, 0, 1e-15);
+    assert_non_null(strstr(mechc_result_message(r), "t = 0.5: the mechanism cannot reach"));
+    assert_string_equal(d.message, mechc_result_message(r));
+    mechc_result_free(r);
     mechc_kernels_free(k);
     mechc_model_free(m);
 }
@@ -435,6 +534,8 @@ int main(void)
         cmocka_unit_test(phi_at_q0),
         cmocka_unit_test(jacobian),
         cmocka_unit_test(batches),
+        cmocka_unit_test(engines_agree),
+        cmocka_unit_test(outputs),
         cmocka_unit_test(diagnostics),
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
@@ -444,5 +545,5 @@ int main(void)
         cmocka_unit_test(info),
         cmocka_unit_test(threads),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, setup, teardown);
 }

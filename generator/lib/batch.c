@@ -173,3 +173,19 @@ mechc_status mechc_force_batch(mechc_kernels *k, size_t n, const double *q, cons
         k->batch.force(k, n, q, qd, TIMES(t, nt), Q);
     return st;
 }
+
+mechc_status mechc_outputs_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                                 const double *qdd, const double *t, size_t nt, double *y,
+                                 double *yd, double *ydd)
+{
+    mechc_status st = check(n, q, t, nt, y);
+    if (st != MECHC_OK || n == 0)
+        return st;
+    const double *times = t ? t : &zero_time;
+    size_t nq = (size_t)k->engine.nq, no = (size_t)k->outputs.n;
+    for (size_t i = 0; i < n && st == MECHC_OK; i++)
+        st = mechc_outputs(k, q + i * nq, qd ? qd + i * nq : NULL, qdd ? qdd + i * nq : NULL,
+                           time_of(times, t ? nt : 1, i), y + i * no, yd ? yd + i * no : NULL,
+                           ydd ? ydd + i * no : NULL);
+    return st;
+}

@@ -235,6 +235,12 @@ mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q,
                               double *M /* n x nq x nq */);
 mechc_status mechc_force_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *Q /* n x nq */);
+/* The outputs' values at n states (qd, qdd, yd, ydd may be NULL as in
+   mechc_outputs). */
+mechc_status mechc_outputs_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                                 const double *qdd, const double *t, size_t nt,
+                                 double *y /* n x nout */, double *yd /* n x nout */,
+                                 double *ydd /* n x nout */);
 
 /* ---- analyses ----
    A run or a simulation returns a result handle holding every state
