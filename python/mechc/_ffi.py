@@ -106,6 +106,9 @@ mechc_status mechc_all_batch(mechc_kernels *k, size_t n, const double *q, const 
 mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q, double *M);
 mechc_status mechc_force_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *Q);
+mechc_status mechc_outputs_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                                 const double *qdd, const double *t, size_t nt, double *y,
+                                 double *yd, double *ydd);
 
 typedef void (*mechc_state_fn)(void *ctx, double t, const double *q, const double *qd,
                                const double *qdd, const double *lambda);

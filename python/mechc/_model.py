@@ -476,30 +476,35 @@ class Model:
         return res
 
     def output_values(self, q, qd=None, qdd=None, t=0.0):
-        """The `output` statements' values at one state: y (nout,), or (y, yd, ydd) with qd and qdd.
+        """The `output` statements' values: y, (nout,) or (n, nout) for n states.
 
-        The names are m.outputs. The library evaluates outputs one state at
-        a time; n states are a loop here.
+        With qd (and qdd, zero when not given) (y, yd, ydd), the outputs'
+        velocities and accelerations too. The names are m.outputs; n
+        states are one call (mechc_outputs_batch).
         """
         q, n = self._states(q)
-        if n is not None:
-            qds = [None] * n if qd is None else qd
-            qdds = [None] * n if qdd is None else qdd
-            res = [self.output_values(q[i], qds[i], qdds[i], t if np.ndim(t) == 0 else t[i])
-                   for i in range(n)]
-            return np.array(res) if qd is None else tuple(np.array(r) for r in zip(*res))
-        y = np.empty(self.nout, _F64)
-        if qd is None:
-            check(lib.mechc_outputs(self._k, _buf(q), ffi.NULL, ffi.NULL, t, _buf(y),
-                                    ffi.NULL, ffi.NULL))
-            return y
-        qd, _ = self._states(qd, "qd")
-        qdd, _ = self._states(np.zeros(self.nq) if qdd is None else qdd, "qdd")
-        yd = np.empty(self.nout, _F64)
-        ydd = np.empty(self.nout, _F64)
-        check(lib.mechc_outputs(self._k, _buf(q), _buf(qd), _buf(qdd), t, _buf(y), _buf(yd),
-                                _buf(ydd)))
-        return y, yd, ydd
+        y = np.empty(q.shape[:-1] + (self.nout,), _F64)
+        rates = qd is not None
+        if rates:
+            qd, nd = self._states(qd, "qd")
+            qdd, ndd = self._states(np.zeros(q.shape) if qdd is None else qdd, "qdd")
+            if nd != n or ndd != n:
+                raise ValueError("mechc: q, qd and qdd hold different numbers of states")
+            yd = np.empty_like(y)
+            ydd = np.empty_like(y)
+            ptrs = (_buf(qd), _buf(qdd), _buf(yd), _buf(ydd))
+        else:
+            ptrs = (ffi.NULL,) * 4
+        if n is None:
+            status = lib.mechc_outputs(self._k, _buf(q), ptrs[0], ptrs[1], t, _buf(y), ptrs[2],
+                                       ptrs[3])
+        else:
+            t = self._times(t, n)
+            status = lib.mechc_outputs_batch(self._k, n, _buf(q), ptrs[0], ptrs[1], _buf(t),
+                                             t.shape[0], _buf(y), ptrs[2], ptrs[3])
+        if status:
+            check(status)
+        return (y, yd, ydd) if rates else y
 
     # ---- analyses ---------------------------------------------------------------------
 

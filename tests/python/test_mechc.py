@@ -303,11 +303,19 @@ def test_design_parameters(tmp_path):
     m.close()
 
 
-def test_outputs(tmp_path):
+def test_outputs():
+    """Outputs at the run's states: the run's own, bit for bit; n states in one call."""
+    m = mechc.load(ex("rssr.mech"))
+    traj = m.run(steps=12)
+    y, yd, ydd = m.output_values(traj.q, traj.qd, traj.qdd, traj.t)
+    assert m.nout > 0 and y.shape == (13, m.nout)
+    assert np.array_equal(y, traj.y) and np.array_equal(yd, traj.yd)
+    assert np.array_equal(ydd, traj.ydd)
+    for i in range(13):
+        assert np.array_equal(m.output_values(traj.q[i], t=traj.t[i]), y[i])
+    m.close()
     m = mechc.load(ex("textbook_four_bar.mech"))
-    assert m.outputs == ("D_pin.x", "D_pin.y")
-    y = m.output_values(m.q0)
-    assert y.shape == (2,) and np.all(np.isfinite(y))
+    assert m.outputs == ("D_pin.x", "D_pin.y") and m.output_values(m.q0).shape == (2,)
     m.close()
 
 
