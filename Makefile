@@ -45,6 +45,9 @@ LDLIBS_TOOL  := -Wl,-Bstatic -ltcc -lgsl -lgslcblas $(SUITESPARSE_LIBS) -lstdc++
                 -Wl,-Bdynamic -Wl,--as-needed -l:libgfortran.so.5 -Wl,--no-as-needed \
                 -l:libmetis.so.5 -ldl -lm -lpthread
 LDLIBS_TEST  := -lcmocka
+# Debian's interpreter, which sees Debian's python3-numpy, -cffi and -pytest
+# (.ci/deps python); another one on the PATH may not.
+PYTHON       ?= /usr/bin/python3
 
 GEN_SRC   := $(filter-out generator/cli/main.c,$(wildcard generator/*/*.c))
 CLI_SRC   := generator/cli/main.c
@@ -90,8 +93,8 @@ help:
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
-	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh)"
-	@echo "make install    install mechc under \$$PREFIX (\$$DESTDIR honoured)"
+	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh), the Python module (bench/python.sh)"
+	@echo "make install    install mechc, libmechc and the Python module under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
 	$(Q)sh .ci/deps
@@ -161,9 +164,13 @@ $(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
 # before a fresh machine has the headers. tests/firmware_rules.sh compiles
 # for the host here, for the Cortex-M boards under firmware-check.
 TEST_JOBS = $(or $(patsubst -j%,%,$(filter -j%,$(MAKEFLAGS))),$(if $(filter -j,$(MAKEFLAGS)),$(shell nproc),1))
+# The Python module's suite (tests/python.sh) needs Debian's NumPy, cffi and
+# pytest: installed here when possible; without them that suite says so and
+# is skipped, the rest runs.
 check: deps
+	$(Q)sh .ci/deps python || echo "mechc: no NumPy, cffi or pytest for $(PYTHON): tests/python.sh will be skipped"
 	$(Q)$(MAKE) --no-print-directory $(MECHC) $(SO) $(TESTS)
-	$(Q)FIRMWARE_RULES=host sh tests/run_all $(BUILD) $(TEST_JOBS)
+	$(Q)FIRMWARE_RULES=host MECHC_PYTHON=$(PYTHON) sh tests/run_all $(BUILD) $(TEST_JOBS)
 
 test: check
 
@@ -260,6 +267,7 @@ bench: deps
 	$(Q)sh bench/sympy_time.sh $(MECHC)
 	$(Q)sh bench/dynamics.sh $(MECHC)
 	$(Q)sh bench/design.sh $(MECHC)
+	$(Q)sh bench/python.sh $(MECHC)
 
 # The library: include/mechc/mechc.h, lib/libmechc.a and .so, and
 # lib/pkgconfig/mechc.pc for `cc prog.c $$(pkg-config --cflags --libs mechc)`
@@ -276,6 +284,22 @@ install: $(MECHC) $(LIB) $(SO)
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' \
 	  -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|' generator/lib/mechc.pc.in \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/mechc.pc
+
+# The Python module (doc/python.md) into $(PYTHON_DIR), Debian's folder of
+# site packages under PREFIX for $(PYTHON), with the installed library's
+# path written into it (mechc/_libpath.py).
+PYTHON_DIR ?= $(PREFIX)/lib/python$(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null || echo 3)/dist-packages
+.PHONY: install-python uninstall-python
+install: install-python
+install-python:
+	install -d $(DESTDIR)$(PYTHON_DIR)/mechc
+	install -m 644 python/mechc/*.py $(DESTDIR)$(PYTHON_DIR)/mechc/
+	printf '# _libpath.py - written by make install: the libmechc.so this package opens.\nLIBRARY = "%s"\n' \
+	  '$(PREFIX)/lib/libmechc.so' > $(DESTDIR)$(PYTHON_DIR)/mechc/_libpath.py
+
+uninstall: uninstall-python
+uninstall-python:
+	rm -rf $(DESTDIR)$(PYTHON_DIR)/mechc
 
 uninstall:
 	rm -f $(DESTDIR)$(PREFIX)/bin/mechc
