@@ -268,6 +268,41 @@ void mechrt_lu_solve(int n, const mechrt_real *lu, int lda, const mechrt_real *p
     }
 }
 
+void mechrt_lu_solve_many(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,
+                          mechrt_real *b, int ldb, int nrhs)
+{
+    size_t ld = (size_t)lda, lb = (size_t)ldb;
+    int i, j, k, c;
+
+    for (k = 0; k < n; k++) {
+        int p = (int)piv[k];
+        if (p != k)
+            for (c = 0; c < nrhs; c++) {
+                mechrt_real tmp = b[(size_t)k * lb + (size_t)c];
+                b[(size_t)k * lb + (size_t)c] = b[(size_t)p * lb + (size_t)c];
+                b[(size_t)p * lb + (size_t)c] = tmp;
+            }
+    }
+    for (i = 1; i < n; i++) {
+        const mechrt_real *ri = lu + (size_t)i * ld;
+        for (c = 0; c < nrhs; c++) {
+            mechrt_real s = b[(size_t)i * lb + (size_t)c];
+            for (j = 0; j < i; j++)
+                s -= ri[j] * b[(size_t)j * lb + (size_t)c];
+            b[(size_t)i * lb + (size_t)c] = s;
+        }
+    }
+    for (i = n - 1; i >= 0; i--) {
+        const mechrt_real *ri = lu + (size_t)i * ld;
+        for (c = 0; c < nrhs; c++) {
+            mechrt_real s = b[(size_t)i * lb + (size_t)c];
+            for (j = i + 1; j < n; j++)
+                s -= ri[j] * b[(size_t)j * lb + (size_t)c];
+            b[(size_t)i * lb + (size_t)c] = s / ri[i];
+        }
+    }
+}
+
 /* Solve A^T x = b from PA = LU, i.e. U^T L^T (P x) = b: U^T y = b forward,
  * L^T w = y backward, both column-oriented (saxpy with row j of the factors,
  * which is contiguous), then x = P^T w by undoing the interchanges in

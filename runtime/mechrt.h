@@ -201,6 +201,7 @@ typedef enum MechrtStatus {
 #define mechrt_lu_solve              mechrtf_lu_solve
 #define mechrt_lu_resume             mechrtf_lu_resume
 #define mechrt_lu_solve_t            mechrtf_lu_solve_t
+#define mechrt_lu_solve_many         mechrtf_lu_solve_many
 #define mechrt_lu_cond1              mechrtf_lu_cond1
 #define mechrt_newton_init           mechrtf_newton_init
 #define mechrt_residual_inf          mechrtf_residual_inf
@@ -408,6 +409,13 @@ MechrtStatus mechrt_lu_resume(int n, mechrt_real *a, int lda, mechrt_real *piv, 
 /* Solve A x = b with the factors of mechrt_lu_factor; b is overwritten by x. */
 void mechrt_lu_solve(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,
                      mechrt_real *b);
+
+/* Solve A X = B for nrhs right-hand sides at once: B is n x nrhs,
+   row-major with leading dimension ldb, overwritten by X. Each column gets
+   exactly mechrt_lu_solve's operations, in its order (the same bits),
+   without copying it out and back. */
+void mechrt_lu_solve_many(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,
+                          mechrt_real *b, int ldb, int nrhs);
 
 /* Solve A^T x = b likewise. */
 void mechrt_lu_solve_t(int n, const mechrt_real *lu, int lda, const mechrt_real *piv,

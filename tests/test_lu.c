@@ -1,4 +1,4 @@
-/* test_lu.c - runtime/lu.c: LU against GSL, the condition estimate, workspaces, options, strings. */
+/* test_lu.c - runtime/lu.c: LU against GSL, many right-hand sides, the condition estimate, workspaces, options, strings. */
 #include "testrt.h"
 
 /* ---- LU ---------------------------------------------------------------- */
@@ -190,6 +190,32 @@ static void test_lu_singular(void **state)
 
 /* ---- workspace, options, strings --------------------------------------- */
 
+/* Many right-hand sides at once give, column by column, the bits of one
+   solve each (the sensitivities' solves rely on it). */
+static void test_lu_solve_many(void **state)
+{
+    (void)state;
+    uint64_t seed = 0x2545F4914F6CDD1DULL;
+    enum { N = 12, LDA = 14, NRHS = 5, LDB = 7 };
+    double a[N * LDA], piv[N], b[N * LDB], col[N];
+    for (int i = 0; i < N * LDA; i++)
+        a[i] = rnd(&seed);
+    for (int i = 0; i < N * LDB; i++)
+        b[i] = rnd(&seed);
+    assert_int_equal(mechrt_lu_factor(N, a, LDA, piv, 1e-12, NULL), MECHRT_OK);
+    double x[N * LDB];
+    memcpy(x, b, sizeof x);
+    mechrt_lu_solve_many(N, a, LDA, piv, x, LDB, NRHS);
+    for (int c = 0; c < LDB; c++) {
+        for (int i = 0; i < N; i++)
+            col[i] = b[i * LDB + c];
+        if (c < NRHS)
+            mechrt_lu_solve(N, a, LDA, piv, col);
+        for (int i = 0; i < N; i++)     /* solved columns equal, the rest untouched */
+            assert_memory_equal(&x[i * LDB + c], &col[i], sizeof(double));
+    }
+}
+
 static void test_workspace_size(void **state)
 {
     (void)state;
@@ -263,6 +289,7 @@ int main(void)
         cmocka_unit_test(test_lu_matches_gsl),
         cmocka_unit_test(test_lu_hilbert),
         cmocka_unit_test(test_lu_singular),
+        cmocka_unit_test(test_lu_solve_many),
         cmocka_unit_test(test_workspace_size),
         cmocka_unit_test(test_options_and_strings),
         cmocka_unit_test(test_lu_factor_norm1),

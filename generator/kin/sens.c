@@ -158,17 +158,20 @@ static void set_scaled(double *c, double sign, const double *a, size_t n)
         c[i] = sign * a[i];
 }
 
-/* x (nq x np) = Phi_q^-1 x, column by column. */
+/* x (nq x np) = Phi_q^-1 x: every column at once with the dense LU
+   (mechrt_lu_solve_many: the same bits as one column at a time), column by
+   column with KLU. */
 static void solve_columns(Sens *s, double *x)
 {
     size_t np = (size_t)s->np;
+    if (!s->klu) {
+        mechrt_lu_solve_many(s->nq, s->jac, s->nq, s->piv, x, s->np, s->np);
+        return;
+    }
     for (int j = 0; j < s->np; j++) {
         for (int i = 0; i < s->nq; i++)
             s->col[i] = x[(size_t)i * np + (size_t)j];
-        if (s->klu)
-            mechrt_host_sparse_solve(s->klu, s->col);   /* as lu_solve: NaN stays NaN */
-        else
-            mechrt_lu_solve(s->nq, s->jac, s->nq, s->piv, s->col);
+        mechrt_host_sparse_solve(s->klu, s->col);   /* as lu_solve: NaN stays NaN */
         for (int i = 0; i < s->nq; i++)
             x[(size_t)i * np + (size_t)j] = s->col[i];
     }
