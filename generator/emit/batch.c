@@ -192,35 +192,35 @@ static void put_part(Emitter *e, const SchedFunction *fn, int c, EmitFunction wh
     e->lanes = false;
     put_indented(sb, body.data);
     sb_free(&body);
-    sb_printf(sb, "        ok[l] = okl;\n    }\n    for (l = 0; l < %s_LANES; l++) {\n", pu);
+    sb_puts(sb, "        ok[l] = okl;\n    }\n");
+    /* a loop per output: gcc -O2 vectorises each (scatter, or a store per
+       lane), not one over the lanes (a group of stores with a stride) */
     for (int i = 0; i < chunk->count; i++) {
         const SchedOutput *o = &fn->outputs[chunk->first + i];
-        sb_printf(sb, "        %s[l * ", o->array);
+        sb_printf(sb, "    for (l = 0; l < %s_LANES; l++)\n        %s[l * ", pu, o->array);
         put_row_size(sb, e, o->array);
         sb_printf(sb, " + %d] = o[%d][l];\n", o->index, i);
     }
-    sb_puts(sb, "    }\n}\n\n");
+    sb_puts(sb, "}\n\n");
 }
 
-/* The block's lane arrays, filled from the callers' rows. */
+/* The block's lane arrays, filled from the callers' rows: a loop per
+   coordinate, which gcc -O2 vectorises into one vector store (a loop over
+   the lanes would store element by element, and the part's vector loads
+   would wait for them: no store forwarding). */
 static void put_gather(StrBuf *sb, const Emitter *e, bool *used[2], Lanes in)
 {
-    const char *pre = e->prefix, *pu = e->prefix_upper;
+    const char *pu = e->prefix_upper;
     int nq = e->kin->model->nq;
-    sb_printf(sb, "        for (l = 0; l < %s_LANES; l++) {\n", pu);
-    for (int k = 0; k < 2; k++) {
-        const char *name = k ? "qd" : "q";
-        if (!(k ? in.qd : in.q))
-            continue;
-        sb_printf(sb, "            const %s_real *%sl = %s + (long)(b + l) * %s_NQ;\n", pre, name,
-                  name, pu);
+    for (int k = 0; k < 2; k++)
         for (int i = 0; i < nq; i++)
             if (used[k][i])
-                sb_printf(sb, "            %sv[%d][l] = %sl[%d];\n", name, i, name, i);
-    }
+                sb_printf(sb, "        for (l = 0; l < %s_LANES; l++)\n            %sv[%d][l] = "
+                          "%s[(long)(b + l) * %s_NQ + %d];\n", pu, k ? "qd" : "q", i,
+                          k ? "qd" : "q", pu, i);
     if (in.t)
-        sb_puts(sb, "            tv[l] = t[b + l];\n");
-    sb_puts(sb, "            ok[l] = 1;\n        }\n");
+        sb_printf(sb, "        for (l = 0; l < %s_LANES; l++)\n            tv[l] = t[b + l];\n", pu);
+    sb_printf(sb, "        for (l = 0; l < %s_LANES; l++)\n            ok[l] = 1;\n", pu);
 }
 
 /* The batch function over its parts: blocks, the fallback to the single
