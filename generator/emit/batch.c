@@ -11,8 +11,9 @@
  * that the file's own sincos would leave to libm (past 2^16 rad, NaN)
  * clears the lane's ok, and that state is evaluated again by the
  * single-state function; so are the n % LANES states of the tail.
- * Functions with loops (roll.c) or without code of their own (the spread
- * Jacobian) get a plain loop over the single-state function.
+ * Functions with loops (roll.c), without code of their own (the spread
+ * Jacobian) or with cheap outputs (BATCH_MIN_OPS_PER_OUTPUT) get a plain
+ * loop over the single-state function.
  */
 #include "emitter.h"
 
@@ -23,6 +24,14 @@
 
 /* Lanes per block: eight doubles fill one AVX-512 register, two AVX2 ones. */
 enum { BATCH_LANES = 8 };
+
+/* Lanes pay for the copies in and out (an extra load and store per
+   output) only where the outputs cost some arithmetic: below this many
+   operations per output (the four-bar's all: 53 for 52; the Jacobian's
+   entries, constants or one product) a plain loop over the single kernel
+   is faster (doc/batch.md: all of the four-bar 0.63x and of the chain
+   N = 10 0.70x as lanes, gcc -O2); gamma (2.7) gains. */
+enum { BATCH_MIN_OPS_PER_OUTPUT = 2 };
 
 bool emit_batch_wanted(const Emitter *e, EmitFunction f)
 {
@@ -281,11 +290,13 @@ void emit_batch_function(Emitter *e, const SchedFunction *fn, EmitFunction which
     sb_puts(e->batch_decl, ");\n");
     StrBuf *sb = e->batch_text;
     sb_printf(sb, "\n/* ---- begin %s_batch ---- */\n", name);
+    if (fn && fn->ops < BATCH_MIN_OPS_PER_OUTPUT * fn->noutputs)
+        fn = NULL;
     if (fn) {
         int fused = e->fused;
         put_blocks(e, fn, which, params, sb);
         e->fused = fused;
-    } else {    /* loops of its own, or no code of its own: state by state */
+    } else {    /* loops or no code of its own, or cheap outputs: state by state */
         sb_printf(sb, "void %s_%s_batch(", pre, name);
         put_signature(sb, e, params);
         sb_puts(sb, ")\n{\n    int b;\n    for (b = 0; b < n; b++)\n");
