@@ -93,7 +93,7 @@ help:
 	@echo "make check-compilers gcc's and clang's builds of mechc print the same bytes"
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
-	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh), the Python module (bench/python.sh)"
+	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh), batch kernels against single calls (bench/batch.sh), the Python module (bench/python.sh)"
 	@echo "make install    install mechc, libmechc and the Python module under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
@@ -267,6 +267,7 @@ bench: deps
 	$(Q)sh bench/sympy_time.sh $(MECHC)
 	$(Q)sh bench/dynamics.sh $(MECHC)
 	$(Q)sh bench/design.sh $(MECHC)
+	$(Q)sh bench/batch.sh $(MECHC)
 	$(Q)sh bench/python.sh $(MECHC)
 
 # The library: include/mechc/mechc.h, lib/libmechc.a and .so, and

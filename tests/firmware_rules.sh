@@ -8,7 +8,8 @@
 #
 # For every examples/*.mech (and a synthetic mechanism that uses every
 # function of the file format) in double and float:
-#   - `mechc gen` output compiles with cc -std=c99 -O2 -ffreestanding
+#   - `mechc gen --lu --batch` output (every function a file can have)
+#     compiles with cc -std=c99 -O2 -ffreestanding
 #     -Wall -Wextra -Wpedantic -Wconversion -Wdouble-promotion -Wvla -Werror
 #     (float code: float literals and sinf/cosf..., no promotion to double;
 #     no variable-length arrays);
@@ -346,7 +347,7 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
     for real in double float; do
         d=$tmp/$name-$real
         mkdir -p "$d"
-        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" --lu \
+        try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" --lu --batch \
             --roll "$roll" $only -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
         if [ -n "$only" ]; then
             try 5 "$name ($real): no dense jac or all, ${prefix}_all_nz" sh -c \

@@ -24,7 +24,7 @@ static const char usage[] =
     "usage: mechc gen FILE.mech [-o OUT.c] [--header OUT.h] [--prefix NAME]\n"
     "                 [--real double|float] [--trig own|libm] [--jac auto|spread|direct]\n"
     "                 [--sparse | --sparse-only] [--roll auto|never|always] [--lu]\n"
-    "                 [--chunk N] [--stats]\n"
+    "                 [--batch] [--chunk N] [--stats]\n"
     "\n"
     "Writes straight-line C99 for Phi, Phi_q (dense and sparse), nu, gamma and the\n"
     "fused _all of the mechanism (loops for joints of one shape, --roll): needs\n"
@@ -82,6 +82,11 @@ static const CliOption options[] = {
              "with run-time pivot checks (square mechanisms without\n"
              "velocity rows, up to 100 coordinates; what run calls;\n"
              "otherwise a note on stderr says why none was written)"},
+    {"--batch", CLI_FLAG_AT(GenCli, emit.batch),
+     .help = "also write PREFIX_NAME_batch for phi, jac, jac_nz, nu,\n"
+             "gamma, all (all_nz): n states a call, PREFIX_LANES at a\n"
+             "time in lock-step so that compilers vectorise across\n"
+             "the states; the same bits as n single calls"},
     {"--chunk", CLI_INT_AT(GenCli, emit.chunk_nodes, 50, 1000000), .metavar = "N",
      .help = "most operations per C function before it is split into\n"
              "static parts, counting operations and stores (default 150;\n"

@@ -30,13 +30,6 @@ bool emit_function_present(const Kinematics *kin, EmitFunction f)
     return true;
 }
 
-/* A parameter of the generated functions. */
-typedef struct Param {
-    const char *name;
-    bool input;         /* read only: const P_real * (q, qd) */
-    bool scalar;        /* by value: P_real (t); else written: P_real * */
-} Param;
-
 #define IN(name) {#name, true, false}
 #define VALUE(name) {#name, false, true}
 #define OUT(name) {#name, false, false}
@@ -56,10 +49,7 @@ static const Param function_params[EMIT_GENERATED_COUNT][12] = {
 #undef NONE
 #undef P
 
-/* The parameters of function which in e's file, into out (NULL-named
-   end): the table's, with `const real *p` before the first output in a
-   file with design parameters. */
-static const Param *params_of(const Emitter *e, EmitFunction which, Param out[13])
+const Param *emit_params_of(const Emitter *e, EmitFunction which, Param out[EMIT_MAX_PARAMS])
 {
     const Param *from = function_params[which];
     if (e->kin->model->np == 0)
@@ -167,17 +157,15 @@ static void sanitize_prefix(const char *name, char *out, size_t size)
         snprintf(out, size, "mech");
 }
 
-/* The statements of one chunk: each store right after the temporaries it
-   is the first to need. */
-static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
-                      EmitFunction which, bool workspace)
+void emit_put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk,
+                    EmitFunction which, bool workspace)
 {
     e->fused += sched_prepare_chunk(&e->sched, fn, chunk);
     e->chunk = chunk;
     const SchedChunk *c = &fn->chunks[chunk];
-    if (!e->roll) {     /* a loop body's parameters are the function's */
-        Param buf[13];
-        const Param *params = params_of(e, which, buf);
+    if (!e->roll && !e->lanes) {    /* a loop's parameters are the function's */
+        Param buf[EMIT_MAX_PARAMS];
+        const Param *params = emit_params_of(e, which, buf);
         sb_puts(sb, "    ");
         for (const Param *p = params; p->name; p++)
             sb_printf(sb, "%s(void)%s;", p == params ? "" : " ", p->name);
@@ -192,6 +180,8 @@ static void put_chunk(Emitter *e, StrBuf *sb, const SchedFunction *fn, int chunk
         const SchedOutput *o = &fn->outputs[c->first + i];
         if (e->roll)
             e->roll->store(e->roll->ctx, sb, o);
+        else if (e->lanes)      /* the part's outputs, scattered after the loop */
+            sb_printf(sb, "    o[%d][l] = ", i);
         else
             sb_printf(sb, "    %s[%d] = ", o->array, o->index);
         emit_put_expr(e, sb, o->value, false);
@@ -227,12 +217,12 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
                          StrBuf *parts, StrBuf *body)
 {
     if (fn->nchunks == 1) {
-        put_chunk(e, body, fn, 0, which, false);
+        emit_put_chunk(e, body, fn, 0, which, false);
         return;
     }
     const char *p = e->prefix;
-    Param buf[13];
-    const Param *params = params_of(e, which, buf);
+    Param buf[EMIT_MAX_PARAMS];
+    const Param *params = emit_params_of(e, which, buf);
     bool workspace = fn->nslots > 0;    /* values that cross parts */
     if (workspace)
         sb_printf(body, "    %s_real ws[%d];\n", p, fn->nslots);
@@ -242,7 +232,7 @@ static void put_function(Emitter *e, SchedFunction *fn, EmitFunction which,
         if (workspace)
             sb_printf(parts, ", %s_real *ws", p);
         sb_puts(parts, ")\n{\n");
-        put_chunk(e, parts, fn, c, which, workspace);
+        emit_put_chunk(e, parts, fn, c, which, workspace);
         sb_puts(parts, "}\n\n");
         sb_printf(body, "    %s_%s_part%d(", p, emit_function_names[which], c);
         put_arguments(body, params);
@@ -390,7 +380,7 @@ static int put_roll_body(void *emitter, const Dag *dag, SchedOutput *outs, int n
     SchedFunction fn;
     sched_function(&e.sched, outs, n, &fn);
     e.fused = 0;
-    put_chunk(&e, sb, &fn, 0, EMIT_PHI, false);
+    emit_put_chunk(&e, sb, &fn, 0, EMIT_PHI, false);
     int ops = fn.ops - e.fused;
     sched_function_free(&fn);
     sched_free(&e.sched);
@@ -480,6 +470,10 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
     const EmitOptions *opt = e->opt;
     sched_init(&e->sched, e->dag,
                opt->chunk_nodes > 0 ? opt->chunk_nodes : emit_default_options().chunk_nodes);
+    if (e->batch_text) {    /* written again after trig_pair_out_of_line */
+        sb_clear(e->batch_text);
+        sb_clear(e->batch_decl);
+    }
     e->sched.max_ops = opt->max_ops;
     bool fits = true;
     for (int f = 0; f < EMIT_FUNCTION_COUNT; f++) {
@@ -487,11 +481,15 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
         sb_init(&bodies[f]);
         sb_puts(&parts[f], "");
         sb_puts(&bodies[f], "");
-        if (!is_written(e, (EmitFunction)f) || !fits)
+        if (!is_written(e, (EmitFunction)f) || !fits) {
+            if (fits && emit_batch_wanted(e, (EmitFunction)f))
+                emit_batch_function(e, NULL, (EmitFunction)f);
             continue;
+        }
         SchedOutput *outs;
         int n;
         collect_outputs(e->kin, (EmitFunction)f, &outs, &n);
+        int all = n;
         long rolled = roll_outputs(e, (EmitFunction)f, &outs, &n, &parts[f], &bodies[f]);
         SchedFunction fn;
         /* gamma split into parts places its inline pairs as calls
@@ -506,6 +504,8 @@ static bool put_functions(Emitter *e, StrBuf *parts, StrBuf *bodies, EmitResult 
             put_function(e, &fn, (EmitFunction)f, &parts[f], &bodies[f]);
             out->ops[f] = (int)(fn.ops - e->fused + rolled);
             out->chunks[f] = fn.nchunks;
+            if (emit_batch_wanted(e, (EmitFunction)f))
+                emit_batch_function(e, n == all ? &fn : NULL, (EmitFunction)f);
         } else {
             fits = false;
         }
@@ -580,6 +580,7 @@ static void put_host_design(const Emitter *e, EmitResult *out)
             && emit_function_written(e->opt, (EmitFunction)f))
             sb_printf(&sb, "#define %s_%s %s_%s_design\n", pre, emit_function_names[f], pre,
                       emit_function_names[f]);
+    emit_batch_host_renames(e, &sb);
     sb_puts(&sb, out->c_text);
     sb_printf(&sb, "\n/* ---- the host's context-free twins ---- */\n"
               "static const %s_real *%s_design_p;\n"
@@ -592,13 +593,14 @@ static void put_host_design(const Emitter *e, EmitResult *out)
         sb_printf(&sb, "#undef %s_%s\nvoid %s_%s(", pre, name, pre, name);
         put_signature(&sb, pre, function_params[f]);
         sb_printf(&sb, ")\n{\n    %s_%s_design(", pre, name);
-        Param buf[13];
-        const Param *params = params_of(e, (EmitFunction)f, buf);
+        Param buf[EMIT_MAX_PARAMS];
+        const Param *params = emit_params_of(e, (EmitFunction)f, buf);
         for (const Param *p = params; p->name; p++)
             sb_printf(&sb, "%s%s%s", p == params ? "" : ", ",
                       strcmp(p->name, "p") == 0 ? pre : "", strcmp(p->name, "p") == 0 ? "_design_p" : p->name);
         sb_puts(&sb, ");\n}\n");
     }
+    emit_batch_host_twins(e, &sb);
     free(out->c_text);
     out->c_text = sb_take(&sb);
 }
@@ -619,6 +621,15 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
 
     Emitter e = {.kin = kin, .dag = &m->dag, .opt = opt, .prefix = out->prefix,
                  .prefix_upper = upper};
+    StrBuf batch[2];
+    for (int i = 0; i < 2 && opt->batch; i++) {
+        sb_init(&batch[i]);
+        sb_puts(&batch[i], "");
+    }
+    if (opt->batch) {
+        e.batch_text = &batch[0];
+        e.batch_decl = &batch[1];
+    }
     trig_init(&e.trig, opt, out->prefix, m->dag.count);
     StrBuf parts[EMIT_FUNCTION_COUNT], bodies[EMIT_FUNCTION_COUNT];
     if (trig_pair_inline(&e.trig) && pair_calls_at_least(&e) > TRIG_INLINE_MAX)
@@ -641,6 +652,8 @@ bool emit_mechanism(const Kinematics *kin, const EmitOptions *options, EmitResul
     if (fits && opt->host_design && m->np > 0)
         put_host_design(&e, out);
     free_functions(parts, bodies);
+    for (int i = 0; i < 2 && opt->batch; i++)
+        sb_free(&batch[i]);
     return fits;
 }
 

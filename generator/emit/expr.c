@@ -42,10 +42,10 @@ void emit_put_expr(const Emitter *e, StrBuf *sb, NodeId id, bool top)
         if (e->roll)    /* a slot of a loop body */
             e->roll->leaf(e->roll->ctx, sb, n->a);
         else
-            sb_printf(sb, "q[%d]", n->a);
+            sb_printf(sb, e->lanes ? "qv[%d][l]" : "q[%d]", n->a);
         return;
-    case OP_VARD:  sb_printf(sb, "qd[%d]", n->a); return;
-    case OP_TIME:  sb_puts(sb, "t"); return;
+    case OP_VARD:  sb_printf(sb, e->lanes ? "qdv[%d][l]" : "qd[%d]", n->a); return;
+    case OP_TIME:  sb_puts(sb, e->lanes ? "tv[l]" : "t"); return;
     case OP_PARAM: sb_printf(sb, "p[%d]", n->a); return;
     case OP_NEG:
         if (sched_fused_negation(&e->sched, id)) {     /* (-c) * y */
@@ -83,5 +83,5 @@ void emit_put_export(const Emitter *e, StrBuf *sb, NodeId id)
 {
     int slot = id == DAG_NONE ? -1 : sched_slot(&e->sched, id);
     if (slot >= 0)
-        sb_printf(sb, "    ws[%d] = u%d;\n", slot, e->sched.temp[id]);
+        sb_printf(sb, "    ws[%d]%s = u%d;\n", slot, e->lanes ? "[l]" : "", e->sched.temp[id]);
 }

@@ -146,7 +146,8 @@ enum {
     FILE_BANNER, FILE_Q0, FILE_COORDS, FILE_ROWS, FILE_JROW, FILE_JCOL, FILE_MATH,
     FILE_IFACE, FILE_ZERO, FILE_JAC, FILE_INC, FILE_MOVES, FILE_NZ_DECL, FILE_NZ_DEF,
     FILE_MROW, FILE_MCOL, FILE_DYN_C, FILE_DYN_H, FILE_JAC_DECL, FILE_ALL_DECL, FILE_ALL_DEF,
-    FILE_MARK, FILE_P0, FILE_DNAMES, FILE_DESIGN_C, FILE_DESIGN_H, FILE_PIN, FILE_PARG, FILE_COUNT
+    FILE_MARK, FILE_P0, FILE_DNAMES, FILE_DESIGN_C, FILE_DESIGN_H, FILE_PIN, FILE_PARG,
+    FILE_BATCH_C, FILE_BATCH_H, FILE_COUNT
 };
 
 /* The design parameters' part of the source (DESIGN) and of the
@@ -286,6 +287,10 @@ static void put_pieces(const Emitter *e, const StrBuf *parts, const StrBuf *bodi
     put_moves(&b[FILE_MOVES], e);
     trig_put_math(&b[FILE_MATH], &e->trig, opt, e->prefix, e->prefix_upper);
     put_all_nz(e, parts, bodies, &b[FILE_NZ_DECL], &b[FILE_NZ_DEF]);
+    if (opt->batch) {   /* ends without a newline: the templates' line gives it */
+        sb_putn(&b[FILE_BATCH_C], e->batch_text->data, e->batch_text->len - 1);
+        emit_batch_interface(e, e->batch_decl->data, &b[FILE_BATCH_H]);
+    }
     emit_lu(e->kin, opt, e->prefix, e->prefix_upper, &b[FILE_NZ_DECL], &b[FILE_NZ_DEF],
             out->lu_skipped, sizeof out->lu_skipped);
 }
@@ -363,7 +368,7 @@ void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const ch
         {"SENS_V_PARTS", parts[EMIT_SENS_V].data}, {"SENS_V_BODY", bodies[EMIT_SENS_V].data},
         {"SENS_G_PARTS", parts[EMIT_SENS_G].data}, {"SENS_G_BODY", bodies[EMIT_SENS_G].data},
         {"SENS_Y_PARTS", parts[EMIT_SENS_Y].data}, {"SENS_Y_BODY", bodies[EMIT_SENS_Y].data},
-        {"NOUT", z.nout},
+        {"NOUT", z.nout}, {"BATCH", b[FILE_BATCH_C].data}, {"BATCH_DECL", b[FILE_BATCH_H].data},
     };
     const char *bad = render(e, vars, (int)(sizeof vars / sizeof *vars), b, out);
     for (int i = 0; i < FILE_COUNT; i++)

@@ -40,6 +40,10 @@ typedef struct EmitOptions {
     bool lu;                    /* also PREFIX_lu_factor and PREFIX_lu_solve
                                    (emit_lu.c; gen --lu): the Jacobian's LU
                                    unrolled for its pattern */
+    bool batch;                 /* also PREFIX_NAME_batch for the kinematic
+                                   functions: n states a call, PREFIX_LANES
+                                   at a time in lock-step (batch.c; gen
+                                   --batch, EngineOptions.batch) */
 } EmitOptions;
 
 /* gen --roll: auto rolls the kinematic functions of a mechanism with at

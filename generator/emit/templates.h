@@ -19,6 +19,7 @@ extern const char template_mech_h[];
 extern const char template_sparse_only[];
 extern const char template_sincos[];
 extern const char template_sincos2[];
+extern const char template_sincos_lane[];
 extern const char template_trig[];
 
 #endif

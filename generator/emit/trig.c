@@ -22,9 +22,9 @@
 void trig_init(EmitTrig *t, const EmitOptions *opt, const char *prefix, int nnodes)
 {
     *t = (EmitTrig){0};
-    static const char *const suffix[5] = {"sincos", "sincos2", "sincos_s", "sincos_c",
-                                          "sincos2_some"};
-    for (int i = 0; i < 5; i++)
+    static const char *const suffix[6] = {"sincos", "sincos2", "sincos_s", "sincos_c",
+                                          "sincos2_some", "sincos_lane"};
+    for (int i = 0; i < 6; i++)
         snprintf(t->names[i], sizeof t->names[i], "%s_%s", prefix, suffix[i]);
     if (!opt->real_float && opt->declare_math) {
         t->sincos_name = opt->libm_trig ? "sincos" : "mechc_sincos";
@@ -35,6 +35,7 @@ void trig_init(EmitTrig *t, const EmitOptions *opt, const char *prefix, int nnod
         t->sin_name = t->names[2];  /* the JIT keeps the tool's pair: its results stay */
         t->cos_name = t->names[3];
         t->sincos2_some_name = t->names[4];
+        t->lane_name = t->names[5];
     }
     t->calls = opt->declare_math || opt->libm_trig || opt->real_float;
     trig_graph(t, nnodes);
@@ -125,6 +126,23 @@ static bool is_single(const Emitter *e, NodeId id)
     return e->trig.sin_name && sincos_partner(e, id) == DAG_NONE;
 }
 
+/* A batch function's lane (emit_batch_function): the group led by id
+   through the lane pair, which clears okl for an angle it leaves to the
+   single-state kernel (templates/sincos_lane.tmpl). */
+static void put_sincos_lane(Emitter *e, StrBuf *sb, NodeId id, const char *ts, const char *tc)
+{
+    NodeId partner = sincos_partner(e, id);
+    e->trig.lane_used = true;
+    e->trig.written[id] = true;
+    if (partner != DAG_NONE)
+        e->trig.written[partner] = true;
+    sb_printf(sb, "    %s_real %s, %s;\n    okl = %s(", e->prefix, ts, tc, e->trig.lane_name);
+    emit_put_expr(e, sb, dag_node(e->dag, id)->a, false);
+    sb_printf(sb, ", &%s, &%s, okl);\n", ts, tc);
+    emit_put_export(e, sb, id);
+    emit_put_export(e, sb, partner);
+}
+
 /* The sin and cos temporaries of the group led by id, through one sincos
    call; with a two-angle function, a later group of the chunk whose
    argument is already at hand (a leaf, or a node written before this
@@ -137,6 +155,10 @@ static void put_sincos(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Node
     char ts[24], tc[24], ts2[24], tc2[24];
     NodeId arg = dag_node(e->dag, id)->a;
     sincos_targets(e, id, sincos_partner(e, id), ts, tc);
+    if (e->lanes && e->trig.lane_name) {
+        put_sincos_lane(e, sb, id, ts, tc);
+        return;
+    }
     NodeId other = DAG_NONE;
     for (int j = at + 1; e->trig.sincos2_name && j < c->nnodes && other == DAG_NONE; j++) {
         NodeId cand = sincos_leader(e, c->nodes[j]);
@@ -193,7 +215,8 @@ void trig_put_temporary(Emitter *e, StrBuf *sb, const SchedChunk *c, int at, Nod
 {
     int slot = sched_slot(&e->sched, id);
     if (sched_is_import(&e->sched, id, e->chunk)) {
-        sb_printf(sb, "    const %s_real u%d = ws[%d];\n", e->prefix, e->sched.temp[id], slot);
+        sb_printf(sb, "    const %s_real u%d = ws[%d]%s;\n", e->prefix, e->sched.temp[id], slot,
+                  e->lanes ? "[l]" : "");
         return;
     }
     DagOp op = dag_op(e->dag, id);
@@ -391,6 +414,17 @@ static void put_some_macros(const EmitTrig *t, StrBuf *opt, StrBuf *plain)
               "     (void)((used) & 8 ? *(c1) = cos(x1) : 0))\n", t->sincos2_some_name);
 }
 
+/* The batch functions' lane pair where optimising (opt), libm's sin and
+   cos elsewhere (plain), which never leave a state to the single kernel. */
+static void put_lane(const EmitTrig *t, const TemplateVar *sv, int nsv, StrBuf *opt, StrBuf *plain)
+{
+    const char *bad = template_render(opt, template_sincos_lane, sv, nsv);
+    if (bad)
+        template_placeholder_bug(bad);
+    sb_printf(plain, "#define %s(x, s, c, ok) ((void)(*(s) = sin(x), *(c) = cos(x)), (ok))\n",
+              t->lane_name);
+}
+
 /* The pair is inlined unless pair_out_of_line. */
 void trig_put_math(StrBuf *math, const EmitTrig *t, const EmitOptions *opt, const char *prefix,
                    const char *upper)
@@ -417,7 +451,7 @@ void trig_put_math(StrBuf *math, const EmitTrig *t, const EmitOptions *opt, cons
               "   sin/cos series into slow code, get sin and cos of <math.h>. */\n"
               "#if defined(__OPTIMIZE__) && !defined(__TINYC__)\n#define %s_OPTIMIZED 1\n"
               "#else\n#define %s_OPTIMIZED 0\n#endif\n", upper, upper);
-    if (!t->sincos_used && !t->single_used)
+    if (!t->sincos_used && !t->single_used && !t->lane_used)
         return;
     bool inline_pair = !t->pair_out_of_line;
     char trig[160];
@@ -447,6 +481,8 @@ void trig_put_math(StrBuf *math, const EmitTrig *t, const EmitOptions *opt, cons
     sb_puts(&single, "");
     if (t->single_used)
         put_some_macros(t, &sincos, &single);
+    if (t->lane_used)
+        put_lane(t, sv, nsv, &sincos, &single);
     template_set(sv, nsv, "SINGLE", single.data);
     template_set(sv, nsv, "SINCOS", sincos.data);
     sb_puts(math, "\n");

@@ -37,7 +37,10 @@ typedef struct EmitTrig {
     int *call_rank;             /* per node: its call's number among the chunk's
                                    sin/cos that may go first (rank_calls) */
     int hoist;                  /* how many of those go first */
-    char names[5][160];         /* the file's own names, P_sincos ... */
+    const char *lane_name;      /* a batch lane's pair (the file's own trig only;
+                                   NULL: the functions above) */
+    bool lane_used;             /* some batch function called lane_name */
+    char names[6][160];         /* the file's own names, P_sincos ... */
 } EmitTrig;
 
 /* Calls of the written file's own sin/cos functions. Inlined at every

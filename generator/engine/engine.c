@@ -188,6 +188,7 @@ static void bind_generic_pattern(Engine *e, const Dynamics *dyn)
 static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag *diag)
 {
     EmitOptions eo = engine_emit_options(mech, ENGINE_AOT);
+    eo.batch = opt->batch;
     double t0 = pipeline_now();
     if (!emit_mechanism(&mech->kin, &eo, &e->emitted, diag))
         return false;
@@ -215,14 +216,18 @@ bool engine_open_with(Engine *e, EngineKind kind, const Mech *mech, const Engine
     e->nv = mech->model->nv;
     e->nr = mech->model->nr;
     switch (kind) {
-    case ENGINE_JIT:
-        e->jit = engine_jit(mech, &e->emitted, &e->gen_seconds, &e->compile_seconds, diag);
+    case ENGINE_JIT: {
+        EmitOptions eo = engine_emit_options(mech, ENGINE_JIT);
+        eo.batch = opt->batch;
+        e->jit = engine_jit_compile(mech, &eo, &e->emitted, &e->gen_seconds,
+                                    &e->compile_seconds, diag);
         if (!e->jit) {
             emit_result_free(&e->emitted);
             return false;
         }
         bind_code(e, jit_kernels(e->jit));
         return true;
+    }
     case ENGINE_GENERIC: {
         double t0 = pipeline_now();
         e->generic = generic_open(mech->model);

@@ -62,6 +62,9 @@ typedef struct Engine {
 typedef struct EngineOptions {
     bool aot_fresh;         /* aot: compile even when the cache has the library
                                (what bench does to time the compiler); default false */
+    bool batch;             /* jit, aot: also compile the batch kernels
+                               (engine_batch); default false: libtcc's
+                               time of every run stays as it was */
 } EngineOptions;
 
 EngineOptions engine_default_options(void);
@@ -175,6 +178,15 @@ static inline const MechrtKernels *engine_kernels(const Engine *e)
 static inline const MechrtHostJacNz *engine_jac_nz(const Engine *e)
 {
     return e->jac_nz.jac.jac_nz ? &e->jac_nz : NULL;
+}
+
+/* The batch kernels (n states a call, generator/emit/batch.c) of an
+   engine opened with EngineOptions.batch: jit or aot; NULL for the
+   generic engine and without the option (callers loop over the single
+   kernels). Fields the unit lacks are NULL (jac and all sparse-only). */
+static inline const BatchKernels *engine_batch(const Engine *e)
+{
+    return e->compiled && e->kernels.batch.gamma ? &e->kernels.batch : NULL;
 }
 
 static inline const MechrtHostMassNz *engine_mass_nz(const Engine *e)

@@ -73,6 +73,18 @@ static void *kernel(KernelFind find, void *handle, const char *prefix, const cha
     return find(handle, symbol);
 }
 
+/* The unit's batch kernels (optional: NULL where absent). */
+static void bind_batch(BatchKernels *b, KernelFind find, void *handle, const char *prefix)
+{
+    *(void **)&b->phi = kernel(find, handle, prefix, "phi_batch");
+    *(void **)&b->jac = kernel(find, handle, prefix, "jac_batch");
+    *(void **)&b->jac_nz = kernel(find, handle, prefix, "jac_nz_batch");
+    *(void **)&b->nu = kernel(find, handle, prefix, "nu_batch");
+    *(void **)&b->gamma = kernel(find, handle, prefix, "gamma_batch");
+    *(void **)&b->all = kernel(find, handle, prefix, "all_batch");
+    *(void **)&b->all_nz = kernel(find, handle, prefix, "all_nz_batch");
+}
+
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
 {
     int found[EMIT_FAMILY_COUNT] = {0}, rows[EMIT_FAMILY_COUNT] = {0};
@@ -90,6 +102,7 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
 #include "../emit/functions.def"
 #undef X
     }
+    bind_batch(&k->batch, find, handle, prefix);
     k->jac_row = kernel(find, handle, prefix, "jac_row");
     k->jac_col = kernel(find, handle, prefix, "jac_col");
     k->mass_row = kernel(find, handle, prefix, "mass_row");

@@ -22,6 +22,24 @@ typedef void (*KernelSensY)(const double *q, const double *qd, double t, double 
 typedef void (*KernelEom)(const double *q, const double *qd, double t,
                           double *M, double *Q, double *jac, double *gamma);
 
+/* The batch kernels (EmitOptions.batch, generator/emit/batch.c): the
+   kernel at n states, q and qd n x NQ, t n values, each output n rows of
+   its single-state size, all row-major; bit for bit n single calls. */
+typedef void (*KernelPhiBatch)(int n, const double *q, const double *t, double *out);
+typedef void (*KernelGammaBatch)(int n, const double *q, const double *qd, const double *t,
+                                 double *gamma);
+typedef void (*KernelAllBatch)(int n, const double *q, const double *qd, const double *t,
+                               double *phi, double *jac, double *nu, double *gamma);
+
+/* A unit's PREFIX_NAME_batch, NULL where it has none: all of them
+   without EmitOptions.batch, jac and all in a sparse-only unit, all_nz
+   without EmitOptions.all_nz. */
+typedef struct BatchKernels {
+    KernelPhiBatch phi, jac, jac_nz, nu;
+    KernelGammaBatch gamma;
+    KernelAllBatch all, all_nz;         /* all_nz: phi, jac_vals (NNZ), nu, gamma */
+} BatchKernels;
+
 /* The generated functions of one mechanism as the compiled unit exports
    them (libtcc, dlopen of a cc-built library), one field per row of
    functions.def: context-free, with the patterns of jac_nz and mass_nz.
@@ -42,6 +60,7 @@ typedef struct Kernels {
     /* a unit with design parameters (EmitOptions.host_design): where its
        functions read p from; NULL otherwise */
     void (*design_bind)(const double *p);
+    BatchKernels batch;     /* PREFIX_NAME_batch, where compiled */
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */
