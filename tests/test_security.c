@@ -238,19 +238,27 @@ static void write_main(const char *path, const char *prefix, const char *header)
 
 /* Emits mech with opt (header "mech.h" added), checks the marker, builds
    and runs the program; the printed names must be the model's. */
+/* Emits mech with opt (header "mech.h" added) into res and checks the
+   marker when given. */
+static void emit_scanned(const Mech *mech, EmitOptions opt, const char *marker, bool banner_ok,
+                         const char *tag, EmitResult *res)
+{
+    opt.header_name = "mech.h";
+    Diag diag;
+    diag_init(&diag, "test", NULL, 0);
+    if (!emit_mechanism(&mech->kin, &opt, res, &diag))
+        fail_msg("%s: emission failed: %s", tag, diag.message);
+    if (marker) {
+        marker_in_strings_only(res->c_text, marker, banner_ok);
+        marker_in_strings_only(res->h_text, marker, banner_ok);
+    }
+}
+
 static void build_and_run(const Mech *mech, EmitOptions opt, const char *marker, bool banner_ok,
                           const char *tag)
 {
-    opt.header_name = "mech.h";
     EmitResult res;
-    Diag diag;
-    diag_init(&diag, "test", NULL, 0);
-    if (!emit_mechanism(&mech->kin, &opt, &res, &diag))
-        fail_msg("%s: emission failed: %s", tag, diag.message);
-    if (marker) {
-        marker_in_strings_only(res.c_text, marker, banner_ok);
-        marker_in_strings_only(res.h_text, marker, banner_ok);
-    }
+    emit_scanned(mech, opt, marker, banner_ok, tag, &res);
     if (!have_gcc) {
         emit_result_free(&res);
         return;
@@ -501,8 +509,18 @@ static void test_hostile_paths(void **state)
     for (size_t i = 0; i < sizeof paths / sizeof *paths; i++) {
         Diag diag;
         Mech *mech = load_ok(text, paths[i], NULL, &diag);
-        /* the marker may be in the banner comment, nowhere else */
-        build_both(mech, "p", "zqxMARK", true, paths[i]);
+        /* the marker may be in the banner comment, nowhere else (prefix
+           p, so that no name holds it); the builds below, at the default
+           prefix, compile and run the same banner */
+        for (int fl = 0; fl < 2; fl++) {
+            EmitOptions opt = emit_default_options();
+            opt.prefix = "p";
+            opt.source_name = mech->model->file;
+            opt.real_float = fl;
+            EmitResult res;
+            emit_scanned(mech, opt, "zqxMARK", true, paths[i], &res);
+            emit_result_free(&res);
+        }
         /* the default prefix, from the stem, is an identifier */
         EmitOptions opt = emit_default_options();
         opt.source_name = paths[i];
