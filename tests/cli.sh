@@ -95,7 +95,7 @@ cp "$tmp/out" "$tmp/pendulum.json"
 
 if have python3; then
     # strict parse and values: Phi = 1.732^2 + 1 - 4, Jacobian (3.464, 2)
-    check "eval --json parses and has the spec's shape and values" python3 - "$tmp/pendulum.json" <<'EOF'
+    check "eval --json parses and has the spec's shape and values" py - "$tmp/pendulum.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert d["coords"] == ["m.x", "m.y"], d["coords"]
@@ -111,7 +111,7 @@ EOF
     run eval "$ex/pendulum_distance.mech" --q 1.7320508075688772,1 --qd -1.5,2.598076211353316 --json
     check "eval --q --qd exits 0" status_is 0
     cp "$tmp/out" "$tmp/pendulum18.json"
-    check "eval --q --qd: gamma = -18, phi = 0" python3 - "$tmp/pendulum18.json" <<'EOF'
+    check "eval --q --qd: gamma = -18, phi = 0" py - "$tmp/pendulum18.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert abs(d["gamma"][0] + 18) < 1e-9, d["gamma"]
@@ -121,7 +121,7 @@ EOF
     run eval "$ex/knife_cart.mech" --json --t 0.25
     check "eval knife_cart --json exits 0" status_is 0
     cp "$tmp/out" "$tmp/knife.json"
-    check "eval knife_cart --json: velocity rows" python3 - "$tmp/knife.json" <<'EOF'
+    check "eval knife_cart --json: velocity rows" py - "$tmp/knife.json" <<'EOF'
 import json, sys, math
 d = json.load(open(sys.argv[1]))
 assert d["coords"] == ["cart.x", "cart.y", "cart.phi"], d["coords"]

@@ -130,7 +130,7 @@ check "slider_crank_toggle at t = 0: regular" out_has "configuration: regular"
 # ---- the JSON parses and has the spec's shape ----
 
 if have python3; then
-    check "info --json parses with the spec's keys (parallelogram)" python3 - "$tmp/parallelogram.json" <<'EOF'
+    check "info --json parses with the spec's keys (parallelogram)" py - "$tmp/parallelogram.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 for k in ("coords", "rows", "nq", "nh", "nv", "dof", "rank", "redundant"):
@@ -144,7 +144,7 @@ assert d["redundant"] == ["A2.y"] and d["rank"] == 11
 assert d["cond"] is None or d["cond"] > 1e14
 EOF
     check "info --json parses: velocity rows carry integrable and law (rolling disk)" \
-        python3 - "$tmp/disk.json" <<'EOF'
+        py - "$tmp/disk.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 vel = [r for r in d["rows"] if r["level"] == "velocity"]
@@ -159,7 +159,7 @@ for r in d["rows"]:
     if r["level"] == "position":
         assert "integrable" not in r
 EOF
-    check "info --json parses: knife blade nonholonomic, no law" python3 - "$tmp/knife.json" <<'EOF'
+    check "info --json parses: knife blade nonholonomic, no law" py - "$tmp/knife.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 blade = [r for r in d["rows"] if r["name"] == "blade"][0]
@@ -335,7 +335,7 @@ for f in "$ex"/*.mech; do
 done
 if have python3; then
     check "--linear sparse and dense: the same rank, redundant rows and mobility on every example" \
-        python3 - "$tmp" "$ex" <<'EOF'
+        py - "$tmp" "$ex" <<'EOF'
 import glob, json, os, sys
 tmp, ex = sys.argv[1], sys.argv[2]
 keys = ("rank", "rank_all", "redundant", "redundant_velocity", "dof_rank", "mobility_rank")

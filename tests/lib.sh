@@ -25,6 +25,9 @@
 #   status_is N, out_empty, out_has TEXT, out_lines N, err_empty,
 #   err_has TEXT (fixed string), err_matches REGEX (grep's basic regex):
 #                  predicates on the last run.
+#   py ARGS...     python3 ARGS: the interpreter python3 names, found at the
+#                  first call and then started directly (a version manager's
+#                  shim, pyenv's, costs ten times the interpreter's start).
 #   csv_value_at T NAME FILE  the value of CSV column NAME in FILE's row
 #                  whose t (first column) is T; nothing when there is none.
 #   suite_end      prints "NAME: N passed, M failed" (CI reads these lines)
@@ -95,6 +98,13 @@ out_lines() { [ "$(wc -l < "$tmp/out")" = "$1" ]; }
 err_empty() { [ ! -s "$tmp/err" ]; }
 err_has() { grep -F -q -- "$1" "$tmp/err"; }
 err_matches() { grep -q -- "$1" "$tmp/err"; }
+
+py() {
+    if [ -z "${py_exe:-}" ]; then
+        py_exe=$(python3 -c 'import sys; print(sys.executable)') && [ -x "$py_exe" ] || py_exe=python3
+    fi
+    "$py_exe" "$@"
+}
 
 csv_value_at() {
     awk -F, -v t="$1" -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }

@@ -320,7 +320,7 @@ check "--stats: ... every time (the pattern LU never needed)" sh -c '! grep -q "
 run "$ex/slider_crank.mech" --steps 4 --json
 check "--json: exit 0" status_is 0
 if have python3; then
-    check "--json: keys and sizes" python3 -c '
+    check "--json: keys and sizes" py -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert list(d)[:5] == ["coords", "t", "q", "qd", "qdd"], list(d)
@@ -409,7 +409,7 @@ check "dead centre passed: the last row written is t = 0.9" \
 run "$tmp/limit.mech" --t1 2 --steps 20 --json
 check "dead centre passed --json: exit 1" status_is 1
 if have python3; then
-    check "dead centre passed --json: valid, 10 states, ok false, the error's time" python3 -c '
+    check "dead centre passed --json: valid, 10 states, ok false, the error's time" py -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert len(d["t"]) == 10 and len(d["q"]) == 10 and d["t"][-1] == 0.9
@@ -718,7 +718,7 @@ run "$ex/slider_crank_torque.mech" --forces --steps 4 --json
 check "run --forces --json: rows, lambda, drivers and efforts" \
     sh -c "grep -q -F '\"rows\": [\"O.x\", \"O.y\", \"A.x\"' '$tmp/out' && grep -q -F '\"lambda\": [[-19.08123517543' '$tmp/out' && grep -q -F '\"drivers\": [\"D\"]' '$tmp/out' && grep -q -F '\"efforts\": [[1.47150000000' '$tmp/out'"
 if have python3; then
-    check "run --forces --json: valid JSON, one lambda per row and state" python3 -c '
+    check "run --forces --json: valid JSON, one lambda per row and state" py -c '
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert d["ok"] and len(d["rows"]) == 9 and len(d["lambda"]) == 5 == len(d["efforts"])

@@ -144,9 +144,13 @@ echo "$cases" | while IFS=: read -r name mech opts; do
         echo "ok"
         qs=$(sed -n 's/^q //p' "$d/out-$cname")
         qds=$(sed -n 's/^qd //p' "$d/out-$cname")
+        # the JIT's values at that state, once per case: every compiler's
+        # driver prints the same state (jit_key lives for the case's loop)
         # shellcheck disable=SC2086
-        if "$mechc" eval "$mech" --q "$qs" --qd "$qds" --t 0.3 --json > "$d/jit.json" 2> "$tmp/err" &&
-           values "$d/jit.json" > "$d/jit.txt" && sed '1,2d' "$d/out-$cname" > "$d/got.txt" &&
+        if { [ "${jit_key:-}" = "$qs $qds" ] ||
+             { "$mechc" eval "$mech" --q "$qs" --qd "$qds" --t 0.3 --json > "$d/jit.json" 2> "$tmp/err" &&
+               values "$d/jit.json" > "$d/jit.txt" && jit_key="$qs $qds"; }; } &&
+           sed '1,2d' "$d/out-$cname" > "$d/got.txt" &&
            same_values "$d/got.txt" "$d/jit.txt" > "$tmp/why"; then
             echo "ok"
         else
