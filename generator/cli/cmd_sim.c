@@ -75,10 +75,10 @@ static const CliOption options[] = {
     {"--rtol", CLI_REAL_AT(SimCli, so.rtol), NONNEGATIVE, .metavar = "X",
      .help = "relative error per step, as GSL's and SUNDIALS' rtol:\n"
              "|err_i| <= atol + rtol |y_i| on every position and rate\n"
-             "(default 1e-10: the errors of the steps add up, and\n"
-             "IFToMM A01's 2000 s need it to end within 1e-5)"},
+             "(default 5e-11: the errors of the steps add up, and\n"
+             "IFToMM A01's 2000 s need it to stay within 1e-5)"},
     {"--atol", CLI_REAL_AT(SimCli, so.atol), NONNEGATIVE, .metavar = "X",
-     .help = "absolute error per step, coordinate units (default 1e-10)"},
+     .help = "absolute error per step, coordinate units (default 5e-11)"},
     {"--qd", CLI_STRING_AT(SimCli, qd_text), .metavar = "V1,V2,...",
      .help = "initial velocities, one per coordinate (default 0);\n"
              "projected onto the velocity equations"},

@@ -36,7 +36,7 @@ typedef struct SimOptions {
     int steps;              /* output intervals, >= 1: steps + 1 states; 100 */
     SimMethod method;       /* SIM_RK8PD */
     /* local error per step |err_i| <= atol + rtol |y_i| on every position
-       and velocity; 1e-10, 1e-10 */
+       and velocity; 5e-11, 5e-11 */
     double rtol, atol;
     MechrtDynOptions dyn;   /* rank tolerance, Baumgarte (off) */
     /* the projections' Newton: tol_phi, tol_dq, max_iter; and assembly's */

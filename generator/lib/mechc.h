@@ -275,7 +275,7 @@ mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag
 typedef struct mechc_sim_options {
     double t0, t1;          /* 0, 1 */
     int steps;              /* output intervals, >= 1; 100 */
-    double rtol, atol;      /* error per step; 1e-10, 1e-10 */
+    double rtol, atol;      /* error per step; 5e-11, 5e-11 */
     const char *method;     /* "rk8pd" (NULL), "rkf45", "rk4imp", "msbdf" */
     const double *qd0;      /* initial velocities (nq), NULL: zero */
     mechc_state_fn on_state;

@@ -539,7 +539,7 @@ class Model:
 
         qd0: initial velocities (made consistent with the rows), default
         zero. method: "rk8pd", "rkf45", "rk4imp" or "msbdf"; rtol, atol
-        default to the command's 1e-10. Returns a Trajectory as run does,
+        default to the command's 5e-11. Returns a Trajectory as run does,
         with the multipliers in .lam and "lambda(ROW)" columns.
         """
         o = ffi.new("mechc_sim_options *", lib.mechc_sim_defaults())
