@@ -253,6 +253,44 @@ static void diagnostics(void **state)
     assert_null(mechc_load_file(NULL, NULL));
 }
 
+/* Loading with limits: the command's --max-... and the line a caret goes under. */
+static void load_with_limits(void **state)
+{
+    (void)state;
+    mechc_diag d;
+    char line[MECHC_DIAG_LINE_MAX] = "x";
+    mechc_limits l = mechc_default_limits();
+    assert_int_equal(l.max_coords, 200000);
+    assert_int_equal(l.max_file_bytes, 4 << 20);
+    mechc_model *m = mechc_load_file_with("examples/four_bar.mech", &l, &d, line);
+    assert_non_null(m);
+    assert_string_equal(line, "");
+    mechc_model_free(m);
+    l.max_coords = 2;
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, line));
+    assert_int_equal(d.status, MECHC_EINPUT);
+    assert_string_equal(d.message, "too many coordinates (the limit is 2)");
+    assert_int_equal(d.line, 36);
+    assert_int_equal(d.column, 6);
+    assert_string_equal(line, "body crank   x = 0.5     y = 0       phi = 0");
+    l.max_file_bytes = 100;     /* no place in the file: no line */
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, line));
+    assert_int_equal(d.line, 0);
+    assert_string_equal(line, "");
+    l = mechc_default_limits();
+    l.max_depth = 0;            /* out of the option's range */
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL));
+    assert_int_equal(d.status, MECHC_EARG);
+    l.max_depth = 1001;
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL));
+    assert_int_equal(d.status, MECHC_EARG);
+    l.max_depth = 64;
+    l.max_jac_entries = 0;      /* not checked while loading */
+    m = mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL);
+    assert_non_null(m);
+    mechc_model_free(m);
+}
+
 /* Failures come back as statuses, never as an exit. */
 static void errors(void **state)
 {
@@ -537,6 +575,7 @@ int main(void)
         cmocka_unit_test(engines_agree),
         cmocka_unit_test(outputs),
         cmocka_unit_test(diagnostics),
+        cmocka_unit_test(load_with_limits),
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
         cmocka_unit_test(design_without_recompiling),

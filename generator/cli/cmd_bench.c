@@ -26,7 +26,7 @@
 
 /* What the command line asked for. */
 typedef struct BenchCli {
-    MechLimits limits;
+    mechc_limits limits;
     int repeat;
     bool json, use_aot;
 } BenchCli;
@@ -397,8 +397,10 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
 }
 
 /* The engines timed and reported. */
-static int bench_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int bench_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     const BenchCli *c = opts;
     Bench *b = xcalloc(1, sizeof *b);
     int status = EXIT_USAGE;
@@ -421,6 +423,6 @@ static const CliCommand command = {
 
 int cmd_bench(int argc, char **argv)
 {
-    BenchCli c = {.limits = mech_default_limits(), .repeat = 15, .use_aot = true};
+    BenchCli c = {.limits = mechc_default_limits(), .repeat = 15, .use_aot = true};
     return cli_main(&command, argc, argv, &c);
 }

@@ -8,7 +8,7 @@
 
 /* What the command line asked for. */
 typedef struct EvalCli {
-    MechLimits limits;
+    mechc_limits limits;
     const char *q_text, *qd_text;
     double t;
     int engine;
@@ -245,8 +245,10 @@ static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const do
 }
 
 /* The state from --q and --qd (default: the file's q0 and zeros), evaluated. */
-static int eval_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int eval_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     const EvalCli *c = opts;
     const Model *m = mech->model;
     double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd);
@@ -268,6 +270,6 @@ static const CliCommand command = {
 
 int cmd_eval(int argc, char **argv)
 {
-    EvalCli c = {.limits = mech_default_limits(), .engine = ENGINE_JIT};
+    EvalCli c = {.limits = mechc_default_limits(), .engine = ENGINE_JIT};
     return cli_main(&command, argc, argv, &c);
 }

@@ -9,7 +9,7 @@
 #include <string.h>
 
 typedef struct FitCli {
-    MechLimits limits;
+    mechc_limits limits;
     const char *data_path, *vary_list;
     CliList bounds;         /* NAME=LO:HI */
     FitOptions fo;
@@ -289,8 +289,10 @@ static void print_json(const Model *m, const FitData *d, const FitResult *r, int
     printf("}}\n");
 }
 
-static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int fit_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     FitCli *c = opts;
     Model *m = mech->model;
     if (m->np == 0) {
@@ -363,7 +365,7 @@ static const CliCommand command = {
 
 int cmd_fit(int argc, char **argv)
 {
-    FitCli c = {.limits = mech_default_limits(), .fo = fit_default_options(),
+    FitCli c = {.limits = mechc_default_limits(), .fo = fit_default_options(),
                 .engine = ENGINE_JIT, .worst = 5};
     return cli_main(&command, argc, argv, &c);
 }

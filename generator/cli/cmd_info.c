@@ -14,7 +14,7 @@
 /* What the command line asked for. */
 typedef struct InfoCli {
     AnalysisOptions analysis;
-    MechLimits limits;
+    mechc_limits limits;
     double t;
     double at;              /* --at T: NAN when absent */
     const char *state;      /* --state FILE.csv, or NULL */
@@ -538,8 +538,10 @@ static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at
 }
 
 /* The analysis at t and its report; exit status 1 when the assembly did not converge. */
-static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int info_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     const InfoCli *c = opts;
     const Model *m = mech->model;
     AnalysisOptions o = c->analysis;
@@ -602,7 +604,7 @@ static const CliCommand command = {
 
 int cmd_info(int argc, char **argv)
 {
-    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits(),
+    InfoCli c = {.analysis = analysis_default_options(), .limits = mechc_default_limits(),
                  .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

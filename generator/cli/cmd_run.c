@@ -26,7 +26,7 @@ enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 /* What the command line asked for. */
 typedef struct RunCli {
     RunOptions ro;
-    MechLimits limits;
+    mechc_limits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list;
     CliList traces;         /* --trace texts */
     double tol;             /* --tol: both Newton tolerances of ro.mechrt; 0: not given */
@@ -513,8 +513,10 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
 }
 
 /* Rows, pictures and engine ready, then the analysis. */
-static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int run_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     RunCli *c = opts;
     RunPictures pics;
     Engine e;
@@ -552,7 +554,7 @@ static const CliCommand command = {
 
 int cmd_run(int argc, char **argv)
 {
-    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
+    RunCli c = {.ro = run_default_options(), .limits = mechc_default_limits(),
                 .engine = ENGINE_JIT, .ode = -1, .view = -1, .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

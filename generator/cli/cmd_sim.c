@@ -27,7 +27,7 @@ enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 /* What the command line asked for. */
 typedef struct SimCli {
     SimOptions so;
-    MechLimits limits;
+    mechc_limits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
     CliList omegas;         /* --w BODY=wx,wy,wz */
     CliList traces;
@@ -328,8 +328,10 @@ static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
 }
 
 /* Masses, velocities and pictures checked, the engine opened, then the simulation. */
-static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int sim_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     SimCli *c = opts;
     const Model *m = mech->model;
     RunPictures pics;
@@ -371,7 +373,7 @@ static const CliCommand command = {
 
 int cmd_sim(int argc, char **argv)
 {
-    SimCli c = {.so = sim_default_options(), .limits = mech_default_limits(),
+    SimCli c = {.so = sim_default_options(), .limits = mechc_default_limits(),
                 .engine = ENGINE_JIT, .method = -1, .view = -1};
     c.max_steps = (int)c.so.max_steps;
     return cli_main(&command, argc, argv, &c);

@@ -95,6 +95,37 @@ mechc_model *mechc_load_file(const char *path, mechc_diag *diag);
 mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *diag);
 void mechc_model_free(mechc_model *m);
 
+/* The limits on one input (examples/README.md, section Limits; what the
+   command's --max-... options set): each bounds the work or memory a file
+   can cause, and loading fails with MECHC_EINPUT, naming the limit, past it. */
+typedef struct mechc_limits {
+    int max_file_bytes;     /* the whole file; 4 MiB */
+    int max_line_length;    /* bytes per line; 4096 */
+    int max_name_length;    /* characters per name; 255 */
+    int max_depth;          /* expression nesting; 64 */
+    int max_expr_tokens;    /* tokens in one statement; 2000 */
+    int max_coords;         /* coordinates; 200000 */
+    int max_rows;           /* constraint rows; 200000 */
+    int max_jac_entries;    /* rows x coordinates of the dense Jacobian; 50000000
+                               (0: not checked while loading) */
+    int max_nodes;          /* expression-graph nodes, derivatives included; 2000000 */
+    int max_code_ops;       /* operations in the generated C; 4000000 */
+    const char *jac_advice; /* NULL, or what ends max_jac_entries' message: how
+                               the caller can do without the dense Jacobian */
+} mechc_limits;
+
+mechc_limits mechc_default_limits(void);
+
+/* The longest source line a diagnostic quotes, its NUL included. */
+enum { MECHC_DIAG_LINE_MAX = 4100 };
+
+/* mechc_load_file with limits (NULL: the defaults). On bad input
+   source_line (NULL, or MECHC_DIAG_LINE_MAX chars) receives the line the
+   diagnostic points into, for a caret under diag->column ("" when the
+   failure has no line): what the command prints under its message. */
+mechc_model *mechc_load_file_with(const char *path, const mechc_limits *limits,
+                                  mechc_diag *diag, char *source_line);
+
 /* ---- sizes and names (the model's; valid as long as it lives) ---- */
 
 int mechc_nq(const mechc_model *m);

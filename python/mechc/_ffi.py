@@ -40,6 +40,24 @@ mechc_model *mechc_load_file(const char *path, mechc_diag *diag);
 mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *diag);
 void mechc_model_free(mechc_model *m);
 
+typedef struct mechc_limits {
+    int max_file_bytes;
+    int max_line_length;
+    int max_name_length;
+    int max_depth;
+    int max_expr_tokens;
+    int max_coords;
+    int max_rows;
+    int max_jac_entries;
+    int max_nodes;
+    int max_code_ops;
+    const char *jac_advice;
+} mechc_limits;
+
+mechc_limits mechc_default_limits(void);
+mechc_model *mechc_load_file_with(const char *path, const mechc_limits *limits,
+                                  mechc_diag *diag, char *source_line);
+
 int mechc_nq(const mechc_model *m);
 int mechc_nh(const mechc_model *m);
 int mechc_nv(const mechc_model *m);
