@@ -309,14 +309,14 @@ static int fit_file(const Args *a, mechc_model *model, void *opts)
         o.xtol = o.gtol = c->tol;
     FitData d = {0};
     Diag data_diag = {0};     /* failed stays false unless the CSV was read */
-    Engine e;
+    mechc_kernels *k = NULL;
     int status = EXIT_USAGE;
     bool data = read_choices(c, m, &o) && fit_data_read(c->data_path, m, &d, &data_diag);
     if (!data && data_diag.failed)
         diag_print(&data_diag, stderr);
-    if (data && cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
+    if (data && (k = cli_compile(a, model, (EngineKind)c->engine))) {
         FitResult r;
-        FitStatus st = fit_run(m, &mech->kin, &e, &d, &o, &r);
+        FitStatus st = fit_run(m, &mech->kin, &k->engine, &d, &o, &r);
         if (st == FIT_BAD_INPUT) {
             fprintf(stderr, "mechc fit: error: %s: %s\n", m->file, r.message);
         } else if (!r.solved) {     /* no estimates to show */
@@ -339,7 +339,7 @@ static int fit_file(const Args *a, mechc_model *model, void *opts)
             status = st == FIT_OK ? EXIT_OK : EXIT_ANALYSIS;
         }
         fit_result_free(&r);
-        engine_close(&e);
+        mechc_kernels_free(k);
     }
     fit_data_free(&d);
     free(o.vary), free(o.lo), free(o.hi);

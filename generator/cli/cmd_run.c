@@ -368,29 +368,31 @@ static bool resolve_pictures(const Model *m, const RunCli *c, RunPictures *p)
 }
 
 /* Before any state: rows against coordinates (before the engine's
-   compile), the pictures' names, the engine, and the masses --forces
-   needs. false when one fails (reported; the engine closed). */
-static bool prepare(const Args *a, const RunCli *c, const Mech *mech, RunPictures *pics,
-                    Engine *e, Diag *diag)
+   compile), the pictures' names, the kernels, and the masses --forces
+   needs. NULL when one fails (reported). */
+static mechc_kernels *prepare(const Args *a, const RunCli *c, mechc_model *model,
+                              RunPictures *pics)
 {
-    const Model *m = mech->model;
+    const Model *m = model->mech->model;
+    Diag *diag = &model->diag;
     char why[300];
     if (!run_rows_match(m, why, sizeof why)) {
         diag_error(diag, m->last_pos, "%s", why);
         diag_print(diag, stderr);
-        return false;
+        return NULL;
     }
-    if (!resolve_pictures(m, c, pics) || !cli_engine_open(a, e, (EngineKind)c->engine, mech,
-                                                          NULL, diag))
-        return false;
-    if (c->forces && (!e->k.mass || !e->k.force)) {
+    mechc_kernels *k = resolve_pictures(m, c, pics)
+                           ? cli_compile(a, model, (EngineKind)c->engine) : NULL;
+    if (!k)
+        return NULL;
+    if (c->forces && !mechc_has_dynamics(model)) {
         diag_error(diag, m->last_pos, "the mechanism has no masses: `run --forces` needs `mass` "
                    "statements (with `gravity`, forces or springs) for its inverse dynamics");
         diag_print(diag, stderr);
-        engine_close(e);
-        return false;
+        mechc_kernels_free(k);
+        return NULL;
     }
-    return true;
+    return k;
 }
 
 /* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
@@ -519,22 +521,23 @@ static int run_file(const Args *a, mechc_model *model, void *opts)
     Diag *diag = &model->diag;     /* the file's: its text for positions */
     RunCli *c = opts;
     RunPictures pics;
-    Engine e;
-    if (!prepare(a, c, mech, &pics, &e, diag))
+    mechc_kernels *k = prepare(a, c, model, &pics);
+    if (!k)
         return EXIT_USAGE;
+    const Engine *e = &k->engine;
     if (c->stats)   /* what it took to have the kernels (wall time) */
         fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
                 "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
-                e.gen_seconds, e.compile_seconds);
+                e->gen_seconds, e->compile_seconds);
     SensColumns sc = {0};
     char why[200];
-    if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, &e, why, sizeof why)) {
+    if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, e, why, sizeof why)) {
         diag_error(diag, mech->model->last_pos, "run --sens: %s", why);
         diag_print(diag, stderr);
-        engine_close(&e);
+        mechc_kernels_free(k);
         return EXIT_USAGE;
     }
-    int status = analyse(c, mech->model, &e, &pics, diag, c->sens ? &sc : NULL);
+    int status = analyse(c, mech->model, e, &pics, diag, c->sens ? &sc : NULL);
     if (c->sens && c->stats && sc.states > 0)
         fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters%s: %.6g ms of "
                 "CPU time, %.0f ns per state\n", sc.sens.np,
@@ -542,7 +545,7 @@ static int run_file(const Args *a, mechc_model *model, void *opts)
                 1e9 * sc.cpu_seconds / (double)sc.states);
     if (c->sens)
         sens_free(&sc.sens);
-    engine_close(&e);
+    mechc_kernels_free(k);
     return status;
 }
 

@@ -327,7 +327,7 @@ static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
     return true;
 }
 
-/* Masses, velocities and pictures checked, the engine opened, then the simulation. */
+/* Masses, velocities and pictures checked, the kernels compiled, then the simulation. */
 static int sim_file(const Args *a, mechc_model *model, void *opts)
 {
     Mech *mech = model->mech;
@@ -335,7 +335,6 @@ static int sim_file(const Args *a, mechc_model *model, void *opts)
     SimCli *c = opts;
     const Model *m = mech->model;
     RunPictures pics;
-    Engine e;
     double *qd0 = xcalloc((size_t)m->nq, sizeof *qd0);
     int status = EXIT_USAGE;
     if ((c->qd_text && !args_vector("sim", "--qd", c->qd_text, m->nq, qd0))
@@ -344,11 +343,12 @@ static int sim_file(const Args *a, mechc_model *model, void *opts)
         return EXIT_USAGE;
     }
     c->so.qd0 = qd0;
-    if (!cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
+    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine);
+    if (!k) {
         free(qd0);
         return EXIT_USAGE;
     }
-    if (!sim_has_masses(&e.k)) {
+    if (!mechc_has_dynamics(model)) {
         diag_error(diag, m->last_pos, "the mechanism has no masses: `mechc sim` needs `mass` "
                    "statements (with `gravity`, forces or springs) to simulate its dynamics");
         diag_print(diag, stderr);
@@ -358,9 +358,9 @@ static int sim_file(const Args *a, mechc_model *model, void *opts)
                    "projection needs at most one row per coordinate", m->nh, m->nq);
         diag_print(diag, stderr);
     } else {
-        status = simulate(c, m, &e, &pics, diag);
+        status = simulate(c, m, &k->engine, &pics, diag);
     }
-    engine_close(&e);
+    mechc_kernels_free(k);
     free(qd0);
     return status;
 }

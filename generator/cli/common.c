@@ -57,3 +57,12 @@ bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech
     cli_error(a, diag);
     return false;
 }
+
+mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind)
+{
+    mechc_diag d;
+    mechc_kernels *k = mechc_compile(model, engine_names[kind], &d);
+    if (!k)
+        fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
+    return k;
+}

@@ -43,10 +43,7 @@ mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
         free(k);
         return NULL;
     }
-    const Model *mo = m->mech->model;
-    outputs_init(&k->outputs, mo);
-    size_t nq = (size_t)mo->nq, nr = (size_t)mo->nr;
-    k->scratch = xcalloc(nr * nq + nq * nq + nq + (size_t)mo->nh + 2 * nr + 1, sizeof(double));
+    outputs_init(&k->outputs, m->mech->model);
     lib_batch_bind(k);
     lib_ok(d);
     return k;
@@ -76,6 +73,18 @@ mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k->model; }
 const char *mechc_kernels_source(const mechc_kernels *k)
 {
     return k->engine.compiled ? k->engine.emitted.c_text : NULL;
+}
+
+/* Room for what a call skips (NULL outputs) or gathers from: nr x nq +
+   nh + 2 nr, made at the first such call (a run of a sparse model of
+   60 000 coordinates never makes its dense Jacobian). */
+static double *scratch(mechc_kernels *k)
+{
+    if (!k->scratch) {
+        size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr;
+        k->scratch = xcalloc(nr * nq + (size_t)k->engine.nh + 2 * nr + 1, sizeof(double));
+    }
+    return k->scratch;
 }
 
 mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
@@ -123,9 +132,10 @@ mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, 
     /* generic: the dense Jacobian, gathered */
     const Kinematics *kin = &k->model->mech->kin;
     int nq = k->engine.nq;
-    engine_jac(&k->engine, q, t, k->scratch);
+    double *jac = scratch(k);
+    engine_jac(&k->engine, q, t, jac);
     for (int i = 0; i < kin->nnz; i++)
-        vals[i] = k->scratch[(size_t)kin->jac[i].row * (size_t)nq + (size_t)kin->jac[i].col];
+        vals[i] = jac[(size_t)kin->jac[i].row * (size_t)nq + (size_t)kin->jac[i].col];
     return MECHC_OK;
 }
 
@@ -154,7 +164,7 @@ mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, doub
     if (!k->engine.k.all)
         return MECHC_ENOTAVAIL;
     size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr;
-    double *s = k->scratch;     /* the outputs the caller does not want */
+    double *s = scratch(k);     /* the outputs the caller does not want */
     engine_all(&k->engine, q, qd, t, phi ? phi : s + nr * nq, jac ? jac : s,
                nu ? nu : s + nr * nq + (size_t)k->engine.nh,
                gamma ? gamma : s + nr * nq + (size_t)k->engine.nh + nr);

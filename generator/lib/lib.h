@@ -41,7 +41,8 @@ struct mechc_kernels {
     mechc_model *model;
     Engine engine;
     OutputEval outputs;     /* the `output` statements, interpreted */
-    double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs) */
+    double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs);
+                               NULL until a call needs it (kernels.c) */
     Sens sens;              /* mechc_sensitivities', made at its first call */
     int sens_state;         /* 0 not made, 1 made, -1 the model has none */
     LibBatch batch;
