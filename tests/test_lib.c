@@ -350,6 +350,59 @@ static void count_state(void *ctx, double t, const double *q, const double *qd,
     *(int *)ctx += 1;
 }
 
+/* mechc_run_with: the command's tuning; states streamed, not kept. */
+static void run_with_tuning(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_kernels *k = compile(m, "jit");
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 4;
+    int seen = 0;
+    o.on_state = count_state;
+    o.ctx = &seen;
+    mechc_run_tuning x = mechc_run_tuning_defaults();
+    assert_int_equal(x.max_substeps, 64);
+    assert_int_equal(x.assembly_max_iter, 100);
+    assert_int_equal(x.keep_states, 1);
+    assert_null(x.linear);
+    mechc_diag d;
+    mechc_result *dense = mechc_run_with(k, &o, &x, &d);
+    x.linear = "sparse";
+    x.ode = "rkf45";
+    x.keep_states = 0;
+    mechc_result *sparse = mechc_run_with(k, &o, &x, &d);
+    assert_non_null(dense);
+    assert_non_null(sparse);
+    assert_int_equal(mechc_result_status(sparse), MECHC_OK);
+    assert_int_equal(mechc_result_states(sparse), 5);
+    assert_int_equal(seen, 10);
+    assert_null(mechc_result_q(sparse));
+    assert_null(mechc_result_time(sparse));
+    assert_near(mechc_result_q(dense)[9 + 8], 1.725386, 0, 1e-6);
+    mechc_result_free(dense);
+    mechc_result_free(sparse);
+    x = mechc_run_tuning_defaults();
+    x.max_dense_entries = 1;    /* the run's dense Jacobian, 81 entries: refused */
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
+    assert_non_null(strstr(d.message, "81 entries"));
+    x = mechc_run_tuning_defaults();
+    x.linear = "qr";
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_run_tuning_defaults();
+    x.max_substeps = 0;
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_run_tuning_defaults();
+    x.ode = "euler";
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 /* The run's last state is what `mechc run --steps 4 --json` prints. */
 static void run_matches_cli(void **state)
 {
@@ -578,6 +631,7 @@ int main(void)
         cmocka_unit_test(load_with_limits),
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
+        cmocka_unit_test(run_with_tuning),
         cmocka_unit_test(design_without_recompiling),
         cmocka_unit_test(sensitivities),
         cmocka_unit_test(sim_matches_cli),

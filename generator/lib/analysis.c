@@ -16,6 +16,8 @@ struct mechc_result {
     int states, cap;
     double *t, *q, *qd, *qdd, *y, *yd, *ydd, *lambda;
     bool with_lambda;
+    bool keep;              /* false: states counted and passed on, not kept */
+    RunResult run;          /* a run's statistics (lib_result_run) */
     mechc_status status;
     char message[RUN_MESSAGE_MAX];
     double t_fail;
@@ -29,10 +31,10 @@ static void grow(double **a, size_t per_state, int cap)
         *a = xrealloc(*a, (size_t)cap * per_state, sizeof **a);
 }
 
-static void keep_state(void *ctx, double t, const double *q, const double *qd,
-                       const double *qdd, const double *lambda)
+/* State number r->states into the arrays, grown as needed. */
+static void store_state(mechc_result *r, double t, const double *q, const double *qd,
+                        const double *qdd, const double *lambda)
 {
-    mechc_result *r = ctx;
     size_t nq = (size_t)r->nq, nr = (size_t)r->nr, no = (size_t)r->nout, i = (size_t)r->states;
     if (r->states == r->cap) {
         r->cap = r->cap ? 2 * r->cap : 64;
@@ -51,6 +53,14 @@ static void keep_state(void *ctx, double t, const double *q, const double *qd,
                      r->ydd + i * no);
     if (r->with_lambda && lambda)
         memcpy(r->lambda + i * nr, lambda, nr * sizeof *lambda);
+}
+
+static void keep_state(void *ctx, double t, const double *q, const double *qd,
+                       const double *qdd, const double *lambda)
+{
+    mechc_result *r = ctx;
+    if (r->keep)
+        store_state(r, t, q, qd, qdd, lambda);
     r->states++;
     if (r->on_state)
         r->on_state(r->ctx, t, q, qd, qdd, r->with_lambda ? lambda : NULL);
@@ -66,7 +76,7 @@ static mechc_result *result_new(mechc_kernels *k, bool with_lambda, mechc_state_
 {
     const Model *m = k->model->mech->model;
     mechc_result *r = xcalloc(1, sizeof *r);
-    *r = (mechc_result){.k = k, .nq = m->nq, .nr = m->nr, .nout = m->nout,
+    *r = (mechc_result){.k = k, .nq = m->nq, .nr = m->nr, .nout = m->nout, .keep = true,
                         .with_lambda = with_lambda, .on_state = fn, .ctx = ctx, .t_fail = NAN};
     return r;
 }
@@ -98,8 +108,50 @@ mechc_run_options mechc_run_defaults(void)
                                .tol = ro.mechrt.tol_phi, .max_iter = ro.mechrt.max_iter};
 }
 
-/* The options as run_analysis takes them; false when one is out of range. */
-static bool run_options(const mechc_run_options *o, RunOptions *ro)
+mechc_run_tuning mechc_run_tuning_defaults(void)
+{
+    RunOptions ro = run_default_options();
+    return (mechc_run_tuning){
+        .max_substeps = ro.max_substeps, .assembly_max_iter = ro.assembly_max_iter,
+        .pivot_tol = ro.mechrt.pivot_tol, .cond_warn = ro.mechrt.cond_warn,
+        .ode_tol = ro.ode.tol, .max_dense_entries = ro.max_dense_entries, .keep_states = 1};
+}
+
+/* The index of name in names (NULL-terminated), fallback for NULL, -1 unknown. */
+static int name_index(const char *const *names, const char *name, int fallback)
+{
+    if (!name)
+        return fallback;
+    for (int i = 0; names[i]; i++)
+        if (strcmp(names[i], name) == 0)
+            return i;
+    return -1;
+}
+
+/* tuning's part of ro; false when a value is out of range. */
+static bool run_tuning(const mechc_run_tuning *x, RunOptions *ro)
+{
+    static const char *const odes[] = {"rk8pd", "rkf45", NULL};
+    int linear = name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    int ode = name_index(odes, x->ode, 0);
+    if (linear < 0 || ode < 0 || x->max_substeps < 1 || x->assembly_max_iter < 1
+        || !(x->pivot_tol >= 0) || !(x->cond_warn >= 0) || !(x->ode_tol > 0)
+        || x->max_dense_entries < 0)
+        return false;
+    ro->linear = (AnalysisLinear)linear;
+    if (x->ode)
+        mechrt_ode_method_from_name(odes[ode], &ro->ode.method);
+    ro->max_substeps = x->max_substeps;
+    ro->assembly_max_iter = x->assembly_max_iter;
+    ro->mechrt.pivot_tol = x->pivot_tol;
+    ro->mechrt.cond_warn = x->cond_warn;
+    ro->ode.tol = x->ode_tol;
+    ro->max_dense_entries = x->max_dense_entries;
+    ro->notes = x->notes;
+    return true;
+}
+
+bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunOptions *ro)
 {
     *ro = run_default_options();
     if (o->steps < 0 || (o->steps > 0 && o->t0 == o->t1) || !isfinite(o->t0)
@@ -110,18 +162,24 @@ static bool run_options(const mechc_run_options *o, RunOptions *ro)
     ro->steps = o->steps;
     ro->mechrt.tol_phi = ro->mechrt.tol_dq = o->tol;
     ro->mechrt.max_iter = o->max_iter;
-    return true;
+    return !x || run_tuning(x, ro);
 }
 
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *d)
+{
+    return mechc_run_with(k, o, NULL, d);
+}
+
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *x, mechc_diag *d)
 {
     mechc_run_options defaults = mechc_run_defaults();
     if (!o)
         o = &defaults;
     RunOptions ro;
-    if (!k || !run_options(o, &ro)) {
-        lib_fail(d, MECHC_EARG, "mechc_run: steps < 0, t0 == t1, a tolerance <= 0 or "
-                 "max_iter < 1");
+    if (!k || !lib_run_options(o, x, &ro)) {
+        lib_fail(d, MECHC_EARG, "mechc_run: steps < 0, t0 == t1, a tolerance <= 0, "
+                 "max_iter < 1 or a tuning value out of range");
         return NULL;
     }
     const Model *m = k->model->mech->model;
@@ -137,14 +195,17 @@ mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag
     }
     ro.source = &k->model->diag;
     mechc_result *r = result_new(k, o->forces, o->on_state, o->ctx);
+    r->keep = !x || x->keep_states;
     MechrtKernels newton = engine_newton_kernels(&k->engine);
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
-    RunResult res;
+    RunResult *res = &r->run;
     AnalysisStatus st = o->forces
-                            ? run_analysis_forces(m, &newton, jnz, &ro, keep_state, r, &res)
-                            : run_analysis(m, &newton, jnz, &ro, keep_kinematic, r, &res);
-    return finish(r, st, res.message, res.t_fail, d);
+                            ? run_analysis_forces(m, &newton, jnz, &ro, keep_state, r, res)
+                            : run_analysis(m, &newton, jnz, &ro, keep_kinematic, r, res);
+    return finish(r, st, res->message, res->t_fail, d);
 }
+
+const RunResult *lib_result_run(const mechc_result *r) { return &r->run; }
 
 mechc_sim_options mechc_sim_defaults(void)
 {

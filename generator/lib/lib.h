@@ -6,6 +6,7 @@
 
 #include "../engine/engine.h"
 #include "../kin/outputs.h"
+#include "../kin/run.h"
 #include "../kin/sens.h"
 #include "../pipeline/pipeline.h"
 
@@ -55,6 +56,13 @@ mechc_status lib_fail(mechc_diag *d, mechc_status status, const char *fmt, ...)
 mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from);
 /* Clears d (may be NULL): status MECHC_OK, nothing else. */
 void lib_ok(mechc_diag *d);
+
+/* A run's options as run_analysis takes them (x NULL: the defaults);
+   false when one is out of range. */
+bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunOptions *ro);
+/* What run_analysis said of a result made by mechc_run_with (its
+   statistics: mechc run --stats). */
+const RunResult *lib_result_run(const mechc_result *r);
 
 /* The loops behind the batch calls (batch.c); then what the engine's
    compiled unit has of its own. */

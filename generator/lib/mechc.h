@@ -21,9 +21,10 @@
  * The first load turns GSL's error handler off (gsl_set_error_handler_off:
  * its default aborts; the library checks every status), for good.
  *
- * The library never prints and never exits on bad input or a failed
- * analysis: every failure is a status (mechc_status) and, where a
- * mechc_diag pointer is taken (it may be NULL), a message. Out of memory
+ * The library never prints (unless given a stream for a run's notes,
+ * mechc_run_tuning) and never exits on bad input or a failed analysis:
+ * every failure is a status (mechc_status) and, where a mechc_diag
+ * pointer is taken (it may be NULL), a message. Out of memory
  * aborts the process, as the mechc command does.
  *
  * Arrays: every matrix is row-major (C order), its size given below as
@@ -40,6 +41,7 @@
 #define MECHC_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -301,6 +303,35 @@ typedef struct mechc_run_options {
 
 mechc_run_options mechc_run_defaults(void);
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *diag);
+
+/* What `mechc run`'s options tune beyond mechc_run_options (mechc_run_with);
+   mechc_run_tuning_defaults() gives the command's defaults. */
+typedef struct mechc_run_tuning {
+    const char *linear;     /* "auto" (NULL), "dense" or "sparse" (KLU; jit and aot) */
+    int max_substeps;       /* a step that seems to leave its branch is redone in
+                               2, 4, 8 ... substeps, at most this many; 64 */
+    int assembly_max_iter;  /* minimum-norm Newton iterations per attempt at t0
+                               when Newton cannot start from q0; 100 */
+    double pivot_tol;       /* singular when an LU pivot <= this times the
+                               largest Jacobian entry; 1e-12 */
+    double cond_warn;       /* a note where the condition estimate exceeds it;
+                               1e10 (0: no estimate) */
+    const char *ode;        /* velocity-level rows' integrator: "rk8pd" (NULL) or "rkf45" */
+    double ode_tol;         /* its error per step; 1e-10 */
+    long long max_dense_entries; /* most rows x coordinates of a dense Jacobian the
+                               run forms; 0 (default): no limit */
+    int keep_states;        /* 1 (default): the result keeps every state; 0: only
+                               on_state sees them (mechc_result_states counts
+                               them, the arrays are NULL): a run of any length */
+    FILE *notes;            /* NULL (default): no notes; else where the run's
+                               notes and warnings go, "FILE: warning: ..." lines
+                               (the only printing the library does) */
+} mechc_run_tuning;
+
+mechc_run_tuning mechc_run_tuning_defaults(void);
+/* mechc_run with tuning (NULL: the defaults, mechc_run itself). */
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *tuning, mechc_diag *diag);
 
 /* Forward dynamics (mechc sim) of a file with masses. */
 typedef struct mechc_sim_options {

@@ -142,6 +142,23 @@ typedef struct mechc_run_options {
 mechc_run_options mechc_run_defaults(void);
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *diag);
 
+typedef struct mechc_run_tuning {
+    const char *linear;
+    int max_substeps;
+    int assembly_max_iter;
+    double pivot_tol;
+    double cond_warn;
+    const char *ode;
+    double ode_tol;
+    long long max_dense_entries;
+    int keep_states;
+    FILE *notes;
+} mechc_run_tuning;
+
+mechc_run_tuning mechc_run_tuning_defaults(void);
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *tuning, mechc_diag *diag);
+
 typedef struct mechc_sim_options {
     double t0, t1;
     int steps;
