@@ -518,6 +518,95 @@ static void sensitivities(void **state)
 }
 
 /* Forward dynamics: `mechc sim examples/pendulum_dynamics.mech --steps 10 --json`. */
+static void count_step(void *ctx, double t)
+{
+    (void)t;
+    *(int *)ctx += 1;
+}
+
+/* The spatial four-bar with its redundant rows (24 holonomic for 21
+   coordinates), its driver left out, with masses (tests/redundant_cli.sh's
+   free_mass.mech): `mechc sim` simulates it, and so does mechc_sim. */
+static void sim_redundant(void **state)
+{
+    (void)state;
+    static const char masses[] =
+        "mass crank   m = 1    J = (0.01, 1/12, 1/12)\n"
+        "mass coupler m = 3    J = (0.01, 3*b^2/12, 3*b^2/12)\n"
+        "mass rocker  m = 2.5  J = (0.01, 2.5*c^2/12, 2.5*c^2/12)\n"
+        "gravity (0, -9.81, 0)\n";
+    FILE *f = fopen("examples/four_bar_spatial_redundant.mech", "r");
+    assert_non_null(f);
+    char *text = calloc(1 << 16, 1), line[4096];
+    size_t n = 0;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "driver", 6) != 0)
+            n += (size_t)snprintf(text + n, (1 << 16) - n, "%s", line);
+    fclose(f);
+    snprintf(text + n, (1 << 16) - n, "%s", masses);
+    mechc_diag d;
+    mechc_model *m = mechc_load_string(text, "free_mass.mech", &d);
+    free(text);
+    assert_non_null(m);
+    assert_true(mechc_nh(m) > mechc_nq(m));
+    mechc_kernels *k = compile(m, "jit");
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 4;
+    mechc_result *r = mechc_sim(k, &o, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_OK);
+    assert_int_equal(mechc_result_states(r), 5);
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* mechc_sim_with: the command's tuning; states streamed, not kept. */
+static void sim_with_tuning(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/pendulum_dynamics.mech");
+    mechc_kernels *k = compile(m, "jit");
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 10;
+    int seen = 0, steps = 0;
+    o.on_state = count_state;
+    o.ctx = &seen;
+    mechc_sim_tuning x = mechc_sim_tuning_defaults();
+    assert_int_equal(x.max_steps, 10000000);
+    assert_int_equal(x.keep_states, 1);
+    x.keep_states = 0;
+    x.interpolate = 1;
+    x.on_step = count_step;
+    x.step_ctx = &steps;
+    mechc_diag d;
+    mechc_result *r = mechc_sim_with(k, &o, &x, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_OK);
+    assert_int_equal(mechc_result_states(r), 11);
+    assert_int_equal(seen, 11);
+    assert_true(steps > 0);
+    assert_null(mechc_result_q(r));
+    mechc_result_free(r);
+    x = mechc_sim_tuning_defaults();
+    x.max_steps = 2;            /* too few: fails part-way, the states before kept */
+    r = mechc_sim_with(k, &o, &x, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_EANALYSIS);
+    assert_int_equal(d.status, MECHC_EANALYSIS);
+    mechc_result_free(r);
+    x = mechc_sim_tuning_defaults();
+    x.baumgarte_alpha = -1;
+    assert_null(mechc_sim_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_sim_tuning_defaults();
+    x.linear = "lu";
+    assert_null(mechc_sim_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 static void sim_matches_cli(void **state)
 {
     (void)state;
@@ -635,6 +724,8 @@ int main(void)
         cmocka_unit_test(design_without_recompiling),
         cmocka_unit_test(sensitivities),
         cmocka_unit_test(sim_matches_cli),
+        cmocka_unit_test(sim_with_tuning),
+        cmocka_unit_test(sim_redundant),
         cmocka_unit_test(info),
         cmocka_unit_test(threads),
     };

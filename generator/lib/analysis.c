@@ -2,6 +2,7 @@
 #include "lib.h"
 
 #include "../base/arena.h"
+#include "../analysis/redundant.h"
 #include "../dyn/sim.h"
 #include "../kin/run.h"
 
@@ -18,6 +19,7 @@ struct mechc_result {
     bool with_lambda;
     bool keep;              /* false: states counted and passed on, not kept */
     RunResult run;          /* a run's statistics (lib_result_run) */
+    SimResult sim;          /* a simulation's (lib_result_sim) */
     mechc_status status;
     char message[RUN_MESSAGE_MAX];
     double t_fail;
@@ -214,17 +216,38 @@ mechc_sim_options mechc_sim_defaults(void)
                                .atol = so.atol};
 }
 
+mechc_sim_tuning mechc_sim_tuning_defaults(void)
+{
+    SimOptions so = sim_default_options();
+    return (mechc_sim_tuning){.max_steps = so.max_steps, .interpolate = so.interpolate,
+                              .baumgarte_alpha = so.dyn.baumgarte_alpha,
+                              .baumgarte_beta = so.dyn.baumgarte_beta, .keep_states = 1};
+}
+
+/* tuning's part of so; false when a value is out of range. */
+static bool sim_tuning(const mechc_sim_tuning *x, SimOptions *so)
+{
+    int linear = name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    if (linear < 0 || x->max_steps < 1 || !(x->baumgarte_alpha >= 0)
+        || !(x->baumgarte_beta >= 0) || !isfinite(x->baumgarte_alpha)
+        || !isfinite(x->baumgarte_beta))
+        return false;
+    so->linear = (AnalysisLinear)linear;
+    so->max_steps = x->max_steps;
+    so->interpolate = x->interpolate != 0;
+    so->dyn.baumgarte_alpha = x->baumgarte_alpha;
+    so->dyn.baumgarte_beta = x->baumgarte_beta;
+    so->notes = x->notes;
+    so->on_step = x->on_step;
+    so->on_step_ctx = x->step_ctx;
+    return true;
+}
+
 /* The options as sim_run takes them; false when one is out of range. */
-static bool sim_options(const mechc_sim_options *o, SimOptions *so)
+static bool sim_options(const mechc_sim_options *o, const mechc_sim_tuning *x, SimOptions *so)
 {
     *so = sim_default_options();
-    int method = 0;
-    if (o->method) {
-        method = -1;
-        for (int i = 0; sim_method_names[i]; i++)
-            if (strcmp(sim_method_names[i], o->method) == 0)
-                method = i;
-    }
+    int method = name_index(sim_method_names, o->method, SIM_RK8PD);
     if (method < 0 || o->steps < 1 || o->t0 == o->t1 || !isfinite(o->t0) || !isfinite(o->t1)
         || !(o->rtol >= 0) || !(o->atol >= 0))
         return false;
@@ -235,18 +258,24 @@ static bool sim_options(const mechc_sim_options *o, SimOptions *so)
     so->atol = o->atol;
     so->method = (SimMethod)method;
     so->qd0 = o->qd0;
-    return true;
+    return !x || sim_tuning(x, so);
 }
 
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *d)
+{
+    return mechc_sim_with(k, o, NULL, d);
+}
+
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *x, mechc_diag *d)
 {
     mechc_sim_options defaults = mechc_sim_defaults();
     if (!o)
         o = &defaults;
     SimOptions so;
-    if (!k || !sim_options(o, &so)) {
-        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0 or an "
-                 "unknown method (rk8pd, rkf45, rk4imp, msbdf)");
+    if (!k || !sim_options(o, x, &so)) {
+        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0, an "
+                 "unknown method (rk8pd, rkf45, rk4imp, msbdf) or a tuning value out of range");
         return NULL;
     }
     const Model *m = k->model->mech->model;
@@ -255,18 +284,21 @@ mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag
                  "statements (with `gravity`, forces or springs)");
         return NULL;
     }
-    if (m->nh > m->nq) {
+    if (m->nh > m->nq && !redundant_applies(m)) {
         lib_fail(d, MECHC_ENOTRUNNABLE, "%d holonomic rows for %d coordinates: sim's position "
                  "projection needs at most one row per coordinate", m->nh, m->nq);
         return NULL;
     }
     so.source = &k->model->diag;
     mechc_result *r = result_new(k, true, o->on_state, o->ctx);
-    SimResult res;
+    r->keep = !x || x->keep_states;
+    SimResult *res = &r->sim;
     AnalysisStatus st = sim_run(m, engine_kernels(&k->engine), engine_jac_nz(&k->engine),
-                                engine_mass_nz(&k->engine), &so, keep_state, r, &res);
-    return finish(r, st, res.message, res.t_fail, d);
+                                engine_mass_nz(&k->engine), &so, keep_state, r, res);
+    return finish(r, st, res->message, res->t_fail, d);
 }
+
+const SimResult *lib_result_sim(const mechc_result *r) { return &r->sim; }
 
 int mechc_result_states(const mechc_result *r) { return r->states; }
 const double *mechc_result_time(const mechc_result *r) { return r->t; }

@@ -7,6 +7,7 @@
 #include "../engine/engine.h"
 #include "../kin/outputs.h"
 #include "../kin/run.h"
+#include "../dyn/sim.h"
 #include "../kin/sens.h"
 #include "../pipeline/pipeline.h"
 
@@ -63,6 +64,8 @@ bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunO
 /* What run_analysis said of a result made by mechc_run_with (its
    statistics: mechc run --stats). */
 const RunResult *lib_result_run(const mechc_result *r);
+/* What sim_run said of a result made by mechc_sim_with (mechc sim --stats). */
+const SimResult *lib_result_sim(const mechc_result *r);
 
 /* The loops behind the batch calls (batch.c); then what the engine's
    compiled unit has of its own. */

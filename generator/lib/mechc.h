@@ -21,8 +21,8 @@
  * The first load turns GSL's error handler off (gsl_set_error_handler_off:
  * its default aborts; the library checks every status), for good.
  *
- * The library never prints (unless given a stream for a run's notes,
- * mechc_run_tuning) and never exits on bad input or a failed analysis:
+ * The library never prints (unless given a stream for the notes of a run
+ * or a simulation, mechc_run_tuning, mechc_sim_tuning) and never exits on bad input or a failed analysis:
  * every failure is a status (mechc_status) and, where a mechc_diag
  * pointer is taken (it may be NULL), a message. Out of memory
  * aborts the process, as the mechc command does.
@@ -346,6 +346,29 @@ typedef struct mechc_sim_options {
 
 mechc_sim_options mechc_sim_defaults(void);
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *diag);
+
+/* What `mechc sim`'s options tune beyond mechc_sim_options (mechc_sim_with);
+   mechc_sim_tuning_defaults() gives the command's defaults. */
+typedef struct mechc_sim_tuning {
+    const char *linear;     /* "auto" (NULL: sparse above 100 coordinates), "dense"
+                               or "sparse" (KLU; jit and aot) */
+    long max_steps;         /* integrator steps allowed in all; 10000000 */
+    int interpolate;        /* 1: step across the output times, the states there
+                               interpolated (degree 8 Hermite); 0 (default): a
+                               step ends at each */
+    double baumgarte_alpha, baumgarte_beta; /* gamma - 2 alpha Phi' - beta^2 Phi,
+                               1/s, >= 0; 0, 0: off (projection alone) */
+    int keep_states;        /* 1 (default) or 0, as mechc_run_tuning's */
+    FILE *notes;            /* NULL (default), or where the simulation's notes go */
+    void (*on_step)(void *ctx, double t);   /* after every accepted integrator
+                               step, with its end (progress); NULL: none */
+    void *step_ctx;         /* passed to on_step */
+} mechc_sim_tuning;
+
+mechc_sim_tuning mechc_sim_tuning_defaults(void);
+/* mechc_sim with tuning (NULL: the defaults, mechc_sim itself). */
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *tuning, mechc_diag *diag);
 
 /* What a result holds. states: how many; time (states values); q, qd, qdd
    (states x nq each); y, yd, ydd, the outputs (states x nout each; NULL

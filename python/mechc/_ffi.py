@@ -171,6 +171,21 @@ typedef struct mechc_sim_options {
 mechc_sim_options mechc_sim_defaults(void);
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *diag);
 
+typedef struct mechc_sim_tuning {
+    const char *linear;
+    long max_steps;
+    int interpolate;
+    double baumgarte_alpha, baumgarte_beta;
+    int keep_states;
+    FILE *notes;
+    void (*on_step)(void *ctx, double t);
+    void *step_ctx;
+} mechc_sim_tuning;
+
+mechc_sim_tuning mechc_sim_tuning_defaults(void);
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *tuning, mechc_diag *diag);
+
 int mechc_result_states(const mechc_result *r);
 const double *mechc_result_time(const mechc_result *r);
 const double *mechc_result_q(const mechc_result *r);
