@@ -197,6 +197,31 @@ static void engines_agree(void **state)
     mechc_model_free(m);
 }
 
+/* mechc_compile_with: aot compiled afresh though its cache holds the
+   library, the same kernels. */
+static void compile_with_options(void **state)
+{
+    (void)state;
+    mechc_compile_options o = mechc_compile_defaults();
+    assert_int_equal(o.aot_fresh, 0);
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_diag d;
+    assert_null(mechc_compile_with(m, "llvm", &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o.aot_fresh = 1;
+    const char *engine = cache.have_cc && !getenv("MECHC_SKIP_GCC_ONLY") ? "aot" : "generic";
+    mechc_kernels *cached = compile(m, engine), *fresh = mechc_compile_with(m, engine, &o, &d);
+    assert_non_null(fresh);
+    assert_string_equal(mechc_kernels_engine(fresh), engine);
+    double a[9], b[9];
+    assert_int_equal(mechc_phi(cached, mechc_q0(m), 0.3, a), MECHC_OK);
+    assert_int_equal(mechc_phi(fresh, mechc_q0(m), 0.3, b), MECHC_OK);
+    assert_memory_equal(a, b, sizeof a);
+    mechc_kernels_free(fresh);
+    mechc_kernels_free(cached);
+    mechc_model_free(m);
+}
+
 /* The outputs of examples/rssr.mech at a run's states, one by one and in one call. */
 static void outputs(void **state)
 {
@@ -715,6 +740,7 @@ int main(void)
         cmocka_unit_test(jacobian),
         cmocka_unit_test(batches),
         cmocka_unit_test(engines_agree),
+        cmocka_unit_test(compile_with_options),
         cmocka_unit_test(outputs),
         cmocka_unit_test(diagnostics),
         cmocka_unit_test(load_with_limits),

@@ -149,13 +149,10 @@ bool cli_apply_design(const Args *a, Model *m);
 void cli_print_design_help(FILE *out);
 /* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
 void cli_error(const Args *a, const Diag *diag);
-/* mechc_compile with the engine of kind, the failure reported as
-   cli_error does; NULL then. */
-mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind);
-/* engine_open_with (options NULL: the defaults), the failure reported by
-   cli_error. */
-bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech,
-                     const EngineOptions *options, Diag *diag);
+/* mechc_compile_with the engine of kind (o NULL: the defaults), the
+   failure reported as cli_error does; NULL then. */
+mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
+                           const mechc_compile_options *o);
 
 int cmd_gen(int argc, char **argv);
 int cmd_eval(int argc, char **argv);

@@ -210,7 +210,7 @@ static bool evaluate(const Args *a, const EvalCli *c, mechc_model *model, const 
 {
     const Model *m = model->mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
-    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine);
+    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine, NULL);
     if (!k)
         return false;
     double *phi = xcalloc((size_t)m->nh + 1, sizeof *phi), *nu = xcalloc(nr, sizeof *nu);

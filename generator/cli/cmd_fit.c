@@ -314,7 +314,7 @@ static int fit_file(const Args *a, mechc_model *model, void *opts)
     bool data = read_choices(c, m, &o) && fit_data_read(c->data_path, m, &d, &data_diag);
     if (!data && data_diag.failed)
         diag_print(&data_diag, stderr);
-    if (data && (k = cli_compile(a, model, (EngineKind)c->engine))) {
+    if (data && (k = cli_compile(a, model, (EngineKind)c->engine, NULL))) {
         FitResult r;
         FitStatus st = fit_run(m, &mech->kin, &k->engine, &d, &o, &r);
         if (st == FIT_BAD_INPUT) {

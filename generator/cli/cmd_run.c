@@ -378,7 +378,7 @@ static mechc_kernels *prepare(const Args *a, const RunCli *c, mechc_model *model
         return NULL;
     }
     mechc_kernels *k = resolve_pictures(m, c, pics)
-                           ? cli_compile(a, model, (EngineKind)c->engine) : NULL;
+                           ? cli_compile(a, model, (EngineKind)c->engine, NULL) : NULL;
     if (!k)
         return NULL;
     if (c->forces && !mechc_has_dynamics(model)) {

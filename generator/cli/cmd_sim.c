@@ -351,7 +351,7 @@ static int sim_file(const Args *a, mechc_model *model, void *opts)
         return EXIT_USAGE;
     }
     c->so.qd0 = qd0;
-    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine);
+    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine, NULL);
     if (!k) {
         free(qd0);
         return EXIT_USAGE;

@@ -49,19 +49,11 @@ void cli_error(const Args *a, const Diag *diag)
     fprintf(stderr, "mechc %s: error: %s\n", a->command, diag->message);
 }
 
-bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech,
-                     const EngineOptions *options, Diag *diag)
-{
-    if (engine_open_with(e, kind, mech, options, diag))
-        return true;
-    cli_error(a, diag);
-    return false;
-}
-
-mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind)
+mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
+                           const mechc_compile_options *o)
 {
     mechc_diag d;
-    mechc_kernels *k = mechc_compile(model, engine_names[kind], &d);
+    mechc_kernels *k = mechc_compile_with(model, engine_names[kind], o, &d);
     if (!k)
         fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
     return k;

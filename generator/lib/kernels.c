@@ -12,17 +12,29 @@
    time in the process, whatever handles the threads hold. */
 static pthread_mutex_t jit_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, Diag *diag)
+static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, const EngineOptions *o,
+                        Diag *diag)
 {
     if (kind != ENGINE_JIT)
-        return engine_open(e, kind, mech, diag);
+        return engine_open_with(e, kind, mech, o, diag);
     pthread_mutex_lock(&jit_lock);
-    bool ok = engine_open(e, kind, mech, diag);
+    bool ok = engine_open_with(e, kind, mech, o, diag);
     pthread_mutex_unlock(&jit_lock);
     return ok;
 }
 
+mechc_compile_options mechc_compile_defaults(void)
+{
+    return (mechc_compile_options){.aot_fresh = engine_default_options().aot_fresh};
+}
+
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
+{
+    return mechc_compile_with(m, engine, NULL, d);
+}
+
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *d)
 {
     const char *name = engine ? engine : "jit";
     int kind = -1;
@@ -36,9 +48,12 @@ mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
     }
     mechc_kernels *k = xcalloc(1, sizeof *k);
     k->model = m;
+    EngineOptions eo = engine_default_options();
+    if (o)
+        eo.aot_fresh = o->aot_fresh != 0;
     Diag diag;
     diag_init(&diag, m->name, NULL, 0);
-    if (!open_engine(&k->engine, (EngineKind)kind, m->mech, &diag)) {
+    if (!open_engine(&k->engine, (EngineKind)kind, m->mech, &eo, &diag)) {
         lib_fail_diag(d, MECHC_ECOMPILE, &diag);
         free(k);
         return NULL;

@@ -184,6 +184,18 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
    MECHC_EARG for an unknown engine, MECHC_ECOMPILE when it cannot compile. */
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
+
+/* What mechc_compile_with can change; mechc_compile_defaults() gives
+   mechc_compile's. */
+typedef struct mechc_compile_options {
+    int aot_fresh;          /* aot: compile even when the cache holds the library
+                               (to time the compiler, as `mechc bench` does); 0 */
+} mechc_compile_options;
+
+mechc_compile_options mechc_compile_defaults(void);
+/* mechc_compile with options (NULL: the defaults). */
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *diag);
 /* "jit", "aot" or "generic". */
 const char *mechc_kernels_engine(const mechc_kernels *k);
 /* Wall time of the emission plus the compilation (generic: its set-up), s. */

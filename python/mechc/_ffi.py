@@ -83,6 +83,14 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
 
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
+
+typedef struct mechc_compile_options {
+    int aot_fresh;
+} mechc_compile_options;
+
+mechc_compile_options mechc_compile_defaults(void);
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *diag);
 const char *mechc_kernels_engine(const mechc_kernels *k);
 double mechc_kernels_compile_seconds(const mechc_kernels *k);
 const char *mechc_kernels_source(const mechc_kernels *k);
