@@ -683,6 +683,57 @@ static void info(void **state)
     mechc_model_free(m);
 }
 
+/* mechc_info_with: `mechc info`'s options, the report in a handle. */
+static void info_with_options(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/parallelogram_redundant.mech");
+    mechc_info_options o = mechc_info_defaults();
+    assert_int_equal(o.samples, 8);
+    assert_true(o.rank_tol < 0);
+    mechc_diag d;
+    mechc_info_report *r = mechc_info_with(m, NULL, &d);    /* what mechc_info_json prints */
+    char *json = mechc_info_report_json(r), *json0 = mechc_info_json(m, &d);
+    assert_string_equal(json, json0);
+    mechc_free(json), mechc_free(json0);
+    mechc_info_report_free(r);
+    o.t = 0.5;
+    o.follow = 1;               /* info --at 0.5 */
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    json = mechc_info_report_json(r);
+    assert_non_null(strstr(json, "\"t\": 0.5"));
+    assert_non_null(strstr(json, "\"state\": {\"source\""));
+    mechc_free(json);
+    mechc_info in;
+    double q[12];
+    assert_int_equal(mechc_info_report_summary(r, &in, NULL, q), MECHC_OK);
+    assert_int_equal(in.assembled, 1);
+    assert_int_equal(in.rank, 11);
+    mechc_info_report_free(r);
+    o = mechc_info_defaults();
+    o.q = q;                    /* info --state: the state reached, as it is */
+    o.t = 0.5;
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    mechc_info_report_free(r);
+    o.follow = 1;               /* both: refused */
+    assert_null(mechc_info_with(m, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o = mechc_info_defaults();
+    o.linear = "dense";
+    o.max_dense = 10;           /* 12 x 12 rows by coordinates: beyond */
+    assert_null(mechc_info_with(m, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o.linear = "sparse";        /* no dense SVD: no condition number */
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_info_report_summary(r, &in, NULL, NULL), MECHC_OK);
+    assert_int_equal(in.rank, in.nh - in.nredundant);
+    mechc_info_report_free(r);
+    mechc_model_free(m);
+}
+
 /* One thread's work on a model of its own: load, jit, run; rocker.phi at t = 1. */
 static void *run_alone(void *out)
 {
@@ -753,6 +804,7 @@ int main(void)
         cmocka_unit_test(sim_with_tuning),
         cmocka_unit_test(sim_redundant),
         cmocka_unit_test(info),
+        cmocka_unit_test(info_with_options),
         cmocka_unit_test(threads),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

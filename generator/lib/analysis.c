@@ -119,23 +119,12 @@ mechc_run_tuning mechc_run_tuning_defaults(void)
         .ode_tol = ro.ode.tol, .max_dense_entries = ro.max_dense_entries, .keep_states = 1};
 }
 
-/* The index of name in names (NULL-terminated), fallback for NULL, -1 unknown. */
-static int name_index(const char *const *names, const char *name, int fallback)
-{
-    if (!name)
-        return fallback;
-    for (int i = 0; names[i]; i++)
-        if (strcmp(names[i], name) == 0)
-            return i;
-    return -1;
-}
-
 /* tuning's part of ro; false when a value is out of range. */
 static bool run_tuning(const mechc_run_tuning *x, RunOptions *ro)
 {
     static const char *const odes[] = {"rk8pd", "rkf45", NULL};
-    int linear = name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
-    int ode = name_index(odes, x->ode, 0);
+    int linear = lib_name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    int ode = lib_name_index(odes, x->ode, 0);
     if (linear < 0 || ode < 0 || x->max_substeps < 1 || x->assembly_max_iter < 1
         || !(x->pivot_tol >= 0) || !(x->cond_warn >= 0) || !(x->ode_tol > 0)
         || x->max_dense_entries < 0)
@@ -227,7 +216,7 @@ mechc_sim_tuning mechc_sim_tuning_defaults(void)
 /* tuning's part of so; false when a value is out of range. */
 static bool sim_tuning(const mechc_sim_tuning *x, SimOptions *so)
 {
-    int linear = name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    int linear = lib_name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
     if (linear < 0 || x->max_steps < 1 || !(x->baumgarte_alpha >= 0)
         || !(x->baumgarte_beta >= 0) || !isfinite(x->baumgarte_alpha)
         || !isfinite(x->baumgarte_beta))
@@ -247,7 +236,7 @@ static bool sim_tuning(const mechc_sim_tuning *x, SimOptions *so)
 static bool sim_options(const mechc_sim_options *o, const mechc_sim_tuning *x, SimOptions *so)
 {
     *so = sim_default_options();
-    int method = name_index(sim_method_names, o->method, SIM_RK8PD);
+    int method = lib_name_index(sim_method_names, o->method, SIM_RK8PD);
     if (method < 0 || o->steps < 1 || o->t0 == o->t1 || !isfinite(o->t0) || !isfinite(o->t1)
         || !(o->rtol >= 0) || !(o->atol >= 0))
         return false;

@@ -37,10 +37,7 @@ mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
                                   const mechc_compile_options *o, mechc_diag *d)
 {
     const char *name = engine ? engine : "jit";
-    int kind = -1;
-    for (int i = 0; i < ENGINE_KIND_COUNT; i++)
-        if (strcmp(engine_names[i], name) == 0)
-            kind = i;
+    int kind = lib_name_index(engine_names, name, -1);
     if (!m || kind < 0) {
         lib_fail(d, MECHC_EARG, m ? "unknown engine '%s': jit, aot or generic" : "no model",
                  name);

@@ -57,6 +57,9 @@ mechc_status lib_fail(mechc_diag *d, mechc_status status, const char *fmt, ...)
 mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from);
 /* Clears d (may be NULL): status MECHC_OK, nothing else. */
 void lib_ok(mechc_diag *d);
+/* The index of name in names (NULL-terminated); fallback when name is
+   NULL, -1 when it is none of them. */
+int lib_name_index(const char *const *names, const char *name, int fallback);
 
 /* A run's options as run_analysis takes them (x NULL: the defaults);
    false when one is out of range. */
@@ -66,6 +69,10 @@ bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunO
 const RunResult *lib_result_run(const mechc_result *r);
 /* What sim_run said of a result made by mechc_sim_with (mechc sim --stats). */
 const SimResult *lib_result_sim(const mechc_result *r);
+
+/* The report behind a mechc_info_report (mechc info's text). */
+struct InfoReport;
+const struct InfoReport *lib_info_report(const mechc_info_report *r);
 
 /* The loops behind the batch calls (batch.c); then what the engine's
    compiled unit has of its own. */

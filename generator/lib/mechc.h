@@ -426,6 +426,39 @@ mechc_status mechc_info_at(mechc_model *m, double t, mechc_info *info, int *redu
    NULL with diag filled on failure. */
 char *mechc_info_json(mechc_model *m, mechc_diag *diag);
 
+/* What `mechc info`'s options set (mechc_info_with); mechc_info_defaults()
+   gives the command's defaults. */
+typedef struct mechc_info_options {
+    double t;               /* the time of the analysis; 0 */
+    double rank_tol;        /* singular values above it count toward the rank;
+                               negative (default): max(rows, coords) eps sigma_max */
+    int samples;            /* random states of the integrability check, >= 1; 8 */
+    const char *linear;     /* "auto" (NULL: sparse QR above 100 coordinates),
+                               "dense" (SVD) or "sparse" (SuiteSparseQR) */
+    double max_dense;       /* rows x coordinates up to which a dense SVD is
+                               allowed; 500000 ("dense" beyond it: MECHC_EARG) */
+    int follow;             /* 1: at the state the motion reaches at t, assembled at
+                               t = 0 and followed (holonomic rows only) */
+    const double *q;        /* NULL, or a state (nq) analysed as it is, at t */
+} mechc_info_options;
+
+/* The whole structure report (mechc info's), kept in a handle. */
+typedef struct mechc_info_report mechc_info_report;
+
+mechc_info_options mechc_info_defaults(void);
+/* The analysis with options (NULL: the defaults); NULL with diag filled
+   (MECHC_EARG) when the options cannot be used. A report whose assembly
+   did not converge is returned: its summary says assembled 0. */
+mechc_info_report *mechc_info_with(mechc_model *m, const mechc_info_options *o,
+                                   mechc_diag *diag);
+/* The report's counts and ranks, as mechc_info_at gives them (redundant
+   and q may be NULL). */
+mechc_status mechc_info_report_summary(const mechc_info_report *r, mechc_info *info,
+                                       int *redundant, double *q);
+/* The report as `mechc info --json` prints it; free with mechc_free. */
+char *mechc_info_report_json(const mechc_info_report *r);
+void mechc_info_report_free(mechc_info_report *r);
+
 #ifdef __cplusplus
 }
 #endif

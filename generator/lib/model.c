@@ -29,6 +29,16 @@ const char *mechc_status_text(mechc_status status)
 
 void mechc_free(void *p) { free(p); }
 
+int lib_name_index(const char *const *names, const char *name, int fallback)
+{
+    if (!name)
+        return fallback;
+    for (int i = 0; names[i]; i++)
+        if (strcmp(names[i], name) == 0)
+            return i;
+    return -1;
+}
+
 void lib_ok(mechc_diag *d)
 {
     if (d)

@@ -209,6 +209,24 @@ double mechc_result_t_fail(const mechc_result *r);
 void mechc_result_free(mechc_result *r);
 
 char *mechc_info_json(mechc_model *m, mechc_diag *diag);
+
+typedef struct mechc_info_options {
+    double t;
+    double rank_tol;
+    int samples;
+    const char *linear;
+    double max_dense;
+    int follow;
+    const double *q;
+} mechc_info_options;
+
+typedef struct mechc_info_report mechc_info_report;
+
+mechc_info_options mechc_info_defaults(void);
+mechc_info_report *mechc_info_with(mechc_model *m, const mechc_info_options *o,
+                                   mechc_diag *diag);
+char *mechc_info_report_json(const mechc_info_report *r);
+void mechc_info_report_free(mechc_info_report *r);
 """
 
 ffi = cffi.FFI()
