@@ -197,6 +197,31 @@ static void engines_agree(void **state)
     mechc_model_free(m);
 }
 
+/* mechc_compile_with: aot compiled afresh though its cache holds the
+   library, the same kernels. */
+static void compile_with_options(void **state)
+{
+    (void)state;
+    mechc_compile_options o = mechc_compile_defaults();
+    assert_int_equal(o.aot_fresh, 0);
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_diag d;
+    assert_null(mechc_compile_with(m, "llvm", &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o.aot_fresh = 1;
+    const char *engine = cache.have_cc && !getenv("MECHC_SKIP_GCC_ONLY") ? "aot" : "generic";
+    mechc_kernels *cached = compile(m, engine), *fresh = mechc_compile_with(m, engine, &o, &d);
+    assert_non_null(fresh);
+    assert_string_equal(mechc_kernels_engine(fresh), engine);
+    double a[9], b[9];
+    assert_int_equal(mechc_phi(cached, mechc_q0(m), 0.3, a), MECHC_OK);
+    assert_int_equal(mechc_phi(fresh, mechc_q0(m), 0.3, b), MECHC_OK);
+    assert_memory_equal(a, b, sizeof a);
+    mechc_kernels_free(fresh);
+    mechc_kernels_free(cached);
+    mechc_model_free(m);
+}
+
 /* The outputs of examples/rssr.mech at a run's states, one by one and in one call. */
 static void outputs(void **state)
 {
@@ -251,6 +276,44 @@ static void diagnostics(void **state)
     assert_int_equal(d.status, MECHC_EINPUT);
     assert_true(d.message[0] != '\0');
     assert_null(mechc_load_file(NULL, NULL));
+}
+
+/* Loading with limits: the command's --max-... and the line a caret goes under. */
+static void load_with_limits(void **state)
+{
+    (void)state;
+    mechc_diag d;
+    char line[MECHC_DIAG_LINE_MAX] = "x";
+    mechc_limits l = mechc_default_limits();
+    assert_int_equal(l.max_coords, 200000);
+    assert_int_equal(l.max_file_bytes, 4 << 20);
+    mechc_model *m = mechc_load_file_with("examples/four_bar.mech", &l, &d, line);
+    assert_non_null(m);
+    assert_string_equal(line, "");
+    mechc_model_free(m);
+    l.max_coords = 2;
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, line));
+    assert_int_equal(d.status, MECHC_EINPUT);
+    assert_string_equal(d.message, "too many coordinates (the limit is 2)");
+    assert_int_equal(d.line, 36);
+    assert_int_equal(d.column, 6);
+    assert_string_equal(line, "body crank   x = 0.5     y = 0       phi = 0");
+    l.max_file_bytes = 100;     /* no place in the file: no line */
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, line));
+    assert_int_equal(d.line, 0);
+    assert_string_equal(line, "");
+    l = mechc_default_limits();
+    l.max_depth = 0;            /* out of the option's range */
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL));
+    assert_int_equal(d.status, MECHC_EARG);
+    l.max_depth = 1001;
+    assert_null(mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL));
+    assert_int_equal(d.status, MECHC_EARG);
+    l.max_depth = 64;
+    l.max_jac_entries = 0;      /* not checked while loading */
+    m = mechc_load_file_with("examples/four_bar.mech", &l, &d, NULL);
+    assert_non_null(m);
+    mechc_model_free(m);
 }
 
 /* Failures come back as statuses, never as an exit. */
@@ -310,6 +373,59 @@ static void count_state(void *ctx, double t, const double *q, const double *qd,
 {
     (void)t, (void)q, (void)qd, (void)qdd, (void)lambda;
     *(int *)ctx += 1;
+}
+
+/* mechc_run_with: the command's tuning; states streamed, not kept. */
+static void run_with_tuning(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/four_bar.mech");
+    mechc_kernels *k = compile(m, "jit");
+    mechc_run_options o = mechc_run_defaults();
+    o.steps = 4;
+    int seen = 0;
+    o.on_state = count_state;
+    o.ctx = &seen;
+    mechc_run_tuning x = mechc_run_tuning_defaults();
+    assert_int_equal(x.max_substeps, 64);
+    assert_int_equal(x.assembly_max_iter, 100);
+    assert_int_equal(x.keep_states, 1);
+    assert_null(x.linear);
+    mechc_diag d;
+    mechc_result *dense = mechc_run_with(k, &o, &x, &d);
+    x.linear = "sparse";
+    x.ode = "rkf45";
+    x.keep_states = 0;
+    mechc_result *sparse = mechc_run_with(k, &o, &x, &d);
+    assert_non_null(dense);
+    assert_non_null(sparse);
+    assert_int_equal(mechc_result_status(sparse), MECHC_OK);
+    assert_int_equal(mechc_result_states(sparse), 5);
+    assert_int_equal(seen, 10);
+    assert_null(mechc_result_q(sparse));
+    assert_null(mechc_result_time(sparse));
+    assert_near(mechc_result_q(dense)[9 + 8], 1.725386, 0, 1e-6);
+    mechc_result_free(dense);
+    mechc_result_free(sparse);
+    x = mechc_run_tuning_defaults();
+    x.max_dense_entries = 1;    /* the run's dense Jacobian, 81 entries: refused */
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
+    assert_non_null(strstr(d.message, "81 entries"));
+    x = mechc_run_tuning_defaults();
+    x.linear = "qr";
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_run_tuning_defaults();
+    x.max_substeps = 0;
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_run_tuning_defaults();
+    x.ode = "euler";
+    assert_null(mechc_run_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
 }
 
 /* The run's last state is what `mechc run --steps 4 --json` prints. */
@@ -427,6 +543,95 @@ static void sensitivities(void **state)
 }
 
 /* Forward dynamics: `mechc sim examples/pendulum_dynamics.mech --steps 10 --json`. */
+static void count_step(void *ctx, double t)
+{
+    (void)t;
+    *(int *)ctx += 1;
+}
+
+/* The spatial four-bar with its redundant rows (24 holonomic for 21
+   coordinates), its driver left out, with masses (tests/redundant_cli.sh's
+   free_mass.mech): `mechc sim` simulates it, and so does mechc_sim. */
+static void sim_redundant(void **state)
+{
+    (void)state;
+    static const char masses[] =
+        "mass crank   m = 1    J = (0.01, 1/12, 1/12)\n"
+        "mass coupler m = 3    J = (0.01, 3*b^2/12, 3*b^2/12)\n"
+        "mass rocker  m = 2.5  J = (0.01, 2.5*c^2/12, 2.5*c^2/12)\n"
+        "gravity (0, -9.81, 0)\n";
+    FILE *f = fopen("examples/four_bar_spatial_redundant.mech", "r");
+    assert_non_null(f);
+    char *text = calloc(1 << 16, 1), line[4096];
+    size_t n = 0;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "driver", 6) != 0)
+            n += (size_t)snprintf(text + n, (1 << 16) - n, "%s", line);
+    fclose(f);
+    snprintf(text + n, (1 << 16) - n, "%s", masses);
+    mechc_diag d;
+    mechc_model *m = mechc_load_string(text, "free_mass.mech", &d);
+    free(text);
+    assert_non_null(m);
+    assert_true(mechc_nh(m) > mechc_nq(m));
+    mechc_kernels *k = compile(m, "jit");
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 4;
+    mechc_result *r = mechc_sim(k, &o, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_OK);
+    assert_int_equal(mechc_result_states(r), 5);
+    mechc_result_free(r);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
+/* mechc_sim_with: the command's tuning; states streamed, not kept. */
+static void sim_with_tuning(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/pendulum_dynamics.mech");
+    mechc_kernels *k = compile(m, "jit");
+    mechc_sim_options o = mechc_sim_defaults();
+    o.steps = 10;
+    int seen = 0, steps = 0;
+    o.on_state = count_state;
+    o.ctx = &seen;
+    mechc_sim_tuning x = mechc_sim_tuning_defaults();
+    assert_int_equal(x.max_steps, 10000000);
+    assert_int_equal(x.keep_states, 1);
+    x.keep_states = 0;
+    x.interpolate = 1;
+    x.on_step = count_step;
+    x.step_ctx = &steps;
+    mechc_diag d;
+    mechc_result *r = mechc_sim_with(k, &o, &x, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_OK);
+    assert_int_equal(mechc_result_states(r), 11);
+    assert_int_equal(seen, 11);
+    assert_true(steps > 0);
+    assert_null(mechc_result_q(r));
+    mechc_result_free(r);
+    x = mechc_sim_tuning_defaults();
+    x.max_steps = 2;            /* too few: fails part-way, the states before kept */
+    r = mechc_sim_with(k, &o, &x, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_result_status(r), MECHC_EANALYSIS);
+    assert_int_equal(d.status, MECHC_EANALYSIS);
+    mechc_result_free(r);
+    x = mechc_sim_tuning_defaults();
+    x.baumgarte_alpha = -1;
+    assert_null(mechc_sim_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    x = mechc_sim_tuning_defaults();
+    x.linear = "lu";
+    assert_null(mechc_sim_with(k, &o, &x, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    mechc_kernels_free(k);
+    mechc_model_free(m);
+}
+
 static void sim_matches_cli(void **state)
 {
     (void)state;
@@ -475,6 +680,57 @@ static void info(void **state)
     assert_non_null(strstr(json, "\"redundant\": ["));
     assert_true(json[0] == '{' && json[strlen(json) - 2] == '}');
     mechc_free(json);
+    mechc_model_free(m);
+}
+
+/* mechc_info_with: `mechc info`'s options, the report in a handle. */
+static void info_with_options(void **state)
+{
+    (void)state;
+    mechc_model *m = load("examples/parallelogram_redundant.mech");
+    mechc_info_options o = mechc_info_defaults();
+    assert_int_equal(o.samples, 8);
+    assert_true(o.rank_tol < 0);
+    mechc_diag d;
+    mechc_info_report *r = mechc_info_with(m, NULL, &d);    /* what mechc_info_json prints */
+    char *json = mechc_info_report_json(r), *json0 = mechc_info_json(m, &d);
+    assert_string_equal(json, json0);
+    mechc_free(json), mechc_free(json0);
+    mechc_info_report_free(r);
+    o.t = 0.5;
+    o.follow = 1;               /* info --at 0.5 */
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    json = mechc_info_report_json(r);
+    assert_non_null(strstr(json, "\"t\": 0.5"));
+    assert_non_null(strstr(json, "\"state\": {\"source\""));
+    mechc_free(json);
+    mechc_info in;
+    double q[12];
+    assert_int_equal(mechc_info_report_summary(r, &in, NULL, q), MECHC_OK);
+    assert_int_equal(in.assembled, 1);
+    assert_int_equal(in.rank, 11);
+    mechc_info_report_free(r);
+    o = mechc_info_defaults();
+    o.q = q;                    /* info --state: the state reached, as it is */
+    o.t = 0.5;
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    mechc_info_report_free(r);
+    o.follow = 1;               /* both: refused */
+    assert_null(mechc_info_with(m, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o = mechc_info_defaults();
+    o.linear = "dense";
+    o.max_dense = 10;           /* 12 x 12 rows by coordinates: beyond */
+    assert_null(mechc_info_with(m, &o, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    o.linear = "sparse";        /* no dense SVD: no condition number */
+    r = mechc_info_with(m, &o, &d);
+    assert_non_null(r);
+    assert_int_equal(mechc_info_report_summary(r, &in, NULL, NULL), MECHC_OK);
+    assert_int_equal(in.rank, in.nh - in.nredundant);
+    mechc_info_report_free(r);
     mechc_model_free(m);
 }
 
@@ -535,14 +791,20 @@ int main(void)
         cmocka_unit_test(jacobian),
         cmocka_unit_test(batches),
         cmocka_unit_test(engines_agree),
+        cmocka_unit_test(compile_with_options),
         cmocka_unit_test(outputs),
         cmocka_unit_test(diagnostics),
+        cmocka_unit_test(load_with_limits),
         cmocka_unit_test(errors),
         cmocka_unit_test(run_matches_cli),
+        cmocka_unit_test(run_with_tuning),
         cmocka_unit_test(design_without_recompiling),
         cmocka_unit_test(sensitivities),
         cmocka_unit_test(sim_matches_cli),
+        cmocka_unit_test(sim_with_tuning),
+        cmocka_unit_test(sim_redundant),
         cmocka_unit_test(info),
+        cmocka_unit_test(info_with_options),
         cmocka_unit_test(threads),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -8,6 +8,8 @@
 #ifndef MECHC_LIMITS_H
 #define MECHC_LIMITS_H
 
+#include <limits.h>
+
 typedef struct MechLimits {
     int max_file_bytes;     /* whole input file (default 4 MiB) */
     int max_line_length;    /* bytes per line, newline excluded (default 4096) */
@@ -27,6 +29,23 @@ typedef struct MechLimits {
                                without the dense Jacobian (gen: --sparse-only);
                                NULL: nothing */
 } MechLimits;
+
+/* Each limit's field, its option and the values the option accepts:
+   X(field, option, min, max). The upper bounds keep what the limits
+   protect: the parser's and differentiator's recursion stays far from the
+   stack's end, and int indices (file offsets, the dense Jacobian of the
+   generated C) cannot overflow. */
+#define MECH_LIMIT_RANGES(X) \
+    X(max_file_bytes, "--max-file-bytes", 1, INT_MAX - 1) \
+    X(max_line_length, "--max-line-length", 1, INT_MAX - 1) \
+    X(max_name_length, "--max-name-length", 1, 4000) \
+    X(max_depth, "--max-depth", 1, 1000) \
+    X(max_expr_tokens, "--max-expr-tokens", 1, 20000) \
+    X(max_coords, "--max-coords", 1, 10000000) \
+    X(max_rows, "--max-rows", 1, 10000000) \
+    X(max_jac_entries, "--max-jac-entries", 1, INT_MAX) \
+    X(max_nodes, "--max-nodes", 16, INT_MAX - 1) \
+    X(max_code_ops, "--max-code-ops", 1, INT_MAX)
 
 static inline MechLimits mech_default_limits(void)
 {

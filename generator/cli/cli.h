@@ -4,6 +4,7 @@
 
 #include "../base/limits.h"
 #include "../engine/engine.h"
+#include "../lib/lib.h"         /* the commands are clients of libmechc (mechc.h) */
 
 #include <math.h>
 #include <stdbool.h>
@@ -102,7 +103,7 @@ typedef struct CliOption {
 #define CLI_NONNEGATIVE             .min = 0, .max = HUGE_VAL
 
 /* A command's options and --help. Every command also takes the --max-...
-   limits (examples/README.md, Limits) into the MechLimits at limits_offset. */
+   limits (examples/README.md, Limits) into the mechc_limits at limits_offset. */
 typedef struct CliCommand {
     const char *name;           /* "run" */
     const char *usage;          /* --help before the options: synopsis, description */
@@ -115,8 +116,9 @@ typedef struct CliCommand {
        them together and fills what they imply; false when they cannot be
        used (reported). Called also when one option was wrong. */
     bool (*finish)(Args *a, void *opts);
-    /* The command's work on the loaded mechanism; returns the exit status. */
-    int (*run)(const Args *a, Mech *mech, Diag *diag, void *opts);
+    /* The command's work on the loaded mechanism (model->mech, its
+       diagnostics' source &model->diag); returns the exit status. */
+    int (*run)(const Args *a, mechc_model *model, void *opts);
 } CliCommand;
 
 #define CLI_OPTIONS(table) .options = (table), .count = (int)(sizeof(table) / sizeof *(table))
@@ -131,12 +133,13 @@ void cli_print_help(const CliCommand *cmd, FILE *out);
 
 /* A whole command: reads the options into opts (holding the defaults),
    then cmd->finish, loads the file with the limits read, runs cmd->run and
-   frees the mechanism. Returns the exit status. */
+   frees the model. Returns the exit status. */
 int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts);
-/* Loads a->file (no file: the usage error of args_need_file) with limits
-   (NULL: the defaults). On bad input prints the diagnostic and returns
-   NULL: exit status 2. diag must outlive the Mech (pipeline_load). */
-Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag);
+/* mechc_load_file_with of a->file (no file: the usage error of
+   args_need_file) with limits (NULL: the defaults). On bad input prints
+   the diagnostic (FILE:LINE:COL, the line, a caret) and returns NULL:
+   exit status 2. */
+mechc_model *cli_load(Args *a, const mechc_limits *limits);
 /* --design's values into m's design (design.c): the design the command
    evaluates and gen writes as P_p0. false (reported, exit status 2) for an
    unknown name, a value that is not a finite number, or a file without
@@ -146,10 +149,10 @@ bool cli_apply_design(const Args *a, Model *m);
 void cli_print_design_help(FILE *out);
 /* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
 void cli_error(const Args *a, const Diag *diag);
-/* engine_open_with (options NULL: the defaults), the failure reported by
-   cli_error. */
-bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech,
-                     const EngineOptions *options, Diag *diag);
+/* mechc_compile_with the engine of kind (o NULL: the defaults), the
+   failure reported as cli_error does; NULL then. */
+mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
+                           const mechc_compile_options *o);
 
 int cmd_gen(int argc, char **argv);
 int cmd_eval(int argc, char **argv);

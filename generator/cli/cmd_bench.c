@@ -26,7 +26,7 @@
 
 /* What the command line asked for. */
 typedef struct BenchCli {
-    MechLimits limits;
+    mechc_limits limits;
     int repeat;
     bool json, use_aot;
 } BenchCli;
@@ -68,7 +68,8 @@ static bool generated_only(int fn)
 static const EngineKind order[ENGINE_KIND_COUNT] = {ENGINE_GENERIC, ENGINE_JIT, ENGINE_AOT};
 
 typedef struct Bench {
-    Engine eng[ENGINE_KIND_COUNT];
+    mechc_kernels *kernels[ENGINE_KIND_COUNT];  /* compiled through libmechc ... */
+    const Engine *eng[ENGINE_KIND_COUNT];       /* ... their engines, timed directly */
     bool open[ENGINE_KIND_COUNT];
     double *q, *qd, t;
     double *phi, *jac, *nu, *gamma, *mass, *force;
@@ -107,7 +108,7 @@ static void call_dynamics(Bench *b, const Engine *e, int fn)
 /* Seconds taken by n calls of one function. */
 static double time_batch(Bench *b, EngineKind k, int fn, long n)
 {
-    const Engine *e = &b->eng[k];
+    const Engine *e = b->eng[k];
     double t0 = pipeline_now();
     for (long i = 0; i < n; i++) {
         if (fn >= FN_PHI_P) {
@@ -145,7 +146,7 @@ static bool shown(const Bench *b, int fn)
 
 static bool has_fn(const Bench *b, int k, int fn)
 {
-    return b->open[k] && (!generated_only(fn) || b->eng[k].compiled) && shown(b, fn);
+    return b->open[k] && (!generated_only(fn) || b->eng[k]->compiled) && shown(b, fn);
 }
 
 
@@ -192,9 +193,9 @@ static void measure(Bench *b, int repeat)
 static const EmitResult *emitted(const Bench *b)
 {
     if (b->open[ENGINE_JIT])
-        return &b->eng[ENGINE_JIT].emitted;
+        return &b->eng[ENGINE_JIT]->emitted;
     if (b->open[ENGINE_AOT])
-        return &b->eng[ENGINE_AOT].emitted;
+        return &b->eng[ENGINE_AOT]->emitted;
     return NULL;
 }
 
@@ -253,17 +254,17 @@ static void print_json(const Model *m, const Bench *b, int repeat)
     const EmitResult *er = emitted(b);
     if (b->open[ENGINE_JIT]) {
         printf(",\n \"gen_s\": ");
-        json_number(stdout, b->eng[ENGINE_JIT].gen_seconds);
+        json_number(stdout, b->eng[ENGINE_JIT]->gen_seconds);
         printf(", \"tcc_s\": ");
-        json_number(stdout, b->eng[ENGINE_JIT].compile_seconds);
+        json_number(stdout, b->eng[ENGINE_JIT]->compile_seconds);
     }
     if (b->open[ENGINE_AOT]) {
         printf(", \"cc_s\": ");
-        json_number(stdout, b->eng[ENGINE_AOT].compile_seconds);
+        json_number(stdout, b->eng[ENGINE_AOT]->compile_seconds);
     }
     if (b->open[ENGINE_GENERIC]) {
         printf(", \"generic_setup_s\": ");
-        json_number(stdout, b->eng[ENGINE_GENERIC].gen_seconds);
+        json_number(stdout, b->eng[ENGINE_GENERIC]->gen_seconds);
     }
     if (er) {
         printf(",\n \"code_bytes\": %zu, \"ops\": {", strlen(er->c_text));
@@ -310,19 +311,20 @@ static void print_text(const Model *m, const Bench *b, int repeat)
     }
     printf("\n");
     if (b->open[ENGINE_JIT])
-        printf("generation %.3f ms (%.1f kB of C), libtcc %.3f ms\n", 1e3 * b->eng[ENGINE_JIT].gen_seconds,
-               er ? (double)strlen(er->c_text) / 1024.0 : 0.0, 1e3 * b->eng[ENGINE_JIT].compile_seconds);
+        printf("generation %.3f ms (%.1f kB of C), libtcc %.3f ms\n", 1e3 * b->eng[ENGINE_JIT]->gen_seconds,
+               er ? (double)strlen(er->c_text) / 1024.0 : 0.0, 1e3 * b->eng[ENGINE_JIT]->compile_seconds);
     if (b->open[ENGINE_AOT])
-        printf("cc %s: %.1f ms (compile and load)\n", AOT_FLAGS, 1e3 * b->eng[ENGINE_AOT].compile_seconds);
+        printf("cc %s: %.1f ms (compile and load)\n", AOT_FLAGS, 1e3 * b->eng[ENGINE_AOT]->compile_seconds);
     if (b->open[ENGINE_GENERIC])
-        printf("generic evaluator set-up: %.3f ms\n", 1e3 * b->eng[ENGINE_GENERIC].gen_seconds);
+        printf("generic evaluator set-up: %.3f ms\n", 1e3 * b->eng[ENGINE_GENERIC]->gen_seconds);
 }
 
-/* Opens every engine asked for (aot only with a compiler); false (reported) when one fails. */
-static bool open_engines(const Args *a, Bench *b, const Mech *mech, bool use_aot, Diag *diag)
+/* Compiles every engine asked for (aot only with a compiler); false
+   (reported) when one fails. */
+static bool open_engines(const Args *a, Bench *b, mechc_model *model, bool use_aot)
 {
-    EngineOptions eo = engine_default_options();
-    eo.aot_fresh = true;        /* time the compiler, not the cache */
+    mechc_compile_options co = mechc_compile_defaults();
+    co.aot_fresh = 1;           /* time the compiler, not the cache */
     for (int i = 0; i < ENGINE_KIND_COUNT; i++) {
         EngineKind k = order[i];
         if (k == ENGINE_AOT && (!use_aot || !aot_compiler_available())) {
@@ -330,9 +332,11 @@ static bool open_engines(const Args *a, Bench *b, const Mech *mech, bool use_aot
                 fprintf(stderr, "mechc bench: note: no C compiler found (set CC): aot left out\n");
             continue;
         }
-        b->open[k] = cli_engine_open(a, &b->eng[k], k, mech, &eo, diag);
-        if (!b->open[k])
+        b->kernels[k] = cli_compile(a, model, k, &co);
+        if (!b->kernels[k])
             return false;
+        b->open[k] = true;
+        b->eng[k] = &b->kernels[k]->engine;
     }
     return true;
 }
@@ -347,7 +351,7 @@ static void open_design(Bench *b, const Model *m)
     size_t most = 0;
     const Kinematics *kin = NULL;
     for (int k = 0; k < ENGINE_KIND_COUNT && !kin; k++)
-        kin = b->open[k] ? &b->eng[k].mech->kin : NULL;
+        kin = b->open[k] ? &b->eng[k]->mech->kin : NULL;
     for (int fn = 0; fn < DESIGN_FN_COUNT && kin; fn++) {
         const NodeId *from[DESIGN_Y_COUNT];
         size_t count[DESIGN_Y_COUNT];
@@ -374,7 +378,7 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
     b->force = xcalloc(nq, sizeof *b->force);
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
         if (b->open[k])
-            b->dynamics = b->eng[k].k.mass != NULL && b->eng[k].k.force != NULL;
+            b->dynamics = b->eng[k]->k.mass != NULL && b->eng[k]->k.force != NULL;
     open_design(b, m);
     for (size_t i = 0; i < nq; i++) {
         b->q[i] = m->q0[i] + 0.01 * (double)((i * 7) % 5);
@@ -397,18 +401,18 @@ static void run_bench(Bench *b, const Model *m, int repeat, bool json)
 }
 
 /* The engines timed and reported. */
-static int bench_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int bench_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
     const BenchCli *c = opts;
     Bench *b = xcalloc(1, sizeof *b);
     int status = EXIT_USAGE;
-    if (open_engines(a, b, mech, c->use_aot, diag)) {
+    if (open_engines(a, b, model, c->use_aot)) {
         run_bench(b, mech->model, c->repeat, c->json);
         status = EXIT_OK;
     }
     for (int k = 0; k < ENGINE_KIND_COUNT; k++)
-        if (b->open[k])
-            engine_close(&b->eng[k]);
+        mechc_kernels_free(b->kernels[k]);
     free(b);
     return status;
 }
@@ -421,6 +425,6 @@ static const CliCommand command = {
 
 int cmd_bench(int argc, char **argv)
 {
-    BenchCli c = {.limits = mech_default_limits(), .repeat = 15, .use_aot = true};
+    BenchCli c = {.limits = mechc_default_limits(), .repeat = 15, .use_aot = true};
     return cli_main(&command, argc, argv, &c);
 }

@@ -10,7 +10,7 @@
 /* What the command line asked for. */
 typedef struct CheckCli {
     CheckOptions opt;
-    MechLimits limits;
+    mechc_limits limits;
     int seed;               /* opt.seed, read as an int */
     int linear;             /* --linear, an AnalysisLinear */
     bool json;
@@ -248,8 +248,10 @@ static void report_failures(const char *file, const Model *m, const CheckReport 
 }
 
 /* The comparisons, their report on stdout and the failures on stderr. */
-static int check_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int check_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     CheckCli *c = opts;
     CheckReport rep;
     c->opt.seed = (unsigned long)c->seed;
@@ -295,7 +297,7 @@ static const CliCommand command = {
 
 int cmd_check(int argc, char **argv)
 {
-    CheckCli c = {.opt = check_default_options(), .limits = mech_default_limits()};
+    CheckCli c = {.opt = check_default_options(), .limits = mechc_default_limits()};
     c.opt.notes = stderr;
     c.seed = (int)c.opt.seed;
     return cli_main(&command, argc, argv, &c);

@@ -8,7 +8,7 @@
 
 /* What the command line asked for. */
 typedef struct EvalCli {
-    MechLimits limits;
+    mechc_limits limits;
     const char *q_text, *qd_text;
     double t;
     int engine;
@@ -202,35 +202,36 @@ static void print_text(const Model *m, double t, const double *q, const double *
     }
 }
 
-/* Evaluates every kernel at (q, qd, t) with the engine asked for and prints
-   the report; false (reported) when the engine does not open. */
-static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const double *q,
-                     const double *qd, Diag *diag)
+/* Evaluates every kernel at (q, qd, t) with the engine asked for
+   (libmechc's calls) and prints the report; false (reported) when the
+   engine does not compile. */
+static bool evaluate(const Args *a, const EvalCli *c, mechc_model *model, const double *q,
+                     const double *qd)
 {
-    const Model *m = mech->model;
+    const Model *m = model->mech->model;
     size_t nq = (size_t)m->nq, nr = (size_t)m->nr;
-    Engine e;
-    if (!cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag))
+    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine, NULL);
+    if (!k)
         return false;
     double *phi = xcalloc((size_t)m->nh + 1, sizeof *phi), *nu = xcalloc(nr, sizeof *nu);
     double *gamma = xcalloc(nr, sizeof *gamma), *jac = xcalloc(nr * nq, sizeof *jac);
-    engine_phi(&e, q, c->t, phi);
-    engine_jac(&e, q, c->t, jac);
-    engine_nu(&e, q, c->t, nu);
-    engine_gamma(&e, q, qd, c->t, gamma);
+    mechc_phi(k, q, c->t, phi);
+    mechc_jacobian(k, q, c->t, jac);
+    mechc_nu(k, q, c->t, nu);
+    mechc_gamma(k, q, qd, c->t, gamma);
     double *M = NULL, *Q = NULL;
-    if (e.k.mass) {         /* the file has masses */
+    if (mechc_has_dynamics(model)) {
         M = xcalloc(nq * nq, sizeof *M);
         Q = xcalloc(nq, sizeof *Q);
-        e.k.mass(e.k.ctx, q, M);
-        e.k.force(e.k.ctx, q, qd, c->t, Q);
+        mechc_mass(k, q, M);
+        mechc_force(k, q, qd, c->t, Q);
     }
     double *phi_p = NULL;
-    if (m->np > 0) {
+    if (mechc_np(model) > 0) {
         phi_p = xcalloc((size_t)m->nh * (size_t)m->np + 1, sizeof *phi_p);
-        engine_phi_p(&e, q, c->t, phi_p);
+        mechc_phi_p(k, q, c->t, phi_p);
     }
-    engine_close(&e);
+    mechc_kernels_free(k);
     if (c->json) {
         print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q, phi_p);
     } else {
@@ -245,16 +246,17 @@ static bool evaluate(const Args *a, const EvalCli *c, const Mech *mech, const do
 }
 
 /* The state from --q and --qd (default: the file's q0 and zeros), evaluated. */
-static int eval_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int eval_file(const Args *a, mechc_model *model, void *opts)
 {
     const EvalCli *c = opts;
-    const Model *m = mech->model;
-    double *q = xcalloc((size_t)m->nq, sizeof *q), *qd = xcalloc((size_t)m->nq, sizeof *qd);
-    memcpy(q, m->q0, (size_t)m->nq * sizeof *q);
+    int nq = mechc_nq(model);
+    double *q = xcalloc((size_t)nq, sizeof *q), *qd = xcalloc((size_t)nq, sizeof *qd);
+    memcpy(q, mechc_q0(model), (size_t)nq * sizeof *q);
+    mechc_qd0(model, qd);
     int status = EXIT_OK;
-    if ((c->q_text && !args_vector("eval", "--q", c->q_text, m->nq, q))
-        || (c->qd_text && !args_vector("eval", "--qd", c->qd_text, m->nq, qd))
-        || !evaluate(a, c, mech, q, qd, diag))
+    if ((c->q_text && !args_vector("eval", "--q", c->q_text, nq, q))
+        || (c->qd_text && !args_vector("eval", "--qd", c->qd_text, nq, qd))
+        || !evaluate(a, c, model, q, qd))
         status = EXIT_USAGE;
     free(q), free(qd);
     return status;
@@ -268,6 +270,6 @@ static const CliCommand command = {
 
 int cmd_eval(int argc, char **argv)
 {
-    EvalCli c = {.limits = mech_default_limits(), .engine = ENGINE_JIT};
+    EvalCli c = {.limits = mechc_default_limits(), .engine = ENGINE_JIT};
     return cli_main(&command, argc, argv, &c);
 }

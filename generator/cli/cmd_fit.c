@@ -9,7 +9,7 @@
 #include <string.h>
 
 typedef struct FitCli {
-    MechLimits limits;
+    mechc_limits limits;
     const char *data_path, *vary_list;
     CliList bounds;         /* NAME=LO:HI */
     FitOptions fo;
@@ -289,8 +289,10 @@ static void print_json(const Model *m, const FitData *d, const FitResult *r, int
     printf("}}\n");
 }
 
-static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int fit_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     FitCli *c = opts;
     Model *m = mech->model;
     if (m->np == 0) {
@@ -307,14 +309,14 @@ static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         o.xtol = o.gtol = c->tol;
     FitData d = {0};
     Diag data_diag = {0};     /* failed stays false unless the CSV was read */
-    Engine e;
+    mechc_kernels *k = NULL;
     int status = EXIT_USAGE;
     bool data = read_choices(c, m, &o) && fit_data_read(c->data_path, m, &d, &data_diag);
     if (!data && data_diag.failed)
         diag_print(&data_diag, stderr);
-    if (data && cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
+    if (data && (k = cli_compile(a, model, (EngineKind)c->engine, NULL))) {
         FitResult r;
-        FitStatus st = fit_run(m, &mech->kin, &e, &d, &o, &r);
+        FitStatus st = fit_run(m, &mech->kin, &k->engine, &d, &o, &r);
         if (st == FIT_BAD_INPUT) {
             fprintf(stderr, "mechc fit: error: %s: %s\n", m->file, r.message);
         } else if (!r.solved) {     /* no estimates to show */
@@ -337,7 +339,7 @@ static int fit_file(const Args *a, Mech *mech, Diag *diag, void *opts)
             status = st == FIT_OK ? EXIT_OK : EXIT_ANALYSIS;
         }
         fit_result_free(&r);
-        engine_close(&e);
+        mechc_kernels_free(k);
     }
     fit_data_free(&d);
     free(o.vary), free(o.lo), free(o.hi);
@@ -363,7 +365,7 @@ static const CliCommand command = {
 
 int cmd_fit(int argc, char **argv)
 {
-    FitCli c = {.limits = mech_default_limits(), .fo = fit_default_options(),
+    FitCli c = {.limits = mechc_default_limits(), .fo = fit_default_options(),
                 .engine = ENGINE_JIT, .worst = 5};
     return cli_main(&command, argc, argv, &c);
 }

@@ -11,7 +11,7 @@
 /* What the command line asked for. */
 typedef struct GenCli {
     EmitOptions emit;
-    MechLimits limits;
+    mechc_limits limits;
     const char *out_path, *header_path;
     int real, trig, jac, dump;      /* indices into the choices below */
     int roll;                       /* rolls[]: EmitRoll's order */
@@ -260,8 +260,10 @@ static bool constants_fit_float(const Mech *mech, Diag *diag)
 }
 
 /* The generated C (or the rows) for the file. */
-static int gen_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int gen_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     GenCli *c = opts;
     if (c->dump == 0) {
         dump_rows(mech);
@@ -310,7 +312,7 @@ static const CliCommand command = {
 
 int cmd_gen(int argc, char **argv)
 {
-    GenCli c = {.emit = emit_default_options(), .limits = mech_default_limits(), .dump = -1};
+    GenCli c = {.emit = emit_default_options(), .limits = mechc_default_limits(), .dump = -1};
     c.limits.jac_advice = "write the file --sparse-only, without the dense Jacobian";
     return cli_main(&command, argc, argv, &c);
 }

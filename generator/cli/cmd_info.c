@@ -13,8 +13,8 @@
 
 /* What the command line asked for. */
 typedef struct InfoCli {
-    AnalysisOptions analysis;
-    MechLimits limits;
+    mechc_info_options info;    /* libmechc's analysis (mechc.h) */
+    mechc_limits limits;
     double t;
     double at;              /* --at T: NAN when absent */
     const char *state;      /* --state FILE.csv, or NULL */
@@ -46,19 +46,19 @@ static const CliOption options[] = {
     {"--json", CLI_FLAG_AT(InfoCli, json),
      .help = "print JSON (keys: coords, rows, nq, nh, nv, dof, rank,\n"
              "redundant, and more)"},
-    {"--rank-tol", CLI_REAL_AT(InfoCli, analysis.rank_tol), CLI_NONNEGATIVE, .what = "a number >= 0",
+    {"--rank-tol", CLI_REAL_AT(InfoCli, info.rank_tol), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "T",
      .help = "singular values above T count toward the rank\n"
              "(default max(rows, coords) * eps * largest singular value)"},
     {"--t", CLI_REAL_AT(InfoCli, t), .metavar = "T",
      .help = "analyse at time T instead of 0 (drivers move with t)"},
-    {"--samples", CLI_INT_AT(InfoCli, analysis.samples, 1, 1000), .metavar = "N",
+    {"--samples", CLI_INT_AT(InfoCli, info.samples, 1, 1000), .metavar = "N",
      .help = "random states for the numerical integrability check (default 8)"},
     {"--linear", CLI_CHOICE_AT(InfoCli, linear, analysis_linear_names), .metavar = "L",
      .help = "rank by dense SVD, or by sparse QR (SuiteSparseQR: the rank,\n"
              "the redundant rows and mobility, no condition number), or\n"
              "auto (default: sparse above " ANALYSIS_DENSE_MAX_NQ_TEXT " coordinates)"},
-    {"--max-dense", CLI_REAL_AT(InfoCli, analysis.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
+    {"--max-dense", CLI_REAL_AT(InfoCli, info.max_dense), CLI_NONNEGATIVE, .what = "a number >= 0",
      .metavar = "N",
      .help = "rows x coordinates up to which a dense SVD is allowed\n"
              "(default 500000): auto goes sparse beyond it, dense refuses"},
@@ -486,39 +486,28 @@ static void print_text(const InfoReport *rep)
     printf("\nverdict: %s\n", rep->verdict);
 }
 
-/* --linear: dense allowed up to --max-dense, auto dense up to 100
-   coordinates as well; false (reported) when dense is refused. */
-static bool choose_linear(const InfoCli *c, const Model *m, AnalysisOptions *o)
+/* --linear into o; false (reported) when dense is refused: the
+   Jacobian beyond --max-dense. */
+static bool choose_linear(const InfoCli *c, const Model *m, mechc_info_options *o)
 {
-    bool fits = (double)m->nr * (double)m->nq <= o->max_dense;
-    switch ((AnalysisLinear)c->linear) {
-    case ANALYSIS_LINEAR_DENSE:
-        if (!fits) {
-            fprintf(stderr, "mechc info: error: --linear dense: the Jacobian is %d x %d, beyond "
-                    "--max-dense %.0f (a dense SVD of it would take long): use --linear sparse "
-                    "or raise --max-dense\n", m->nr, m->nq, o->max_dense);
-            return false;
-        }
-        break;
-    case ANALYSIS_LINEAR_SPARSE:
-        o->max_dense = -1;
-        break;
-    case ANALYSIS_LINEAR_AUTO:
-        if (m->nq > ANALYSIS_DENSE_MAX_NQ)
-            o->max_dense = -1;
-        break;
+    o->linear = analysis_linear_names[c->linear];
+    if (c->linear == ANALYSIS_LINEAR_DENSE && (double)m->nr * (double)m->nq > o->max_dense) {
+        fprintf(stderr, "mechc info: error: --linear dense: the Jacobian is %d x %d, beyond "
+                "--max-dense %.0f (a dense SVD of it would take long): use --linear sparse "
+                "or raise --max-dense\n", m->nr, m->nq, o->max_dense);
+        return false;
     }
     return true;
 }
 
-/* --at and --state: where the state comes from; q (nq) receives a state
-   read from the CSV. *t is the time of the analysis. false on a bad
+/* --at and --state into o: the motion followed to T, or a state read
+   from the CSV into q (nq), o->t the time of the analysis. false on a bad
    --state (reported). */
-static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at, double *t)
+static bool choose_state(const InfoCli *c, const Model *m, double *q, mechc_info_options *o)
 {
-    *t = isnan(c->at) ? c->t : c->at;
-    *at = (InfoAt){.follow = !isnan(c->at) && !c->state};
-    if (at->follow && m->nv > 0) {
+    o->t = isnan(c->at) ? c->t : c->at;
+    o->follow = !isnan(c->at) && !c->state;
+    if (o->follow && m->nv > 0) {
         fprintf(stderr, "mechc info: error: --at follows the holonomic rows only, and %s has "
                 "velocity-level rows, whose positions run integrates: write the motion with "
                 "`mechc run FILE --t1 T --csv STATE.csv` and give it with "
@@ -529,57 +518,67 @@ static bool choose_state(const InfoCli *c, const Model *m, double *q, InfoAt *at
     if (!c->state)
         return true;
     Diag diag;
-    if (!state_csv_read(c->state, m, c->at, q, t, &diag)) {
+    if (!state_csv_read(c->state, m, c->at, q, &o->t, &diag)) {
         diag_print(&diag, stderr);
         return false;
     }
-    at->q = q;
+    o->q = q;
     return true;
 }
 
-/* The analysis at t and its report; exit status 1 when the assembly did not converge. */
-static int info_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+/* Exit status 1, said on stderr, when the assembly did not converge or
+   the motion could not be followed to t. */
+static int assembly_status(const Model *m, const InfoReport *rep, double t, bool follow)
+{
+    if (rep->assembled)
+        return EXIT_OK;
+    if (rep->state.asked && follow) {
+        fprintf(stderr, "mechc info: error: t = %g: the motion from t = 0 could not be followed "
+                "to t = %g (residual %.3g)\n", t, t, rep->assembly.residual);
+        return EXIT_ANALYSIS;
+    }
+    fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
+            rep->state.asked ? 0.0 : t, rep->assembly.residual);
+    if (rep->assembly.worst_row >= 0)
+        fprintf(stderr, ", worst row %s", m->rows[rep->assembly.worst_row].name);
+    fprintf(stderr, ")");
+    if (rep->loop && rep->loop[0])
+        fprintf(stderr, ": %s", rep->loop);
+    if (rep->violated && rep->violated[0])
+        fprintf(stderr, "; rows left unsatisfied at the best point found: %s", rep->violated);
+    fprintf(stderr, "\n");
+    return EXIT_ANALYSIS;
+}
+
+/* The analysis (mechc_info_with) and its report; exit status 1 when the
+   assembly did not converge. */
+static int info_file(const Args *a, mechc_model *model, void *opts)
 {
     const InfoCli *c = opts;
-    const Model *m = mech->model;
-    AnalysisOptions o = c->analysis;
-    double *q = xmalloc(((size_t)m->nq + 1) * sizeof *q), t;
-    InfoAt at;
-    if (!choose_linear(c, m, &o) || !choose_state(c, m, q, &at, &t)) {
+    const Model *m = model->mech->model;
+    mechc_info_options o = c->info;
+    double *q = xmalloc(((size_t)m->nq + 1) * sizeof *q);
+    if (!choose_linear(c, m, &o) || !choose_state(c, m, q, &o)) {
         free(q);
         return EXIT_USAGE;
     }
-    bool asked = at.follow || at.q;
-    InfoReport rep;
-    if (!info_analyse_at(mech, t, asked ? &at : NULL, &o, &rep, diag)) {
-        free(q);
-        cli_error(a, diag);
-        return EXIT_USAGE;
-    }
+    mechc_diag d;
+    mechc_info_report *r = mechc_info_with(model, &o, &d);
     free(q);
-    if (c->json)
-        info_print_json(stdout, &rep);
-    else
-        print_text(&rep);
-    int status = EXIT_OK;
-    if (!rep.assembled && rep.state.asked && at.follow) {
-        fprintf(stderr, "mechc info: error: t = %g: the motion from t = 0 could not be followed "
-                "to t = %g (residual %.3g)\n", t, t, rep.assembly.residual);
-        status = EXIT_ANALYSIS;
-    } else if (!rep.assembled) {
-        fprintf(stderr, "mechc info: error: t = %g: the assembly did not converge (residual %.3g",
-                rep.state.asked ? 0.0 : t, rep.assembly.residual);
-        if (rep.assembly.worst_row >= 0)
-            fprintf(stderr, ", worst row %s", m->rows[rep.assembly.worst_row].name);
-        fprintf(stderr, ")");
-        if (rep.loop && rep.loop[0])
-            fprintf(stderr, ": %s", rep.loop);
-        if (rep.violated && rep.violated[0])
-            fprintf(stderr, "; rows left unsatisfied at the best point found: %s", rep.violated);
-        fprintf(stderr, "\n");
-        status = EXIT_ANALYSIS;
+    if (!r) {
+        fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
+        return EXIT_USAGE;
     }
-    info_report_free(&rep);
+    const InfoReport *rep = lib_info_report(r);
+    if (c->json) {
+        char *json = mechc_info_report_json(r);
+        fputs(json, stdout);
+        mechc_free(json);
+    } else {
+        print_text(rep);
+    }
+    int status = assembly_status(m, rep, o.t, o.follow);
+    mechc_info_report_free(r);
     return status;
 }
 
@@ -602,7 +601,7 @@ static const CliCommand command = {
 
 int cmd_info(int argc, char **argv)
 {
-    InfoCli c = {.analysis = analysis_default_options(), .limits = mech_default_limits(),
+    InfoCli c = {.info = mechc_info_defaults(), .limits = mechc_default_limits(),
                  .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

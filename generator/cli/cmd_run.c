@@ -25,13 +25,14 @@ enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 
 /* What the command line asked for. */
 typedef struct RunCli {
-    RunOptions ro;
-    MechLimits limits;
+    mechc_run_options ro;   /* libmechc's run (mechc.h) ... */
+    mechc_run_tuning tune;  /* ... with the command's tuning */
+    mechc_limits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list;
     CliList traces;         /* --trace texts */
-    double tol;             /* --tol: both Newton tolerances of ro.mechrt; 0: not given */
+    double tol;             /* --tol: ro.tol, both Newton tolerances; 0: not given */
     double at;              /* --at: one instant, t0 = at and no steps; NaN: not given */
-    int engine, ode, digits;
+    int engine, ode, digits;   /* ode: an index of ode_methods, -1 not given */
     int view;               /* --view: an SvgView; -1: not given (iso) */
     int linear;             /* --linear, an AnalysisLinear */
     bool json, stats, forces, sens;
@@ -101,25 +102,25 @@ static const CliOption options[] = {
     {"--tol", CLI_REAL_AT(RunCli, tol), POSITIVE, .metavar = "X",
      .help = "Newton: converged when max |Phi_i| <= X and the last\n"
              "step max |dq_j| <= X (default 1e-8)"},
-    {"--max-iter", CLI_INT_AT(RunCli, ro.mechrt.max_iter, 1, 10000), .metavar = "N",
+    {"--max-iter", CLI_INT_AT(RunCli, ro.max_iter, 1, 10000), .metavar = "N",
      .help = "Newton iterations per time step (default 25)"},
-    {"--assembly-iter", CLI_INT_AT(RunCli, ro.assembly_max_iter, 1, 100000), .metavar = "N",
+    {"--assembly-iter", CLI_INT_AT(RunCli, tune.assembly_max_iter, 1, 100000), .metavar = "N",
      .help = "minimum-norm Newton iterations per attempt when Newton\n"
              "cannot start from the initial values (default 100)"},
-    {"--max-substeps", CLI_INT_AT(RunCli, ro.max_substeps, 1, 1 << 20), .metavar = "N",
+    {"--max-substeps", CLI_INT_AT(RunCli, tune.max_substeps, 1, 1 << 20), .metavar = "N",
      .help = "a step that seems to leave its assembly branch (Newton\n"
              "corrects far more than the predicted motion) is redone\n"
              "in 2, 4, 8 ... substeps, at most N (default 64), and\n"
              "the run fails past that; substeps are not output"},
-    {"--pivot-tol", CLI_REAL_AT(RunCli, ro.mechrt.pivot_tol), NONNEGATIVE, .metavar = "X",
+    {"--pivot-tol", CLI_REAL_AT(RunCli, tune.pivot_tol), NONNEGATIVE, .metavar = "X",
      .help = "singular when an LU pivot <= X times the largest\n"
              "Jacobian entry (default 1e-12)"},
-    {"--cond-warn", CLI_REAL_AT(RunCli, ro.mechrt.cond_warn), NONNEGATIVE, .metavar = "X",
+    {"--cond-warn", CLI_REAL_AT(RunCli, tune.cond_warn), NONNEGATIVE, .metavar = "X",
      .help = "warn where the Jacobian's condition estimate exceeds X\n"
              "(default 1e10; 0: no estimate)"},
     {"--ode", CLI_CHOICE_AT(RunCli, ode, ode_methods), .metavar = "M",
      .help = "integrator for velocity-level rows: rk8pd (default) or rkf45"},
-    {"--ode-tol", CLI_REAL_AT(RunCli, ro.ode.tol), POSITIVE, .metavar = "X",
+    {"--ode-tol", CLI_REAL_AT(RunCli, tune.ode_tol), POSITIVE, .metavar = "X",
      .help = "its error per step, absolute and relative (default 1e-10)"},
     {"--stats", CLI_FLAG_AT(RunCli, stats),
      .help = "print time per step, Newton iterations per step, the\n"
@@ -292,12 +293,6 @@ static void on_state_keep(void *ctx, double t, const double *q, const double *qd
     memcpy(ls->qd, qd, (size_t)ls->out->nq * sizeof *qd);
 }
 
-static void on_state_kinematic(void *ctx, double t, const double *q, const double *qd,
-                               const double *qdd)
-{
-    on_state_keep(ctx, t, q, qd, qdd, NULL);
-}
-
 /* Checks the options together and fills what they imply; false when
    they cannot be used (reported). */
 static bool finish(Args *a, void *opts)
@@ -306,11 +301,12 @@ static bool finish(Args *a, void *opts)
     if (!args_need_file(a))
         return false;
     if (c->tol > 0)
-        c->ro.mechrt.tol_phi = c->ro.mechrt.tol_dq = c->tol;
+        c->ro.tol = c->tol;
     if (c->ode >= 0)
-        mechrt_ode_method_from_name(ode_methods[c->ode], &c->ro.ode.method);
+        c->tune.ode = ode_methods[c->ode];
+    c->tune.linear = analysis_linear_names[c->linear];
     if (!isnan(c->at)) {
-        RunOptions d = run_default_options();
+        mechc_run_options d = mechc_run_defaults();
         if (c->ro.t0 != d.t0 || c->ro.t1 != d.t1 || c->ro.steps != d.steps) {
             fprintf(stderr, "mechc run: error: --at T is --t0 T --steps 0: give it alone, "
                     "without --t0, --t1 or --steps\n");
@@ -320,7 +316,7 @@ static bool finish(Args *a, void *opts)
         c->ro.steps = 0;
     }
     if (c->linear != ANALYSIS_LINEAR_DENSE) { /* checked by the run, where a dense one is formed */
-        c->ro.max_dense_entries = c->limits.max_jac_entries;
+        c->tune.max_dense_entries = c->limits.max_jac_entries;
         c->limits.max_jac_entries = 0;
     }
     if (c->ro.steps > 0 && c->ro.t0 == c->ro.t1) {
@@ -368,52 +364,58 @@ static bool resolve_pictures(const Model *m, const RunCli *c, RunPictures *p)
 }
 
 /* Before any state: rows against coordinates (before the engine's
-   compile), the pictures' names, the engine, and the masses --forces
-   needs. false when one fails (reported; the engine closed). */
-static bool prepare(const Args *a, const RunCli *c, const Mech *mech, RunPictures *pics,
-                    Engine *e, Diag *diag)
+   compile), the pictures' names, the kernels, and the masses --forces
+   needs. NULL when one fails (reported). */
+static mechc_kernels *prepare(const Args *a, const RunCli *c, mechc_model *model,
+                              RunPictures *pics)
 {
-    const Model *m = mech->model;
+    const Model *m = model->mech->model;
+    Diag *diag = &model->diag;
     char why[300];
     if (!run_rows_match(m, why, sizeof why)) {
         diag_error(diag, m->last_pos, "%s", why);
         diag_print(diag, stderr);
-        return false;
+        return NULL;
     }
-    if (!resolve_pictures(m, c, pics) || !cli_engine_open(a, e, (EngineKind)c->engine, mech,
-                                                          NULL, diag))
-        return false;
-    if (c->forces && (!e->k.mass || !e->k.force)) {
+    mechc_kernels *k = resolve_pictures(m, c, pics)
+                           ? cli_compile(a, model, (EngineKind)c->engine, NULL) : NULL;
+    if (!k)
+        return NULL;
+    if (c->forces && !mechc_has_dynamics(model)) {
         diag_error(diag, m->last_pos, "the mechanism has no masses: `run --forces` needs `mass` "
                    "statements (with `gravity`, forces or springs) for its inverse dynamics");
         diag_print(diag, stderr);
-        engine_close(e);
-        return false;
+        mechc_kernels_free(k);
+        return NULL;
     }
-    return true;
+    return k;
 }
 
-/* After the analysis: pictures, JSON, the failure, --stats; the exit status. */
+/* After the analysis (r, or NULL and d when it could not start):
+   pictures, JSON, the failure, --stats; the exit status. */
 static int report(const RunCli *c, const Model *m, const RunOutput *out, const RunPictures *pics,
-                  AnalysisStatus rs, const RunResult *res, const MechrtKernels *k,
-                  const MechrtHostJacNz *jnz, const LastState *last)
+                  const mechc_result *r, const mechc_diag *d, const Engine *e,
+                  const LastState *last)
 {
-    int status = EXIT_OK;
-    if (rs == ANALYSIS_BAD_INPUT) {
-        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
+    if (!r) {
+        fprintf(stderr, "%s: error: %s\n", m->file, d->message);
         return EXIT_USAGE;
     }
+    const char *failure = mechc_result_status(r) == MECHC_EANALYSIS ? mechc_result_message(r)
+                                                                     : NULL;
+    const RunResult *res = lib_result_run(r);  /* the statistics */
+    int status = EXIT_OK;
     if (c->pictures && !run_output_pictures(out, pics))
         status = EXIT_USAGE;
     if (c->json)
-        run_output_json(stdout, out, rs == ANALYSIS_FAILED ? res->message : NULL, res->t_fail);
-    if (c->table && rs == ANALYSIS_OK && out->trace.rows == 1)
+        run_output_json(stdout, out, failure, mechc_result_t_fail(r));
+    if (c->table && !failure && out->trace.rows == 1)
         print_table(m, out, res, c->digits);
-    if (run_output_report_failure(out, m, rs == ANALYSIS_FAILED ? res->message : NULL, res->states,
-                                  res->t_fail))
+    if (run_output_report_failure(out, m, failure, mechc_result_states(r), mechc_result_t_fail(r)))
         status = EXIT_ANALYSIS;
     if (c->stats)
-        print_stats(res, k, jnz, last->q, last->qd, last->t, c->forces);
+        print_stats(res, engine_kernels(e), engine_jac_nz(e), last->q, last->qd, last->t,
+                    c->forces);
     return status;
 }
 
@@ -472,9 +474,10 @@ static void open_sens(RunOutput *out, SensColumns *sc)
     run_output_set_extra(out, n, names, fill_sens, sc);
 }
 
-/* Runs the analysis with the open engine, the states going where c says. */
-static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures *pics,
-                   const Diag *source, SensColumns *sc)
+/* The run (mechc_run_with) with the compiled kernels, the states going
+   where c says: streamed, not kept by the library. */
+static int analyse(RunCli *c, const Model *m, mechc_kernels *k, const RunPictures *pics,
+                   SensColumns *sc)
 {
     RunOutput out = {.cmd = "run", .keep = c->json || c->pictures || c->table,
                      .lambda_use = c->forces ? RUN_OUTPUT_FORCES : RUN_OUTPUT_NO_LAMBDA,
@@ -488,51 +491,56 @@ static int analyse(RunCli *c, const Model *m, const Engine *e, const RunPictures
     run_output_open(&out, m);
     if (sc)
         open_sens(&out, sc);
-    const MechrtKernels *k = engine_kernels(e);
-    const MechrtHostJacNz *jnz = engine_jac_nz(e);
-    RunResult res;
-    c->ro.notes = stderr;
-    c->ro.source = source;
-    c->ro.linear = (AnalysisLinear)c->linear;
-    if (sc && run_linear_is_sparse(m, jnz, &c->ro))
-        sens_use_sparse(&sc->sens, jnz);    /* KLU as the run; else the dense LU */
     LastState last = {&out, c->ro.t0, xcalloc((size_t)m->nq, sizeof(double)),
                       xcalloc((size_t)m->nq, sizeof(double))};
     memcpy(last.q, m->q0, (size_t)m->nq * sizeof(double));
+    mechc_run_options ro = c->ro;
+    ro.forces = c->forces;
+    ro.on_state = on_state_keep;
+    ro.ctx = &last;
+    mechc_run_tuning tune = c->tune;
+    tune.notes = stderr;
+    tune.keep_states = 0;
+    RunOptions full;
+    const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
+    if (sc && lib_run_options(&ro, &tune, &full) && run_linear_is_sparse(m, jnz, &full))
+        sens_use_sparse(&sc->sens, jnz);    /* KLU as the run; else the dense LU */
     progress_start(&out.progress, "run", 1000);
-    MechrtKernels newton = engine_newton_kernels(e);
-    AnalysisStatus rs = c->forces
-                   ? run_analysis_forces(m, &newton, jnz, &c->ro, on_state_keep, &last, &res)
-                   : run_analysis(m, &newton, jnz, &c->ro, on_state_kinematic, &last, &res);
+    mechc_diag d;
+    mechc_result *r = mechc_run_with(k, &ro, &tune, &d);
     progress_finish(&out.progress);
-    int status = report(c, m, &out, pics, rs, &res, k, jnz, &last);
+    int status = report(c, m, &out, pics, r, &d, &k->engine, &last);
     status = finish_output(c, out.csv, status);
+    mechc_result_free(r);
     free(last.q), free(last.qd);
     run_output_close(&out);
     return status;
 }
 
 /* Rows, pictures and engine ready, then the analysis. */
-static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+static int run_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     RunCli *c = opts;
     RunPictures pics;
-    Engine e;
-    if (!prepare(a, c, mech, &pics, &e, diag))
+    mechc_kernels *k = prepare(a, c, model, &pics);
+    if (!k)
         return EXIT_USAGE;
+    const Engine *e = &k->engine;
     if (c->stats)   /* what it took to have the kernels (wall time) */
         fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
                 "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
-                e.gen_seconds, e.compile_seconds);
+                e->gen_seconds, e->compile_seconds);
     SensColumns sc = {0};
     char why[200];
-    if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, &e, why, sizeof why)) {
+    if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, e, why, sizeof why)) {
         diag_error(diag, mech->model->last_pos, "run --sens: %s", why);
         diag_print(diag, stderr);
-        engine_close(&e);
+        mechc_kernels_free(k);
         return EXIT_USAGE;
     }
-    int status = analyse(c, mech->model, &e, &pics, diag, c->sens ? &sc : NULL);
+    int status = analyse(c, mech->model, k, &pics, c->sens ? &sc : NULL);
     if (c->sens && c->stats && sc.states > 0)
         fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters%s: %.6g ms of "
                 "CPU time, %.0f ns per state\n", sc.sens.np,
@@ -540,7 +548,7 @@ static int run_file(const Args *a, Mech *mech, Diag *diag, void *opts)
                 1e9 * sc.cpu_seconds / (double)sc.states);
     if (c->sens)
         sens_free(&sc.sens);
-    engine_close(&e);
+    mechc_kernels_free(k);
     return status;
 }
 
@@ -552,7 +560,7 @@ static const CliCommand command = {
 
 int cmd_run(int argc, char **argv)
 {
-    RunCli c = {.ro = run_default_options(), .limits = mech_default_limits(),
+    RunCli c = {.ro = mechc_run_defaults(), .tune = mechc_run_tuning_defaults(), .limits = mechc_default_limits(),
                 .engine = ENGINE_JIT, .ode = -1, .view = -1, .at = NAN};
     return cli_main(&command, argc, argv, &c);
 }

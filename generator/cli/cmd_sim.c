@@ -26,13 +26,14 @@ enum { MAX_TRACES = RUN_OUTPUT_MAX_TRACES };
 
 /* What the command line asked for. */
 typedef struct SimCli {
-    SimOptions so;
-    MechLimits limits;
+    mechc_sim_options so;   /* libmechc's simulation (mechc.h) ... */
+    mechc_sim_tuning tune;  /* ... with the command's tuning */
+    mechc_limits limits;
     const char *csv_path, *svg_path, *plot_path, *plot_list, *qd_text, *baumgarte;
     CliList omegas;         /* --w BODY=wx,wy,wz */
     CliList traces;
     int engine, method, digits, view, linear, max_steps;
-    bool json, stats;
+    bool json, stats, interpolate;
     bool pictures, csv_stdout;      /* worked out from the above */
 } SimCli;
 
@@ -85,7 +86,7 @@ static const CliOption options[] = {
     {"--w", CLI_LIST_AT(SimCli, omegas, CLI_LIST_MAX), .what = "bodies", .metavar = "B=WX,WY,WZ",
      .help = "initial angular velocity of spatial body B, global frame\n"
              "(rad/s; repeatable): its Euler-parameter rates, after --qd"},
-    {"--interpolate", CLI_FLAG_AT(SimCli, so.interpolate),
+    {"--interpolate", CLI_FLAG_AT(SimCli, interpolate),
      .help = "step across the output times: states there from the\n"
              "Hermite interpolant of q, qd, qdd at the ends of the\n"
              "last two steps, degree 8 (quintic within the first step;\n"
@@ -188,14 +189,16 @@ static bool finish(Args *a, void *opts)
     if (!args_need_file(a))
         return false;
     if (c->method >= 0)
-        c->so.method = (SimMethod)c->method;
+        c->so.method = sim_method_names[c->method];
+    c->tune.linear = analysis_linear_names[c->linear];
     if (c->so.t0 == c->so.t1) {
         fprintf(stderr, "mechc sim: error: --t0 and --t1 are both %g: nothing to simulate\n",
                 c->so.t0);
         return false;
     }
-    c->so.max_steps = c->max_steps;
-    if (c->so.steps > c->so.max_steps && !c->so.interpolate) {
+    c->tune.max_steps = c->max_steps;
+    c->tune.interpolate = c->interpolate;
+    if (c->so.steps > c->max_steps && !c->interpolate) {
         fprintf(stderr, "mechc sim: error: --steps %d output states need at least as many "
                 "integrator steps, more than --max-steps %d (raise it, or --interpolate)\n",
                 c->so.steps, c->max_steps);
@@ -218,8 +221,8 @@ static bool finish(Args *a, void *opts)
                     "one makes the drift grow), got %g,%g\n", ab[0], ab[1]);
             return false;
         }
-        c->so.dyn.baumgarte_alpha = ab[0];
-        c->so.dyn.baumgarte_beta = ab[1];
+        c->tune.baumgarte_alpha = ab[0];
+        c->tune.baumgarte_beta = ab[1];
     }
     if ((c->traces.n > 0 && !c->svg_path) || (c->plot_list && !c->plot_path)) {
         fprintf(stderr, "mechc sim: error: %s goes with %s\n",
@@ -239,24 +242,26 @@ static bool finish(Args *a, void *opts)
     return true;
 }
 
-/* After the simulation: pictures, JSON, the failure, --stats; the exit status. */
+/* After the simulation (r, or NULL and d when it could not start):
+   pictures, JSON, the failure, --stats; the exit status. */
 static int report(const SimCli *c, const Model *m, const RunOutput *out, const RunPictures *p,
-                  AnalysisStatus st, const SimResult *res)
+                  const mechc_result *r, const mechc_diag *d)
 {
-    int status = EXIT_OK;
-    if (st == ANALYSIS_BAD_INPUT) {
-        fprintf(stderr, "%s: error: %s\n", m->file, res->message);
+    if (!r) {
+        fprintf(stderr, "%s: error: %s\n", m->file, d->message);
         return EXIT_USAGE;
     }
+    const char *failure = mechc_result_status(r) == MECHC_EANALYSIS ? mechc_result_message(r)
+                                                                     : NULL;
+    int status = EXIT_OK;
     if (c->pictures && !run_output_pictures(out, p))
         status = EXIT_USAGE;        /* as run: a file that cannot be written */
     if (c->json)
-        run_output_json(stdout, out, st == ANALYSIS_FAILED ? res->message : NULL, res->t_fail);
-    if (run_output_report_failure(out, m, st == ANALYSIS_FAILED ? res->message : NULL, res->states,
-                                  res->t_fail))
+        run_output_json(stdout, out, failure, mechc_result_t_fail(r));
+    if (run_output_report_failure(out, m, failure, mechc_result_states(r), mechc_result_t_fail(r)))
         status = EXIT_ANALYSIS;
     if (c->stats)
-        print_stats(res, m->nr);
+        print_stats(lib_result_sim(r), m->nr);
     return status;
 }
 
@@ -267,9 +272,9 @@ static void step_progress(void *ctx, double t)
     progress_update(&out->progress, (long)(1000.0 * (t - out->t0) / (out->t1 - out->t0)));
 }
 
-/* The simulation with the open engine, the states going where c says. */
-static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPictures *p,
-                    const Diag *source)
+/* The simulation (mechc_sim_with) with the compiled kernels, the states
+   going where c says: streamed, not kept by the library. */
+static int simulate(SimCli *c, const Model *m, mechc_kernels *k, const RunPictures *p)
 {
     RunOutput out = {.cmd = "sim", .keep = c->json || c->pictures,
                      .lambda_use = RUN_OUTPUT_LAMBDA_JSON, .digits = c->digits, .t0 = c->so.t0,
@@ -281,17 +286,20 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
         return EXIT_USAGE;
     }
     run_output_open(&out, m);
-    c->so.notes = stderr;
-    c->so.source = source;
-    c->so.linear = (AnalysisLinear)c->linear;
-    SimResult res;
-    c->so.on_step = step_progress;
-    c->so.on_step_ctx = &out;
+    mechc_sim_options so = c->so;
+    so.on_state = run_output_state;
+    so.ctx = &out;
+    mechc_sim_tuning tune = c->tune;
+    tune.notes = stderr;
+    tune.keep_states = 0;
+    tune.on_step = step_progress;
+    tune.step_ctx = &out;
     progress_start(&out.progress, "sim", 1000);
-    AnalysisStatus st = sim_run(m, engine_kernels(e), engine_jac_nz(e), engine_mass_nz(e),
-                                &c->so, run_output_state, &out, &res);
+    mechc_diag d;
+    mechc_result *r = mechc_sim_with(k, &so, &tune, &d);
     progress_finish(&out.progress);
-    int status = report(c, m, &out, p, st, &res);
+    int status = report(c, m, &out, p, r, &d);
+    mechc_result_free(r);
     if (out.csv && out.csv != stdout && fclose(out.csv) != 0) {
         fprintf(stderr, "mechc sim: error: writing '%s': %s\n", c->csv_path, strerror(errno));
         status = status == EXIT_OK ? EXIT_USAGE : status;
@@ -327,13 +335,14 @@ static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
     return true;
 }
 
-/* Masses, velocities and pictures checked, the engine opened, then the simulation. */
-static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
+/* Masses, velocities and pictures checked, the kernels compiled, then the simulation. */
+static int sim_file(const Args *a, mechc_model *model, void *opts)
 {
+    Mech *mech = model->mech;
+    Diag *diag = &model->diag;     /* the file's: its text for positions */
     SimCli *c = opts;
     const Model *m = mech->model;
     RunPictures pics;
-    Engine e;
     double *qd0 = xcalloc((size_t)m->nq, sizeof *qd0);
     int status = EXIT_USAGE;
     if ((c->qd_text && !args_vector("sim", "--qd", c->qd_text, m->nq, qd0))
@@ -342,11 +351,12 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
         return EXIT_USAGE;
     }
     c->so.qd0 = qd0;
-    if (!cli_engine_open(a, &e, (EngineKind)c->engine, mech, NULL, diag)) {
+    mechc_kernels *k = cli_compile(a, model, (EngineKind)c->engine, NULL);
+    if (!k) {
         free(qd0);
         return EXIT_USAGE;
     }
-    if (!sim_has_masses(&e.k)) {
+    if (!mechc_has_dynamics(model)) {
         diag_error(diag, m->last_pos, "the mechanism has no masses: `mechc sim` needs `mass` "
                    "statements (with `gravity`, forces or springs) to simulate its dynamics");
         diag_print(diag, stderr);
@@ -356,9 +366,9 @@ static int sim_file(const Args *a, Mech *mech, Diag *diag, void *opts)
                    "projection needs at most one row per coordinate", m->nh, m->nq);
         diag_print(diag, stderr);
     } else {
-        status = simulate(c, m, &e, &pics, diag);
+        status = simulate(c, m, k, &pics);
     }
-    engine_close(&e);
+    mechc_kernels_free(k);
     free(qd0);
     return status;
 }
@@ -371,8 +381,8 @@ static const CliCommand command = {
 
 int cmd_sim(int argc, char **argv)
 {
-    SimCli c = {.so = sim_default_options(), .limits = mech_default_limits(),
-                .engine = ENGINE_JIT, .method = -1, .view = -1};
-    c.max_steps = (int)c.so.max_steps;
+    SimCli c = {.so = mechc_sim_defaults(), .tune = mechc_sim_tuning_defaults(),
+                .limits = mechc_default_limits(), .engine = ENGINE_JIT, .method = -1, .view = -1};
+    c.max_steps = (int)c.tune.max_steps;
     return cli_main(&command, argc, argv, &c);
 }

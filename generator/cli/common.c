@@ -8,28 +8,40 @@ int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts)
         return EXIT_OK;         /* --help */
     if (cmd->finish && !cmd->finish(&a, opts))
         return EXIT_USAGE;
-    Diag diag;      /* outlives the Mech, as cli_load wants */
-    Mech *mech = cli_load(&a, (const MechLimits *)((const char *)opts + cmd->limits_offset), &diag);
-    if (!mech)
+    mechc_model *model = cli_load(&a, (const mechc_limits *)((const char *)opts + cmd->limits_offset));
+    if (!model)
         return EXIT_USAGE;
-    if (!cli_apply_design(&a, mech->model)) {
-        pipeline_free(mech);
-        return EXIT_USAGE;
-    }
-    int status = cmd->run(&a, mech, &diag, opts);
-    pipeline_free(mech);
+    int status = EXIT_USAGE;
+    if (cli_apply_design(&a, model->mech->model))
+        status = cmd->run(&a, model, opts);
+    mechc_model_free(model);
     return status;
 }
 
-Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag)
+/* d as the front end's diagnostics print (diag_print): the file as the
+   user gave it, then with a place the line and a caret. */
+static void print_diag(const char *file, const mechc_diag *d, const char *source_line)
+{
+    Diag diag;
+    diag_init(&diag, file, NULL, 0);
+    diag.has_pos = d->line > 0;
+    diag.line = d->line;
+    diag.col = d->column;
+    snprintf(diag.message, sizeof diag.message, "%.*s", (int)sizeof diag.message - 1, d->message);
+    snprintf(diag.source_line, sizeof diag.source_line, "%s", source_line);
+    diag_print(&diag, stderr);
+}
+
+mechc_model *cli_load(Args *a, const mechc_limits *limits)
 {
     if (!args_need_file(a))
         return NULL;
-    MechLimits defaults = mech_default_limits();
-    Mech *mech = pipeline_load(a->file, limits ? limits : &defaults, diag);
-    if (!mech)
-        diag_print(diag, stderr);
-    return mech;
+    mechc_diag d;
+    char source_line[MECHC_DIAG_LINE_MAX];
+    mechc_model *model = mechc_load_file_with(a->file, limits, &d, source_line);
+    if (!model)
+        print_diag(a->file, &d, source_line);
+    return model;
 }
 
 void cli_error(const Args *a, const Diag *diag)
@@ -37,11 +49,12 @@ void cli_error(const Args *a, const Diag *diag)
     fprintf(stderr, "mechc %s: error: %s\n", a->command, diag->message);
 }
 
-bool cli_engine_open(const Args *a, Engine *e, EngineKind kind, const Mech *mech,
-                     const EngineOptions *options, Diag *diag)
+mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
+                           const mechc_compile_options *o)
 {
-    if (engine_open_with(e, kind, mech, options, diag))
-        return true;
-    cli_error(a, diag);
-    return false;
+    mechc_diag d;
+    mechc_kernels *k = mechc_compile_with(model, engine_names[kind], o, &d);
+    if (!k)
+        fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
+    return k;
 }

@@ -4,22 +4,10 @@
 #include <limits.h>
 #include <string.h>
 
-/* The --max-... options of every command, into a MechLimits. The upper
-   bounds keep what the limits protect: the parser's and differentiator's
-   recursion stays far from the stack's end, and int indices (file
-   offsets, the dense Jacobian of the generated C) cannot overflow. */
-static const CliOption limit_options[] = {
-    {"--max-file-bytes", CLI_INT_AT(MechLimits, max_file_bytes, 1, INT_MAX - 1)},
-    {"--max-line-length", CLI_INT_AT(MechLimits, max_line_length, 1, INT_MAX - 1)},
-    {"--max-name-length", CLI_INT_AT(MechLimits, max_name_length, 1, 4000)},
-    {"--max-depth", CLI_INT_AT(MechLimits, max_depth, 1, 1000)},
-    {"--max-expr-tokens", CLI_INT_AT(MechLimits, max_expr_tokens, 1, 20000)},
-    {"--max-coords", CLI_INT_AT(MechLimits, max_coords, 1, 10000000)},
-    {"--max-rows", CLI_INT_AT(MechLimits, max_rows, 1, 10000000)},
-    {"--max-jac-entries", CLI_INT_AT(MechLimits, max_jac_entries, 1, INT_MAX)},
-    {"--max-nodes", CLI_INT_AT(MechLimits, max_nodes, 16, INT_MAX - 1)},
-    {"--max-code-ops", CLI_INT_AT(MechLimits, max_code_ops, 1, INT_MAX)},
-};
+/* The --max-... options of every command, into a mechc_limits. */
+#define LIMIT_OPTION(field, option, lo, hi) {option, CLI_INT_AT(mechc_limits, field, lo, hi)},
+static const CliOption limit_options[] = {MECH_LIMIT_RANGES(LIMIT_OPTION)};
+#undef LIMIT_OPTION
 enum { LIMIT_COUNT = (int)(sizeof limit_options / sizeof *limit_options) };
 
 static const CliOption *find(const CliOption *table, int count, const char *name)

@@ -2,6 +2,7 @@
 #include "lib.h"
 
 #include "../base/arena.h"
+#include "../analysis/redundant.h"
 #include "../dyn/sim.h"
 #include "../kin/run.h"
 
@@ -16,6 +17,9 @@ struct mechc_result {
     int states, cap;
     double *t, *q, *qd, *qdd, *y, *yd, *ydd, *lambda;
     bool with_lambda;
+    bool keep;              /* false: states counted and passed on, not kept */
+    RunResult run;          /* a run's statistics (lib_result_run) */
+    SimResult sim;          /* a simulation's (lib_result_sim) */
     mechc_status status;
     char message[RUN_MESSAGE_MAX];
     double t_fail;
@@ -29,10 +33,10 @@ static void grow(double **a, size_t per_state, int cap)
         *a = xrealloc(*a, (size_t)cap * per_state, sizeof **a);
 }
 
-static void keep_state(void *ctx, double t, const double *q, const double *qd,
-                       const double *qdd, const double *lambda)
+/* State number r->states into the arrays, grown as needed. */
+static void store_state(mechc_result *r, double t, const double *q, const double *qd,
+                        const double *qdd, const double *lambda)
 {
-    mechc_result *r = ctx;
     size_t nq = (size_t)r->nq, nr = (size_t)r->nr, no = (size_t)r->nout, i = (size_t)r->states;
     if (r->states == r->cap) {
         r->cap = r->cap ? 2 * r->cap : 64;
@@ -51,6 +55,14 @@ static void keep_state(void *ctx, double t, const double *q, const double *qd,
                      r->ydd + i * no);
     if (r->with_lambda && lambda)
         memcpy(r->lambda + i * nr, lambda, nr * sizeof *lambda);
+}
+
+static void keep_state(void *ctx, double t, const double *q, const double *qd,
+                       const double *qdd, const double *lambda)
+{
+    mechc_result *r = ctx;
+    if (r->keep)
+        store_state(r, t, q, qd, qdd, lambda);
     r->states++;
     if (r->on_state)
         r->on_state(r->ctx, t, q, qd, qdd, r->with_lambda ? lambda : NULL);
@@ -66,7 +78,7 @@ static mechc_result *result_new(mechc_kernels *k, bool with_lambda, mechc_state_
 {
     const Model *m = k->model->mech->model;
     mechc_result *r = xcalloc(1, sizeof *r);
-    *r = (mechc_result){.k = k, .nq = m->nq, .nr = m->nr, .nout = m->nout,
+    *r = (mechc_result){.k = k, .nq = m->nq, .nr = m->nr, .nout = m->nout, .keep = true,
                         .with_lambda = with_lambda, .on_state = fn, .ctx = ctx, .t_fail = NAN};
     return r;
 }
@@ -98,8 +110,39 @@ mechc_run_options mechc_run_defaults(void)
                                .tol = ro.mechrt.tol_phi, .max_iter = ro.mechrt.max_iter};
 }
 
-/* The options as run_analysis takes them; false when one is out of range. */
-static bool run_options(const mechc_run_options *o, RunOptions *ro)
+mechc_run_tuning mechc_run_tuning_defaults(void)
+{
+    RunOptions ro = run_default_options();
+    return (mechc_run_tuning){
+        .max_substeps = ro.max_substeps, .assembly_max_iter = ro.assembly_max_iter,
+        .pivot_tol = ro.mechrt.pivot_tol, .cond_warn = ro.mechrt.cond_warn,
+        .ode_tol = ro.ode.tol, .max_dense_entries = ro.max_dense_entries, .keep_states = 1};
+}
+
+/* tuning's part of ro; false when a value is out of range. */
+static bool run_tuning(const mechc_run_tuning *x, RunOptions *ro)
+{
+    static const char *const odes[] = {"rk8pd", "rkf45", NULL};
+    int linear = lib_name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    int ode = lib_name_index(odes, x->ode, 0);
+    if (linear < 0 || ode < 0 || x->max_substeps < 1 || x->assembly_max_iter < 1
+        || !(x->pivot_tol >= 0) || !(x->cond_warn >= 0) || !(x->ode_tol > 0)
+        || x->max_dense_entries < 0)
+        return false;
+    ro->linear = (AnalysisLinear)linear;
+    if (x->ode)
+        mechrt_ode_method_from_name(odes[ode], &ro->ode.method);
+    ro->max_substeps = x->max_substeps;
+    ro->assembly_max_iter = x->assembly_max_iter;
+    ro->mechrt.pivot_tol = x->pivot_tol;
+    ro->mechrt.cond_warn = x->cond_warn;
+    ro->ode.tol = x->ode_tol;
+    ro->max_dense_entries = x->max_dense_entries;
+    ro->notes = x->notes;
+    return true;
+}
+
+bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunOptions *ro)
 {
     *ro = run_default_options();
     if (o->steps < 0 || (o->steps > 0 && o->t0 == o->t1) || !isfinite(o->t0)
@@ -110,18 +153,24 @@ static bool run_options(const mechc_run_options *o, RunOptions *ro)
     ro->steps = o->steps;
     ro->mechrt.tol_phi = ro->mechrt.tol_dq = o->tol;
     ro->mechrt.max_iter = o->max_iter;
-    return true;
+    return !x || run_tuning(x, ro);
 }
 
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *d)
+{
+    return mechc_run_with(k, o, NULL, d);
+}
+
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *x, mechc_diag *d)
 {
     mechc_run_options defaults = mechc_run_defaults();
     if (!o)
         o = &defaults;
     RunOptions ro;
-    if (!k || !run_options(o, &ro)) {
-        lib_fail(d, MECHC_EARG, "mechc_run: steps < 0, t0 == t1, a tolerance <= 0 or "
-                 "max_iter < 1");
+    if (!k || !lib_run_options(o, x, &ro)) {
+        lib_fail(d, MECHC_EARG, "mechc_run: steps < 0, t0 == t1, a tolerance <= 0, "
+                 "max_iter < 1 or a tuning value out of range");
         return NULL;
     }
     const Model *m = k->model->mech->model;
@@ -137,14 +186,17 @@ mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag
     }
     ro.source = &k->model->diag;
     mechc_result *r = result_new(k, o->forces, o->on_state, o->ctx);
+    r->keep = !x || x->keep_states;
     MechrtKernels newton = engine_newton_kernels(&k->engine);
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
-    RunResult res;
+    RunResult *res = &r->run;
     AnalysisStatus st = o->forces
-                            ? run_analysis_forces(m, &newton, jnz, &ro, keep_state, r, &res)
-                            : run_analysis(m, &newton, jnz, &ro, keep_kinematic, r, &res);
-    return finish(r, st, res.message, res.t_fail, d);
+                            ? run_analysis_forces(m, &newton, jnz, &ro, keep_state, r, res)
+                            : run_analysis(m, &newton, jnz, &ro, keep_kinematic, r, res);
+    return finish(r, st, res->message, res->t_fail, d);
 }
+
+const RunResult *lib_result_run(const mechc_result *r) { return &r->run; }
 
 mechc_sim_options mechc_sim_defaults(void)
 {
@@ -153,17 +205,38 @@ mechc_sim_options mechc_sim_defaults(void)
                                .atol = so.atol};
 }
 
+mechc_sim_tuning mechc_sim_tuning_defaults(void)
+{
+    SimOptions so = sim_default_options();
+    return (mechc_sim_tuning){.max_steps = so.max_steps, .interpolate = so.interpolate,
+                              .baumgarte_alpha = so.dyn.baumgarte_alpha,
+                              .baumgarte_beta = so.dyn.baumgarte_beta, .keep_states = 1};
+}
+
+/* tuning's part of so; false when a value is out of range. */
+static bool sim_tuning(const mechc_sim_tuning *x, SimOptions *so)
+{
+    int linear = lib_name_index(analysis_linear_names, x->linear, ANALYSIS_LINEAR_AUTO);
+    if (linear < 0 || x->max_steps < 1 || !(x->baumgarte_alpha >= 0)
+        || !(x->baumgarte_beta >= 0) || !isfinite(x->baumgarte_alpha)
+        || !isfinite(x->baumgarte_beta))
+        return false;
+    so->linear = (AnalysisLinear)linear;
+    so->max_steps = x->max_steps;
+    so->interpolate = x->interpolate != 0;
+    so->dyn.baumgarte_alpha = x->baumgarte_alpha;
+    so->dyn.baumgarte_beta = x->baumgarte_beta;
+    so->notes = x->notes;
+    so->on_step = x->on_step;
+    so->on_step_ctx = x->step_ctx;
+    return true;
+}
+
 /* The options as sim_run takes them; false when one is out of range. */
-static bool sim_options(const mechc_sim_options *o, SimOptions *so)
+static bool sim_options(const mechc_sim_options *o, const mechc_sim_tuning *x, SimOptions *so)
 {
     *so = sim_default_options();
-    int method = 0;
-    if (o->method) {
-        method = -1;
-        for (int i = 0; sim_method_names[i]; i++)
-            if (strcmp(sim_method_names[i], o->method) == 0)
-                method = i;
-    }
+    int method = lib_name_index(sim_method_names, o->method, SIM_RK8PD);
     if (method < 0 || o->steps < 1 || o->t0 == o->t1 || !isfinite(o->t0) || !isfinite(o->t1)
         || !(o->rtol >= 0) || !(o->atol >= 0))
         return false;
@@ -174,18 +247,24 @@ static bool sim_options(const mechc_sim_options *o, SimOptions *so)
     so->atol = o->atol;
     so->method = (SimMethod)method;
     so->qd0 = o->qd0;
-    return true;
+    return !x || sim_tuning(x, so);
 }
 
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *d)
+{
+    return mechc_sim_with(k, o, NULL, d);
+}
+
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *x, mechc_diag *d)
 {
     mechc_sim_options defaults = mechc_sim_defaults();
     if (!o)
         o = &defaults;
     SimOptions so;
-    if (!k || !sim_options(o, &so)) {
-        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0 or an "
-                 "unknown method (rk8pd, rkf45, rk4imp, msbdf)");
+    if (!k || !sim_options(o, x, &so)) {
+        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0, an "
+                 "unknown method (rk8pd, rkf45, rk4imp, msbdf) or a tuning value out of range");
         return NULL;
     }
     const Model *m = k->model->mech->model;
@@ -194,18 +273,21 @@ mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag
                  "statements (with `gravity`, forces or springs)");
         return NULL;
     }
-    if (m->nh > m->nq) {
+    if (m->nh > m->nq && !redundant_applies(m)) {
         lib_fail(d, MECHC_ENOTRUNNABLE, "%d holonomic rows for %d coordinates: sim's position "
                  "projection needs at most one row per coordinate", m->nh, m->nq);
         return NULL;
     }
     so.source = &k->model->diag;
     mechc_result *r = result_new(k, true, o->on_state, o->ctx);
-    SimResult res;
+    r->keep = !x || x->keep_states;
+    SimResult *res = &r->sim;
     AnalysisStatus st = sim_run(m, engine_kernels(&k->engine), engine_jac_nz(&k->engine),
-                                engine_mass_nz(&k->engine), &so, keep_state, r, &res);
-    return finish(r, st, res.message, res.t_fail, d);
+                                engine_mass_nz(&k->engine), &so, keep_state, r, res);
+    return finish(r, st, res->message, res->t_fail, d);
 }
+
+const SimResult *lib_result_sim(const mechc_result *r) { return &r->sim; }
 
 int mechc_result_states(const mechc_result *r) { return r->states; }
 const double *mechc_result_time(const mechc_result *r) { return r->t; }

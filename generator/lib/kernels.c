@@ -12,23 +12,32 @@
    time in the process, whatever handles the threads hold. */
 static pthread_mutex_t jit_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, Diag *diag)
+static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, const EngineOptions *o,
+                        Diag *diag)
 {
     if (kind != ENGINE_JIT)
-        return engine_open(e, kind, mech, diag);
+        return engine_open_with(e, kind, mech, o, diag);
     pthread_mutex_lock(&jit_lock);
-    bool ok = engine_open(e, kind, mech, diag);
+    bool ok = engine_open_with(e, kind, mech, o, diag);
     pthread_mutex_unlock(&jit_lock);
     return ok;
 }
 
+mechc_compile_options mechc_compile_defaults(void)
+{
+    return (mechc_compile_options){.aot_fresh = engine_default_options().aot_fresh};
+}
+
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
 {
+    return mechc_compile_with(m, engine, NULL, d);
+}
+
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *d)
+{
     const char *name = engine ? engine : "jit";
-    int kind = -1;
-    for (int i = 0; i < ENGINE_KIND_COUNT; i++)
-        if (strcmp(engine_names[i], name) == 0)
-            kind = i;
+    int kind = lib_name_index(engine_names, name, -1);
     if (!m || kind < 0) {
         lib_fail(d, MECHC_EARG, m ? "unknown engine '%s': jit, aot or generic" : "no model",
                  name);
@@ -36,17 +45,17 @@ mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
     }
     mechc_kernels *k = xcalloc(1, sizeof *k);
     k->model = m;
+    EngineOptions eo = engine_default_options();
+    if (o)
+        eo.aot_fresh = o->aot_fresh != 0;
     Diag diag;
     diag_init(&diag, m->name, NULL, 0);
-    if (!open_engine(&k->engine, (EngineKind)kind, m->mech, &diag)) {
+    if (!open_engine(&k->engine, (EngineKind)kind, m->mech, &eo, &diag)) {
         lib_fail_diag(d, MECHC_ECOMPILE, &diag);
         free(k);
         return NULL;
     }
-    const Model *mo = m->mech->model;
-    outputs_init(&k->outputs, mo);
-    size_t nq = (size_t)mo->nq, nr = (size_t)mo->nr;
-    k->scratch = xcalloc(nr * nq + nq * nq + nq + (size_t)mo->nh + 2 * nr + 1, sizeof(double));
+    outputs_init(&k->outputs, m->mech->model);
     lib_batch_bind(k);
     lib_ok(d);
     return k;
@@ -76,6 +85,18 @@ mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k->model; }
 const char *mechc_kernels_source(const mechc_kernels *k)
 {
     return k->engine.compiled ? k->engine.emitted.c_text : NULL;
+}
+
+/* Room for what a call skips (NULL outputs) or gathers from: nr x nq +
+   nh + 2 nr, made at the first such call (a run of a sparse model of
+   60 000 coordinates never makes its dense Jacobian). */
+static double *scratch(mechc_kernels *k)
+{
+    if (!k->scratch) {
+        size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr;
+        k->scratch = xcalloc(nr * nq + (size_t)k->engine.nh + 2 * nr + 1, sizeof(double));
+    }
+    return k->scratch;
 }
 
 mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
@@ -123,9 +144,10 @@ mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, 
     /* generic: the dense Jacobian, gathered */
     const Kinematics *kin = &k->model->mech->kin;
     int nq = k->engine.nq;
-    engine_jac(&k->engine, q, t, k->scratch);
+    double *jac = scratch(k);
+    engine_jac(&k->engine, q, t, jac);
     for (int i = 0; i < kin->nnz; i++)
-        vals[i] = k->scratch[(size_t)kin->jac[i].row * (size_t)nq + (size_t)kin->jac[i].col];
+        vals[i] = jac[(size_t)kin->jac[i].row * (size_t)nq + (size_t)kin->jac[i].col];
     return MECHC_OK;
 }
 
@@ -154,7 +176,7 @@ mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, doub
     if (!k->engine.k.all)
         return MECHC_ENOTAVAIL;
     size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr;
-    double *s = k->scratch;     /* the outputs the caller does not want */
+    double *s = scratch(k);     /* the outputs the caller does not want */
     engine_all(&k->engine, q, qd, t, phi ? phi : s + nr * nq, jac ? jac : s,
                nu ? nu : s + nr * nq + (size_t)k->engine.nh,
                gamma ? gamma : s + nr * nq + (size_t)k->engine.nh + nr);

@@ -6,6 +6,8 @@
 
 #include "../engine/engine.h"
 #include "../kin/outputs.h"
+#include "../kin/run.h"
+#include "../dyn/sim.h"
 #include "../kin/sens.h"
 #include "../pipeline/pipeline.h"
 
@@ -41,7 +43,8 @@ struct mechc_kernels {
     mechc_model *model;
     Engine engine;
     OutputEval outputs;     /* the `output` statements, interpreted */
-    double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs) */
+    double *scratch;        /* nr * nq + nh + 2 nr: what a call skips (NULL outputs);
+                               NULL until a call needs it (kernels.c) */
     Sens sens;              /* mechc_sensitivities', made at its first call */
     int sens_state;         /* 0 not made, 1 made, -1 the model has none */
     LibBatch batch;
@@ -54,6 +57,22 @@ mechc_status lib_fail(mechc_diag *d, mechc_status status, const char *fmt, ...)
 mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from);
 /* Clears d (may be NULL): status MECHC_OK, nothing else. */
 void lib_ok(mechc_diag *d);
+/* The index of name in names (NULL-terminated); fallback when name is
+   NULL, -1 when it is none of them. */
+int lib_name_index(const char *const *names, const char *name, int fallback);
+
+/* A run's options as run_analysis takes them (x NULL: the defaults);
+   false when one is out of range. */
+bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunOptions *ro);
+/* What run_analysis said of a result made by mechc_run_with (its
+   statistics: mechc run --stats). */
+const RunResult *lib_result_run(const mechc_result *r);
+/* What sim_run said of a result made by mechc_sim_with (mechc sim --stats). */
+const SimResult *lib_result_sim(const mechc_result *r);
+
+/* The report behind a mechc_info_report (mechc info's text). */
+struct InfoReport;
+const struct InfoReport *lib_info_report(const mechc_info_report *r);
 
 /* The loops behind the batch calls (batch.c); then what the engine's
    compiled unit has of its own. */

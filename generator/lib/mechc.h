@@ -21,9 +21,10 @@
  * The first load turns GSL's error handler off (gsl_set_error_handler_off:
  * its default aborts; the library checks every status), for good.
  *
- * The library never prints and never exits on bad input or a failed
- * analysis: every failure is a status (mechc_status) and, where a
- * mechc_diag pointer is taken (it may be NULL), a message. Out of memory
+ * The library never prints (unless given a stream for the notes of a run
+ * or a simulation, mechc_run_tuning, mechc_sim_tuning) and never exits on bad input or a failed analysis:
+ * every failure is a status (mechc_status) and, where a mechc_diag
+ * pointer is taken (it may be NULL), a message. Out of memory
  * aborts the process, as the mechc command does.
  *
  * Arrays: every matrix is row-major (C order), its size given below as
@@ -40,6 +41,7 @@
 #define MECHC_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -94,6 +96,37 @@ mechc_model *mechc_load_file(const char *path, mechc_diag *diag);
    gives the mechanism's default name (its stem), NULL: "<string>". */
 mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *diag);
 void mechc_model_free(mechc_model *m);
+
+/* The limits on one input (examples/README.md, section Limits; what the
+   command's --max-... options set): each bounds the work or memory a file
+   can cause, and loading fails with MECHC_EINPUT, naming the limit, past it. */
+typedef struct mechc_limits {
+    int max_file_bytes;     /* the whole file; 4 MiB */
+    int max_line_length;    /* bytes per line; 4096 */
+    int max_name_length;    /* characters per name; 255 */
+    int max_depth;          /* expression nesting; 64 */
+    int max_expr_tokens;    /* tokens in one statement; 2000 */
+    int max_coords;         /* coordinates; 200000 */
+    int max_rows;           /* constraint rows; 200000 */
+    int max_jac_entries;    /* rows x coordinates of the dense Jacobian; 50000000
+                               (0: not checked while loading) */
+    int max_nodes;          /* expression-graph nodes, derivatives included; 2000000 */
+    int max_code_ops;       /* operations in the generated C; 4000000 */
+    const char *jac_advice; /* NULL, or what ends max_jac_entries' message: how
+                               the caller can do without the dense Jacobian */
+} mechc_limits;
+
+mechc_limits mechc_default_limits(void);
+
+/* The longest source line a diagnostic quotes, its NUL included. */
+enum { MECHC_DIAG_LINE_MAX = 4100 };
+
+/* mechc_load_file with limits (NULL: the defaults). On bad input
+   source_line (NULL, or MECHC_DIAG_LINE_MAX chars) receives the line the
+   diagnostic points into, for a caret under diag->column ("" when the
+   failure has no line): what the command prints under its message. */
+mechc_model *mechc_load_file_with(const char *path, const mechc_limits *limits,
+                                  mechc_diag *diag, char *source_line);
 
 /* ---- sizes and names (the model's; valid as long as it lives) ---- */
 
@@ -151,6 +184,18 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
    MECHC_EARG for an unknown engine, MECHC_ECOMPILE when it cannot compile. */
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
+
+/* What mechc_compile_with can change; mechc_compile_defaults() gives
+   mechc_compile's. */
+typedef struct mechc_compile_options {
+    int aot_fresh;          /* aot: compile even when the cache holds the library
+                               (to time the compiler, as `mechc bench` does); 0 */
+} mechc_compile_options;
+
+mechc_compile_options mechc_compile_defaults(void);
+/* mechc_compile with options (NULL: the defaults). */
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *diag);
 /* "jit", "aot" or "generic". */
 const char *mechc_kernels_engine(const mechc_kernels *k);
 /* Wall time of the emission plus the compilation (generic: its set-up), s. */
@@ -271,6 +316,35 @@ typedef struct mechc_run_options {
 mechc_run_options mechc_run_defaults(void);
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *diag);
 
+/* What `mechc run`'s options tune beyond mechc_run_options (mechc_run_with);
+   mechc_run_tuning_defaults() gives the command's defaults. */
+typedef struct mechc_run_tuning {
+    const char *linear;     /* "auto" (NULL), "dense" or "sparse" (KLU; jit and aot) */
+    int max_substeps;       /* a step that seems to leave its branch is redone in
+                               2, 4, 8 ... substeps, at most this many; 64 */
+    int assembly_max_iter;  /* minimum-norm Newton iterations per attempt at t0
+                               when Newton cannot start from q0; 100 */
+    double pivot_tol;       /* singular when an LU pivot <= this times the
+                               largest Jacobian entry; 1e-12 */
+    double cond_warn;       /* a note where the condition estimate exceeds it;
+                               1e10 (0: no estimate) */
+    const char *ode;        /* velocity-level rows' integrator: "rk8pd" (NULL) or "rkf45" */
+    double ode_tol;         /* its error per step; 1e-10 */
+    long long max_dense_entries; /* most rows x coordinates of a dense Jacobian the
+                               run forms; 0 (default): no limit */
+    int keep_states;        /* 1 (default): the result keeps every state; 0: only
+                               on_state sees them (mechc_result_states counts
+                               them, the arrays are NULL): a run of any length */
+    FILE *notes;            /* NULL (default): no notes; else where the run's
+                               notes and warnings go, "FILE: warning: ..." lines
+                               (the only printing the library does) */
+} mechc_run_tuning;
+
+mechc_run_tuning mechc_run_tuning_defaults(void);
+/* mechc_run with tuning (NULL: the defaults, mechc_run itself). */
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *tuning, mechc_diag *diag);
+
 /* Forward dynamics (mechc sim) of a file with masses. */
 typedef struct mechc_sim_options {
     double t0, t1;          /* 0, 1 */
@@ -284,6 +358,29 @@ typedef struct mechc_sim_options {
 
 mechc_sim_options mechc_sim_defaults(void);
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *diag);
+
+/* What `mechc sim`'s options tune beyond mechc_sim_options (mechc_sim_with);
+   mechc_sim_tuning_defaults() gives the command's defaults. */
+typedef struct mechc_sim_tuning {
+    const char *linear;     /* "auto" (NULL: sparse above 100 coordinates), "dense"
+                               or "sparse" (KLU; jit and aot) */
+    long max_steps;         /* integrator steps allowed in all; 10000000 */
+    int interpolate;        /* 1: step across the output times, the states there
+                               interpolated (degree 8 Hermite); 0 (default): a
+                               step ends at each */
+    double baumgarte_alpha, baumgarte_beta; /* gamma - 2 alpha Phi' - beta^2 Phi,
+                               1/s, >= 0; 0, 0: off (projection alone) */
+    int keep_states;        /* 1 (default) or 0, as mechc_run_tuning's */
+    FILE *notes;            /* NULL (default), or where the simulation's notes go */
+    void (*on_step)(void *ctx, double t);   /* after every accepted integrator
+                               step, with its end (progress); NULL: none */
+    void *step_ctx;         /* passed to on_step */
+} mechc_sim_tuning;
+
+mechc_sim_tuning mechc_sim_tuning_defaults(void);
+/* mechc_sim with tuning (NULL: the defaults, mechc_sim itself). */
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *tuning, mechc_diag *diag);
 
 /* What a result holds. states: how many; time (states values); q, qd, qdd
    (states x nq each); y, yd, ydd, the outputs (states x nout each; NULL
@@ -328,6 +425,39 @@ mechc_status mechc_info_at(mechc_model *m, double t, mechc_info *info, int *redu
 /* What `mechc info --json` prints, as a string to free with mechc_free;
    NULL with diag filled on failure. */
 char *mechc_info_json(mechc_model *m, mechc_diag *diag);
+
+/* What `mechc info`'s options set (mechc_info_with); mechc_info_defaults()
+   gives the command's defaults. */
+typedef struct mechc_info_options {
+    double t;               /* the time of the analysis; 0 */
+    double rank_tol;        /* singular values above it count toward the rank;
+                               negative (default): max(rows, coords) eps sigma_max */
+    int samples;            /* random states of the integrability check, >= 1; 8 */
+    const char *linear;     /* "auto" (NULL: sparse QR above 100 coordinates),
+                               "dense" (SVD) or "sparse" (SuiteSparseQR) */
+    double max_dense;       /* rows x coordinates up to which a dense SVD is
+                               allowed; 500000 ("dense" beyond it: MECHC_EARG) */
+    int follow;             /* 1: at the state the motion reaches at t, assembled at
+                               t = 0 and followed (holonomic rows only) */
+    const double *q;        /* NULL, or a state (nq) analysed as it is, at t */
+} mechc_info_options;
+
+/* The whole structure report (mechc info's), kept in a handle. */
+typedef struct mechc_info_report mechc_info_report;
+
+mechc_info_options mechc_info_defaults(void);
+/* The analysis with options (NULL: the defaults); NULL with diag filled
+   (MECHC_EARG) when the options cannot be used. A report whose assembly
+   did not converge is returned: its summary says assembled 0. */
+mechc_info_report *mechc_info_with(mechc_model *m, const mechc_info_options *o,
+                                   mechc_diag *diag);
+/* The report's counts and ranks, as mechc_info_at gives them (redundant
+   and q may be NULL). */
+mechc_status mechc_info_report_summary(const mechc_info_report *r, mechc_info *info,
+                                       int *redundant, double *q);
+/* The report as `mechc info --json` prints it; free with mechc_free. */
+char *mechc_info_report_json(const mechc_info_report *r);
+void mechc_info_report_free(mechc_info_report *r);
 
 #ifdef __cplusplus
 }

@@ -29,6 +29,16 @@ const char *mechc_status_text(mechc_status status)
 
 void mechc_free(void *p) { free(p); }
 
+int lib_name_index(const char *const *names, const char *name, int fallback)
+{
+    if (!name)
+        return fallback;
+    for (int i = 0; names[i]; i++)
+        if (strcmp(names[i], name) == 0)
+            return i;
+    return -1;
+}
+
 void lib_ok(mechc_diag *d)
 {
     if (d)
@@ -70,19 +80,59 @@ mechc_status lib_fail_diag(mechc_diag *d, mechc_status status, const Diag *from)
 static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
 static void gsl_quiet(void) { gsl_set_error_handler_off(); }
 
-/* pipeline_load or pipeline_load_text into a new model; NULL with d filled. */
-static mechc_model *load(const char *path, const char *text, const char *name, mechc_diag *d)
+_Static_assert((int)MECHC_DIAG_LINE_MAX == (int)DIAG_LINE_MAX, "mechc_diag's source line is Diag's");
+
+mechc_limits mechc_default_limits(void)
+{
+    MechLimits l = mech_default_limits();
+    return (mechc_limits){
+        .max_file_bytes = l.max_file_bytes, .max_line_length = l.max_line_length,
+        .max_name_length = l.max_name_length, .max_depth = l.max_depth,
+        .max_expr_tokens = l.max_expr_tokens, .max_coords = l.max_coords,
+        .max_rows = l.max_rows, .max_jac_entries = l.max_jac_entries,
+        .max_nodes = l.max_nodes, .max_code_ops = l.max_code_ops, .jac_advice = l.jac_advice};
+}
+
+static MechLimits mech_limits(const mechc_limits *l)
+{
+    return (MechLimits){
+        .max_file_bytes = l->max_file_bytes, .max_line_length = l->max_line_length,
+        .max_name_length = l->max_name_length, .max_depth = l->max_depth,
+        .max_expr_tokens = l->max_expr_tokens, .max_coords = l->max_coords,
+        .max_rows = l->max_rows, .max_jac_entries = l->max_jac_entries,
+        .max_nodes = l->max_nodes, .max_code_ops = l->max_code_ops, .jac_advice = l->jac_advice};
+}
+
+/* Every limit within what the command's --max-... options accept
+   (max_jac_entries 0 too: not checked while loading). */
+static bool limits_valid(const mechc_limits *given)
+{
+    mechc_limits l = *given;
+    if (l.max_jac_entries == 0)
+        l.max_jac_entries = 1;
+#define IN_RANGE(field, option, lo, hi) &&l.field >= (lo) && l.field <= (hi)
+    return true MECH_LIMIT_RANGES(IN_RANGE);
+#undef IN_RANGE
+}
+
+/* pipeline_load or pipeline_load_text into a new model; NULL with d (and
+   source_line, when given) filled. */
+static mechc_model *load(const char *path, const char *text, const char *name,
+                         const mechc_limits *l, mechc_diag *d, char *source_line)
 {
     pthread_once(&gsl_once, gsl_quiet);
     mechc_model *m = xcalloc(1, sizeof *m);
     const char *given = path ? path : name;
     size_t len = strlen(given) + 1;
     m->name = memcpy(xmalloc(len), given, len);
-    MechLimits limits = mech_default_limits();
+    mechc_limits defaults = mechc_default_limits();
+    MechLimits limits = mech_limits(l ? l : &defaults);
     m->mech = path ? pipeline_load(m->name, &limits, &m->diag)
                    : pipeline_load_text(text, m->name, &limits, &m->diag);
     if (!m->mech) {
         lib_fail_diag(d, MECHC_EINPUT, &m->diag);
+        if (source_line && m->diag.has_pos)
+            snprintf(source_line, MECHC_DIAG_LINE_MAX, "%s", m->diag.source_line);
         free(m->name);
         free(m);
         return NULL;
@@ -93,11 +143,24 @@ static mechc_model *load(const char *path, const char *text, const char *name, m
 
 mechc_model *mechc_load_file(const char *path, mechc_diag *d)
 {
+    return mechc_load_file_with(path, NULL, d, NULL);
+}
+
+mechc_model *mechc_load_file_with(const char *path, const mechc_limits *limits, mechc_diag *d,
+                                  char *source_line)
+{
+    if (source_line)
+        source_line[0] = '\0';
     if (!path) {
         lib_fail(d, MECHC_EARG, "mechc_load_file: no path");
         return NULL;
     }
-    return load(path, NULL, NULL, d);
+    if (limits && !limits_valid(limits)) {
+        lib_fail(d, MECHC_EARG, "mechc_load_file_with: a limit out of its range "
+                 "(examples/README.md, Limits)");
+        return NULL;
+    }
+    return load(path, NULL, NULL, limits, d, source_line);
 }
 
 mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *d)
@@ -106,7 +169,7 @@ mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *d
         lib_fail(d, MECHC_EARG, "mechc_load_string: no text");
         return NULL;
     }
-    return load(NULL, text, name ? name : "<string>", d);
+    return load(NULL, text, name ? name : "<string>", NULL, d, NULL);
 }
 
 void mechc_model_free(mechc_model *m)

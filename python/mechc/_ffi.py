@@ -40,6 +40,24 @@ mechc_model *mechc_load_file(const char *path, mechc_diag *diag);
 mechc_model *mechc_load_string(const char *text, const char *name, mechc_diag *diag);
 void mechc_model_free(mechc_model *m);
 
+typedef struct mechc_limits {
+    int max_file_bytes;
+    int max_line_length;
+    int max_name_length;
+    int max_depth;
+    int max_expr_tokens;
+    int max_coords;
+    int max_rows;
+    int max_jac_entries;
+    int max_nodes;
+    int max_code_ops;
+    const char *jac_advice;
+} mechc_limits;
+
+mechc_limits mechc_default_limits(void);
+mechc_model *mechc_load_file_with(const char *path, const mechc_limits *limits,
+                                  mechc_diag *diag, char *source_line);
+
 int mechc_nq(const mechc_model *m);
 int mechc_nh(const mechc_model *m);
 int mechc_nv(const mechc_model *m);
@@ -65,6 +83,14 @@ mechc_status mechc_set_design_vector(mechc_model *m, const double *p);
 
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *diag);
 void mechc_kernels_free(mechc_kernels *k);
+
+typedef struct mechc_compile_options {
+    int aot_fresh;
+} mechc_compile_options;
+
+mechc_compile_options mechc_compile_defaults(void);
+mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
+                                  const mechc_compile_options *o, mechc_diag *diag);
 const char *mechc_kernels_engine(const mechc_kernels *k);
 double mechc_kernels_compile_seconds(const mechc_kernels *k);
 const char *mechc_kernels_source(const mechc_kernels *k);
@@ -124,6 +150,23 @@ typedef struct mechc_run_options {
 mechc_run_options mechc_run_defaults(void);
 mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag *diag);
 
+typedef struct mechc_run_tuning {
+    const char *linear;
+    int max_substeps;
+    int assembly_max_iter;
+    double pivot_tol;
+    double cond_warn;
+    const char *ode;
+    double ode_tol;
+    long long max_dense_entries;
+    int keep_states;
+    FILE *notes;
+} mechc_run_tuning;
+
+mechc_run_tuning mechc_run_tuning_defaults(void);
+mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
+                             const mechc_run_tuning *tuning, mechc_diag *diag);
+
 typedef struct mechc_sim_options {
     double t0, t1;
     int steps;
@@ -135,6 +178,21 @@ typedef struct mechc_sim_options {
 } mechc_sim_options;
 mechc_sim_options mechc_sim_defaults(void);
 mechc_result *mechc_sim(mechc_kernels *k, const mechc_sim_options *o, mechc_diag *diag);
+
+typedef struct mechc_sim_tuning {
+    const char *linear;
+    long max_steps;
+    int interpolate;
+    double baumgarte_alpha, baumgarte_beta;
+    int keep_states;
+    FILE *notes;
+    void (*on_step)(void *ctx, double t);
+    void *step_ctx;
+} mechc_sim_tuning;
+
+mechc_sim_tuning mechc_sim_tuning_defaults(void);
+mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
+                             const mechc_sim_tuning *tuning, mechc_diag *diag);
 
 int mechc_result_states(const mechc_result *r);
 const double *mechc_result_time(const mechc_result *r);
@@ -151,6 +209,24 @@ double mechc_result_t_fail(const mechc_result *r);
 void mechc_result_free(mechc_result *r);
 
 char *mechc_info_json(mechc_model *m, mechc_diag *diag);
+
+typedef struct mechc_info_options {
+    double t;
+    double rank_tol;
+    int samples;
+    const char *linear;
+    double max_dense;
+    int follow;
+    const double *q;
+} mechc_info_options;
+
+typedef struct mechc_info_report mechc_info_report;
+
+mechc_info_options mechc_info_defaults(void);
+mechc_info_report *mechc_info_with(mechc_model *m, const mechc_info_options *o,
+                                   mechc_diag *diag);
+char *mechc_info_report_json(const mechc_info_report *r);
+void mechc_info_report_free(mechc_info_report *r);
 """
 
 ffi = cffi.FFI()
