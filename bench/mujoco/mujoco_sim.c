@@ -41,6 +41,13 @@ static double cpu_ms(void)
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
+/* MuJoCo's own handler prints to stdout and appends to MUJOCO_LOG.TXT in
+   the working directory: stderr instead. */
+static void warn_stderr(const char *msg)
+{
+    fprintf(stderr, "mujoco_sim: MuJoCo: %s\n", msg);
+}
+
 static int usage(const char *why)
 {
     fprintf(stderr, "mujoco_sim: %s\n"
@@ -175,6 +182,7 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &a))
         return 2;
     char err[1000] = "";
+    mju_user_warning = warn_stderr;
     double t0 = cpu_ms();
     mjModel *m = mj_loadXML(a.model, NULL, err, sizeof err);
     if (!m) {
