@@ -94,6 +94,7 @@ help:
 	@echo "make fuzz FUZZ_SECONDS=N  fuzz the front end with libFuzzer (clang)"
 	@echo "make firmware-check  the firmware example on emulated Cortex-M3/M4F boards (QEMU)"
 	@echo "make bench      time the engines side by side (bench/run), written files (bench/written.sh), run's scaling (bench/scaling.sh), rolled against straight-line code (bench/roll.sh), against SymPy (bench/sympy_time.sh), forward dynamics (bench/dynamics.sh), batch kernels against single calls (bench/batch.sh), the Python module (bench/python.sh)"
+	@echo "make bench-mujoco  mechc sim against MuJoCo's C API on A01, A02 and Andrews (bench/mujoco.sh; installs libmujoco-dev)"
 	@echo "make install    install mechc, libmechc and the Python module under \$$PREFIX (\$$DESTDIR honoured)"
 
 deps:
@@ -269,6 +270,14 @@ bench: deps
 	$(Q)sh bench/design.sh $(MECHC)
 	$(Q)sh bench/batch.sh $(MECHC)
 	$(Q)sh bench/python.sh $(MECHC)
+
+# MuJoCo (Debian's libmujoco-dev) is the bench's own dependency: neither
+# the build nor a test needs it.
+.PHONY: bench-mujoco
+bench-mujoco: deps
+	$(Q)sh .ci/deps bench
+	$(Q)$(MAKE) --no-print-directory $(MECHC)
+	$(Q)sh bench/mujoco.sh $(MECHC)
 
 # The library: include/mechc/mechc.h, lib/libmechc.a and .so, and
 # lib/pkgconfig/mechc.pc for `cc prog.c $$(pkg-config --cflags --libs mechc)`
