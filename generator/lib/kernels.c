@@ -12,8 +12,16 @@
    time in the process, whatever handles the threads hold. */
 static pthread_mutex_t jit_lock = PTHREAD_MUTEX_INITIALIZER;
 
+/* The aot engine's unit comes with the batch kernels (gen --batch), which
+   cc -O2 vectorises and the batch calls use (batch.c); libtcc does not
+   vectorise, so the jit's would only lengthen its compile. */
 static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, Diag *diag)
 {
+    if (kind == ENGINE_AOT) {
+        EngineOptions opt = engine_default_options();
+        opt.batch = true;
+        return engine_open_with(e, kind, mech, &opt, diag);
+    }
     if (kind != ENGINE_JIT)
         return engine_open(e, kind, mech, diag);
     pthread_mutex_lock(&jit_lock);
