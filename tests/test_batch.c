@@ -1,4 +1,4 @@
-/* test_batch.c - the batch kernels (PREFIX_NAME_batch, _batch_soa) give, bit for bit, what n single-state calls give.
+/* test_batch.c - batch kernels (P_NAME_batch, _batch_soa) give, bit for bit, what single calls give.
  *
  * For the four-bar, the Stewart platform (spatial, functions in several
  * parts), the N = 10 chain, Freudenstein's design file (p read through the

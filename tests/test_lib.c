@@ -155,7 +155,8 @@ static void check_batches(const char *engine)
         for (int r = 0; r < 81; r++)
             assert_true(jac[i * 81 + r] == j1[r]);
         for (int r = 0; r < 9; r++)
-            assert_true(phi[i * 9 + r] == p1[r] && nu[i * 9 + r] == n1[r] && g2[i * 9 + r] == g1[r]);
+            assert_true(phi[i * 9 + r] == p1[r] && nu[i * 9 + r] == n1[r]
+                        && g2[i * 9 + r] == g1[r]);
     }
     assert_int_equal(mechc_all_batch(k, N, q, qd, t, 1, phi, jac, NULL, NULL), MECHC_OK);
     assert_int_equal(mechc_phi_batch(k, N, q, t, N, phi), MECHC_OK);

@@ -349,7 +349,8 @@ static void put_blocks(Emitter *e, const SchedFunction *fn, EmitFunction which,
     for (const Param *p = params; p->name; p++)
         dense |= strcmp(p->name, "jac") == 0;
     if (dense && layout == LAYOUT_COLS)
-        sb_printf(sb, "    if (n > 0)\n        memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ * (unsigned)n);\n", pre, pu, pu);
+        sb_printf(sb, "    if (n > 0)\n        memset(jac, 0, sizeof(%s_real) * %s_NR * %s_NQ "
+                  "* (unsigned)n);\n", pre, pu, pu);
     sb_printf(sb, "    for (b = 0; b + %s_LANES <= n; b += %s_LANES) {\n", pu, pu);
     put_gather(sb, e, used, in, layout);
     if (dense && layout == LAYOUT_ROWS)
@@ -364,7 +365,8 @@ static void put_blocks(Emitter *e, const SchedFunction *fn, EmitFunction which,
     sb_puts(sb, "        if (ok[0]");
     for (int l = 1; l < BATCH_LANES; l++)
         sb_printf(sb, " * ok[%d]", l);
-    sb_printf(sb, " == 0)\n            for (l = 0; l < %s_LANES; l++)\n                if (ok[l] == 0)\n", pu);
+    sb_printf(sb, " == 0)\n            for (l = 0; l < %s_LANES; l++)\n"
+              "                if (ok[l] == 0)\n", pu);
     put_one(sb, e, which, params, layout, "b + l", "                    ");
     sb_puts(sb, "    }\n    for (; b < n; b++)\n");
     put_one(sb, e, which, params, layout, "b", "        ");

@@ -223,8 +223,10 @@ static void hash_machine(Hash *h)
 {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
     char features[8] = {
-        (char)('0' + !!__builtin_cpu_supports("sse4.2")), (char)('0' + !!__builtin_cpu_supports("avx")),
-        (char)('0' + !!__builtin_cpu_supports("avx2")), (char)('0' + !!__builtin_cpu_supports("fma")),
+        (char)('0' + !!__builtin_cpu_supports("sse4.2")),
+        (char)('0' + !!__builtin_cpu_supports("avx")),
+        (char)('0' + !!__builtin_cpu_supports("avx2")),
+        (char)('0' + !!__builtin_cpu_supports("fma")),
         (char)('0' + !!__builtin_cpu_supports("avx512f")), 0};
     hash_bytes(h, features, strlen(features));
 #else
