@@ -11,10 +11,12 @@
 # machine has; ISO C, so no FMA contraction: the batch equals the single
 # calls to the bit) and by gcc -std=c99 -O2 (what the aot engine builds,
 # SSE2 on x86-64). bench/batch_time.c times 10^6 evaluations of each kernel
-# over STATES states (default 1000): one m_NAME_batch call per round against
-# STATES calls of m_NAME, alternating, median of REPEAT (default 7) CPU
-# times, and prints ns per evaluation and the ratio single / batch (above 1:
-# the batch is faster). It exits 1 when the outputs differ. POSIX sh.
+# over STATES states (default 1000): STATES calls of m_NAME on rows, one
+# m_NAME_batch call on the same rows, one m_NAME_batch_soa call on the
+# states by coordinate, in turn, REPEAT (default 7) CPU times each, and
+# prints ns per evaluation (minimum and median) and the ratios single /
+# batch by minima (above 1: the batch is faster). It exits 1 when the
+# outputs differ. POSIX sh.
 set -u
 mechc=${1:-build/mechc}
 repeat=${REPEAT:-7}
@@ -35,8 +37,8 @@ ext=$(gcc -march=native -Q --help=target 2>/dev/null |
 # define NAME HEADER: the value of #define M_NAME in HEADER
 define() { sed -n "s/^#define M_$1 *\([0-9]*\).*/\1/p" "$2"; }
 
-printf 'batch kernels against single calls: 10^6 evaluations over %s states, ns per\n' "$states"
-printf 'evaluation (median of %s alternating rounds); -march=native here: %s\n\n' "$repeat" "$ext"
+printf 'batch kernels against single calls: 10^6 evaluations over %s states, %s rounds\n' "$states" "$repeat"
+printf 'in turn; -march=native here: %s\n\n' "$ext"
 status=0
 for entry in "four_bar:$root/examples/four_bar.mech" "chain_10:$tmp/chain_10.mech"; do
     name=${entry%%:*}

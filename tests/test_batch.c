@@ -1,4 +1,4 @@
-/* test_batch.c - the batch kernels (PREFIX_NAME_batch) give, bit for bit, what n single-state calls give.
+/* test_batch.c - batch kernels (P_NAME_batch, _batch_soa) give, bit for bit, what single calls give.
  *
  * For the four-bar, the Stewart platform (spatial, functions in several
  * parts), the N = 10 chain, Freudenstein's design file (p read through the
@@ -7,7 +7,9 @@
  * past 2^16 rad, which the file's own sincos leaves to libm (the lane is
  * then evaluated again by the single-state kernel), through the aot
  * engine (cc -O2, the written file's own sin/cos inlined and vectorised)
- * and the JIT (libtcc). The AOT cache goes to a private folder.
+ * and the JIT (libtcc), with the arrays by rows (_batch) and by
+ * coordinate (_batch_soa: the same states transposed, the outputs read
+ * transposed). The AOT cache goes to a private folder.
  */
 #include "testutil.h"
 #include "testcache.h"
@@ -38,11 +40,19 @@ static int teardown(void **state)
 }
 
 /* N states around q0: q, qd (N x nq) and t (N); state 13's first
-   coordinate 1e6, past the own sincos' range when it is an angle. */
+   coordinate 1e6, past the own sincos' range when it is an angle. q_soa
+   and qd_soa hold them by coordinate (nq x N), the inputs of _batch_soa;
+   soa says which a check is of. */
 typedef struct States {
     int nq;
     double *q, *qd, t[N];
+    double *q_soa, *qd_soa;
+    bool soa;
 } States;
+
+/* The batch kernels' q and qd: by rows or by coordinate. */
+static const double *q_in(const States *s) { return s->soa ? s->q_soa : s->q; }
+static const double *qd_in(const States *s) { return s->soa ? s->qd_soa : s->qd; }
 
 static States make_states(const Mech *mech)
 {
@@ -60,6 +70,13 @@ static States make_states(const Mech *mech)
     }
     for (int j = 0; j < m->nq; j++)
         s.q[13 * m->nq + j] = 1e6 + j;
+    s.q_soa = xcalloc((size_t)N * m->nq + 1, sizeof(double));
+    s.qd_soa = xcalloc((size_t)N * m->nq + 1, sizeof(double));
+    for (int i = 0; i < N; i++)
+        for (int j = 0; j < m->nq; j++) {
+            s.q_soa[j * N + i] = s.q[i * m->nq + j];
+            s.qd_soa[j * N + i] = s.qd[i * m->nq + j];
+        }
     return s;
 }
 
@@ -67,6 +84,8 @@ static void free_states(States *s)
 {
     free(s->q);
     free(s->qd);
+    free(s->q_soa);
+    free(s->qd_soa);
 }
 
 /* Output arrays of one function for N states, batch and single. */
@@ -86,14 +105,18 @@ static Outs make_outs(size_t a, size_t b, size_t c, size_t d)
     return o;
 }
 
-/* Batch and single agree to the bit, and hold numbers (not the fill). */
-static void check_outs(Outs *o, const char *what)
+/* Batch (by coordinate where soa) and single agree to the bit, and hold
+   numbers (not the fill). */
+static void check_outs(Outs *o, const char *what, bool soa)
 {
     for (int i = 0; i < 4; i++) {
-        for (size_t k = 0; k < N * o->size[i]; k++)
-            if (memcmp(&o->batch[i][k], &o->single[i][k], sizeof(double)) != 0)
-                fail_msg("%s: output %d entry %zu (state %zu): batch %.17g, single %.17g", what, i,
-                         k, k / o->size[i], o->batch[i][k], o->single[i][k]);
+        for (size_t k = 0; k < N * o->size[i]; k++) {
+            size_t state = k / o->size[i], entry = k % o->size[i];
+            const double *b = &o->batch[i][soa ? entry * N + state : k];
+            if (memcmp(b, &o->single[i][k], sizeof(double)) != 0)
+                fail_msg("%s%s: output %d entry %zu (state %zu): batch %.17g, single %.17g", what,
+                         soa ? " (soa)" : "", i, entry, state, *b, o->single[i][k]);
+        }
         free(o->batch[i]);
         free(o->single[i]);
     }
@@ -105,19 +128,19 @@ static void check_phi_like(KernelPhiBatch batch, KernelPhi single, const States 
     if (!batch)
         fail_msg("%s: no batch kernel", what);
     Outs o = make_outs(size, 0, 0, 0);
-    batch(N, s->q, s->t, o.batch[0]);
+    batch(N, q_in(s), s->t, o.batch[0]);
     for (int i = 0; i < N; i++)
         single(s->q + i * s->nq, s->t[i], o.single[0] + i * size);
-    check_outs(&o, what);
+    check_outs(&o, what, s->soa);
 }
 
-static void check_gamma(const Kernels *k, const States *s, size_t nr)
+static void check_gamma(KernelGammaBatch batch, const Kernels *k, const States *s, size_t nr)
 {
     Outs o = make_outs(nr, 0, 0, 0);
-    k->batch.gamma(N, s->q, s->qd, s->t, o.batch[0]);
+    batch(N, q_in(s), qd_in(s), s->t, o.batch[0]);
     for (int i = 0; i < N; i++)
         k->gamma(s->q + i * s->nq, s->qd + i * s->nq, s->t[i], o.single[0] + i * nr);
-    check_outs(&o, "gamma");
+    check_outs(&o, "gamma", s->soa);
 }
 
 /* all (dense) or all_nz (jac_size the nonzeros). */
@@ -127,35 +150,44 @@ static void check_all(KernelAllBatch batch, KernelAll single, const States *s, s
     if (!batch)
         fail_msg("%s: no batch kernel", what);
     Outs o = make_outs(nh, jac_size, nr, nr);
-    batch(N, s->q, s->qd, s->t, o.batch[0], o.batch[1], o.batch[2], o.batch[3]);
+    batch(N, q_in(s), qd_in(s), s->t, o.batch[0], o.batch[1], o.batch[2], o.batch[3]);
     for (int i = 0; i < N; i++)
         single(s->q + i * s->nq, s->qd + i * s->nq, s->t[i], o.single[0] + i * nh,
                o.single[1] + i * jac_size, o.single[2] + i * nr, o.single[3] + i * nr);
-    check_outs(&o, what);
+    check_outs(&o, what, s->soa);
+}
+
+/* Every batch kernel of one layout (b) against the single kernels. */
+static void check_layout(const Engine *e, const BatchKernels *b, const States *s)
+{
+    assert_non_null(b);
+    const Kernels *k = &e->kernels;
+    const Model *m = e->mech->model;
+    size_t nh = (size_t)m->nh, nr = (size_t)m->nr, nnz = (size_t)(e->mech->kin.nnz > 0 ? e->mech->kin.nnz : 1);
+    check_phi_like(b->phi, k->phi, s, nh, "phi");
+    check_phi_like(b->jac_nz, k->jac_nz, s, nnz, "jac_nz");
+    check_phi_like(b->nu, k->nu, s, nr, "nu");
+    check_gamma(b->gamma, k, s, nr);
+    if (k->all) {
+        check_phi_like(b->jac, k->jac, s, nr * (size_t)m->nq, "jac");
+        check_all(b->all, k->all, s, nh, nr * (size_t)m->nq, nr, "all");
+    } else {
+        assert_null(b->jac);
+        assert_null(b->all);
+    }
+    if (k->all_nz)
+        check_all(b->all_nz, k->all_nz, s, nh, nnz, nr, "all_nz");
 }
 
 /* Every batch kernel the engine has against its single kernels. */
 static void check_engine(const Engine *e)
 {
     const BatchKernels *b = engine_batch(e);
-    assert_non_null(b);
-    const Kernels *k = &e->kernels;
-    const Model *m = e->mech->model;
-    size_t nh = (size_t)m->nh, nr = (size_t)m->nr, nnz = (size_t)(e->mech->kin.nnz > 0 ? e->mech->kin.nnz : 1);
+    size_t nr = (size_t)e->mech->model->nr;
     States s = make_states(e->mech);
-    check_phi_like(b->phi, k->phi, &s, nh, "phi");
-    check_phi_like(b->jac_nz, k->jac_nz, &s, nnz, "jac_nz");
-    check_phi_like(b->nu, k->nu, &s, nr, "nu");
-    check_gamma(k, &s, nr);
-    if (k->all) {
-        check_phi_like(b->jac, k->jac, &s, nr * (size_t)m->nq, "jac");
-        check_all(b->all, k->all, &s, nh, nr * (size_t)m->nq, nr, "all");
-    } else {
-        assert_null(b->jac);
-        assert_null(b->all);
-    }
-    if (k->all_nz)
-        check_all(b->all_nz, k->all_nz, &s, nh, nnz, nr, "all_nz");
+    check_layout(e, b, &s);
+    s.soa = true;
+    check_layout(e, engine_batch_soa(e), &s);
     /* a real value: the batch's gamma of state 0 is the model's (finite) */
     double *g = xcalloc(N * nr + 1, sizeof(double));
     b->gamma(N, s.q, s.qd, s.t, g);
@@ -219,6 +251,7 @@ static void test_absent(void **state)
         if (!engine_open(&e, (EngineKind)kind, mech, &diag))
             fail_msg("%s: %s", engine_names[kind], diag.message);
         assert_null(engine_batch(&e));
+        assert_null(engine_batch_soa(&e));
         engine_close(&e);
     }
     EngineOptions opt = engine_default_options();

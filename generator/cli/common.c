@@ -52,8 +52,12 @@ void cli_error(const Args *a, const Diag *diag)
 mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
                            const mechc_compile_options *o)
 {
+    /* The commands call no batch kernel: their aot units stay as small
+       (and as quick to compile) as gen's. */
+    mechc_compile_options co = o ? *o : mechc_compile_defaults();
+    co.batch = 0;
     mechc_diag d;
-    mechc_kernels *k = mechc_compile_with(model, engine_names[kind], o, &d);
+    mechc_kernels *k = mechc_compile_with(model, engine_names[kind], &co, &d);
     if (!k)
         fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
     return k;

@@ -157,9 +157,10 @@ static bool write_file(const char *path, const char *text)
 }
 
 /* Compiles source into lib (via a temporary name). */
-static bool build(const char *dir, const char *hex, const char *source, const char *lib, Diag *diag)
+static bool build(const char *dir, const char *hex, const char *source, const char *lib,
+                  bool batch, Diag *diag)
 {
-    char cc_buf[1024], *argv[AOT_MAX_WORDS + 16];
+    char cc_buf[1024], *argv[AOT_MAX_WORDS + 19];
     int n = compiler_words(cc_buf, sizeof cc_buf, argv);
     if (n == 0) {
         diag_error_nopos(diag, "the aot engine needs a C compiler: CC is blank");
@@ -175,8 +176,10 @@ static bool build(const char *dir, const char *hex, const char *source, const ch
         unlink(src);
         return false;
     }
-    char flags[] = AOT_FLAGS;
+    char flags[] = AOT_FLAGS, batch_flags[] = AOT_BATCH_FLAGS;
     n = split_words(flags, argv, n, AOT_MAX_WORDS + 10);
+    if (batch)
+        n = split_words(batch_flags, argv, n, AOT_MAX_WORDS + 13);
     char opt_o[] = "-o", opt_lm[] = "-lm";
     argv[n++] = opt_o;
     argv[n++] = tmp;
@@ -214,7 +217,30 @@ struct Aot {
     Kernels kernels;
 };
 
+/* The vector extensions of this machine (x86: what -march=native may
+   use), for the batch units' cache key. */
+static void hash_machine(Hash *h)
+{
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    char features[8] = {
+        (char)('0' + !!__builtin_cpu_supports("sse4.2")),
+        (char)('0' + !!__builtin_cpu_supports("avx")),
+        (char)('0' + !!__builtin_cpu_supports("avx2")),
+        (char)('0' + !!__builtin_cpu_supports("fma")),
+        (char)('0' + !!__builtin_cpu_supports("avx512f")), 0};
+    hash_bytes(h, features, strlen(features));
+#else
+    (void)h;
+#endif
+}
+
 Aot *aot_load(const char *source, const char *prefix, bool fresh, AotResult *out, Diag *diag)
+{
+    return aot_load_with(source, prefix, fresh, false, out, diag);
+}
+
+Aot *aot_load_with(const char *source, const char *prefix, bool fresh, bool batch, AotResult *out,
+                   Diag *diag)
 {
     memset(out, 0, sizeof *out);
     double t0 = pipeline_now();
@@ -228,12 +254,16 @@ Aot *aot_load(const char *source, const char *prefix, bool fresh, AotResult *out
     for (int i = 0; i < n; i++)
         hash_bytes(&h, words[i], strlen(words[i]));
     hash_bytes(&h, AOT_FLAGS, strlen(AOT_FLAGS));
+    if (batch) {
+        hash_bytes(&h, AOT_BATCH_FLAGS, strlen(AOT_BATCH_FLAGS));
+        hash_machine(&h);
+    }
     char hex[40];
     snprintf(hex, sizeof hex, "%016llx%016llx", (unsigned long long)h.a, (unsigned long long)h.b);
     snprintf(out->path, sizeof out->path, "%s/%s.so", dir, hex);
 
     out->cached = !fresh && access(out->path, R_OK) == 0;
-    if (!out->cached && !build(dir, hex, source, out->path, diag))
+    if (!out->cached && !build(dir, hex, source, out->path, batch, diag))
         return NULL;
     void *handle = dlopen(out->path, RTLD_NOW | RTLD_LOCAL);
     if (!handle) {

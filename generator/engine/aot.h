@@ -10,6 +10,14 @@
 /* The compiler command ($CC split at blanks, default "cc") and the flags
    every library is built with. */
 #define AOT_FLAGS "-O2 -fPIC -shared"
+/* Added for a unit with batch kernels (EngineOptions.batch): the vector
+   instructions of this machine, which its lane loops need to gain (doc/
+   batch.md), and no contraction into FMA, so that its kernels give the
+   bits of the plain build; no basic-block vectorisation either, where
+   GCC 12 makes FMA (vfmsubadd) of add/sub pairs whatever -ffp-contract
+   says (the Stewart platform's single all). The cache key then holds this
+   machine's vector extensions too. */
+#define AOT_BATCH_FLAGS "-march=native -ffp-contract=off -fno-tree-slp-vectorize"
 
 /* A loaded library and its kernels; the kernel pointers die with it. */
 typedef struct Aot Aot;
@@ -29,6 +37,9 @@ typedef struct AotResult {
    diag filled when no compiler is found, it fails, or the library cannot
    be loaded. */
 Aot *aot_load(const char *source, const char *prefix, bool fresh, AotResult *out, Diag *diag);
+/* The same with AOT_BATCH_FLAGS added where batch. */
+Aot *aot_load_with(const char *source, const char *prefix, bool fresh, bool batch, AotResult *out,
+                   Diag *diag);
 const Kernels *aot_kernels(const Aot *aot);
 void aot_unload(Aot *aot);
 

@@ -194,7 +194,8 @@ static bool open_aot(Engine *e, const Mech *mech, const EngineOptions *opt, Diag
         return false;
     e->gen_seconds = pipeline_now() - t0;
     AotResult res;
-    e->aot = aot_load(e->emitted.c_text, e->emitted.prefix, opt->aot_fresh, &res, diag);
+    e->aot = aot_load_with(e->emitted.c_text, e->emitted.prefix, opt->aot_fresh, opt->batch, &res,
+                           diag);
     if (!e->aot)
         return false;
     bind_code(e, aot_kernels(e->aot));

@@ -189,6 +189,13 @@ static inline const BatchKernels *engine_batch(const Engine *e)
     return e->compiled && e->kernels.batch.gamma ? &e->kernels.batch : NULL;
 }
 
+/* The same kernels over arrays by coordinate (q[j * n + i], the outputs
+   alike: PREFIX_NAME_batch_soa). */
+static inline const BatchKernels *engine_batch_soa(const Engine *e)
+{
+    return e->compiled && e->kernels.batch_soa.gamma ? &e->kernels.batch_soa : NULL;
+}
+
 static inline const MechrtHostMassNz *engine_mass_nz(const Engine *e)
 {
     return e->mass_nz.mass_nz ? &e->mass_nz : NULL;

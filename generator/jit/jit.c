@@ -73,16 +73,18 @@ static void *kernel(KernelFind find, void *handle, const char *prefix, const cha
     return find(handle, symbol);
 }
 
-/* The unit's batch kernels (optional: NULL where absent). */
-static void bind_batch(BatchKernels *b, KernelFind find, void *handle, const char *prefix)
+/* The unit's batch kernels NAME + suffix (optional: NULL where absent). */
+static void bind_batch(BatchKernels *b, KernelFind find, void *handle, const char *prefix,
+                       const char *suffix)
 {
-    *(void **)&b->phi = kernel(find, handle, prefix, "phi_batch");
-    *(void **)&b->jac = kernel(find, handle, prefix, "jac_batch");
-    *(void **)&b->jac_nz = kernel(find, handle, prefix, "jac_nz_batch");
-    *(void **)&b->nu = kernel(find, handle, prefix, "nu_batch");
-    *(void **)&b->gamma = kernel(find, handle, prefix, "gamma_batch");
-    *(void **)&b->all = kernel(find, handle, prefix, "all_batch");
-    *(void **)&b->all_nz = kernel(find, handle, prefix, "all_nz_batch");
+    void **slots[] = {(void **)&b->phi, (void **)&b->jac, (void **)&b->jac_nz, (void **)&b->nu,
+                      (void **)&b->gamma, (void **)&b->all, (void **)&b->all_nz};
+    static const char *const names[] = {"phi", "jac", "jac_nz", "nu", "gamma", "all", "all_nz"};
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "%s%s", names[i], suffix);
+        *slots[i] = kernel(find, handle, prefix, name);
+    }
 }
 
 bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
@@ -102,7 +104,8 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
 #include "../emit/functions.def"
 #undef X
     }
-    bind_batch(&k->batch, find, handle, prefix);
+    bind_batch(&k->batch, find, handle, prefix, "_batch");
+    bind_batch(&k->batch_soa, find, handle, prefix, "_batch_soa");
     k->jac_row = kernel(find, handle, prefix, "jac_row");
     k->jac_col = kernel(find, handle, prefix, "jac_col");
     k->mass_row = kernel(find, handle, prefix, "mass_row");

@@ -24,14 +24,16 @@ typedef void (*KernelEom)(const double *q, const double *qd, double t,
 
 /* The batch kernels (EmitOptions.batch, generator/emit/batch.c): the
    kernel at n states, q and qd n x NQ, t n values, each output n rows of
-   its single-state size, all row-major; bit for bit n single calls. */
+   its single-state size, all row-major (PREFIX_NAME_batch), or the same
+   arrays by coordinate, q[j * n + i] (PREFIX_NAME_batch_soa); bit for
+   bit n single calls. */
 typedef void (*KernelPhiBatch)(int n, const double *q, const double *t, double *out);
 typedef void (*KernelGammaBatch)(int n, const double *q, const double *qd, const double *t,
                                  double *gamma);
 typedef void (*KernelAllBatch)(int n, const double *q, const double *qd, const double *t,
                                double *phi, double *jac, double *nu, double *gamma);
 
-/* A unit's PREFIX_NAME_batch, NULL where it has none: all of them
+/* A unit's PREFIX_NAME_batch (or _batch_soa), NULL where it has none: all of them
    without EmitOptions.batch, jac and all in a sparse-only unit, all_nz
    without EmitOptions.all_nz. */
 typedef struct BatchKernels {
@@ -61,6 +63,7 @@ typedef struct Kernels {
        functions read p from; NULL otherwise */
     void (*design_bind)(const double *p);
     BatchKernels batch;     /* PREFIX_NAME_batch, where compiled */
+    BatchKernels batch_soa; /* PREFIX_NAME_batch_soa, where compiled */
 } Kernels;
 
 /* Looks a symbol up in a compiled unit (tcc_get_symbol, dlsym). */

@@ -1,9 +1,12 @@
 /* batch.c - libmechc's batch calls: a kernel over n states, each call through one slot of LibBatch.
  *
  * Every slot starts as a loop over the engine's single-state kernel. The
- * generated batch kernels (P_*_batch, issue 29 part 3) plug in at
- * lib_batch_bind: where the compiled unit has one, its slot calls it
- * instead, and the public functions below do not change.
+ * generated batch kernels (P_*_batch, generator/emit/batch.c) plug in at
+ * lib_batch_bind: where the compiled unit has them (the aot engine's,
+ * kernels.c), phi, jac, nu, gamma and all call them instead, in runs of
+ * at most BATCH_RUN states (their n is an int; one time for all states
+ * goes in as BATCH_RUN copies), and the public functions below do not
+ * change. The batch kernels give the single kernels' bits.
  */
 #include "lib.h"
 
@@ -76,11 +79,98 @@ static void loop_all(mechc_kernels *k, size_t n, const double *q, const double *
                   at(jac, i, nr * nq), at(nu, i, nr), at(gamma, i, nr));
 }
 
+enum { BATCH_RUN = 256 };
+
+/* The times of the run of m states from state i: t's own, or copies of
+   its one value (filled once, by fill_copies). */
+static const double *run_times(const double *t, size_t nt, size_t i, const double *copies)
+{
+    return nt == 1 ? copies : t + i;
+}
+
+static void fill_copies(const double *t, size_t nt, double copies[BATCH_RUN])
+{
+    for (size_t j = 0; nt == 1 && j < BATCH_RUN; j++)
+        copies[j] = t[0];
+}
+
+static size_t run_length(size_t n, size_t i) { return n - i < BATCH_RUN ? n - i : BATCH_RUN; }
+
+/* phi, jac or nu (size per state) through the unit's batch kernel f. */
+static void kernel_phi_like(KernelPhiBatch f, size_t size, mechc_kernels *k, size_t n,
+                            const double *q, const double *t, size_t nt, double *out)
+{
+    size_t nq = (size_t)k->engine.nq;
+    double copies[BATCH_RUN];
+    fill_copies(t, nt, copies);
+    for (size_t i = 0; i < n; i += BATCH_RUN)
+        f((int)run_length(n, i), q + i * nq, run_times(t, nt, i, copies), out + i * size);
+}
+
+static void kernel_phi(mechc_kernels *k, size_t n, const double *q, const double *t, size_t nt,
+                       double *out)
+{
+    kernel_phi_like(engine_batch(&k->engine)->phi, (size_t)k->engine.nh, k, n, q, t, nt, out);
+}
+
+static void kernel_jac(mechc_kernels *k, size_t n, const double *q, const double *t, size_t nt,
+                       double *out)
+{
+    size_t size = (size_t)k->engine.nr * (size_t)k->engine.nq;
+    kernel_phi_like(engine_batch(&k->engine)->jac, size, k, n, q, t, nt, out);
+}
+
+static void kernel_nu(mechc_kernels *k, size_t n, const double *q, const double *t, size_t nt,
+                      double *out)
+{
+    kernel_phi_like(engine_batch(&k->engine)->nu, (size_t)k->engine.nr, k, n, q, t, nt, out);
+}
+
+static void kernel_gamma(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                         const double *t, size_t nt, double *out)
+{
+    const BatchKernels *b = engine_batch(&k->engine);
+    size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr;
+    double copies[BATCH_RUN];
+    fill_copies(t, nt, copies);
+    for (size_t i = 0; i < n; i += BATCH_RUN)
+        b->gamma((int)run_length(n, i), q + i * nq, qd + i * nq, run_times(t, nt, i, copies),
+                 out + i * nr);
+}
+
+/* all with every output given; a NULL one (skipped) goes state by state. */
+static void kernel_all(mechc_kernels *k, size_t n, const double *q, const double *qd,
+                       const double *t, size_t nt, double *phi, double *jac, double *nu,
+                       double *gamma)
+{
+    if (!phi || !jac || !nu || !gamma) {
+        loop_all(k, n, q, qd, t, nt, phi, jac, nu, gamma);
+        return;
+    }
+    const BatchKernels *b = engine_batch(&k->engine);
+    size_t nq = (size_t)k->engine.nq, nr = (size_t)k->engine.nr, nh = (size_t)k->engine.nh;
+    double copies[BATCH_RUN];
+    fill_copies(t, nt, copies);
+    for (size_t i = 0; i < n; i += BATCH_RUN)
+        b->all((int)run_length(n, i), q + i * nq, qd + i * nq, run_times(t, nt, i, copies),
+               phi + i * nh, jac + i * nr * nq, nu + i * nr, gamma + i * nr);
+}
+
 void lib_batch_bind(mechc_kernels *k)
 {
     k->batch = (LibBatch){.phi = loop_phi, .jac = loop_jac, .nu = loop_nu,
                           .gamma = loop_gamma, .force = loop_force, .all = loop_all,
                           .mass = loop_mass};
+    const BatchKernels *b = engine_batch(&k->engine);
+    if (!b)
+        return;
+    k->batch.phi = kernel_phi;
+    k->batch.nu = kernel_nu;
+    k->batch.gamma = kernel_gamma;
+    if (b->jac)
+        k->batch.jac = kernel_jac;
+    if (b->all)
+        k->batch.all = kernel_all;
 }
 
 /* The checks every batch call makes: arrays given (n > 0), nt 1 or n. */

@@ -25,7 +25,7 @@ static bool open_engine(Engine *e, EngineKind kind, const Mech *mech, const Engi
 
 mechc_compile_options mechc_compile_defaults(void)
 {
-    return (mechc_compile_options){.aot_fresh = engine_default_options().aot_fresh};
+    return (mechc_compile_options){.aot_fresh = engine_default_options().aot_fresh, .batch = 1};
 }
 
 mechc_kernels *mechc_compile(mechc_model *m, const char *engine, mechc_diag *d)
@@ -46,8 +46,11 @@ mechc_kernels *mechc_compile_with(mechc_model *m, const char *engine,
     mechc_kernels *k = xcalloc(1, sizeof *k);
     k->model = m;
     EngineOptions eo = engine_default_options();
-    if (o)
-        eo.aot_fresh = o->aot_fresh != 0;
+    mechc_compile_options co = o ? *o : mechc_compile_defaults();
+    eo.aot_fresh = co.aot_fresh != 0;
+    /* cc vectorises the batch kernels (batch.c calls them); libtcc does
+       not, so the jit's would only lengthen its compile. */
+    eo.batch = kind == ENGINE_AOT && co.batch != 0;
     Diag diag;
     diag_init(&diag, m->name, NULL, 0);
     if (!open_engine(&k->engine, (EngineKind)kind, m->mech, &eo, &diag)) {

@@ -190,6 +190,9 @@ void mechc_kernels_free(mechc_kernels *k);
 typedef struct mechc_compile_options {
     int aot_fresh;          /* aot: compile even when the cache holds the library
                                (to time the compiler, as `mechc bench` does); 0 */
+    int batch;              /* aot: the unit also holds the batch kernels (gen
+                               --batch, built with the machine's vector
+                               extensions), which the *_batch calls use; 1 */
 } mechc_compile_options;
 
 mechc_compile_options mechc_compile_defaults(void);

@@ -86,6 +86,7 @@ void mechc_kernels_free(mechc_kernels *k);
 
 typedef struct mechc_compile_options {
     int aot_fresh;
+    int batch;
 } mechc_compile_options;
 
 mechc_compile_options mechc_compile_defaults(void);
