@@ -420,8 +420,10 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
 }
 
 /* The run over one period at the model's design, Newton to 1e-12, on the
-   dense path; on the sparse one (KLU, the sensitivities' too) with sparse. */
-static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse)
+   dense path; on the sparse one (KLU, the sensitivities' too) with sparse;
+   lending its LU to lend when that is not NULL. */
+static void run_motion_lending(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse,
+                               RunLu *lend)
 {
     const Model *m = mech->model;
     memset(mo, 0, sizeof *mo);
@@ -439,11 +441,17 @@ static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, b
     o.linear = sparse ? ANALYSIS_LINEAR_SPARSE : ANALYSIS_LINEAR_DENSE;
     if (sparse && sens)
         assert_true(sens_use_sparse(sens, engine_jac_nz(e)));
+    o.lend_lu = lend;
     RunResult res;
     if (run_analysis(m, engine_kernels(e), engine_jac_nz(e), &o, on_state, mo, &res) != ANALYSIS_OK)
         fail_msg("run: %s", res.message);
     assert_int_equal(mo->n, STEPS + 1);
     outputs_free(&mo->oe);
+}
+
+static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse)
+{
+    run_motion_lending(mech, e, sens, mo, sparse, NULL);
 }
 
 static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
@@ -574,6 +582,45 @@ static void test_sensitivities_sparse(void **s)
     (void)s;
     check_sparse_sensitivities(planar_text, "fbd.mech");
     check_sparse_sensitivities(spatial_axis_text, "rssr_axes.mech");
+}
+
+/* With the run's LU lent (RunOptions.lend_lu, as run --sens does) the
+   sensitivities solve with it at every state, and they are those of
+   sens's own LU bit for bit: the pattern LU replays lu.c's. */
+static void check_borrowed_lu(const char *text, const char *name)
+{
+    Mech *mech = load_text(text, name);
+    Model *m = mech->model;
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_JIT, mech));
+    Sens own, borrowing;
+    char why[256];
+    assert_true(sens_init(&own, m, &mech->kin, &e, why, sizeof why));
+    assert_true(sens_init(&borrowing, m, &mech->kin, &e, why, sizeof why));
+    RunLu lent = {0};
+    sens_borrow_lu(&borrowing, &lent);
+    Motion a, b;
+    run_motion(mech, &e, &own, &a);
+    run_motion_lending(mech, &e, &borrowing, &b, false, &lent);
+    assert_int_equal(own.borrowed_count, 0);
+    assert_int_equal(borrowing.borrowed_count, STEPS + 1);
+    assert_null(lent.lup);      /* the run took it back */
+    assert_memory_equal(a.x, b.x, (size_t)(STEPS + 1) * 3 * (size_t)a.nv * sizeof *a.x);
+    for (size_t i = 0; i < (size_t)(STEPS + 1) * (size_t)a.ncol; i++)
+        if (!(a.cols[i] == b.cols[i]))
+            fail_msg("%s: column value %zu: borrowed %.17g, own %.17g", name, i, b.cols[i],
+                     a.cols[i]);
+    motion_free(&a), motion_free(&b);
+    sens_free(&own), sens_free(&borrowing);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+static void test_sensitivities_borrowed_lu(void **s)
+{
+    (void)s;
+    check_borrowed_lu(planar_text, "fbd.mech");
+    check_borrowed_lu(spatial_text, "rssr_design.mech");
 }
 
 /* The CSV names: d(NAME)/d(P), d(d(NAME))/d(P), d(dd(NAME))/d(P), in
@@ -815,6 +862,7 @@ int main(void)
         cmocka_unit_test(test_sensitivities_spatial_axes),
         cmocka_unit_test(test_sensitivity_column_names),
         cmocka_unit_test(test_sensitivities_sparse),
+        cmocka_unit_test(test_sensitivities_borrowed_lu),
         cmocka_unit_test(test_designed_masses_planar),
         cmocka_unit_test(test_designed_masses_spatial),
         cmocka_unit_test(test_check_designed),
