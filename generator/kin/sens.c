@@ -4,7 +4,9 @@
  * (the generated PREFIX_phi_p, _sens_v, _sens_g, _sens_y, or the graph
  * interpreted by the generic engine), and the sensitivities of all design
  * parameters at once are products and solves with one LU of Phi_q (dense,
- * or KLU on the sparse path):
+ * or KLU on the sparse path, where Phi_p comes on its nonzeros,
+ * PREFIX_phi_p_nz; the dense path solves with the run's own LU of Phi_q
+ * wherever the run lends it, sens_borrow_lu):
  *
  *   Q_p   = -Phi_q^-1 Phi_p
  *   Qd_p  = -Phi_q^-1 (V_q Q_p + V_p)                          V at qd
@@ -86,6 +88,7 @@ bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *
         s->g[k] = xcalloc(k == 2 ? qp : qq, sizeof(double));
     s->work = xcalloc(qp + yp, sizeof(double));
     collect_nonzeros(s, kin);
+    s->p_nz = kin->design.p_nz, s->p_nnz = kin->design.p_nnz;
     return true;
 }
 
@@ -94,8 +97,10 @@ bool sens_use_sparse(Sens *s, const MechrtHostJacNz *jnz)
     s->klu = jnz ? mechrt_host_sparse_new(s->nq, jnz) : NULL;
     if (!s->klu)
         return false;
-    free(s->jac), free(s->piv);     /* nq x nq: not needed */
+    /* nq x nq and nh x np: not needed; Phi_p comes on its nonzeros */
+    free(s->jac), free(s->piv), free(s->phi_p);
     s->jac = s->piv = NULL;
+    s->phi_p = xcalloc((size_t)(s->p_nnz > 0 ? s->p_nnz : 1), sizeof *s->phi_p);
     return true;
 }
 
@@ -240,13 +245,28 @@ static MechrtStatus factor(Sens *s, double t, const double *q)
         return MECHRT_OK;
     }
     if (s->klu) {
-        engine_phi_p(s->e, q, t, s->phi_p);
+        double *const nz[DESIGN_Y_COUNT] = {s->phi_p};
+        engine_design(s->e, DESIGN_PHI_P_NZ, q, NULL, t, nz);
         mechrt_host_sparse_eval(s->klu, q, t);
         return mechrt_host_sparse_factor(s->klu, tol);
     }
     engine_jac(s->e, q, t, s->jac);
     engine_phi_p(s->e, q, t, s->phi_p);
     return mechrt_lu_factor(n, s->jac, n, s->piv, tol, NULL);
+}
+
+/* q_p = -Phi_p: from the dense Phi_p, or on the sparse path from its
+   nonzeros (the zeros then +0, not -0). */
+static void positions_rhs(Sens *s)
+{
+    size_t len = (size_t)s->nq * (size_t)s->np;
+    if (!s->klu) {
+        set_scaled(s->q_p, -1.0, s->phi_p, len);
+        return;
+    }
+    memset(s->q_p, 0, len * sizeof *s->q_p);
+    for (int e = 0; e < s->p_nnz; e++)
+        s->q_p[(size_t)s->p_nz[e].row * (size_t)s->np + (size_t)s->p_nz[e].col] = -s->phi_p[e];
 }
 
 /* The outputs' sensitivities from the coordinates' (y partials taken). */
@@ -291,7 +311,7 @@ MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, con
     partials_at(s, AT_QD, q, qd, t);
     partials_at(s, AT_QD_QDD, q, both, t);
     engine_design(s->e, DESIGN_G, q, qd, t, s->g);
-    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    positions_rhs(s);
     solve_columns(s, s->q_p);
     set_scaled(s->qd_p, -1.0, s->v[AT_QD][1], len);
     add_product_nz(s, NZ_V, s->qd_p, -1.0, s->v[AT_QD][0], s->q_p);
@@ -314,8 +334,7 @@ MechrtStatus sens_eval_positions(Sens *s, double t, const double *q)
     MechrtStatus st = factor(s, t, q);
     if (st != MECHRT_OK)
         return st;
-    size_t len = (size_t)s->nq * (size_t)s->np;
-    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    positions_rhs(s);
     solve_columns(s, s->q_p);
     if (s->nout) {
         memset(s->work, 0, (size_t)s->nq * sizeof *s->work);

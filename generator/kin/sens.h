@@ -30,7 +30,9 @@ typedef struct Sens {
     double *y_p, *yd_p, *ydd_p;     /* nout x np: the outputs' */
     /* the rest is sens.c's: Phi_q's LU, Phi_p, the engine's partials at
        qd and qd + qdd (V's and the outputs'), gamma's, scratch */
-    double *jac, *piv, *phi_p, *col, *work;
+    double *jac, *piv, *phi_p, *col, *work;    /* phi_p: on its nonzeros with klu */
+    const JacEntry *p_nz;       /* Phi_p's pattern (p_nnz entries) */
+    int p_nnz;
     double *v[2][2];
     double *y[2][DESIGN_Y_COUNT];
     double *g[3];
