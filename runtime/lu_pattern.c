@@ -559,6 +559,56 @@ void mechrt_lup_solve(const MechrtLup *f, const mechrt_real *b, mechrt_real *x)
     }
 }
 
+/* mechrt_lup_solve on every column of b, the columns innermost: each
+   column's operations and their order are mechrt_lup_solve's, and the
+   columns' chains (a division per row in the back substitution) overlap
+   instead of following one another. */
+void mechrt_lup_solve_many(const MechrtLup *f, mechrt_real *b, int ldb, int nrhs,
+                           mechrt_real *work)
+{
+    const mechrt_real *lu = f->lu;
+    const int *p, *end;
+    size_t lb = (size_t)ldb, m = (size_t)nrhs;
+    int n = f->n, i, c;
+
+    if (f->dense_now) {
+        mechrt_lu_solve_many(n, f->dense, n, f->piv, b, ldb, nrhs);
+        return;
+    }
+    if (f->gen_now) {
+        for (c = 0; c < nrhs; c++) {
+            for (i = 0; i < n; i++)
+                work[i] = b[(size_t)i * lb + (size_t)c];
+            f->gen->solve(f->gen->ctx, f->dense, work, work);
+            for (i = 0; i < n; i++)
+                b[(size_t)i * lb + (size_t)c] = work[i];
+        }
+        return;
+    }
+    for (i = 0; i < n; i++)
+        for (c = 0; c < nrhs; c++)
+            work[(size_t)i * m + (size_t)c] = b[(size_t)f->prow[i] * lb + (size_t)c];
+    for (p = f->fwd, end = p + 3 * f->nfwd; p < end; p += 3) {
+        mechrt_real l = lu[p[1]], *yi = work + (size_t)p[0] * m;
+        const mechrt_real *yj = work + (size_t)p[2] * m;
+        for (c = 0; c < nrhs; c++)
+            yi[c] -= l * yj[c];
+    }
+    for (i = n - 1, p = f->bwd; i >= 0; i--) {
+        mechrt_real u = lu[p[0]], *xi = b + (size_t)i * lb, *yi = work + (size_t)i * m;
+        int cnt = p[1];
+        const int *q = p + 2;
+        for (c = 0; c < nrhs; c++) {
+            mechrt_real s = yi[c];
+            int k;
+            for (k = 0; k < cnt; k++)
+                s -= lu[q[2 * k]] * b[(size_t)q[2 * k + 1] * lb + (size_t)c];
+            xi[c] = s / u;
+        }
+        p = q + 2 * cnt;
+    }
+}
+
 /* analysis.c's an_pivot_spread, over the pivots in step order. */
 mechrt_real mechrt_lup_spread(const MechrtLup *f)
 {

@@ -92,9 +92,8 @@ typedef enum MechrtStatus {
 
 /* MECHRT_DEFINE_DESIGN_KERNELS(fb, FB) does the same for a file with design
    parameters (`design NAME = value`), whose functions take p: the wrappers
-   pass ctx as p, and `fb_design_kernels(p)` returns the MechrtKernels of
-   the design p (FB_NP values; fb_p0 is the file's), which must outlive
-   them. */
+   pass ctx as p, and `fb_design_kernels(p)` returns the MechrtKernels of the
+   design p (FB_NP values; fb_p0 is the file's), which must outlive them. */
 #define MECHRT_DEFINE_DESIGN_KERNELS(p, P)                                       \
     static void p##_mechrt_phi(void *ctx, const mechrt_real *q, mechrt_real t,   \
                                mechrt_real *out)                                 \
@@ -223,6 +222,7 @@ typedef enum MechrtStatus {
 #define mechrt_lup_values            mechrtf_lup_values
 #define mechrt_lup_factor_dense      mechrtf_lup_factor_dense
 #define mechrt_lup_solve             mechrtf_lup_solve
+#define mechrt_lup_solve_many        mechrtf_lup_solve_many
 #define mechrt_lup_spread            mechrtf_lup_spread
 #define mechrt_lup_norm1             mechrtf_lup_norm1
 #define mechrt_lup_cond1             mechrtf_lup_cond1
@@ -438,8 +438,8 @@ mechrt_real mechrt_lu_cond1(int n, const mechrt_real *lu, int lda, const mechrt_
 MechrtStatus mechrt_residual_inf(const mechrt_real *phi, int nh, mechrt_real *residual,
                                  int *worst_row);
 
-/* Binds the state to q (updated in place) and the workspace; evaluates Phi
-   and Phi_q at q. */
+/* Binds the state to q (updated in place) and the workspace; evaluates
+   Phi and Phi_q at q. */
 MechrtStatus mechrt_newton_init(MechrtNewton *s, const MechrtKernels *k,
                                 const MechrtOptions *opts, mechrt_real *q, mechrt_real t,
                                 mechrt_real *work, size_t lwork);
@@ -642,8 +642,8 @@ typedef struct MechrtLuGen {
    recorded (on the integer workspace) and replayed by the later ones over
    the nonzeros only, as long as partial pivoting would choose the same
    pivots; otherwise that factorisation is the dense one again, and its
-   order is recorded. The state is the
-   caller's; its fields are for reading (counts, tests). */
+   order is recorded. The state is the caller's; its fields are for
+   reading (counts, tests). */
 typedef struct MechrtLup {
     int n, nnz;
     const int *row, *col;   /* the pattern, kept by pointer */
@@ -685,27 +685,25 @@ typedef struct MechrtJacNz {
 size_t mechrt_lup_work_size(int n);
 size_t mechrt_lup_iwork_size(int n);
 
-/* Binds f to the pattern (nnz entries, checked: in range, none repeated)
-   and the workspaces; nothing recorded yet. MECHRT_EINVAL on a bad
-   pattern, MECHRT_EBADLEN when lwork < MECHRT_LUP_WORK_LEN(n) or liwork <
-   n*n + 6n. */
+/* Binds f to the pattern (nnz entries, checked: in range, none repeated) and
+   the workspaces; nothing recorded yet. MECHRT_EINVAL on a bad pattern,
+   MECHRT_EBADLEN when lwork < MECHRT_LUP_WORK_LEN(n) or liwork < n*n + 6n. */
 MechrtStatus mechrt_lup_init(MechrtLup *f, int n, int nnz, const int *row, const int *col,
                              mechrt_real *work, size_t lwork, int *iwork, size_t liwork);
 
-/* Makes mechrt_lup_factor try gen first (NULL: no longer): where its
-   checks pass its factors serve the solves, elsewhere the pattern LU
-   factors as before. Results then agree with partial pivoting's to
-   rounding, not bit for bit. MECHRT_EINVAL when gen's functions are
-   missing or its nslots exceed n*n. */
+/* Makes mechrt_lup_factor try gen first (NULL: no longer): where its checks
+   pass its factors serve the solves, elsewhere the pattern LU factors as
+   before. Results then agree with partial pivoting's to rounding, not bit
+   for bit. MECHRT_EINVAL when gen's functions are missing or its nslots
+   exceed n*n. */
 MechrtStatus mechrt_lup_use(MechrtLup *f, const MechrtLuGen *gen);
 
 /* Where the pattern's values go (nnz reals, entry e at e) before
    mechrt_lup_factor, which consumes them. */
 mechrt_real *mechrt_lup_values(MechrtLup *f);
 
-/* Factors the matrix whose pattern values are in mechrt_lup_values(f):
-   status, *sing_index and factors those of mechrt_lu_factor on the dense
-   matrix. sing_index may be NULL. */
+/* Factors the matrix whose pattern values are in mechrt_lup_values(f): status,
+   *sing_index (may be NULL) and factors mechrt_lu_factor's on the dense one. */
 MechrtStatus mechrt_lup_factor(MechrtLup *f, mechrt_real pivot_tol, int *sing_index);
 
 /* The same from a dense row-major matrix (left unchanged), zero outside
@@ -715,6 +713,10 @@ MechrtStatus mechrt_lup_factor_dense(MechrtLup *f, const mechrt_real *a, int lda
 
 /* x = A^-1 b with the last successful factorisation; x may be b. */
 void mechrt_lup_solve(const MechrtLup *f, const mechrt_real *b, mechrt_real *x);
+/* The same for the nrhs columns of B at once (n x nrhs, row-major, leading
+   dimension ldb, overwritten by X), mechrt_lup_solve's bits; work: n*nrhs. */
+void mechrt_lup_solve_many(const MechrtLup *f, mechrt_real *b, int ldb, int nrhs,
+                           mechrt_real *work);
 
 /* max|u_kk| / min|u_kk| of the last successful factorisation: the
    condition estimate's screen (analysis.c's). */

@@ -85,6 +85,16 @@ check "chain 20 --sens auto: sensitivities by KLU" \
 check "chain 20 --sens: the columns are there" \
     sh -c "head -1 '$tmp/cs.a.csv' | grep -q ',d(dd(rod20.phi))/d(gx)'"
 check "chain 20 --sens: sparse equals dense to 1e-9" same_csv "$tmp/cs.d.csv" "$tmp/cs.a.csv" 1e-9
+# the dense path solves with the run's own LU at every state (a pattern LU
+# up to ANALYSIS_DENSE_MAX_NQ coordinates), the sparse path with KLU's
+run "$ex/freudenstein.mech" --steps 10 --sens --csv "$tmp/fr.d.csv" --stats
+check "freudenstein --sens: the run's LU at every state" err_has "reused at 11 of 11"
+check "freudenstein --sens: the ratio less the clock() span" err_has "run --sens costs"
+run "$ex/freudenstein.mech" --steps 10 --sens --linear sparse --csv "$tmp/fr.s.csv" --stats
+check "freudenstein --sens sparse: KLU's own" err_has "(KLU of Phi_q): "
+check "freudenstein --sens sparse: no run's LU" err_has "reused at 0 of 11"
+check "freudenstein --sens: sparse (phi_p_nz) equals dense to 1e-12" \
+    same_csv "$tmp/fr.d.csv" "$tmp/fr.s.csv" 1e-12
 
 # ---- refusals ------------------------------------------------------------------
 run "$ex/slider_crank.mech" --linear banded

@@ -246,6 +246,10 @@ static void test_emit_design_file(void **s)
     assert_non_null(strstr(res.c_text, "void fbd_phi_p(const fbd_real *q, fbd_real t, "
                                        "const fbd_real *p, fbd_real *phi_p)"));
     assert_non_null(strstr(res.c_text, "fbd_p0[FBD_NP]"));
+    assert_non_null(strstr(res.c_text, "void fbd_phi_p_nz(const fbd_real *q, fbd_real t, "
+                                       "const fbd_real *p, fbd_real *vals)"));
+    assert_non_null(strstr(res.c_text, "const int fbd_phi_p_row[FBD_PNNZ] = {"));
+    assert_non_null(strstr(res.h_text, "#define FBD_PNNZ 17"));
     assert_non_null(strstr(res.c_text, "fbd_design_names[FBD_NP]"));
     assert_null(strstr(res.c_text, "design_bind"));    /* the engines' twins only */
     emit_result_free(&res);
@@ -262,6 +266,12 @@ static void test_emit_design_file(void **s)
         fail_msg("jit_compile: %s", diag.message);
     const Kernels *k = jit_kernels(jit);
     assert_non_null(k->design_bind);
+    assert_non_null(k->phi_p_nz);
+    const DesignKin *dk = &mech->kin.design;
+    for (int i = 0; i < dk->p_nnz; i++) {
+        assert_int_equal(k->phi_p_row[i], dk->p_nz[i].row);
+        assert_int_equal(k->phi_p_col[i], dk->p_nz[i].col);
+    }
     /* at a design of its own, the unit's phi is the generic engine's */
     const Model *m = mech->model;
     assert_int_equal(m->np, 8);
@@ -309,8 +319,34 @@ static void test_emit_file_without_design(void **s)
 
 /* ---- engines ------------------------------------------------------------ */
 
+/* Engine e's phi_p_nz at (q, t) against the dense dense (nh x np): the
+   same values on the pattern, which is row-major, strictly increasing and
+   holds every nonzero of dense. */
+static void check_phi_p_nz(const Engine *e, const Mech *mech, const double *q, double t,
+                           const double *dense)
+{
+    const Model *m = mech->model;
+    const DesignKin *dk = &mech->kin.design;
+    double *nz = xcalloc((size_t)dk->p_nnz + 1, sizeof *nz);
+    double *const out[DESIGN_Y_COUNT] = {nz};
+    engine_design(e, DESIGN_PHI_P_NZ, q, NULL, t, out);
+    size_t np = (size_t)m->np, at = 0, nonzero = 0;
+    for (int k = 0; k < dk->p_nnz; k++) {
+        size_t i = (size_t)dk->p_nz[k].row * np + (size_t)dk->p_nz[k].col;
+        assert_true(k == 0 || i > at);
+        at = i;
+        assert_near(nz[k], dense[i], 0, 1e-12);
+    }
+    for (size_t i = 0; i < (size_t)m->nh * np; i++)
+        nonzero += dense[i] != 0.0;
+    assert_true(nonzero <= (size_t)dk->p_nnz);
+    assert_true(nonzero > 0);
+    free(nz);
+}
+
 /* Phi and Phi_p of every engine at a design set after they were opened,
-   the same to 1e-12; Phi_p the central difference of Phi (1e-7). */
+   the same to 1e-12; Phi_p the central difference of Phi (1e-7); the
+   nonzeros' phi_p_nz Phi_p's. */
 static void check_engines(const char *text, const char *name, const double *dp)
 {
     Mech *mech = load_text(text, name);
@@ -342,6 +378,7 @@ static void check_engines(const char *text, const char *name, const double *dp)
             assert_near(phi[r], phi0[r], 0, 1e-12);
         for (size_t i = 0; i < nhp; i++)
             assert_near(phi_p[i], ref_p[i], 0, 1e-12);
+        check_phi_p_nz(&e[k], mech, q, t, ref_p);
     }
     for (int j = 0; j < np; j++) {
         double h = 1e-5 * fmax(1.0, fabs(p[j])), pj = p[j];
@@ -420,8 +457,10 @@ static void on_state(void *ctx, double t, const double *q, const double *qd, con
 }
 
 /* The run over one period at the model's design, Newton to 1e-12, on the
-   dense path; on the sparse one (KLU, the sensitivities' too) with sparse. */
-static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse)
+   dense path; on the sparse one (KLU, the sensitivities' too) with sparse;
+   lending its LU to lend when that is not NULL. */
+static void run_motion_lending(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse,
+                               RunLu *lend)
 {
     const Model *m = mech->model;
     memset(mo, 0, sizeof *mo);
@@ -439,11 +478,17 @@ static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, b
     o.linear = sparse ? ANALYSIS_LINEAR_SPARSE : ANALYSIS_LINEAR_DENSE;
     if (sparse && sens)
         assert_true(sens_use_sparse(sens, engine_jac_nz(e)));
+    o.lend_lu = lend;
     RunResult res;
     if (run_analysis(m, engine_kernels(e), engine_jac_nz(e), &o, on_state, mo, &res) != ANALYSIS_OK)
         fail_msg("run: %s", res.message);
     assert_int_equal(mo->n, STEPS + 1);
     outputs_free(&mo->oe);
+}
+
+static void run_motion_on(Mech *mech, const Engine *e, Sens *sens, Motion *mo, bool sparse)
+{
+    run_motion_lending(mech, e, sens, mo, sparse, NULL);
 }
 
 static void run_motion(Mech *mech, const Engine *e, Sens *sens, Motion *mo)
@@ -574,6 +619,45 @@ static void test_sensitivities_sparse(void **s)
     (void)s;
     check_sparse_sensitivities(planar_text, "fbd.mech");
     check_sparse_sensitivities(spatial_axis_text, "rssr_axes.mech");
+}
+
+/* With the run's LU lent (RunOptions.lend_lu, as run --sens does) the
+   sensitivities solve with it at every state, and they are those of
+   sens's own LU bit for bit: the pattern LU replays lu.c's. */
+static void check_borrowed_lu(const char *text, const char *name)
+{
+    Mech *mech = load_text(text, name);
+    Model *m = mech->model;
+    Engine e;
+    assert_true(open_kind(&e, ENGINE_JIT, mech));
+    Sens own, borrowing;
+    char why[256];
+    assert_true(sens_init(&own, m, &mech->kin, &e, why, sizeof why));
+    assert_true(sens_init(&borrowing, m, &mech->kin, &e, why, sizeof why));
+    RunLu lent = {0};
+    sens_borrow_lu(&borrowing, &lent);
+    Motion a, b;
+    run_motion(mech, &e, &own, &a);
+    run_motion_lending(mech, &e, &borrowing, &b, false, &lent);
+    assert_int_equal(own.borrowed_count, 0);
+    assert_int_equal(borrowing.borrowed_count, STEPS + 1);
+    assert_null(lent.lup);      /* the run took it back */
+    assert_memory_equal(a.x, b.x, (size_t)(STEPS + 1) * 3 * (size_t)a.nv * sizeof *a.x);
+    for (size_t i = 0; i < (size_t)(STEPS + 1) * (size_t)a.ncol; i++)
+        if (!(a.cols[i] == b.cols[i]))
+            fail_msg("%s: column value %zu: borrowed %.17g, own %.17g", name, i, b.cols[i],
+                     a.cols[i]);
+    motion_free(&a), motion_free(&b);
+    sens_free(&own), sens_free(&borrowing);
+    engine_close(&e);
+    pipeline_free(mech);
+}
+
+static void test_sensitivities_borrowed_lu(void **s)
+{
+    (void)s;
+    check_borrowed_lu(planar_text, "fbd.mech");
+    check_borrowed_lu(spatial_text, "rssr_design.mech");
 }
 
 /* The CSV names: d(NAME)/d(P), d(d(NAME))/d(P), d(dd(NAME))/d(P), in
@@ -815,6 +899,7 @@ int main(void)
         cmocka_unit_test(test_sensitivities_spatial_axes),
         cmocka_unit_test(test_sensitivity_column_names),
         cmocka_unit_test(test_sensitivities_sparse),
+        cmocka_unit_test(test_sensitivities_borrowed_lu),
         cmocka_unit_test(test_designed_masses_planar),
         cmocka_unit_test(test_designed_masses_spatial),
         cmocka_unit_test(test_check_designed),

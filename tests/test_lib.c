@@ -357,6 +357,8 @@ static void errors(void **state)
     double M[81], q[9] = {0};
     assert_int_equal(mechc_mass(k, q, M), MECHC_ENOTAVAIL);
     assert_int_equal(mechc_phi_p(k, q, 0, M), MECHC_ENOTAVAIL);
+    assert_int_equal(mechc_phi_p_nz(k), 0);
+    assert_int_equal(mechc_phi_p_values(k, q, 0, M), MECHC_ENOTAVAIL);
     assert_int_equal(mechc_phi(k, NULL, 0, M), MECHC_EARG);
     assert_null(mechc_sim(k, NULL, &d));
     assert_int_equal(d.status, MECHC_ENOTRUNNABLE);
@@ -522,6 +524,18 @@ static void design_without_recompiling(void **state)
     mechc_result_free(r);
     double phi_p[9 * 3];
     assert_int_equal(mechc_phi_p(k, mechc_q0(m), 0, phi_p), MECHC_OK);
+    /* Phi_p's nonzeros: 12 (eval --json's phi_p_nz), each the dense entry */
+    int rows[12], params[12];
+    double vals[12];
+    assert_int_equal(mechc_phi_p_nz(k), 12);
+    assert_int_equal(mechc_phi_p_pattern(k, rows, params), MECHC_OK);
+    assert_int_equal(mechc_phi_p_values(k, mechc_q0(m), 0, vals), MECHC_OK);
+    for (int e = 0; e < 12; e++) {
+        assert_true(vals[e] != 0);
+        assert_true(vals[e] == phi_p[rows[e] * 3 + params[e]]);
+    }
+    assert_int_equal(rows[1], 1);
+    assert_int_equal(params[3], 1);
     assert_int_equal(mechc_set_design_vector(m, NULL), MECHC_OK);
     assert_int_equal(mechc_design(m, p), MECHC_OK);
     assert_near(p[0], 1, 0, 0);

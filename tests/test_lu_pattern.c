@@ -35,6 +35,29 @@ static void lup_dense_of(const LupCase *c, double *a)
         a[c->row[e] * c->n + c->col[e]] = c->val[e];
 }
 
+/* mechrt_lup_solve_many on three right sides (leading dimension 4, the
+   fourth column left alone) against mechrt_lup_solve on each, bit for bit. */
+static void lup_check_many(const MechrtLup *f, int n, uint64_t *seed)
+{
+    double b[20 * 4], x[20], work[20 * 3];
+    for (int i = 0; i < 4 * n; i++)
+        b[i] = rnd(seed);
+    double keep[20 * 4];
+    memcpy(keep, b, sizeof keep);
+    mechrt_lup_solve_many(f, b, 4, 3, work);
+    for (int c = 0; c < 3; c++) {
+        for (int i = 0; i < n; i++)
+            x[i] = keep[4 * i + c];
+        mechrt_lup_solve(f, x, x);
+        for (int i = 0; i < n; i++)
+            if (b[4 * i + c] != x[i])
+                fail_msg("n = %d, column %d, x[%d]: many %.17g, one %.17g", n, c, i,
+                         b[4 * i + c], x[i]);
+    }
+    for (int i = 0; i < n; i++)
+        assert_true(b[4 * i + 3] == keep[4 * i + 3]);
+}
+
 /* Factors c's values both ways and checks statuses, sing_index and, when
    both succeed, the solution of a random right side, bit for bit. */
 static MechrtStatus lup_check(MechrtLup *f, const LupCase *c, uint64_t *seed)
@@ -59,6 +82,7 @@ static MechrtStatus lup_check(MechrtLup *f, const LupCase *c, uint64_t *seed)
         if (xp[i] != xd[i])
             fail_msg("n = %d, x[%d]: pattern %.17g, dense %.17g", n, i, xp[i], xd[i]);
     assert_true(mechrt_lup_spread(f) >= 1);
+    lup_check_many(f, n, seed);
     return std;
 }
 

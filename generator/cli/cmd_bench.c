@@ -55,10 +55,11 @@ static const CliOption options[] = {
 /* jac_nz (the sparse Jacobian) exists only in generated code; the
    dynamics rows only for a file with masses. */
 enum { FN_PHI, FN_JAC, FN_NU, FN_GAMMA, FN_ALL, FN_JAC_NZ, FN_MASS, FN_FORCE, FN_MQ, FN_EOM,
-       FN_MASS_NZ, FN_MQ_NZ, FN_PHI_P, FN_SENS_V, FN_SENS_G, FN_SENS_Y, FN_COUNT };
+       FN_MASS_NZ, FN_MQ_NZ, FN_PHI_P, FN_SENS_V, FN_SENS_G, FN_SENS_Y, FN_PHI_P_NZ, FN_COUNT };
 static const char *const fn_names[FN_COUNT] = {"phi", "jac", "nu", "gamma", "all", "jac_nz",
                                                "mass", "force", "m+q", "eom", "mass_nz",
-                                               "m+q_nz", "phi_p", "sens_v", "sens_g", "sens_y"};
+                                               "m+q_nz", "phi_p", "sens_v", "sens_g", "sens_y",
+                                               "phi_p_nz"};
 
 /* Functions only generated code has (no generic counterpart, no ratio). */
 static bool generated_only(int fn)
@@ -205,7 +206,7 @@ static int ops_of(const EmitResult *er, int fn)
     static const int map[FN_COUNT] = {EMIT_PHI, EMIT_JAC, EMIT_NU, EMIT_GAMMA, EMIT_ALL,
                                       EMIT_JAC_NZ, EMIT_MASS, EMIT_FORCE, -1, EMIT_EOM,
                                       EMIT_MASS_NZ, -1, EMIT_PHI_P, EMIT_SENS_V, EMIT_SENS_G,
-                                      EMIT_SENS_Y};
+                                      EMIT_SENS_Y, EMIT_PHI_P_NZ};
     if (fn == FN_MQ)
         return er->ops[EMIT_MASS] + er->ops[EMIT_FORCE];
     if (fn == FN_MQ_NZ)

@@ -72,13 +72,33 @@ static void print_json_dynamics(const Model *m, const double *M, const double *Q
     json_vector("Q", Q, m->nq);
 }
 
-/* "design", "p" and "phi_p" (a file with design parameters): after the others. */
-static void print_json_design(const Model *m, const double *phi_p)
+/* Phi_p of a file with design parameters: dense, and on its structural
+   nonzeros (PREFIX_phi_p_nz: values and pattern, nnz of them). */
+typedef struct EvalDesign {
+    double *phi_p, *nz;
+    const JacEntry *pattern;
+    int nnz;
+} EvalDesign;
+
+/* "design", "p", "phi_p" and "phi_p_nz" {"row", "col", "values"}: after the others. */
+static void print_json_design(const Model *m, const EvalDesign *d)
 {
     printf(",\n \"design\": ");
     json_string_list(stdout, m->design_names, m->np);
     json_vector("p", m->dag.param_values, m->np);
-    json_matrix("phi_p", phi_p, m->nh, m->np);
+    json_matrix("phi_p", d->phi_p, m->nh, m->np);
+    printf(",\n \"phi_p_nz\": {\"row\": [");
+    for (int e = 0; e < d->nnz; e++)
+        printf("%s%d", e ? ", " : "", d->pattern[e].row);
+    printf("], \"col\": [");
+    for (int e = 0; e < d->nnz; e++)
+        printf("%s%d", e ? ", " : "", d->pattern[e].col);
+    printf("],\n              \"values\": [");
+    for (int e = 0; e < d->nnz; e++) {
+        printf(e ? ", " : "");
+        json_number(stdout, d->nz[e]);
+    }
+    printf("]}");
 }
 
 /* The design and dPhi/dp's nonzero entries row by row. */
@@ -102,7 +122,7 @@ static void print_text_design(const Model *m, const double *phi_p)
 
 static void print_json(const Model *m, double t, const double *q, const double *qd, const double *phi,
                        const double *jac, const double *nu, const double *gamma, const double *M,
-                       const double *Q, const double *phi_p)
+                       const double *Q, const EvalDesign *design)
 {
     printf("{\"coords\": ");
     json_string_list(stdout, m->coord_names, m->nq);
@@ -126,8 +146,8 @@ static void print_json(const Model *m, double t, const double *q, const double *
     json_matrix("jac", jac, m->nr, m->nq);
     if (M)
         print_json_dynamics(m, M, Q);
-    if (phi_p)
-        print_json_design(m, phi_p);
+    if (design->phi_p)
+        print_json_design(m, design);
     printf("}\n");
 }
 
@@ -226,22 +246,27 @@ static bool evaluate(const Args *a, const EvalCli *c, mechc_model *model, const 
         mechc_mass(k, q, M);
         mechc_force(k, q, qd, c->t, Q);
     }
-    double *phi_p = NULL;
+    EvalDesign design = {0};
     if (mechc_np(model) > 0) {
-        phi_p = xcalloc((size_t)m->nh * (size_t)m->np + 1, sizeof *phi_p);
-        mechc_phi_p(k, q, c->t, phi_p);
+        const DesignKin *dk = &model->mech->kin.design;
+        design.phi_p = xcalloc((size_t)m->nh * (size_t)m->np + 1, sizeof *design.phi_p);
+        design.nz = xcalloc((size_t)dk->p_nnz + 1, sizeof *design.nz);
+        design.pattern = dk->p_nz, design.nnz = dk->p_nnz;
+        mechc_phi_p(k, q, c->t, design.phi_p);
+        mechc_phi_p_values(k, q, c->t, design.nz);
     }
     mechc_kernels_free(k);
     if (c->json) {
-        print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q, phi_p);
+        print_json(m, c->t, q, qd, phi, jac, nu, gamma, M, Q, &design);
     } else {
         print_text(m, c->t, q, qd, phi, jac, nu, gamma);
         if (M)
             print_text_dynamics(m, M, Q);
-        if (phi_p)
-            print_text_design(m, phi_p);
+        if (design.phi_p)
+            print_text_design(m, design.phi_p);
     }
-    free(phi), free(nu), free(gamma), free(jac), free(M), free(Q), free(phi_p);
+    free(phi), free(nu), free(gamma), free(jac), free(M), free(Q);
+    free(design.phi_p), free(design.nz);
     return true;
 }
 

@@ -439,18 +439,28 @@ static int finish_output(const RunCli *c, FILE *csv, int status)
    state where they cannot be had (Phi_q singular) gets NaN, said once. */
 typedef struct SensColumns {
     Sens sens;
-    bool warned;
+    bool warned, timed;     /* timed: --stats */
     long states;
-    double cpu_seconds;     /* in sens_eval (clock()), for --stats */
+    /* for --stats: the CPU and wall time in sens_eval, and the run's CPU
+       time per step (its "of CPU time in the steps" line) */
+    double cpu_seconds, wall_seconds, step_cpu_ns;
 } SensColumns;
 
 static void fill_sens(void *ctx, double t, const double *q, const double *qd, const double *qdd,
                       double *x)
 {
     SensColumns *sc = ctx;
-    clock_t start = clock();
+    /* a clock() reading is a system call (1.6 us of CPU time on a loaded
+       virtual machine, more than the sensitivities of a four-bar): made
+       only for --stats, around a span shaped like the step's (run.c),
+       with two wall-clock readings in it, so that one calibration serves */
+    clock_t start = sc->timed ? clock() : 0;
+    double wall = sc->timed ? pipeline_now() : 0;
     MechrtStatus st = sens_eval(&sc->sens, t, q, qd, qdd);
-    sc->cpu_seconds += (double)(clock() - start) / CLOCKS_PER_SEC;
+    if (sc->timed) {
+        sc->wall_seconds += pipeline_now() - wall;
+        sc->cpu_seconds += (double)(clock() - start) / CLOCKS_PER_SEC;
+    }
     sc->states++;
     if (st == MECHRT_OK) {
         sens_columns(&sc->sens, x);
@@ -503,18 +513,61 @@ static int analyse(RunCli *c, const Model *m, mechc_kernels *k, const RunPicture
     tune.keep_states = 0;
     RunOptions full;
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
-    if (sc && lib_run_options(&ro, &tune, &full) && run_linear_is_sparse(m, jnz, &full))
-        sens_use_sparse(&sc->sens, jnz);    /* KLU as the run; else the dense LU */
+    RunLu lent = {0};
+    RunLu *lend = NULL;
+    if (sc && lib_run_options(&ro, &tune, &full) && run_linear_is_sparse(m, jnz, &full)) {
+        sens_use_sparse(&sc->sens, jnz);    /* KLU as the run; else ... */
+    } else if (sc) {
+        lend = &lent;                       /* ... the run's own LU, where it has one */
+        sens_borrow_lu(&sc->sens, &lent);
+    }
     progress_start(&out.progress, "run", 1000);
     mechc_diag d;
-    mechc_result *r = mechc_run_with(k, &ro, &tune, &d);
+    mechc_result *r = lib_run_lending(k, &ro, &tune, lend, &d);
     progress_finish(&out.progress);
     int status = report(c, m, &out, pics, r, &d, &k->engine, &last);
+    if (sc && r && lib_result_run(r)->steps_done > 0)
+        sc->step_cpu_ns = 1e9 * lib_result_run(r)->step_cpu_seconds
+                          / lib_result_run(r)->steps_done;
     status = finish_output(c, out.csv, status);
     mechc_result_free(r);
     free(last.q), free(last.qd);
     run_output_close(&out);
     return status;
+}
+
+/* The CPU time an empty span between two clock() readings reads, with
+   the two wall-clock readings the spans of the steps and sensitivities
+   have inside (run.c, fill_sens): mean of n. */
+static double clock_span_ns(int n)
+{
+    double sum = 0;
+    for (int i = 0; i < n; i++) {
+        clock_t c0 = clock();
+        sum -= pipeline_now() - pipeline_now();
+        sum += (double)(clock() - c0) / CLOCKS_PER_SEC;
+    }
+    return 1e9 * sum / n;
+}
+
+/* --stats of --sens: its cost per state beside the step's, in CPU time
+   less what the clock() readings around every span take themselves (a
+   system call: 1.6 us on a loaded virtual machine, twice a four-bar's
+   step), measured here after the run. */
+static void print_sens_stats(const SensColumns *sc)
+{
+    double cpu = 1e9 * sc->cpu_seconds / (double)sc->states;
+    fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters%s: %.6g ms of "
+            "CPU time, %.0f ns per state (wall time %.0f ns); the run's LU of Phi_q reused "
+            "at %ld of %ld\n", sc->sens.np, sc->sens.klu ? " (KLU of Phi_q)" : "",
+            1e3 * sc->cpu_seconds, cpu, 1e9 * sc->wall_seconds / (double)sc->states,
+            sc->sens.borrowed_count, sc->states);
+    if (!(sc->step_cpu_ns > 0))
+        return;
+    double span = clock_span_ns(4000), sens = cpu - span, step = sc->step_cpu_ns - span;
+    fprintf(stderr, "mechc run: stats: less the %.0f ns an empty clock() span reads: "
+            "sensitivities %.0f ns per state, steps %.0f ns: run --sens costs %.3g times "
+            "the run\n", span, sens, step, 1 + sens / step);
 }
 
 /* Rows, pictures and engine ready, then the analysis. */
@@ -532,7 +585,7 @@ static int run_file(const Args *a, mechc_model *model, void *opts)
         fprintf(stderr, "mechc run: stats: set-up: load %.3f s, derivatives %.3f s, emission "
                 "%.3f s, compilation %.3f s\n", mech->load_seconds, mech->diff_seconds,
                 e->gen_seconds, e->compile_seconds);
-    SensColumns sc = {0};
+    SensColumns sc = {.timed = c->stats};
     char why[200];
     if (c->sens && !sens_init(&sc.sens, mech->model, &mech->kin, e, why, sizeof why)) {
         diag_error(diag, mech->model->last_pos, "run --sens: %s", why);
@@ -542,10 +595,7 @@ static int run_file(const Args *a, mechc_model *model, void *opts)
     }
     int status = analyse(c, mech->model, k, &pics, c->sens ? &sc : NULL);
     if (c->sens && c->stats && sc.states > 0)
-        fprintf(stderr, "mechc run: stats: sensitivities to %d design parameters%s: %.6g ms of "
-                "CPU time, %.0f ns per state\n", sc.sens.np,
-                sc.sens.klu ? " (KLU of Phi_q)" : "", 1e3 * sc.cpu_seconds,
-                1e9 * sc.cpu_seconds / (double)sc.states);
+        print_sens_stats(&sc);
     if (c->sens)
         sens_free(&sc.sens);
     mechc_kernels_free(k);

@@ -35,6 +35,26 @@ static void output_partials(Model *m, Differ *df, DesignKin *dk)
         dk->y[k] = partials(m, df, of[k], n, design_y_by_p(k) ? np : nq, by[k]);
 }
 
+/* Phi_p's structural nonzeros, row-major (a placeholder slot when none). */
+static void collect_p_nz(Model *m, const NodeId *phi_p, DesignKin *dk)
+{
+    size_t n = (size_t)m->nh * (size_t)m->np;
+    int count = 0;
+    for (size_t i = 0; i < n; i++)
+        count += phi_p[i] != DAG_ZERO;
+    dk->p_nz = arena_alloc_array(&m->arena, (size_t)count + 1, sizeof *dk->p_nz);
+    dk->p_nz_values = arena_alloc_array(&m->arena, (size_t)count + 1, sizeof *dk->p_nz_values);
+    dk->p_nz[0] = (JacEntry){0, 0, DAG_ZERO};
+    dk->p_nz_values[0] = DAG_ZERO;
+    dk->p_nnz = 0;
+    for (size_t i = 0; i < n; i++)
+        if (phi_p[i] != DAG_ZERO) {
+            dk->p_nz_values[dk->p_nnz] = phi_p[i];
+            dk->p_nz[dk->p_nnz++] = (JacEntry){(int)(i / (size_t)m->np),
+                                               (int)(i % (size_t)m->np), phi_p[i]};
+        }
+}
+
 bool design_build(Model *m, Kinematics *kin, Diag *diag)
 {
     Differ df;
@@ -51,6 +71,8 @@ bool design_build(Model *m, Kinematics *kin, Diag *diag)
     dk->g_qd = partials(m, &df, kin->gamma, nh, nq, diff_by_qd);
     dk->g_p = partials(m, &df, kin->gamma, nh, np, diff_by_p);
     output_partials(m, &df, dk);
+    if (!m->dag.overflow)
+        collect_p_nz(m, kin->phi_p, dk);
     differ_free(&df);
     return dag_check_limit(&m->dag, diag);
 }
@@ -74,6 +96,9 @@ int design_arrays(const Kinematics *kin, DesignFn fn, const NodeId *from[DESIGN_
         from[1] = dk->g_qd, count[1] = nh * nq;
         from[2] = dk->g_p, count[2] = nh * np;
         return 3;
+    case DESIGN_PHI_P_NZ:
+        from[0] = dk->p_nz_values, count[0] = dk->p_nnz > 0 ? (size_t)dk->p_nnz : 1;
+        return 1;
     case DESIGN_Y:
     case DESIGN_FN_COUNT:
         break;

@@ -32,6 +32,11 @@ typedef struct DesignKin {
     NodeId *g_q, *g_qd, *g_p;       /* nh x nq, nh x nq, nh x np */
     /* f_q, f_p, Df_q, Df_qd, Df_p, DDf_q, DDf_qd, DDf_p: nout x (nq or np) */
     NodeId *y[DESIGN_Y_COUNT];
+    /* Phi_p's structural nonzeros (nodes other than DAG_ZERO), row-major,
+       columns ascending: PREFIX_phi_p_nz's pattern */
+    JacEntry *p_nz;
+    NodeId *p_nz_values;    /* their nodes, at least one (DAG_ZERO when none) */
+    int p_nnz;
 } DesignKin;
 
 /* Everything the emitter and the interpreters need, row by row. */
@@ -67,8 +72,11 @@ static inline bool design_y_by_p(int k) { return k == 1 || k == 4 || k == 7; }
 
 /* The generated functions of a design file (functions.def's EMIT_DESIGN
    rows, in order) and the arrays each writes: from[i] holds count[i] nodes
-   (phi_p; v_q, v_p; g_q, g_qd, g_p; y[0 .. 7]). Returns how many. */
-typedef enum DesignFn { DESIGN_PHI_P, DESIGN_V, DESIGN_G, DESIGN_Y, DESIGN_FN_COUNT } DesignFn;
+   (phi_p; v_q, v_p; g_q, g_qd, g_p; y[0 .. 7]; Phi_p's nonzeros, at
+   least one slot). Returns how many. */
+typedef enum DesignFn {
+    DESIGN_PHI_P, DESIGN_V, DESIGN_G, DESIGN_Y, DESIGN_PHI_P_NZ, DESIGN_FN_COUNT
+} DesignFn;
 int design_arrays(const Kinematics *kin, DesignFn fn, const NodeId *from[DESIGN_Y_COUNT],
                   size_t count[DESIGN_Y_COUNT]);
 

@@ -147,7 +147,7 @@ enum {
     FILE_IFACE, FILE_ZERO, FILE_JAC, FILE_INC, FILE_MOVES, FILE_NZ_DECL, FILE_NZ_DEF,
     FILE_MROW, FILE_MCOL, FILE_DYN_C, FILE_DYN_H, FILE_JAC_DECL, FILE_ALL_DECL, FILE_ALL_DEF,
     FILE_MARK, FILE_P0, FILE_DNAMES, FILE_DESIGN_C, FILE_DESIGN_H, FILE_PIN, FILE_PARG,
-    FILE_BATCH_C, FILE_BATCH_H, FILE_COUNT
+    FILE_BATCH_C, FILE_BATCH_H, FILE_PNNZ, FILE_PROW, FILE_PCOL, FILE_COUNT
 };
 
 /* The design parameters' part of the source (DESIGN) and of the
@@ -169,6 +169,13 @@ static const char *put_design(const Emitter *e, TemplateVar *vars, int nvars, St
         sb_puts(&b[FILE_P0], ",\n");
     }
     put_string_list(&b[FILE_DNAMES], m->design_names, m->np);
+    const DesignKin *dk = &e->kin->design;     /* Phi_p's pattern, as the Jacobian's */
+    sb_printf(&b[FILE_PNNZ], "%d", dk->p_nnz > 0 ? dk->p_nnz : 1);
+    put_int_list(&b[FILE_PROW], dk->p_nz, dk->p_nnz, true);
+    put_int_list(&b[FILE_PCOL], dk->p_nz, dk->p_nnz, false);
+    template_set(vars, nvars, "PNNZ", b[FILE_PNNZ].data);
+    template_set(vars, nvars, "PHI_P_ROW", b[FILE_PROW].data);
+    template_set(vars, nvars, "PHI_P_COL", b[FILE_PCOL].data);
     template_set(vars, nvars, "P0", b[FILE_P0].data);
     template_set(vars, nvars, "DESIGN_NAMES", b[FILE_DNAMES].data);
     StrBuf *c = &b[FILE_DESIGN_C], *h = &b[FILE_DESIGN_H];
@@ -368,6 +375,9 @@ void emit_render_files(const Emitter *e, StrBuf *parts, StrBuf *bodies, const ch
         {"SENS_V_PARTS", parts[EMIT_SENS_V].data}, {"SENS_V_BODY", bodies[EMIT_SENS_V].data},
         {"SENS_G_PARTS", parts[EMIT_SENS_G].data}, {"SENS_G_BODY", bodies[EMIT_SENS_G].data},
         {"SENS_Y_PARTS", parts[EMIT_SENS_Y].data}, {"SENS_Y_BODY", bodies[EMIT_SENS_Y].data},
+        {"PHI_P_NZ_PARTS", parts[EMIT_PHI_P_NZ].data},
+        {"PHI_P_NZ_BODY", bodies[EMIT_PHI_P_NZ].data},
+        {"PNNZ", ""}, {"PHI_P_ROW", ""}, {"PHI_P_COL", ""},
         {"NOUT", z.nout}, {"BATCH", b[FILE_BATCH_C].data}, {"BATCH_DECL", b[FILE_BATCH_H].data},
     };
     const char *bad = render(e, vars, (int)(sizeof vars / sizeof *vars), b, out);

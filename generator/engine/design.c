@@ -52,6 +52,9 @@ static void call_compiled(const Kernels *k, DesignFn fn, const double *q, const 
     case DESIGN_G:
         k->sens_g(q, qd, t, o[0], o[1], o[2]);
         return;
+    case DESIGN_PHI_P_NZ:
+        k->phi_p_nz(q, t, o[0]);
+        return;
     case DESIGN_Y:
     case DESIGN_FN_COUNT:
         break;

@@ -110,6 +110,8 @@ bool kernels_bind(Kernels *k, KernelFind find, void *handle, const char *prefix)
     k->jac_col = kernel(find, handle, prefix, "jac_col");
     k->mass_row = kernel(find, handle, prefix, "mass_row");
     k->mass_col = kernel(find, handle, prefix, "mass_col");
+    k->phi_p_row = kernel(find, handle, prefix, "phi_p_row");
+    k->phi_p_col = kernel(find, handle, prefix, "phi_p_col");
     *(void **)&k->design_bind = kernel(find, handle, prefix, "design_bind");
     /* a unit with design parameters but no context-free twins has
        functions that take p: calling them through k would be wrong */

@@ -59,6 +59,7 @@ typedef struct Kernels {
 #undef X
     const int *jac_row, *jac_col;
     const int *mass_row, *mass_col;
+    const int *phi_p_row, *phi_p_col;   /* phi_p_nz's pattern (design files) */
     /* a unit with design parameters (EmitOptions.host_design): where its
        functions read p from; NULL otherwise */
     void (*design_bind)(const double *p);

@@ -95,6 +95,7 @@ RunOptions run_default_options(void)
     o.notes = NULL;
     o.linear = ANALYSIS_LINEAR_AUTO;
     o.max_dense_entries = 0;
+    o.lend_lu = NULL;
     return o;
 }
 
@@ -449,6 +450,9 @@ static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const Mechr
        turning crank: lu.c's LU costs less there (bench/redundant.sh) */
     if (!sparse && !red)
         r.lup = run_lup_new(m, jnz);
+    RunLu *lent = o->lend_lu;
+    if (lent && r.lup)
+        *lent = (RunLu){.lup = r.lup, .q = xcalloc(nq, sizeof *lent->q)};
     r.lwork = sparse ? MECHRT_HOST_SPARSE_WORK_LEN(m->nq) : mechrt_workspace_size(m->nq, m->nr);
     r.work = xcalloc(r.lwork, sizeof *r.work);
     memcpy(r.q, m->q0, nq * sizeof *r.q);
@@ -464,6 +468,10 @@ static AnalysisStatus run_on(const Model *m, const MechrtKernels *k, const Mechr
     if (r.sp) {
         mechrt_host_sparse_counts(r.sp, &res->fresh_factorisations, &res->refactorisations);
         mechrt_host_sparse_free(r.sp);
+    }
+    if (lent) {
+        free(lent->q);
+        *lent = (RunLu){0};
     }
     if (r.lup) {
         res->fresh_factorisations = r.lup->analyses;

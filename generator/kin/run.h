@@ -19,6 +19,20 @@
 #include "../model/model.h"
 #include "../analysis/common.h"
 
+/* The dense path's LU of Phi_q, lent to a caller that solves with the
+   same matrix at the states handed out (run --sens). After a step that
+   ended with the run's pattern LU factored at its converged state, `valid`
+   is true and (t, q) is that state: then lup holds Phi_q(q, t) (solve with
+   mechrt_lup_solve) until the next step. lup is NULL when the run has no
+   pattern LU (sparse path, redundant rows, velocity-level rows). The run
+   owns q (nq values) and clears the whole when it returns. */
+typedef struct RunLu {
+    const MechrtLup *lup;
+    bool valid;
+    double t;
+    double *q;
+} RunLu;
+
 /* What a run does; fill with run_default_options(), then change fields. */
 typedef struct RunOptions {
     double t0, t1;           /* time interval, t1 != t0 (t1 < t0 runs backwards); 0, 1 */
@@ -49,6 +63,7 @@ typedef struct RunOptions {
        0: no limit (default; mechc run passes --max-jac-entries here when
        the sparse path may serve, instead of the model builder) */
     long long max_dense_entries;
+    RunLu *lend_lu;          /* where the run lends its LU; NULL (default): nowhere */
 } RunOptions;
 
 RunOptions run_default_options(void);

@@ -4,7 +4,9 @@
  * (the generated PREFIX_phi_p, _sens_v, _sens_g, _sens_y, or the graph
  * interpreted by the generic engine), and the sensitivities of all design
  * parameters at once are products and solves with one LU of Phi_q (dense,
- * or KLU on the sparse path):
+ * or KLU on the sparse path, where Phi_p comes on its nonzeros,
+ * PREFIX_phi_p_nz; the dense path solves with the run's own LU of Phi_q
+ * wherever the run lends it, sens_borrow_lu):
  *
  *   Q_p   = -Phi_q^-1 Phi_p
  *   Qd_p  = -Phi_q^-1 (V_q Q_p + V_p)                          V at qd
@@ -31,26 +33,27 @@
    Phi_q qdd = V(qdd) - V(0) are V's at qd + qdd less V's at qd. */
 enum { AT_QD, AT_QD_QDD, AT_COUNT };
 
-/* The structural nonzeros of V_q, G_q and G_qd (kin's nodes). */
+/* The structural nonzeros of V_q, G_q and G_qd (kin's nodes), by rows. */
 static void collect_nonzeros(Sens *s, const Kinematics *kin)
 {
     const NodeId *of[3] = {kin->design.v_q, kin->design.g_q, kin->design.g_qd};
-    size_t nn = (size_t)s->nq * (size_t)s->nq, n = 0;
+    size_t nq = (size_t)s->nq, nn = nq * nq, n = 0;
     for (int k = 0; k < 3; k++)
         for (size_t i = 0; i < nn; i++)
             n += of[k][i] != DAG_ZERO;
-    s->nz_rc = xcalloc(2 * n + 1, sizeof *s->nz_rc);
+    s->nz_col = xcalloc(n + 1, sizeof *s->nz_col);
+    s->nz_ptr = xcalloc(3 * (nq + 1), sizeof *s->nz_ptr);
     int at = 0;
     for (int k = 0; k < 3; k++) {
-        s->nz_at[k] = at;
-        for (size_t i = 0; i < nn; i++)
-            if (of[k][i] != DAG_ZERO) {
-                s->nz_rc[2 * at] = (int)(i / (size_t)s->nq);
-                s->nz_rc[2 * at + 1] = (int)(i % (size_t)s->nq);
-                at++;
-            }
+        int *ptr = s->nz_ptr + (size_t)k * (nq + 1);
+        for (size_t r = 0; r < nq; r++) {
+            ptr[r] = at;
+            for (size_t c = 0; c < nq; c++)
+                if (of[k][r * nq + c] != DAG_ZERO)
+                    s->nz_col[at++] = (int)c;
+        }
+        ptr[nq] = at;
     }
-    s->nz_at[3] = at;
 }
 
 bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *why, size_t size)
@@ -85,6 +88,7 @@ bool sens_init(Sens *s, Model *m, const Kinematics *kin, const Engine *e, char *
         s->g[k] = xcalloc(k == 2 ? qp : qq, sizeof(double));
     s->work = xcalloc(qp + yp, sizeof(double));
     collect_nonzeros(s, kin);
+    s->p_nz = kin->design.p_nz, s->p_nnz = kin->design.p_nnz;
     return true;
 }
 
@@ -93,15 +97,24 @@ bool sens_use_sparse(Sens *s, const MechrtHostJacNz *jnz)
     s->klu = jnz ? mechrt_host_sparse_new(s->nq, jnz) : NULL;
     if (!s->klu)
         return false;
-    free(s->jac), free(s->piv);     /* nq x nq: not needed */
+    /* nq x nq and nh x np: not needed; Phi_p comes on its nonzeros */
+    free(s->jac), free(s->piv), free(s->phi_p);
     s->jac = s->piv = NULL;
+    s->phi_p = xcalloc((size_t)(s->p_nnz > 0 ? s->p_nnz : 1), sizeof *s->phi_p);
     return true;
+}
+
+void sens_borrow_lu(Sens *s, const RunLu *lent)
+{
+    s->lent = lent;
+    if (!s->solve_work)
+        s->solve_work = xcalloc((size_t)s->nq * (size_t)s->np, sizeof *s->solve_work);
 }
 
 void sens_free(Sens *s)
 {
     free(s->q_p), free(s->qd_p), free(s->qdd_p), free(s->y_p), free(s->yd_p), free(s->ydd_p);
-    free(s->jac), free(s->piv), free(s->phi_p), free(s->col), free(s->work);
+    free(s->jac), free(s->piv), free(s->phi_p), free(s->col), free(s->work), free(s->solve_work);
     for (int a = 0; a < AT_COUNT; a++) {
         free(s->v[a][0]), free(s->v[a][1]);
         for (int k = 0; k < DESIGN_Y_COUNT; k++)
@@ -109,10 +122,56 @@ void sens_free(Sens *s)
     }
     for (int k = 0; k < 3; k++)
         free(s->g[k]);
-    free(s->nz_rc);
+    free(s->nz_col), free(s->nz_ptr);
     if (s->klu)
         mechrt_host_sparse_free(s->klu);
     memset(s, 0, sizeof *s);
+}
+
+/* Columns j .. j + w - 1 (w <= 4) of one row of a product: cr[j + l] +=
+   sign * a_k b[k][j + l] for the k in cols (count of them; NULL: 0 ..
+   count - 1) in that order, terms whose factor sign * a_k is zero left
+   out; the w sums held in registers. */
+static inline void add_block(double *restrict cr, double sign, const double *ar, const int *cols,
+                             int count, const double *restrict b, size_t ld, int j, int w)
+{
+    double c[4];
+    for (int l = 0; l < w; l++)
+        c[l] = cr[j + l];
+    for (int i = 0; i < count; i++) {
+        int k = cols ? cols[i] : i;
+        double f = sign * ar[k];
+        if (f == 0.0)
+            continue;
+        const double *bk = b + (size_t)k * ld + (size_t)j;
+        for (int l = 0; l < w; l++)
+            c[l] += f * bk[l];
+    }
+    for (int l = 0; l < w; l++)
+        cr[j + l] = c[l];
+}
+
+/* One row of a product, every cr[j] with the operations of the loop over
+   k outside and j inside, in that order: add_block four columns at a time. */
+static void add_row(double *cr, double sign, const double *ar, const int *cols, int count,
+                    const double *b, int np)
+{
+    int j = 0;
+    for (; j + 4 <= np; j += 4)
+        add_block(cr, sign, ar, cols, count, b, (size_t)np, j, 4);
+    switch (np - j) {     /* w a constant in each call: the sums stay in registers */
+    case 3:
+        add_block(cr, sign, ar, cols, count, b, (size_t)np, j, 3);
+        break;
+    case 2:
+        add_block(cr, sign, ar, cols, count, b, (size_t)np, j, 2);
+        break;
+    case 1:
+        add_block(cr, sign, ar, cols, count, b, (size_t)np, j, 1);
+        break;
+    default:
+        break;
+    }
 }
 
 /* c (n x np) += sign * a (n x nq) b (nq x np), all row-major. */
@@ -120,15 +179,7 @@ static void add_product(double *c, double sign, const double *a, const double *b
                         int np)
 {
     for (int r = 0; r < n; r++)
-        for (int k = 0; k < nq; k++) {
-            double f = sign * a[(size_t)r * (size_t)nq + (size_t)k];
-            if (f == 0.0)
-                continue;
-            const double *bk = b + (size_t)k * (size_t)np;
-            double *cr = c + (size_t)r * (size_t)np;
-            for (int j = 0; j < np; j++)
-                cr[j] += f * bk[j];
-        }
+        add_row(c + (size_t)r * (size_t)np, sign, a + (size_t)r * (size_t)nq, NULL, nq, b, np);
 }
 
 /* c (nq x np) += sign * a (nq x nq) b (nq x np) over a's structural
@@ -137,16 +188,9 @@ static void add_product_nz(const Sens *s, int k, double *c, double sign, const d
                            const double *b)
 {
     size_t nq = (size_t)s->nq, np = (size_t)s->np;
-    for (int e = s->nz_at[k]; e < s->nz_at[k + 1]; e++) {
-        size_t r = (size_t)s->nz_rc[2 * e], col = (size_t)s->nz_rc[2 * e + 1];
-        double f = sign * a[r * nq + col];
-        if (f == 0.0)
-            continue;
-        const double *bk = b + col * np;
-        double *cr = c + r * np;
-        for (size_t j = 0; j < np; j++)
-            cr[j] += f * bk[j];
-    }
+    const int *ptr = s->nz_ptr + (size_t)k * (nq + 1);
+    for (size_t r = 0; r < nq; r++)
+        add_row(c + r * np, sign, a + r * nq, s->nz_col + ptr[r], ptr[r + 1] - ptr[r], b, s->np);
 }
 
 enum { NZ_V, NZ_GQ, NZ_GQD };
@@ -164,6 +208,10 @@ static void set_scaled(double *c, double sign, const double *a, size_t n)
 static void solve_columns(Sens *s, double *x)
 {
     size_t np = (size_t)s->np;
+    if (s->borrowed) {
+        mechrt_lup_solve_many(s->lent->lup, x, s->np, s->np, s->solve_work);
+        return;
+    }
     if (!s->klu) {
         mechrt_lu_solve_many(s->nq, s->jac, s->nq, s->piv, x, s->np, s->np);
         return;
@@ -177,19 +225,48 @@ static void solve_columns(Sens *s, double *x)
     }
 }
 
-/* Phi_q factored and Phi_p at (q, t). */
+/* Whether the run's LU is Phi_q at (q, t). */
+static bool lent_at(const Sens *s, double t, const double *q)
+{
+    const RunLu *l = s->lent;
+    return l && l->lup && l->valid && l->t == t
+           && memcmp(l->q, q, (size_t)s->nq * sizeof *q) == 0;
+}
+
+/* Phi_q factored (or the run's LU at (q, t) borrowed) and Phi_p at (q, t). */
 static MechrtStatus factor(Sens *s, double t, const double *q)
 {
     int n = s->nq;
     double tol = mechrt_default_options().pivot_tol;
-    if (s->klu) {
+    s->borrowed = !s->klu && lent_at(s, t, q);
+    if (s->borrowed) {
+        s->borrowed_count++;
         engine_phi_p(s->e, q, t, s->phi_p);
+        return MECHRT_OK;
+    }
+    if (s->klu) {
+        double *const nz[DESIGN_Y_COUNT] = {s->phi_p};
+        engine_design(s->e, DESIGN_PHI_P_NZ, q, NULL, t, nz);
         mechrt_host_sparse_eval(s->klu, q, t);
         return mechrt_host_sparse_factor(s->klu, tol);
     }
     engine_jac(s->e, q, t, s->jac);
     engine_phi_p(s->e, q, t, s->phi_p);
     return mechrt_lu_factor(n, s->jac, n, s->piv, tol, NULL);
+}
+
+/* q_p = -Phi_p: from the dense Phi_p, or on the sparse path from its
+   nonzeros (the zeros then +0, not -0). */
+static void positions_rhs(Sens *s)
+{
+    size_t len = (size_t)s->nq * (size_t)s->np;
+    if (!s->klu) {
+        set_scaled(s->q_p, -1.0, s->phi_p, len);
+        return;
+    }
+    memset(s->q_p, 0, len * sizeof *s->q_p);
+    for (int e = 0; e < s->p_nnz; e++)
+        s->q_p[(size_t)s->p_nz[e].row * (size_t)s->np + (size_t)s->p_nz[e].col] = -s->phi_p[e];
 }
 
 /* The outputs' sensitivities from the coordinates' (y partials taken). */
@@ -234,7 +311,7 @@ MechrtStatus sens_eval(Sens *s, double t, const double *q, const double *qd, con
     partials_at(s, AT_QD, q, qd, t);
     partials_at(s, AT_QD_QDD, q, both, t);
     engine_design(s->e, DESIGN_G, q, qd, t, s->g);
-    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    positions_rhs(s);
     solve_columns(s, s->q_p);
     set_scaled(s->qd_p, -1.0, s->v[AT_QD][1], len);
     add_product_nz(s, NZ_V, s->qd_p, -1.0, s->v[AT_QD][0], s->q_p);
@@ -257,8 +334,7 @@ MechrtStatus sens_eval_positions(Sens *s, double t, const double *q)
     MechrtStatus st = factor(s, t, q);
     if (st != MECHRT_OK)
         return st;
-    size_t len = (size_t)s->nq * (size_t)s->np;
-    set_scaled(s->q_p, -1.0, s->phi_p, len);
+    positions_rhs(s);
     solve_columns(s, s->q_p);
     if (s->nout) {
         memset(s->work, 0, (size_t)s->nq * sizeof *s->work);

@@ -18,6 +18,7 @@
 #define MECHC_SENS_H
 
 #include "../engine/engine.h"
+#include "run.h"
 
 typedef struct Sens {
     const Model *m;
@@ -29,14 +30,21 @@ typedef struct Sens {
     double *y_p, *yd_p, *ydd_p;     /* nout x np: the outputs' */
     /* the rest is sens.c's: Phi_q's LU, Phi_p, the engine's partials at
        qd and qd + qdd (V's and the outputs'), gamma's, scratch */
-    double *jac, *piv, *phi_p, *col, *work;
+    double *jac, *piv, *phi_p, *col, *work;    /* phi_p: on its nonzeros with klu */
+    const JacEntry *p_nz;       /* Phi_p's pattern (p_nnz entries) */
+    int p_nnz;
     double *v[2][2];
     double *y[2][DESIGN_Y_COUNT];
     double *g[3];
-    /* the structural nonzeros of V_q, G_q and G_qd: (row, col) pairs in
-       row-major order, nz_at[k] .. nz_at[k + 1] - 1 those of the k-th */
-    int *nz_rc, nz_at[4];
+    /* the structural nonzeros of V_q, G_q and G_qd by rows: the columns
+       of row r of the k-th are nz_col[p[r]] .. nz_col[p[r + 1] - 1], p =
+       nz_ptr + k (nq + 1) */
+    int *nz_col, *nz_ptr;
     MechrtHostSparse *klu;      /* the sparse path's factorisation, or NULL */
+    const RunLu *lent;          /* the run's LU (sens_borrow_lu), or NULL ... */
+    double *solve_work;         /* ... and its solves' nq x np scratch */
+    bool borrowed;              /* the last factor() found it at its state */
+    long borrowed_count;        /* states solved with it */
 } Sens;
 
 /* Prepares s for the motion of m through e (np > 0, no velocity-level
@@ -48,6 +56,10 @@ void sens_free(Sens *s);
    instead of the dense LU: the run's sparse path. false, the dense LU
    kept, when the pattern cannot be analysed. */
 bool sens_use_sparse(Sens *s, const MechrtHostJacNz *jnz);
+/* Solves with the run's own factorisation of Phi_q (RunOptions.lend_lu)
+   at the states where it holds one: no Jacobian, no LU of sens's own
+   there (the pattern LU gives lu.c's factors bit for bit). */
+void sens_borrow_lu(Sens *s, const RunLu *lent);
 
 /* The sensitivities at the state (t, q, qd, qdd) of the motion, at the
    model's design. MECHRT_OK, or the LU's status when Phi_q is singular

@@ -64,9 +64,20 @@ MechrtStatus run_step(Run *r, double t, double h, MechrtReport *rep)
     if (r->sp)
         return mechrt_host_sparse_step(r->sp, r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h,
                                        r->work, r->lwork, rep);
-    if (r->lup)
-        return mechrt_step_lup(r->k, &r->jnz->jac, r->lup, &r->o->mechrt, r->q, r->qd, r->qdd,
-                               t, h, r->work, r->lwork, rep);
+    if (r->lup) {
+        RunLu *lent = r->o->lend_lu;
+        if (lent)
+            lent->valid = false;
+        MechrtStatus st = mechrt_step_lup(r->k, &r->jnz->jac, r->lup, &r->o->mechrt, r->q, r->qd,
+                                          r->qdd, t, h, r->work, r->lwork, rep);
+        /* the kernels' own P_step leaves no factors in the pattern LU */
+        if (lent && lent->lup && st == MECHRT_OK && !(r->lup->gen && r->lup->gen->step)) {
+            lent->valid = true;
+            lent->t = t + h;
+            memcpy(lent->q, r->q, (size_t)r->nq * sizeof *r->q);
+        }
+        return st;
+    }
     return mechrt_step(r->k, &r->o->mechrt, r->q, r->qd, r->qdd, t, h, r->work, r->lwork, rep);
 }
 

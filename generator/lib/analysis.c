@@ -164,6 +164,12 @@ mechc_result *mechc_run(mechc_kernels *k, const mechc_run_options *o, mechc_diag
 mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
                              const mechc_run_tuning *x, mechc_diag *d)
 {
+    return lib_run_lending(k, o, x, NULL, d);
+}
+
+mechc_result *lib_run_lending(mechc_kernels *k, const mechc_run_options *o,
+                              const mechc_run_tuning *x, RunLu *lend, mechc_diag *d)
+{
     mechc_run_options defaults = mechc_run_defaults();
     if (!o)
         o = &defaults;
@@ -185,6 +191,7 @@ mechc_result *mechc_run_with(mechc_kernels *k, const mechc_run_options *o,
         return NULL;
     }
     ro.source = &k->model->diag;
+    ro.lend_lu = lend;
     mechc_result *r = result_new(k, o->forces, o->on_state, o->ctx);
     r->keep = !x || x->keep_states;
     MechrtKernels newton = engine_newton_kernels(&k->engine);

@@ -238,6 +238,29 @@ mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *ph
     return MECHC_OK;
 }
 
+int mechc_phi_p_nz(const mechc_kernels *k) { return k->model->mech->kin.design.p_nnz; }
+
+mechc_status mechc_phi_p_pattern(const mechc_kernels *k, int *rows, int *params)
+{
+    if (!rows || !params)
+        return MECHC_EARG;
+    const DesignKin *dk = &k->model->mech->kin.design;
+    for (int i = 0; i < dk->p_nnz; i++)
+        rows[i] = dk->p_nz[i].row, params[i] = dk->p_nz[i].col;
+    return MECHC_OK;
+}
+
+mechc_status mechc_phi_p_values(mechc_kernels *k, const double *q, double t, double *vals)
+{
+    if (!q || !vals)
+        return MECHC_EARG;
+    if (k->model->mech->model->np == 0)
+        return MECHC_ENOTAVAIL;
+    double *const out[DESIGN_Y_COUNT] = {vals};
+    engine_design(&k->engine, DESIGN_PHI_P_NZ, q, NULL, t, out);
+    return MECHC_OK;
+}
+
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
                            const double *qdd, double t, double *y, double *yd, double *ydd)
 {

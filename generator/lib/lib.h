@@ -64,6 +64,10 @@ int lib_name_index(const char *const *names, const char *name, int fallback);
 /* A run's options as run_analysis takes them (x NULL: the defaults);
    false when one is out of range. */
 bool lib_run_options(const mechc_run_options *o, const mechc_run_tuning *x, RunOptions *ro);
+/* mechc_run_with, the run lending its LU of Phi_q to `lend` at every
+   step (RunOptions.lend_lu; NULL: nowhere): run --sens solves with it. */
+mechc_result *lib_run_lending(mechc_kernels *k, const mechc_run_options *o,
+                              const mechc_run_tuning *x, RunLu *lend, mechc_diag *d);
 /* What run_analysis said of a result made by mechc_run_with (its
    statistics: mechc run --stats). */
 const RunResult *lib_result_run(const mechc_result *r);

@@ -243,6 +243,13 @@ mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, doub
 /* dPhi/dp at the current design: MECHC_ENOTAVAIL when np == 0. */
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t,
                          double *phi_p /* nh x np */);
+/* dPhi/dp's structural nonzeros, as the Jacobian's: their count (0 when
+   np == 0), pattern (rows and parameter indices) and values. */
+int mechc_phi_p_nz(const mechc_kernels *k);
+mechc_status mechc_phi_p_pattern(const mechc_kernels *k, int *rows /* pnnz */,
+                                 int *params /* pnnz */);
+mechc_status mechc_phi_p_values(mechc_kernels *k, const double *q, double t,
+                                double *vals /* pnnz */);
 /* The sensitivities of a state of the motion (q, qd, qdd at t, as a run
    gives them) to the design parameters, what `run --sens` writes:
    variable-major, [i * np + j] = d(variable i)/d(p_j); q_p, qd_p, qdd_p

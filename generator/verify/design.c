@@ -39,7 +39,24 @@ static double *sens_values(Checker *c, int k, DesignFn fn, size_t *n)
     return all;
 }
 
-/* sens_v, sens_g and sens_y of every pair of engines. */
+/* Engine k's phi_p_nz against the other engine's dense phi_p, entry by
+   entry of the pattern (the dense zeros elsewhere are the graph's),
+   recorded with the pair's phi_p, k's value first when first. */
+static void compare_phi_p_nz(Checker *c, int pair, EngineKind k, const double *dense, bool first)
+{
+    const DesignKin *dk = &c->eng[k].mech->kin.design;
+    size_t n, np = (size_t)c->m->np;
+    double *nz = sens_values(c, k, DESIGN_PHI_P_NZ, &n);
+    for (int e = 0; e < dk->p_nnz; e++) {
+        const JacEntry *at = &dk->p_nz[e];
+        double d = dense[(size_t)at->row * np + (size_t)at->col];
+        check_record(c, CHECK_PHI_P_PAIR_FIRST + pair, at->row, at->col, first ? nz[e] : d,
+                     first ? d : nz[e], 0.0);
+    }
+    free(nz);
+}
+
+/* sens_v, sens_g, sens_y and phi_p_nz of every pair of engines. */
 static void compare_sens(Checker *c)
 {
     for (int pair = 0; pair < PAIR_COUNT; pair++) {
@@ -87,6 +104,8 @@ void check_design(Checker *c)
         for (size_t i = 0; i < n; i++)
             check_record(c, CHECK_PHI_P_PAIR_FIRST + pair, (int)(i / (size_t)m->np),
                          (int)(i % (size_t)m->np), phi_p[a][i], phi_p[b][i], 0.0);
+        compare_phi_p_nz(c, pair, a, phi_p[b], true);
+        compare_phi_p_nz(c, pair, b, phi_p[a], false);
         if (n == 0)
             c->rep->items[CHECK_PHI_P_PAIR_FIRST + pair].checked = true;
     }

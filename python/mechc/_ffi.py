@@ -113,6 +113,9 @@ mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *M, double *Q, double *jac, double *gamma);
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *phi_p);
+int mechc_phi_p_nz(const mechc_kernels *k);
+mechc_status mechc_phi_p_pattern(const mechc_kernels *k, int *rows, int *params);
+mechc_status mechc_phi_p_values(mechc_kernels *k, const double *q, double t, double *vals);
 mechc_status mechc_sensitivities(mechc_kernels *k, const double *q, const double *qd,
                                  const double *qdd, double t, double *q_p, double *qd_p,
                                  double *qdd_p, double *y_p, double *yd_p, double *ydd_p);
