@@ -1,4 +1,4 @@
-"""bench/python.py - the Python module's costs against issue 29's targets.
+"""bench/python.py - the Python module's costs against the library's targets (doc/python.md).
 
     PYTHONPATH=python /usr/bin/python3 bench/python.py     (part of `make bench`)
 

@@ -87,7 +87,7 @@ qd=$(sh "$ex/a02_four_bar.sh" --qd 2)
 falls "a02, N = 2" $(errors 2 "$tmp/a02.mech" --qd "$qd")
 falls "a02, N = 2, --linear sparse" $(errors 2 "$tmp/a02.mech" --qd "$qd" --linear sparse)
 
-# The defaults keep the benchmarks' targets of issue 30 (doc/dynamics.md,
+# The defaults keep the benchmarks' targets (doc/dynamics.md,
 # "Step control near singular positions"): A01 over its 2000 s within 1e-5
 # at every one of the 4001 states (1.06e-5 at the old default 1e-10), A02
 # N = 2 with its 400 output steps within 1e-7.
