@@ -122,7 +122,7 @@ if [ "$checked" -gt 100 ]; then ok; else bad "only $checked citations checked: t
 # Nothing in the tree cites an issue number of the tracker or a page that
 # was never written (a dynamics page once cited): files describe what is.
 # (The patterns are spelled so that this file does not match them.)
-word=issue
+word=ssue
 grep -rnIE --exclude-dir='build*' --exclude-dir=.git --exclude-dir=__pycache__ \
     "[Ii]${word}s? ?#?[0-9]+|DYN[.]md" . > "$tmp/cites"
 while read -r line; do bad "cites the tracker or a missing page: $line"; done < "$tmp/cites"
