@@ -83,9 +83,13 @@ void lib_batch_bind(mechc_kernels *k)
                           .mass = loop_mass};
 }
 
-/* The checks every batch call makes: arrays given (n > 0), nt 1 or n. */
-static mechc_status check(size_t n, const double *q, const double *t, size_t nt, const void *out)
+/* The checks every batch call makes: kernels given, arrays given (n > 0),
+   nt 1 or n. */
+static mechc_status check(const mechc_kernels *k, size_t n, const double *q, const double *t,
+                          size_t nt, const void *out)
 {
+    if (!k)
+        return MECHC_EARG;
     if (n == 0)
         return MECHC_OK;
     if (!q || !out || (t && nt != 1 && nt != n) || (!t && nt != 0))
@@ -100,7 +104,7 @@ static const double zero_time = 0;
 mechc_status mechc_phi_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                              size_t nt, double *phi)
 {
-    mechc_status st = check(n, q, t, nt, phi);
+    mechc_status st = check(k, n, q, t, nt, phi);
     if (st == MECHC_OK && n > 0)
         k->batch.phi(k, n, q, TIMES(t, nt), phi);
     return st;
@@ -109,7 +113,7 @@ mechc_status mechc_phi_batch(mechc_kernels *k, size_t n, const double *q, const 
 mechc_status mechc_jacobian_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                                   size_t nt, double *jac)
 {
-    mechc_status st = check(n, q, t, nt, jac);
+    mechc_status st = check(k, n, q, t, nt, jac);
     if (st == MECHC_OK && !k->engine.k.jac)
         st = MECHC_ENOTAVAIL;
     if (st == MECHC_OK && n > 0)
@@ -120,7 +124,7 @@ mechc_status mechc_jacobian_batch(mechc_kernels *k, size_t n, const double *q, c
 mechc_status mechc_nu_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                             size_t nt, double *nu)
 {
-    mechc_status st = check(n, q, t, nt, nu);
+    mechc_status st = check(k, n, q, t, nt, nu);
     if (st == MECHC_OK && n > 0)
         k->batch.nu(k, n, q, TIMES(t, nt), nu);
     return st;
@@ -129,7 +133,7 @@ mechc_status mechc_nu_batch(mechc_kernels *k, size_t n, const double *q, const d
 mechc_status mechc_gamma_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *gamma)
 {
-    mechc_status st = check(n, q, t, nt, gamma);
+    mechc_status st = check(k, n, q, t, nt, gamma);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && n > 0)
@@ -141,7 +145,7 @@ mechc_status mechc_all_batch(mechc_kernels *k, size_t n, const double *q, const 
                              const double *t, size_t nt, double *phi, double *jac, double *nu,
                              double *gamma)
 {
-    mechc_status st = check(n, q, t, nt, q);
+    mechc_status st = check(k, n, q, t, nt, q);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && !k->engine.k.all)
@@ -153,7 +157,7 @@ mechc_status mechc_all_batch(mechc_kernels *k, size_t n, const double *q, const 
 
 mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q, double *M)
 {
-    mechc_status st = check(n, q, NULL, 0, M);
+    mechc_status st = check(k, n, q, NULL, 0, M);
     if (st == MECHC_OK && !k->engine.k.mass)
         st = MECHC_ENOTAVAIL;
     if (st == MECHC_OK && n > 0)
@@ -164,7 +168,7 @@ mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q, doubl
 mechc_status mechc_force_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *Q)
 {
-    mechc_status st = check(n, q, t, nt, Q);
+    mechc_status st = check(k, n, q, t, nt, Q);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && !k->engine.k.force)
@@ -178,7 +182,7 @@ mechc_status mechc_outputs_batch(mechc_kernels *k, size_t n, const double *q, co
                                  const double *qdd, const double *t, size_t nt, double *y,
                                  double *yd, double *ydd)
 {
-    mechc_status st = check(n, q, t, nt, y);
+    mechc_status st = check(k, n, q, t, nt, y);
     if (st != MECHC_OK || n == 0)
         return st;
     const double *times = t ? t : &zero_time;

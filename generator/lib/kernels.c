@@ -64,23 +64,26 @@ void mechc_kernels_free(mechc_kernels *k)
     free(k);
 }
 
-const char *mechc_kernels_engine(const mechc_kernels *k) { return engine_names[k->engine.kind]; }
+const char *mechc_kernels_engine(const mechc_kernels *k)
+{
+    return k ? engine_names[k->engine.kind] : NULL;
+}
 
 double mechc_kernels_compile_seconds(const mechc_kernels *k)
 {
-    return k->engine.gen_seconds + k->engine.compile_seconds;
+    return k ? k->engine.gen_seconds + k->engine.compile_seconds : 0;
 }
 
-mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k->model; }
+mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k ? k->model : NULL; }
 
 const char *mechc_kernels_source(const mechc_kernels *k)
 {
-    return k->engine.compiled ? k->engine.emitted.c_text : NULL;
+    return k && k->engine.compiled ? k->engine.emitted.c_text : NULL;
 }
 
 mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
 {
-    if (!q || !phi)
+    if (!k || !q || !phi)
         return MECHC_EARG;
     engine_phi(&k->engine, q, t, phi);
     return MECHC_OK;
@@ -88,7 +91,7 @@ mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
 
 mechc_status mechc_jacobian(mechc_kernels *k, const double *q, double t, double *jac)
 {
-    if (!q || !jac)
+    if (!k || !q || !jac)
         return MECHC_EARG;
     if (!k->engine.k.jac)
         return MECHC_ENOTAVAIL;     /* sparse-only kernels */
@@ -96,11 +99,11 @@ mechc_status mechc_jacobian(mechc_kernels *k, const double *q, double t, double 
     return MECHC_OK;
 }
 
-int mechc_jacobian_nz(const mechc_kernels *k) { return k->model->mech->kin.nnz; }
+int mechc_jacobian_nz(const mechc_kernels *k) { return k ? k->model->mech->kin.nnz : 0; }
 
 mechc_status mechc_jacobian_pattern(const mechc_kernels *k, int *rows, int *cols)
 {
-    if (!rows || !cols)
+    if (!k || !rows || !cols)
         return MECHC_EARG;
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
     const Kinematics *kin = &k->model->mech->kin;
@@ -113,7 +116,7 @@ mechc_status mechc_jacobian_pattern(const mechc_kernels *k, int *rows, int *cols
 
 mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, double *vals)
 {
-    if (!q || !vals)
+    if (!k || !q || !vals)
         return MECHC_EARG;
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
     if (jnz) {
@@ -131,7 +134,7 @@ mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, 
 
 mechc_status mechc_nu(mechc_kernels *k, const double *q, double t, double *nu)
 {
-    if (!q || !nu)
+    if (!k || !q || !nu)
         return MECHC_EARG;
     engine_nu(&k->engine, q, t, nu);
     return MECHC_OK;
@@ -140,7 +143,7 @@ mechc_status mechc_nu(mechc_kernels *k, const double *q, double t, double *nu)
 mechc_status mechc_gamma(mechc_kernels *k, const double *q, const double *qd, double t,
                          double *gamma)
 {
-    if (!q || !qd || !gamma)
+    if (!k || !q || !qd || !gamma)
         return MECHC_EARG;
     engine_gamma(&k->engine, q, qd, t, gamma);
     return MECHC_OK;
@@ -149,7 +152,7 @@ mechc_status mechc_gamma(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *phi, double *jac, double *nu, double *gamma)
 {
-    if (!q || !qd)
+    if (!k || !q || !qd)
         return MECHC_EARG;
     if (!k->engine.k.all)
         return MECHC_ENOTAVAIL;
@@ -163,7 +166,7 @@ mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, doub
 
 mechc_status mechc_mass(mechc_kernels *k, const double *q, double *M)
 {
-    if (!q || !M)
+    if (!k || !q || !M)
         return MECHC_EARG;
     if (!k->engine.k.mass)
         return MECHC_ENOTAVAIL;
@@ -174,7 +177,7 @@ mechc_status mechc_mass(mechc_kernels *k, const double *q, double *M)
 mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, double t,
                          double *Q)
 {
-    if (!q || !qd || !Q)
+    if (!k || !q || !qd || !Q)
         return MECHC_EARG;
     if (!k->engine.k.force)
         return MECHC_ENOTAVAIL;
@@ -185,7 +188,7 @@ mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *M, double *Q, double *jac, double *gamma)
 {
-    if (!q || !qd)
+    if (!k || !q || !qd)
         return MECHC_EARG;
     if (!k->engine.k.mass)
         return MECHC_ENOTAVAIL;
@@ -205,7 +208,7 @@ mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, doub
 
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *phi_p)
 {
-    if (!q || !phi_p)
+    if (!k || !q || !phi_p)
         return MECHC_EARG;
     if (k->model->mech->model->np == 0)
         return MECHC_ENOTAVAIL;
@@ -216,7 +219,7 @@ mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *ph
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
                            const double *qdd, double t, double *y, double *yd, double *ydd)
 {
-    if (!q || !y || (yd && !qd) || (ydd && (!qd || !qdd || !yd)))
+    if (!k || !q || !y || (yd && !qd) || (ydd && (!qd || !qdd || !yd)))
         return MECHC_EARG;
     outputs_eval(&k->outputs, q, yd ? qd : NULL, ydd ? qdd : NULL, t, y, yd, ydd);
     return MECHC_OK;
