@@ -101,6 +101,17 @@ check "fit, a bad number: FILE:LINE:COL" err_has "$tmp/bad.csv:3:3: error: '1.4x
 check "fit, a bad number: the line" err_has "    1,1.4x"
 check "fit, a bad number: the caret" err_matches '^      \^$'
 
+# a NUL byte ended the field there: "1.4<NUL>" was read as 1.4 and the fit
+# ran (exit 1, no convergence); now refused where it is (issue 31's corpus)
+printf 't,rocker.phi\n0.5,1.4\000\n1,1.6\n1.5,1.7\n' > "$tmp/nul.csv"
+run_mechc fit "$fr" --data "$tmp/nul.csv"
+check "fit, a NUL byte: exit 2" status_is 2
+check "fit, a NUL byte: FILE:LINE:COL" err_has "$tmp/nul.csv:2:8: error: a NUL byte: a data file is text (is this a binary file?)"
+check "fit, a NUL byte: the caret" err_matches '^           \^$'
+run_mechc info "$ex/four_bar.mech" --state "$tmp/nul.csv"
+check "info --state, a NUL byte: exit 2" status_is 2
+check "info --state, a NUL byte: FILE:LINE:COL" err_has "$tmp/nul.csv:2:8: error: a NUL byte"
+
 printf 'rocker.phi\n1.45\n' > "$tmp/not.csv"
 run_mechc fit "$fr" --data "$tmp/not.csv"
 check "fit, no t column: exit 2" status_is 2

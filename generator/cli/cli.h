@@ -144,6 +144,10 @@ Mech *cli_load(Args *a, const MechLimits *limits, Diag *diag);
 bool cli_apply_design(const Args *a, Model *m);
 /* --design's line of --help. */
 void cli_print_design_help(FILE *out);
+/* PATH opened for writing (created or truncated), or NULL after
+   "mechc COMMAND: error: cannot write ..." on stderr; never blocks on a
+   named pipe that no process reads. */
+FILE *cli_open_output(const char *command, const char *path);
 /* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
 void cli_error(const Args *a, const Diag *diag);
 /* engine_open_with (options NULL: the defaults), the failure reported by

@@ -276,10 +276,8 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
                      .t1 = c->so.t1};
     if (c->csv_stdout)
         out.csv = stdout;
-    else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
-        fprintf(stderr, "mechc sim: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
+    else if (c->csv_path && !(out.csv = cli_open_output("sim", c->csv_path)))
         return EXIT_USAGE;
-    }
     run_output_open(&out, m);
     c->so.notes = stderr;
     c->so.source = source;

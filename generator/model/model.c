@@ -774,6 +774,21 @@ char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag
     return buf;
 }
 
+char *model_read_data_file(const char *path, const MechLimits *limits, int *len, Diag *diag)
+{
+    char *text = model_read_file(path, limits, len, diag);
+    const char *nul = text ? memchr(text, '\0', (size_t)*len) : NULL;
+    if (nul) {
+        diag_init(diag, path, text, *len);
+        diag_error(diag, (SrcPos){(int32_t)(nul - text)}, "a NUL byte: a data file is text "
+                   "(is this a binary file?)");
+        free(text);
+        diag->text = NULL, diag->text_len = 0;     /* the line is copied */
+        return NULL;
+    }
+    return text;
+}
+
 char *model_file_stem(Arena *arena, const char *path)
 {
     const char *base = strrchr(path, '/');
