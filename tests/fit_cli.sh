@@ -193,6 +193,14 @@ check "eval --design a: exit 2" status_is 2
 run_mechc eval "$ex/four_bar.mech" --design a=1
 check "eval --design on a file without design parameters: exit 2" status_is 2
 check "eval --design on a file without design parameters: said" err_has "has no design parameters"
+# one parameter given twice was taken at its last value, silently (issue
+# 31's outside corpus): refused, whether in one list or two options
+run_mechc run "$fr" --design a=1,a=2 --steps 2
+check "run --design a=1,a=2: exit 2" status_is 2
+check "run --design a=1,a=2: said" err_has "mechc run: error: --design: 'a' is given more than once"
+run_mechc eval "$fr" --design a=1 --design b=2,a=1
+check "eval --design a=1 --design b=2,a=1: exit 2" status_is 2
+check "eval --design a=1 --design b=2,a=1: said" err_has "'a' is given more than once"
 run_mechc eval "$fr" --design c=2.25 --design a=1.5 --json
 check "eval --design twice: exit 0" status_is 0
 check "eval --design twice: p" out_has '"p": [1.5, 3, 2.25]'

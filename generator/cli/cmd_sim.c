@@ -302,11 +302,18 @@ static int simulate(SimCli *c, const Model *m, const Engine *e, const RunPicture
 }
 
 /* --w B=wx,wy,wz into qd0: B's Euler-parameter rates at the file's
-   orientation; false (reported) for a name that is no spatial body or a
-   value that is not three numbers. */
+   orientation; false (reported) for a name that is no spatial body, a
+   value that is not three numbers, or a body given twice. */
 static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
 {
     for (int i = 0; i < c->omegas.n; i++) {
+        size_t len_i = strcspn(c->omegas.items[i], "=");
+        for (int k = 0; k < i; k++)
+            if (strncmp(c->omegas.items[k], c->omegas.items[i], len_i + 1) == 0) {
+                fprintf(stderr, "mechc sim: error: --w: body '%.*s' is given more than once\n",
+                        (int)len_i, c->omegas.items[i]);
+                return false;
+            }
         const char *item = c->omegas.items[i], *eq = strchr(item, '=');
         char name[256];
         size_t len = eq ? (size_t)(eq - item) : 0;

@@ -443,6 +443,11 @@ static void build_joint(Builder *b, const Stmt *s)
     }
     if (s->option) {
         j->option = build_lower(b, s->option, EXPR_TIMED);
+        double r;
+        /* a disk's contact point is R below its centre, on the plane */
+        if (s->joint == JOINT_S_ROLLING && dag_is_const(&m->dag, j->option, &r) && !(r > 0))
+            diag_fail(b->diag, s->option_pos, "the radius of rolling '%s' is %g: a disk's "
+                      "radius must be positive", s->name, r);
     }
     switch (info->level) {
     case LEVEL_POSITION: j->velocity = false; break;
