@@ -145,6 +145,16 @@ a02_exact() {
     [ "$(wc -l < "$2")" -eq "$((${3:-401} + 1))" ] && awk -v e="$worst" 'BEGIN { exit !(e <= 1e-3) }'
 }
 check "a02 N = 4: B0 and its velocity = the exact solution within 1e-3, 20 s" a02_exact 4 "$tmp/a02.csv"
+# --error on a CSV without B0's columns or rows printed 0 (a perfect
+# match) and exited 0 (issue 31's outside corpus)
+: > "$tmp/a02_empty.csv"
+printf 't,rod0.x\n0,0.5\n' > "$tmp/a02_other.csv"
+for f in a02_empty a02_other; do
+    sh "$ex/a02_four_bar.sh" --error 4 "$tmp/$f.csv" > "$tmp/out" 2> "$tmp/err"
+    check "a02 --error on $f.csv: exit 2" test $? = 2
+    check "a02 --error on $f.csv: nothing on stdout" out_empty
+done
+check "a02 --error on a CSV without B0: says which column" err_has "a02_other.csv: no column B0.x"
 check "a02 N = 4: on the parallelogram branch throughout, energy I/2 + K" awk -F, '
     NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     { p = $(c["rod0.phi"]); e = 0
