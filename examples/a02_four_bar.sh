@@ -63,8 +63,14 @@ if [ "$mode" = error ]; then
     BEGIN { pi = atan2(0, -1); ii = (n + 1) / 3 + n; k = 9.81 * ((n + 1) / 2 + n)
             th = pi / 2; w = -1; tt = 0; h = 1e-4 }
     function acc(a) { return -k * cos(a) / ii }
-    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
-    {
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i
+              split("B0.x B0.y d(B0.x) d(B0.y)", need, " ")
+              for (j = 1; j <= 4; j++) if (!(need[j] in c)) {
+                  printf "%s: no column %s: give the CSV of mechc sim on the file this script writes\n", FILENAME, need[j] > "/dev/stderr"
+                  bad = 1; exit 2
+              }
+              next }
+    { rows++
         while (tt < $1 - 1e-12) {
             hh = ($1 - tt < h) ? $1 - tt : h
             k1 = w; l1 = acc(th); k2 = w + hh / 2 * l1; l2 = acc(th + hh / 2 * k1)
@@ -75,7 +81,9 @@ if [ "$mode" = error ]; then
         e[3] = $(c["d(B0.x)"]) + sin(th) * w; e[4] = $(c["d(B0.y)"]) - cos(th) * w
         for (j = 1; j <= 4; j++) { d = e[j] < 0 ? -e[j] : e[j]; if (d > worst) worst = d }
     }
-    END { printf "%.3g\n", worst }' "$2"
+    END { if (bad) exit 2
+          if (!rows) { printf "%s: no data row\n", FILENAME > "/dev/stderr"; exit 2 }
+          printf "%.3g\n", worst }' "$2" || exit 2
     exit
 fi
 

@@ -131,4 +131,18 @@ check "driver past reach, run: the time it stopped (not the output time 0.37), t
     err_has "past_reach.mech: error: t = 0.36140625: the mechanism cannot reach the driven position: driver 'drive' pushes it past a limit position, where the Jacobian loses rank (smallest singular value 0.003 of the largest, along rows drive, O2.y, A.y, O4.y, B.y and O4.x)"
 check "driver past reach, run: no headline at t = 0.37" sh -c '! grep -q "error: t = 0.37" "$1"' _ "$tmp/err"
 
+# ---- a row not defined at the file's initial values ----
+# sqrt of a negative number in a driver: NaN from the start, which the
+# message blamed on the lengths ("minimum-norm Newton reached NaN or
+# infinity ... the mechanism may not close with these lengths"); now the
+# row is named (the outside corpus)
+printf 'body b x = 1 y = 0 phi = 0\nrevolute O: ground b(-1, 0)\ndriver D: b.phi = sqrt(-1 - t)\n' > "$tmp/sqrt_neg.mech"
+for cmd in run sim; do
+    [ $cmd = sim ] && printf 'mass b m = 1 J = 1\n' >> "$tmp/sqrt_neg.mech"
+    run_mechc $cmd "$tmp/sqrt_neg.mech"
+    check "row NaN at the initial values, $cmd: exit 1" status_is 1
+    check "row NaN at the initial values, $cmd: the row named" \
+        err_has "sqrt_neg.mech: error: t = 0: could not assemble from these initial values: rows not a finite number at the file's initial values: D (an expression not defined there: the square root or log of a negative number, 0/0, asin or acos past 1, an overflow?)"
+done
+
 suite_end

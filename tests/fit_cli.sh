@@ -101,6 +101,17 @@ check "fit, a bad number: FILE:LINE:COL" err_has "$tmp/bad.csv:3:3: error: '1.4x
 check "fit, a bad number: the line" err_has "    1,1.4x"
 check "fit, a bad number: the caret" err_matches '^      \^$'
 
+# a NUL byte ended the field there: "1.4<NUL>" was read as 1.4 and the fit
+# ran (exit 1, no convergence); now refused where it is (the outside corpus)
+printf 't,rocker.phi\n0.5,1.4\000\n1,1.6\n1.5,1.7\n' > "$tmp/nul.csv"
+run_mechc fit "$fr" --data "$tmp/nul.csv"
+check "fit, a NUL byte: exit 2" status_is 2
+check "fit, a NUL byte: FILE:LINE:COL" err_has "$tmp/nul.csv:2:8: error: a NUL byte: a data file is text (is this a binary file?)"
+check "fit, a NUL byte: the caret" err_matches '^           \^$'
+run_mechc info "$ex/four_bar.mech" --state "$tmp/nul.csv"
+check "info --state, a NUL byte: exit 2" status_is 2
+check "info --state, a NUL byte: FILE:LINE:COL" err_has "$tmp/nul.csv:2:8: error: a NUL byte"
+
 printf 'rocker.phi\n1.45\n' > "$tmp/not.csv"
 run_mechc fit "$fr" --data "$tmp/not.csv"
 check "fit, no t column: exit 2" status_is 2
@@ -182,6 +193,14 @@ check "eval --design a: exit 2" status_is 2
 run_mechc eval "$ex/four_bar.mech" --design a=1
 check "eval --design on a file without design parameters: exit 2" status_is 2
 check "eval --design on a file without design parameters: said" err_has "has no design parameters"
+# one parameter given twice was taken at its last value, silently (the
+# outside corpus): refused, whether in one list or two options
+run_mechc run "$fr" --design a=1,a=2 --steps 2
+check "run --design a=1,a=2: exit 2" status_is 2
+check "run --design a=1,a=2: said" err_has "mechc run: error: --design: 'a' is given more than once"
+run_mechc eval "$fr" --design a=1 --design b=2,a=1
+check "eval --design a=1 --design b=2,a=1: exit 2" status_is 2
+check "eval --design a=1 --design b=2,a=1: said" err_has "'a' is given more than once"
 run_mechc eval "$fr" --design c=2.25 --design a=1.5 --json
 check "eval --design twice: exit 0" status_is 0
 check "eval --design twice: p" out_has '"p": [1.5, 3, 2.25]'

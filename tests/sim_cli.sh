@@ -145,6 +145,16 @@ a02_exact() {
     [ "$(wc -l < "$2")" -eq "$((${3:-401} + 1))" ] && awk -v e="$worst" 'BEGIN { exit !(e <= 1e-3) }'
 }
 check "a02 N = 4: B0 and its velocity = the exact solution within 1e-3, 20 s" a02_exact 4 "$tmp/a02.csv"
+# --error on a CSV without B0's columns or rows printed 0 (a perfect
+# match) and exited 0 (the outside corpus)
+: > "$tmp/a02_empty.csv"
+printf 't,rod0.x\n0,0.5\n' > "$tmp/a02_other.csv"
+for f in a02_empty a02_other; do
+    sh "$ex/a02_four_bar.sh" --error 4 "$tmp/$f.csv" > "$tmp/out" 2> "$tmp/err"
+    check "a02 --error on $f.csv: exit 2" test $? = 2
+    check "a02 --error on $f.csv: nothing on stdout" out_empty
+done
+check "a02 --error on a CSV without B0: says which column" err_has "a02_other.csv: no column B0.x"
 check "a02 N = 4: on the parallelogram branch throughout, energy I/2 + K" awk -F, '
     NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     { p = $(c["rod0.phi"]); e = 0
@@ -489,10 +499,20 @@ for f in a01_pendulum heavy_top; do
 done
 
 # ---- bounded work: --max-steps, and --steps beyond it ----
-run "$ex/a01_pendulum.mech" --t1 1e9 --max-steps 2000
-check "--t1 1e9 --max-steps 2000: exit 1" status_is 1
-check "--t1 1e9 --max-steps 2000: the time reached and the option" \
-    err_matches 'error: t = [0-9.]*: integration failed: more than 2000 integrator steps (--max-steps) at [0-9.e-]*% of the interval from t = 0 to 1000000000'
+run "$ex/a01_pendulum.mech" --t1 200 --max-steps 2000
+check "--t1 200 --max-steps 2000: exit 1" status_is 1
+check "--t1 200 --max-steps 2000: the time reached and the option" \
+    err_matches 'error: t = [0-9.]*: integration failed: more than 2000 integrator steps (--max-steps) at [0-9.e-]*% of the interval from t = 0 to 200'
+# a span the budget cannot cover at this rate ends once a hundredth of it
+# is spent (--t1 1e9 at the default budget: 2e10 steps needed, once a
+# minute of CPU before the budget's end; the outside corpus)
+for budget in "" "--max-steps 2000"; do
+    # shellcheck disable=SC2086 # the option and its value are two words
+    run "$ex/a01_pendulum.mech" --t1 1e9 $budget
+    check "--t1 1e9 $budget: exit 1" status_is 1
+    check "--t1 1e9 $budget: the forecast, the time reached and the option" \
+        err_matches 'error: t = [0-9.]*: integration failed: [0-9]* integrator steps so far, at this rate about [0-9.e+]* for the whole interval: more than [0-9]* (--max-steps) at [0-9.e-]*% of the interval from t = 0 to 1000000000'
+done
 run "$ex/a01_pendulum.mech" --steps 20000 --max-steps 1000
 check "--steps beyond --max-steps: exit 2" status_is 2
 check "--steps beyond --max-steps: says so" \

@@ -94,6 +94,10 @@ sim "$ex/heavy_top.mech" --w "ground=1,2,3"
 check "--w of ground: exit 2 naming what it takes" err_has "--w takes B=WX,WY,WZ with B a spatial body"
 sim "$ex/heavy_top.mech" --w "top=1,2"
 check "--w with two numbers: exit 2" status_is 2
+# a body given twice took its last value, silently (the outside corpus)
+sim "$ex/heavy_top.mech" --w "top=1,2,3" --w "top=0,0,0"
+check "--w twice for one body: exit 2" status_is 2
+check "--w twice for one body: said" err_has "mechc sim: error: --w: body 'top' is given more than once"
 # the gyroscopic approximation m g l / (I3 w3) = 2.4525 is not it (the test can tell them apart)
 check "heavy top: the exact rate differs from the gyroscopic approximation" \
     awk -v w="$omega" 'BEGIN { exit !(w - 2.4525 > 0.1) }'

@@ -698,8 +698,69 @@ static void sim_matches_cli(void **state)
     o.method = "euler";
     assert_null(mechc_sim(k, &o, &d));
     assert_int_equal(d.status, MECHC_EARG);
+    /* options the command refuses (the outside corpus): no
+       tolerance at all, an infinite one, a NaN initial velocity */
+    mechc_sim_options bad = mechc_sim_defaults();
+    bad.rtol = bad.atol = 0;
+    assert_null(mechc_sim(k, &bad, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    bad = mechc_sim_defaults();
+    bad.atol = INFINITY;
+    assert_null(mechc_sim(k, &bad, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    bad = mechc_sim_defaults();
+    double qd[3] = {0, NAN, 0};
+    bad.qd0 = qd;
+    assert_null(mechc_sim(k, &bad, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    assert_string_equal(d.message, "mechc_sim: qd0[1] (rod.y) is not a finite number");
     mechc_kernels_free(k);
     mechc_model_free(m);
+}
+
+/* NULL handles: a status, a zero or NULL, never a crash (Python's
+   methods on a closed Model pass NULL kernels). */
+static void null_handles(void **state)
+{
+    (void)state;
+    double q[4] = {0}, out[16];
+    mechc_diag d;
+    assert_int_equal(mechc_nq(NULL), 0);
+    assert_int_equal(mechc_np(NULL), 0);
+    assert_null(mechc_model_name(NULL));
+    assert_null(mechc_q0(NULL));
+    assert_null(mechc_coord_name(NULL, 0));
+    assert_int_equal(mechc_coord_index(NULL, "b.x"), -1);
+    assert_int_equal(mechc_body_coords(NULL, 0, NULL, NULL), MECHC_EARG);
+    assert_int_equal(mechc_set_design(NULL, "a", 1), MECHC_EARG);
+    assert_int_equal(mechc_qd0(NULL, out), MECHC_EARG);
+    assert_null(mechc_kernels_engine(NULL));
+    assert_null(mechc_kernels_model(NULL));
+    assert_int_equal(mechc_jacobian_nz(NULL), 0);
+    assert_int_equal(mechc_phi_p_nz(NULL), 0);
+    assert_int_equal(mechc_phi_p_values(NULL, q, 0, out), MECHC_EARG);
+    assert_null(mechc_compile_with(NULL, "jit", NULL, &d));
+    assert_null(mechc_sim_with(NULL, NULL, NULL, &d));
+    assert_null(mechc_info_with(NULL, NULL, &d));
+    assert_null(mechc_info_report_json(NULL));
+    assert_int_equal(mechc_phi(NULL, q, 0, out), MECHC_EARG);
+    assert_int_equal(mechc_jacobian(NULL, q, 0, out), MECHC_EARG);
+    assert_int_equal(mechc_gamma(NULL, q, q, 0, out), MECHC_EARG);
+    assert_int_equal(mechc_mass(NULL, q, out), MECHC_EARG);
+    assert_int_equal(mechc_outputs(NULL, q, NULL, NULL, 0, out, NULL, NULL), MECHC_EARG);
+    assert_int_equal(mechc_phi_batch(NULL, 1, q, NULL, 0, out), MECHC_EARG);
+    assert_int_equal(mechc_mass_batch(NULL, 0, q, out), MECHC_EARG);
+    assert_int_equal(mechc_sensitivities(NULL, q, q, q, 0, out, out, out, NULL, NULL, NULL),
+                     MECHC_EARG);
+    assert_null(mechc_run(NULL, NULL, &d));
+    assert_int_equal(d.status, MECHC_EARG);
+    assert_int_equal(mechc_result_states(NULL), 0);
+    assert_int_equal(mechc_result_status(NULL), MECHC_EARG);
+    assert_null(mechc_result_q(NULL));
+    assert_true(isnan(mechc_result_t_fail(NULL)));
+    mechc_model_free(NULL);
+    mechc_kernels_free(NULL);
+    mechc_result_free(NULL);
 }
 
 /* mechc info's figures: as a struct and as its JSON. */
@@ -846,6 +907,7 @@ int main(void)
         cmocka_unit_test(sim_matches_cli),
         cmocka_unit_test(sim_with_tuning),
         cmocka_unit_test(sim_redundant),
+        cmocka_unit_test(null_handles),
         cmocka_unit_test(info),
         cmocka_unit_test(info_with_options),
         cmocka_unit_test(threads),

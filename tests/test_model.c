@@ -63,6 +63,9 @@ static const BadInput bad_inputs[] = {
     {"spatial\nbody b\nuniversal U: ground b axis(0, 0, 1) axis(0, 0, 2)\n", 3, 37, "the two axes of universal 'U' are parallel in the initial orientations"},
     {"spatial\nbody b orient = axis(1, 0, 0, pi/2)\nperpendicular P: ground b axis(0, 0, 1) axis(0, 1, 0)\n", 3, 41, "the two axes of perpendicular 'P' are parallel"},
     {"spatial\nbody d z = 1\nrolling R: d radius = 1 axis(0, 0, 1)\n", 3, 25, "the disk of rolling 'R' lies flat"},
+    /* a disk of no or negative radius (accepted, exit 0: the outside corpus) */
+    {"spatial\nbody d z = 1\nrolling R: d radius = 0 axis(0, 1, 0)\n", 3, 14, "the radius of rolling 'R' is 0: a disk's radius must be positive"},
+    {"spatial\nbody d z = 1\nrolling R: d radius = 1 - 2 axis(0, 1, 0)\n", 3, 14, "the radius of rolling 'R' is -1: a disk's radius must be positive"},
 };
 
 static void test_bad_inputs(void **state)

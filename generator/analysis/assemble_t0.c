@@ -181,6 +181,24 @@ bool assemble_t0_violated(const Model *m, const MechrtKernels *k, double t, doub
     return finite;
 }
 
+/* Appends the rows that are NaN or infinite at the file's initial values
+   (an expression not defined there: no iterate can help); how many. */
+static int nonfinite_at_q0(const Model *m, const MechrtKernels *k, double t, char *msg,
+                           size_t size)
+{
+    size_t nh = (size_t)k->nh;
+    double *phi = xcalloc(nh + 1, sizeof *phi), *bad = xcalloc(nh + 1, sizeof *bad);
+    const char **names = xcalloc(nh + 1, sizeof *names);
+    k->phi(k->ctx, m->q0, t, phi);
+    for (size_t i = 0; i < nh; i++) {
+        bad[i] = isfinite(phi[i]) ? 0 : 1;
+        names[i] = m->rows[i].name;
+    }
+    int n = analysis_name_above(msg, size, names, bad, (int)nh, 1);
+    free(phi), free(bad), free(names);
+    return n;
+}
+
 void assemble_t0_describe(const Model *m, const MechrtKernels *k, const AssembleT0Report *rep,
                           const double *q, char *msg, size_t size)
 {
@@ -190,6 +208,13 @@ void assemble_t0_describe(const Model *m, const MechrtKernels *k, const Assemble
     AssembleViolated v;
     msg[0] = '\0';
     analysis_msgf(msg, size, "t = %.10g: could not assemble from these initial values: ", rep->t0);
+    if (nonfinite_at_q0(m, k, rep->t0, rows, sizeof rows) > 0) {
+        analysis_msgf(msg, size, "rows not a finite number at the file's initial values: %s "
+                      "(an expression not defined there: the square root or log of a negative "
+                      "number, 0/0, asin or acos past 1, an overflow?); give initial values and "
+                      "t0 where every row is defined", rows);
+        return;
+    }
     bool finite = assemble_t0_violated(m, k, rep->t0, rep->tol_phi, q, &v, rows, sizeof rows);
     if (finite && assemble_t0_loop(m, k, rep->t0, rep->tol_phi, q, loop, sizeof loop) > 0)
         analysis_msgf(msg, size, "%s; ", loop);     /* the cause first */

@@ -147,6 +147,10 @@ mechc_model *cli_load(Args *a, const mechc_limits *limits);
 bool cli_apply_design(const Args *a, Model *m);
 /* --design's line of --help. */
 void cli_print_design_help(FILE *out);
+/* PATH opened for writing (created or truncated), or NULL after
+   "mechc COMMAND: error: cannot write ..." on stderr; never blocks on a
+   named pipe that no process reads. */
+FILE *cli_open_output(const char *command, const char *path);
 /* "mechc COMMAND: error: MESSAGE" for a failure reported in diag. */
 void cli_error(const Args *a, const Diag *diag);
 /* mechc_compile_with the engine of kind (o NULL: the defaults), the

@@ -117,11 +117,9 @@ static void dump_rows(const Mech *mech)
 
 static bool write_file(const char *path, const char *text)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "mechc gen: error: cannot write '%s': %s\n", path, strerror(errno));
+    FILE *f = cli_open_output("gen", path);
+    if (!f)
         return false;
-    }
     fputs(text, f);
     bool ok = fclose(f) == 0;
     if (!ok)

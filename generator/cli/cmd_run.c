@@ -494,8 +494,7 @@ static int analyse(RunCli *c, const Model *m, mechc_kernels *k, const RunPicture
                      .digits = c->digits, .t0 = c->ro.t0, .t1 = c->ro.t1};
     if (c->csv_stdout) {
         out.csv = stdout;
-    } else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
-        fprintf(stderr, "mechc run: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
+    } else if (c->csv_path && !(out.csv = cli_open_output("run", c->csv_path))) {
         return EXIT_USAGE;
     }
     run_output_open(&out, m);

@@ -281,10 +281,8 @@ static int simulate(SimCli *c, const Model *m, mechc_kernels *k, const RunPictur
                      .t1 = c->so.t1};
     if (c->csv_stdout)
         out.csv = stdout;
-    else if (c->csv_path && !(out.csv = fopen(c->csv_path, "w"))) {
-        fprintf(stderr, "mechc sim: error: cannot write '%s': %s\n", c->csv_path, strerror(errno));
+    else if (c->csv_path && !(out.csv = cli_open_output("sim", c->csv_path)))
         return EXIT_USAGE;
-    }
     run_output_open(&out, m);
     mechc_sim_options so = c->so;
     so.on_state = run_output_state;
@@ -312,11 +310,18 @@ static int simulate(SimCli *c, const Model *m, mechc_kernels *k, const RunPictur
 }
 
 /* --w B=wx,wy,wz into qd0: B's Euler-parameter rates at the file's
-   orientation; false (reported) for a name that is no spatial body or a
-   value that is not three numbers. */
+   orientation; false (reported) for a name that is no spatial body, a
+   value that is not three numbers, or a body given twice. */
 static bool read_omegas(const SimCli *c, const Model *m, double *qd0)
 {
     for (int i = 0; i < c->omegas.n; i++) {
+        size_t len_i = strcspn(c->omegas.items[i], "=");
+        for (int k = 0; k < i; k++)
+            if (strncmp(c->omegas.items[k], c->omegas.items[i], len_i + 1) == 0) {
+                fprintf(stderr, "mechc sim: error: --w: body '%.*s' is given more than once\n",
+                        (int)len_i, c->omegas.items[i]);
+                return false;
+            }
         const char *item = c->omegas.items[i], *eq = strchr(item, '=');
         char name[256];
         size_t len = eq ? (size_t)(eq - item) : 0;

@@ -1,6 +1,11 @@
 /* common.c - what the commands do alike: the order of their steps, loading the file, opening an engine, reporting a failure. */
 #include "cli.h"
 
+#include <errno.h>
+#include <fcntl.h>
+#include <string.h>
+#include <unistd.h>
+
 int cli_main(const CliCommand *cmd, int argc, char **argv, void *opts)
 {
     Args a;
@@ -61,4 +66,25 @@ mechc_kernels *cli_compile(const Args *a, mechc_model *model, EngineKind kind,
     if (!k)
         fprintf(stderr, "mechc %s: error: %s\n", a->command, d.message);
     return k;
+}
+
+FILE *cli_open_output(const char *command, const char *path)
+{
+    /* O_NONBLOCK: a named pipe with no reader fails (ENXIO) at once
+       instead of blocking the open forever; one with a reader (a shell's
+       process substitution) is written as usual, blocking again. */
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_NONBLOCK | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        fprintf(stderr, "mechc %s: error: cannot write '%s': %s\n", command, path,
+                errno == ENXIO ? "a named pipe that no process reads" : strerror(errno));
+        return NULL;
+    }
+    int flags = fcntl(fd, F_GETFL);
+    FILE *f = flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) < 0 ? NULL : fdopen(fd, "w");
+    if (!f) {
+        fprintf(stderr, "mechc %s: error: cannot write '%s': %s\n", command, path,
+                strerror(errno));
+        close(fd);
+    }
+    return f;
 }

@@ -1,6 +1,8 @@
 /* design.c - --design NAME=VALUE: the design a command evaluates, without compiling again. */
 #include "cli.h"
 
+#include "../base/arena.h"
+
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,8 +23,9 @@ static int find_design(const Model *m, const char *name, size_t len)
     return -1;
 }
 
-/* One NAME=VALUE of item at *s; false (reported) when it cannot be used. */
-static bool apply_one(const Args *a, Model *m, const char *item, size_t len)
+/* One NAME=VALUE of item at *s; false (reported) when it cannot be used
+   or names a parameter already given (seen: one flag per parameter). */
+static bool apply_one(const Args *a, Model *m, const char *item, size_t len, bool *seen)
 {
     const char *eq = memchr(item, '=', len);
     if (!eq) {
@@ -39,6 +42,12 @@ static bool apply_one(const Args *a, Model *m, const char *item, size_t len)
         fputs(")\n", stderr);
         return false;
     }
+    if (seen[j]) {
+        fprintf(stderr, "mechc %s: error: --design: '%s' is given more than once\n",
+                a->command, m->design_names[j]);
+        return false;
+    }
+    seen[j] = true;
     char buf[64];
     size_t vlen = len - (size_t)(eq + 1 - item);
     char *end = NULL;
@@ -67,13 +76,16 @@ bool cli_apply_design(const Args *a, Model *m)
                 "them with `design NAME = value`)\n", a->command, m->file);
         return false;
     }
-    for (int i = 0; i < a->ndesign; i++)
-        for (const char *s = a->design[i]; *s;) {
+    bool *seen = xcalloc((size_t)m->np, sizeof *seen);
+    bool ok = true;
+    for (int i = 0; i < a->ndesign && ok; i++)
+        for (const char *s = a->design[i]; *s && ok;) {
             size_t len = strcspn(s, ",");
-            if (!apply_one(a, m, s, len))
-                return false;
+            ok = apply_one(a, m, s, len, seen);
             s += len + (s[len] == ',');
         }
-    model_set_design(m, NULL);
-    return true;
+    free(seen);
+    if (ok)
+        model_set_design(m, NULL);
+    return ok;
 }

@@ -295,12 +295,9 @@ static bool write_picture(const RunOutput *out, const RunPictures *p, int which,
     const Model *m = out->m;
     const char *path = which == 0 ? p->svg_path : p->plot_path;
     int n = (int)out->trace.rows;
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "mechc %s: error: cannot write '%s': %s\n", out->cmd, path,
-                strerror(errno));
+    FILE *f = cli_open_output(out->cmd, path);
+    if (!f)
         return false;
-    }
     bool wrote;
     if (which == 0) {
         SvgAnimOptions ao = svg_anim_default_options();

@@ -146,7 +146,7 @@ bool state_csv_read(const char *path, const Model *m, double at, double *q, doub
     limits.max_file_bytes = INT_MAX - 1;
     int len = 0;
     diag_init(diag, path, NULL, 0);
-    char *text = model_read_file(path, &limits, &len, diag);
+    char *text = model_read_data_file(path, &limits, &len, diag);
     if (!text)
         return false;
     /* work is cut in place by strsep and next_field; text stays whole

@@ -209,7 +209,8 @@ double dag_op_eval(DagOp op, double a, double b)
     return NAN;
 }
 
-/* Folds op over constant operands when the result is finite. */
+/* Folds op over constant operands when the result is finite; one that is
+   not is noted (range.c) and reported once the graph is complete. */
 static bool try_fold(Dag *dag, DagOp op, NodeId a, NodeId b, NodeId *out)
 {
     double va, vb = 0.0;
@@ -218,8 +219,10 @@ static bool try_fold(Dag *dag, DagOp op, NodeId a, NodeId b, NodeId *out)
     if (b != DAG_NONE && !dag_is_const(dag, b, &vb))
         return false;
     double r = dag_op_eval(op, va, vb);
-    if (!isfinite(r))
+    if (!isfinite(r)) {
+        dag_range_note_nonfinite(dag, r);
         return false;
+    }
     *out = r == 0.0 ? DAG_ZERO : dag_const(dag, r);     /* one zero: no -0 node */
     return true;
 }

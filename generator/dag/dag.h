@@ -41,12 +41,13 @@ typedef struct Dag {
        once with dag_check_limit. No dag_* call ever jumps out. */
     bool overflow;
     int32_t overflow_where; /* where at the first overflow */
-    /* Sticky too: set when a constant that is not finite is asked for.
-       Folding keeps only finite results, so such a constant comes from the
-       numbers a builder combines itself (an offset turned by an
-       orientation, an axis normalised, m |com|^2, m g) past the range of a
-       double; it would print as inf or nan, which C does not read.
-       dag_check_finite reports it once, at its statement. */
+    /* Sticky too: set when a constant that is not finite is asked for
+       (the numbers a builder combines itself past the range of a double:
+       an offset turned by an orientation, an axis normalised, m |com|^2,
+       m g; it would print as inf or nan, which C does not read), or when
+       constant operands fold to one (0/0 or 1e308*10 in a force: folding
+       keeps only finite results, so the C would compute it at every
+       call). dag_check_finite reports it once, at its statement. */
     bool nonfinite;
     int32_t nonfinite_where; /* where_expr, else where, at the first one */
     bool nonfinite_expr;     /* ... and it was where_expr */
@@ -84,10 +85,13 @@ bool dag_check_limit(const Dag *dag, Diag *diag);
    NaN) and why, at the statement it came from. dag_check_float: true when
    no constant the roots reach overflows a float or vanishes in one;
    otherwise the same about the first one. dag_range_note: dag_const's
-   record of a new constant node. */
+   record of a new constant node; dag_range_note_nonfinite: of a value
+   that constant operands fold to but no node can hold (0/0, 1e308*10 in
+   a force: left unfolded, the C would compute it at every call). */
 bool dag_check_finite(const Dag *dag, Diag *diag);
 bool dag_check_float(const Dag *dag, const NodeId *roots, int nroots, Diag *diag);
 void dag_range_note(Dag *dag, NodeId id);
+void dag_range_note_nonfinite(Dag *dag, double v);
 /* dag_const of a value a builder combined, named (what: "the weight m g")
    if it is out of range. */
 NodeId dag_const_named(Dag *dag, double value, const char *what);

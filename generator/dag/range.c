@@ -28,20 +28,26 @@ static bool float_loses(double v)
     return isfinite(v) && (isinf(f) || (v != 0.0 && f == 0.0f));
 }
 
+void dag_range_note_nonfinite(Dag *dag, double v)
+{
+    if (isfinite(v) || dag->nonfinite)
+        return;
+    bool expr = dag->where_expr >= 0;
+    dag->nonfinite = true;
+    dag->nonfinite_where = expr ? dag->where_expr : dag->where;
+    dag->nonfinite_expr = expr;
+    dag->nonfinite_what = dag->what;
+    dag->nonfinite_value = v;
+}
+
 void dag_range_note(Dag *dag, NodeId id)
 {
     double v = dag->nodes[id].value;
-    bool expr = dag->where_expr >= 0;
-    int32_t where = expr ? dag->where_expr : dag->where;
-    if (!isfinite(v) && !dag->nonfinite) {
-        dag->nonfinite = true;
-        dag->nonfinite_where = where;
-        dag->nonfinite_expr = expr;
-        dag->nonfinite_what = dag->what;
-        dag->nonfinite_value = v;
-    }
+    dag_range_note_nonfinite(dag, v);
     if (!float_loses(v))
         return;
+    bool expr = dag->where_expr >= 0;
+    int32_t where = expr ? dag->where_expr : dag->where;
     if (dag->nwide == dag->wide_cap) {
         dag->wide_cap = dag->wide_cap ? 2 * dag->wide_cap : 8;
         dag->wide = xrealloc(dag->wide, (size_t)dag->wide_cap, sizeof *dag->wide);

@@ -15,6 +15,13 @@
  * the gradient itself (a turn beyond 60 degrees) in one accepted step far
  * shorter than those before names the rows. Both end the simulation with
  * exit 1, the time and the rows.
+ *
+ * The step budget (--max-steps) is checked as it is spent, and forecast:
+ * once a hundredth of it is spent, a rate of progress that would need
+ * more than SIM_BUDGET_FORECAST times the budget for the whole interval
+ * (sim --t1 1e9 on a pendulum: 2e10 steps) ends the run there, in a
+ * second, instead of at the budget's end a minute later with the same
+ * message.
  */
 #include "watch.h"
 
@@ -33,6 +40,8 @@
    turns that far only in a long step: a fast spin at loose tolerances). */
 #define SIM_TURN_SHARE 1.0
 #define SIM_TURN_STEP 1e-3
+/* The step budget's forecast: past SIM_BUDGET_FORECAST times the budget. */
+#define SIM_BUDGET_FORECAST 10.0
 
 /* The gradients are watched: rows and their Jacobian, dense or the
    sparse path's nonzeros. */
@@ -104,16 +113,34 @@ static bool collapsed(Sim *s, double t)
            || (fabs(mean) < SIM_STALL_SHARE * s->hmax && rejected >= SIM_STALL_STEPS / 2);
 }
 
+/* More steps than --max-steps, taken or (at this rate) needed: false
+   with the message set. */
+static bool over_budget(Sim *s, double t)
+{
+    long steps = s->res->steps, budget = s->o->max_steps;
+    double done = (t - s->o->t0) / (s->o->t1 - s->o->t0);
+    double needed = steps / fmax(done, 1e-300);
+    if (steps > budget) {
+        sim_fail(s, MECHRT_ESTEP, t, "integration");
+        msgf(s, "more than %ld integrator steps (--max-steps)", budget);
+    } else if (steps >= SIM_STALL_STEPS && steps >= budget / 100
+               && needed > SIM_BUDGET_FORECAST * (double)budget) {
+        sim_fail(s, MECHRT_ESTEP, t, "integration");
+        msgf(s, "%ld integrator steps so far, at this rate about %.2g for the whole interval: "
+             "more than %ld (--max-steps)", steps, needed, budget);
+    } else {
+        return true;
+    }
+    msgf(s, " at %.3g%% of the interval from t = %.10g to %.10g: the motion is stiff or too "
+         "fast for --rtol/--atol (an implicit --method may help), or the interval too long",
+         100 * done, s->o->t0, s->o->t1);
+    return false;
+}
+
 bool sim_watch_step(Sim *s, const double *y, double t, double t_before)
 {
-    if (s->res->steps > s->o->max_steps) {
-        sim_fail(s, MECHRT_ESTEP, t, "integration");
-        msgf(s, "more than %ld integrator steps (--max-steps) at %.3g%% of the interval from "
-             "t = %.10g to %.10g: the motion is stiff or too fast for --rtol/--atol (an "
-             "implicit --method may help), or the interval too long", s->o->max_steps,
-             100 * (t - s->o->t0) / (s->o->t1 - s->o->t0), s->o->t0, s->o->t1);
+    if (!over_budget(s, t))
         return false;
-    }
     if (s->wsteps == 0) {
         s->wt0 = t_before;
         s->wrejected0 = s->res->rejected;

@@ -189,7 +189,7 @@ bool fit_data_read(const char *path, const Model *m, FitData *d, Diag *diag)
     diag_init(diag, path, "", 0);
     MechLimits limits = mech_default_limits();
     int len;
-    char *text = model_read_file(path, &limits, &len, diag);
+    char *text = model_read_data_file(path, &limits, &len, diag);
     if (!text)
         return false;
     diag_init(diag, path, text, len);

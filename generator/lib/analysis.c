@@ -245,7 +245,8 @@ static bool sim_options(const mechc_sim_options *o, const mechc_sim_tuning *x, S
     *so = sim_default_options();
     int method = lib_name_index(sim_method_names, o->method, SIM_RK8PD);
     if (method < 0 || o->steps < 1 || o->t0 == o->t1 || !isfinite(o->t0) || !isfinite(o->t1)
-        || !(o->rtol >= 0) || !(o->atol >= 0))
+        || !(o->rtol >= 0) || !(o->atol >= 0) || !isfinite(o->rtol) || !isfinite(o->atol)
+        || (o->rtol == 0 && o->atol == 0))
         return false;
     so->t0 = o->t0;
     so->t1 = o->t1;
@@ -270,11 +271,18 @@ mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
         o = &defaults;
     SimOptions so;
     if (!k || !sim_options(o, x, &so)) {
-        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0, an "
-                 "unknown method (rk8pd, rkf45, rk4imp, msbdf) or a tuning value out of range");
+        lib_fail(d, MECHC_EARG, "mechc_sim: steps < 1, t0 == t1, a tolerance < 0 or not "
+                 "finite, rtol and atol both 0, an unknown method (rk8pd, rkf45, rk4imp, "
+                 "msbdf) or a tuning value out of range");
         return NULL;
     }
     const Model *m = k->model->mech->model;
+    for (int j = 0; o->qd0 && j < m->nq; j++)
+        if (!isfinite(o->qd0[j])) {
+            lib_fail(d, MECHC_EARG, "mechc_sim: qd0[%d] (%s) is not a finite number", j,
+                     m->coord_names[j]);
+            return NULL;
+        }
     if (!sim_has_masses(&k->engine.k)) {
         lib_fail(d, MECHC_ENOTRUNNABLE, "the mechanism has no masses: sim needs `mass` "
                  "statements (with `gravity`, forces or springs)");
@@ -296,18 +304,22 @@ mechc_result *mechc_sim_with(mechc_kernels *k, const mechc_sim_options *o,
 
 const SimResult *lib_result_sim(const mechc_result *r) { return &r->sim; }
 
-int mechc_result_states(const mechc_result *r) { return r->states; }
-const double *mechc_result_time(const mechc_result *r) { return r->t; }
-const double *mechc_result_q(const mechc_result *r) { return r->q; }
-const double *mechc_result_qd(const mechc_result *r) { return r->qd; }
-const double *mechc_result_qdd(const mechc_result *r) { return r->qdd; }
-const double *mechc_result_y(const mechc_result *r) { return r->nout ? r->y : NULL; }
-const double *mechc_result_yd(const mechc_result *r) { return r->nout ? r->yd : NULL; }
-const double *mechc_result_ydd(const mechc_result *r) { return r->nout ? r->ydd : NULL; }
-const double *mechc_result_lambda(const mechc_result *r) { return r->with_lambda ? r->lambda : NULL; }
-mechc_status mechc_result_status(const mechc_result *r) { return r->status; }
-const char *mechc_result_message(const mechc_result *r) { return r->message; }
-double mechc_result_t_fail(const mechc_result *r) { return r->t_fail; }
+/* A NULL result (a run that could not start) reads as empty. */
+int mechc_result_states(const mechc_result *r) { return r ? r->states : 0; }
+const double *mechc_result_time(const mechc_result *r) { return r ? r->t : NULL; }
+const double *mechc_result_q(const mechc_result *r) { return r ? r->q : NULL; }
+const double *mechc_result_qd(const mechc_result *r) { return r ? r->qd : NULL; }
+const double *mechc_result_qdd(const mechc_result *r) { return r ? r->qdd : NULL; }
+const double *mechc_result_y(const mechc_result *r) { return r && r->nout ? r->y : NULL; }
+const double *mechc_result_yd(const mechc_result *r) { return r && r->nout ? r->yd : NULL; }
+const double *mechc_result_ydd(const mechc_result *r) { return r && r->nout ? r->ydd : NULL; }
+const double *mechc_result_lambda(const mechc_result *r)
+{
+    return r && r->with_lambda ? r->lambda : NULL;
+}
+mechc_status mechc_result_status(const mechc_result *r) { return r ? r->status : MECHC_EARG; }
+const char *mechc_result_message(const mechc_result *r) { return r ? r->message : ""; }
+double mechc_result_t_fail(const mechc_result *r) { return r ? r->t_fail : NAN; }
 
 void mechc_result_free(mechc_result *r)
 {

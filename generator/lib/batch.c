@@ -173,9 +173,13 @@ void lib_batch_bind(mechc_kernels *k)
         k->batch.all = kernel_all;
 }
 
-/* The checks every batch call makes: arrays given (n > 0), nt 1 or n. */
-static mechc_status check(size_t n, const double *q, const double *t, size_t nt, const void *out)
+/* The checks every batch call makes: kernels given, arrays given (n > 0),
+   nt 1 or n. */
+static mechc_status check(const mechc_kernels *k, size_t n, const double *q, const double *t,
+                          size_t nt, const void *out)
 {
+    if (!k)
+        return MECHC_EARG;
     if (n == 0)
         return MECHC_OK;
     if (!q || !out || (t && nt != 1 && nt != n) || (!t && nt != 0))
@@ -190,7 +194,7 @@ static const double zero_time = 0;
 mechc_status mechc_phi_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                              size_t nt, double *phi)
 {
-    mechc_status st = check(n, q, t, nt, phi);
+    mechc_status st = check(k, n, q, t, nt, phi);
     if (st == MECHC_OK && n > 0)
         k->batch.phi(k, n, q, TIMES(t, nt), phi);
     return st;
@@ -199,7 +203,7 @@ mechc_status mechc_phi_batch(mechc_kernels *k, size_t n, const double *q, const 
 mechc_status mechc_jacobian_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                                   size_t nt, double *jac)
 {
-    mechc_status st = check(n, q, t, nt, jac);
+    mechc_status st = check(k, n, q, t, nt, jac);
     if (st == MECHC_OK && !k->engine.k.jac)
         st = MECHC_ENOTAVAIL;
     if (st == MECHC_OK && n > 0)
@@ -210,7 +214,7 @@ mechc_status mechc_jacobian_batch(mechc_kernels *k, size_t n, const double *q, c
 mechc_status mechc_nu_batch(mechc_kernels *k, size_t n, const double *q, const double *t,
                             size_t nt, double *nu)
 {
-    mechc_status st = check(n, q, t, nt, nu);
+    mechc_status st = check(k, n, q, t, nt, nu);
     if (st == MECHC_OK && n > 0)
         k->batch.nu(k, n, q, TIMES(t, nt), nu);
     return st;
@@ -219,7 +223,7 @@ mechc_status mechc_nu_batch(mechc_kernels *k, size_t n, const double *q, const d
 mechc_status mechc_gamma_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *gamma)
 {
-    mechc_status st = check(n, q, t, nt, gamma);
+    mechc_status st = check(k, n, q, t, nt, gamma);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && n > 0)
@@ -231,7 +235,7 @@ mechc_status mechc_all_batch(mechc_kernels *k, size_t n, const double *q, const 
                              const double *t, size_t nt, double *phi, double *jac, double *nu,
                              double *gamma)
 {
-    mechc_status st = check(n, q, t, nt, q);
+    mechc_status st = check(k, n, q, t, nt, q);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && !k->engine.k.all)
@@ -243,7 +247,7 @@ mechc_status mechc_all_batch(mechc_kernels *k, size_t n, const double *q, const 
 
 mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q, double *M)
 {
-    mechc_status st = check(n, q, NULL, 0, M);
+    mechc_status st = check(k, n, q, NULL, 0, M);
     if (st == MECHC_OK && !k->engine.k.mass)
         st = MECHC_ENOTAVAIL;
     if (st == MECHC_OK && n > 0)
@@ -254,7 +258,7 @@ mechc_status mechc_mass_batch(mechc_kernels *k, size_t n, const double *q, doubl
 mechc_status mechc_force_batch(mechc_kernels *k, size_t n, const double *q, const double *qd,
                                const double *t, size_t nt, double *Q)
 {
-    mechc_status st = check(n, q, t, nt, Q);
+    mechc_status st = check(k, n, q, t, nt, Q);
     if (st == MECHC_OK && n > 0 && !qd)
         st = MECHC_EARG;
     if (st == MECHC_OK && !k->engine.k.force)
@@ -268,7 +272,7 @@ mechc_status mechc_outputs_batch(mechc_kernels *k, size_t n, const double *q, co
                                  const double *qdd, const double *t, size_t nt, double *y,
                                  double *yd, double *ydd)
 {
-    mechc_status st = check(n, q, t, nt, y);
+    mechc_status st = check(k, n, q, t, nt, y);
     if (st != MECHC_OK || n == 0)
         return st;
     const double *times = t ? t : &zero_time;

@@ -100,6 +100,8 @@ mechc_status mechc_info_report_summary(const mechc_info_report *r, mechc_info *i
 
 char *mechc_info_report_json(const mechc_info_report *r)
 {
+    if (!r)
+        return NULL;
     char *text = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&text, &len);

@@ -76,18 +76,21 @@ void mechc_kernels_free(mechc_kernels *k)
     free(k);
 }
 
-const char *mechc_kernels_engine(const mechc_kernels *k) { return engine_names[k->engine.kind]; }
+const char *mechc_kernels_engine(const mechc_kernels *k)
+{
+    return k ? engine_names[k->engine.kind] : NULL;
+}
 
 double mechc_kernels_compile_seconds(const mechc_kernels *k)
 {
-    return k->engine.gen_seconds + k->engine.compile_seconds;
+    return k ? k->engine.gen_seconds + k->engine.compile_seconds : 0;
 }
 
-mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k->model; }
+mechc_model *mechc_kernels_model(const mechc_kernels *k) { return k ? k->model : NULL; }
 
 const char *mechc_kernels_source(const mechc_kernels *k)
 {
-    return k->engine.compiled ? k->engine.emitted.c_text : NULL;
+    return k && k->engine.compiled ? k->engine.emitted.c_text : NULL;
 }
 
 /* Room for what a call skips (NULL outputs) or gathers from: nr x nq +
@@ -104,7 +107,7 @@ static double *scratch(mechc_kernels *k)
 
 mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
 {
-    if (!q || !phi)
+    if (!k || !q || !phi)
         return MECHC_EARG;
     engine_phi(&k->engine, q, t, phi);
     return MECHC_OK;
@@ -112,7 +115,7 @@ mechc_status mechc_phi(mechc_kernels *k, const double *q, double t, double *phi)
 
 mechc_status mechc_jacobian(mechc_kernels *k, const double *q, double t, double *jac)
 {
-    if (!q || !jac)
+    if (!k || !q || !jac)
         return MECHC_EARG;
     if (!k->engine.k.jac)
         return MECHC_ENOTAVAIL;     /* sparse-only kernels */
@@ -120,11 +123,11 @@ mechc_status mechc_jacobian(mechc_kernels *k, const double *q, double t, double 
     return MECHC_OK;
 }
 
-int mechc_jacobian_nz(const mechc_kernels *k) { return k->model->mech->kin.nnz; }
+int mechc_jacobian_nz(const mechc_kernels *k) { return k ? k->model->mech->kin.nnz : 0; }
 
 mechc_status mechc_jacobian_pattern(const mechc_kernels *k, int *rows, int *cols)
 {
-    if (!rows || !cols)
+    if (!k || !rows || !cols)
         return MECHC_EARG;
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
     const Kinematics *kin = &k->model->mech->kin;
@@ -137,7 +140,7 @@ mechc_status mechc_jacobian_pattern(const mechc_kernels *k, int *rows, int *cols
 
 mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, double *vals)
 {
-    if (!q || !vals)
+    if (!k || !q || !vals)
         return MECHC_EARG;
     const MechrtHostJacNz *jnz = engine_jac_nz(&k->engine);
     if (jnz) {
@@ -156,7 +159,7 @@ mechc_status mechc_jacobian_values(mechc_kernels *k, const double *q, double t, 
 
 mechc_status mechc_nu(mechc_kernels *k, const double *q, double t, double *nu)
 {
-    if (!q || !nu)
+    if (!k || !q || !nu)
         return MECHC_EARG;
     engine_nu(&k->engine, q, t, nu);
     return MECHC_OK;
@@ -165,7 +168,7 @@ mechc_status mechc_nu(mechc_kernels *k, const double *q, double t, double *nu)
 mechc_status mechc_gamma(mechc_kernels *k, const double *q, const double *qd, double t,
                          double *gamma)
 {
-    if (!q || !qd || !gamma)
+    if (!k || !q || !qd || !gamma)
         return MECHC_EARG;
     engine_gamma(&k->engine, q, qd, t, gamma);
     return MECHC_OK;
@@ -174,7 +177,7 @@ mechc_status mechc_gamma(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *phi, double *jac, double *nu, double *gamma)
 {
-    if (!q || !qd)
+    if (!k || !q || !qd)
         return MECHC_EARG;
     if (!k->engine.k.all)
         return MECHC_ENOTAVAIL;
@@ -188,7 +191,7 @@ mechc_status mechc_all(mechc_kernels *k, const double *q, const double *qd, doub
 
 mechc_status mechc_mass(mechc_kernels *k, const double *q, double *M)
 {
-    if (!q || !M)
+    if (!k || !q || !M)
         return MECHC_EARG;
     if (!k->engine.k.mass)
         return MECHC_ENOTAVAIL;
@@ -199,7 +202,7 @@ mechc_status mechc_mass(mechc_kernels *k, const double *q, double *M)
 mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, double t,
                          double *Q)
 {
-    if (!q || !qd || !Q)
+    if (!k || !q || !qd || !Q)
         return MECHC_EARG;
     if (!k->engine.k.force)
         return MECHC_ENOTAVAIL;
@@ -210,7 +213,7 @@ mechc_status mechc_force(mechc_kernels *k, const double *q, const double *qd, do
 mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, double t,
                        double *M, double *Q, double *jac, double *gamma)
 {
-    if (!q || !qd)
+    if (!k || !q || !qd)
         return MECHC_EARG;
     if (!k->engine.k.mass)
         return MECHC_ENOTAVAIL;
@@ -230,7 +233,7 @@ mechc_status mechc_eom(mechc_kernels *k, const double *q, const double *qd, doub
 
 mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *phi_p)
 {
-    if (!q || !phi_p)
+    if (!k || !q || !phi_p)
         return MECHC_EARG;
     if (k->model->mech->model->np == 0)
         return MECHC_ENOTAVAIL;
@@ -238,11 +241,11 @@ mechc_status mechc_phi_p(mechc_kernels *k, const double *q, double t, double *ph
     return MECHC_OK;
 }
 
-int mechc_phi_p_nz(const mechc_kernels *k) { return k->model->mech->kin.design.p_nnz; }
+int mechc_phi_p_nz(const mechc_kernels *k) { return k ? k->model->mech->kin.design.p_nnz : 0; }
 
 mechc_status mechc_phi_p_pattern(const mechc_kernels *k, int *rows, int *params)
 {
-    if (!rows || !params)
+    if (!k || !rows || !params)
         return MECHC_EARG;
     const DesignKin *dk = &k->model->mech->kin.design;
     for (int i = 0; i < dk->p_nnz; i++)
@@ -252,7 +255,7 @@ mechc_status mechc_phi_p_pattern(const mechc_kernels *k, int *rows, int *params)
 
 mechc_status mechc_phi_p_values(mechc_kernels *k, const double *q, double t, double *vals)
 {
-    if (!q || !vals)
+    if (!k || !q || !vals)
         return MECHC_EARG;
     if (k->model->mech->model->np == 0)
         return MECHC_ENOTAVAIL;
@@ -264,7 +267,7 @@ mechc_status mechc_phi_p_values(mechc_kernels *k, const double *q, double t, dou
 mechc_status mechc_outputs(mechc_kernels *k, const double *q, const double *qd,
                            const double *qdd, double t, double *y, double *yd, double *ydd)
 {
-    if (!q || !y || (yd && !qd) || (ydd && (!qd || !qdd || !yd)))
+    if (!k || !q || !y || (yd && !qd) || (ydd && (!qd || !qdd || !yd)))
         return MECHC_EARG;
     outputs_eval(&k->outputs, q, yd ? qd : NULL, ydd ? qdd : NULL, t, y, yd, ydd);
     return MECHC_OK;

@@ -22,10 +22,12 @@
  * its default aborts; the library checks every status), for good.
  *
  * The library never prints (unless given a stream for the notes of a run
- * or a simulation, mechc_run_tuning, mechc_sim_tuning) and never exits on bad input or a failed analysis:
- * every failure is a status (mechc_status) and, where a mechc_diag
- * pointer is taken (it may be NULL), a message. Out of memory
- * aborts the process, as the mechc command does.
+ * or a simulation: mechc_run_tuning, mechc_sim_tuning) and never exits on
+ * bad input or a failed analysis: every failure is a status
+ * (mechc_status) and, where a mechc_diag pointer is taken (it may be
+ * NULL), a message. Out of memory aborts the process, as the mechc
+ * command does. A NULL handle gives MECHC_EARG (or NULL), and 0, -1 or
+ * NULL from the accessors.
  *
  * Arrays: every matrix is row-major (C order), its size given below as
  * ROWS x COLS; the caller allocates every output array. Sizes:

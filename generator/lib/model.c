@@ -181,49 +181,61 @@ void mechc_model_free(mechc_model *m)
     free(m);
 }
 
-int mechc_nq(const mechc_model *m) { return m->mech->model->nq; }
-int mechc_nh(const mechc_model *m) { return m->mech->model->nh; }
-int mechc_nv(const mechc_model *m) { return m->mech->model->nv; }
-int mechc_nr(const mechc_model *m) { return m->mech->model->nr; }
-int mechc_nout(const mechc_model *m) { return m->mech->model->nout; }
-int mechc_nbodies(const mechc_model *m) { return m->mech->model->nbodies; }
-int mechc_np(const mechc_model *m) { return m->mech->model->np; }
-int mechc_has_dynamics(const mechc_model *m) { return m->mech->model->nmasses > 0; }
-int mechc_is_spatial(const mechc_model *m) { return m->mech->model->spatial; }
-const char *mechc_model_name(const mechc_model *m) { return m->mech->model->name; }
+int mechc_nq(const mechc_model *m) { return m ? m->mech->model->nq : 0; }
+int mechc_nh(const mechc_model *m) { return m ? m->mech->model->nh : 0; }
+int mechc_nv(const mechc_model *m) { return m ? m->mech->model->nv : 0; }
+int mechc_nr(const mechc_model *m) { return m ? m->mech->model->nr : 0; }
+int mechc_nout(const mechc_model *m) { return m ? m->mech->model->nout : 0; }
+int mechc_nbodies(const mechc_model *m) { return m ? m->mech->model->nbodies : 0; }
+int mechc_np(const mechc_model *m) { return m ? m->mech->model->np : 0; }
+int mechc_has_dynamics(const mechc_model *m) { return m ? m->mech->model->nmasses > 0 : 0; }
+int mechc_is_spatial(const mechc_model *m) { return m ? m->mech->model->spatial : 0; }
+const char *mechc_model_name(const mechc_model *m) { return m ? m->mech->model->name : NULL; }
 
 const char *mechc_coord_name(const mechc_model *m, int i)
 {
+    if (!m)
+        return NULL;
     const Model *mo = m->mech->model;
     return i >= 0 && i < mo->nq ? mo->coord_names[i] : NULL;
 }
 
 const char *mechc_row_name(const mechc_model *m, int i)
 {
+    if (!m)
+        return NULL;
     const Model *mo = m->mech->model;
     return i >= 0 && i < mo->nr ? mo->rows[i].name : NULL;
 }
 
 const char *mechc_output_name(const mechc_model *m, int i)
 {
+    if (!m)
+        return NULL;
     const Model *mo = m->mech->model;
     return i >= 0 && i < mo->nout ? mo->outputs[i].name : NULL;
 }
 
 const char *mechc_body_name(const mechc_model *m, int i)
 {
+    if (!m)
+        return NULL;
     const Model *mo = m->mech->model;
     return i >= 0 && i < mo->nbodies ? mo->bodies[i].name : NULL;
 }
 
 const char *mechc_design_name(const mechc_model *m, int i)
 {
+    if (!m)
+        return NULL;
     const Model *mo = m->mech->model;
     return i >= 0 && i < mo->np ? mo->design_names[i] : NULL;
 }
 
 int mechc_coord_index(const mechc_model *m, const char *name)
 {
+    if (!m)
+        return -1;
     const Model *mo = m->mech->model;
     for (int i = 0; name && i < mo->nq; i++)
         if (strcmp(mo->coord_names[i], name) == 0)
@@ -233,6 +245,8 @@ int mechc_coord_index(const mechc_model *m, const char *name)
 
 mechc_status mechc_body_coords(const mechc_model *m, int i, int *first, int *count)
 {
+    if (!m)
+        return MECHC_EARG;
     const Model *mo = m->mech->model;
     if (i < 0 || i >= mo->nbodies)
         return MECHC_EARG;
@@ -243,11 +257,11 @@ mechc_status mechc_body_coords(const mechc_model *m, int i, int *first, int *cou
     return MECHC_OK;
 }
 
-const double *mechc_q0(const mechc_model *m) { return m->mech->model->q0; }
+const double *mechc_q0(const mechc_model *m) { return m ? m->mech->model->q0 : NULL; }
 
 mechc_status mechc_qd0(const mechc_model *m, double *qd0)
 {
-    if (!qd0)
+    if (!m || !qd0)
         return MECHC_EARG;
     memset(qd0, 0, (size_t)m->mech->model->nq * sizeof *qd0);
     return MECHC_OK;
@@ -255,6 +269,8 @@ mechc_status mechc_qd0(const mechc_model *m, double *qd0)
 
 mechc_status mechc_design(const mechc_model *m, double *p)
 {
+    if (!m)
+        return MECHC_EARG;
     const Model *mo = m->mech->model;
     if (!p && mo->np > 0)
         return MECHC_EARG;
@@ -265,6 +281,8 @@ mechc_status mechc_design(const mechc_model *m, double *p)
 
 mechc_status mechc_set_design(mechc_model *m, const char *name, double value)
 {
+    if (!m)
+        return MECHC_EARG;
     Model *mo = m->mech->model;
     if (mo->np == 0)
         return MECHC_ENOTAVAIL;
@@ -280,6 +298,8 @@ mechc_status mechc_set_design(mechc_model *m, const char *name, double value)
 
 mechc_status mechc_set_design_vector(mechc_model *m, const double *p)
 {
+    if (!m)
+        return MECHC_EARG;
     Model *mo = m->mech->model;
     if (mo->np == 0)
         return MECHC_ENOTAVAIL;

@@ -7,7 +7,7 @@ mechc_status mechc_sensitivities(mechc_kernels *k, const double *q, const double
                                  const double *qdd, double t, double *q_p, double *qd_p,
                                  double *qdd_p, double *y_p, double *yd_p, double *ydd_p)
 {
-    if (!q || !qd || !qdd || !q_p || !qd_p || !qdd_p)
+    if (!k || !q || !qd || !qdd || !q_p || !qd_p || !qdd_p)
         return MECHC_EARG;
     if (k->sens_state == 0) {
         char why[200];

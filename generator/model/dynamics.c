@@ -150,6 +150,14 @@ static void spatial_body_mass(Builder *b, const Stmt *s, const Entity *ent, Mass
     Attach at = {.q = ent->q, .spatial = true, .has_p = body};
     if (s->vec[0])
         com_offset(b, s, &at);
+    /* M's entries carry m |com|^2 as products of these numbers (the
+       planar builder folds J + m |com|^2 into one constant): past the
+       range of a double they would be inf at every call. */
+    Dag *d = &b->model->dag;
+    const char *outer = d->what;
+    d->what = "its moment about the body's reference point, m |com|^2";
+    dag_range_note_nonfinite(d, e->m * (at.sx * at.sx + at.sy * at.sy + at.sz * at.sz));
+    d->what = outer;
     NodeId xyz[3];
     joints_spatial_point(b->model, at, xyz);
     e->px = xyz[0], e->py = xyz[1], e->pz = xyz[2];

@@ -11,14 +11,10 @@
 #include "../parse/parse.h"
 #include "orient.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 const char *build_entity_word(EntityKind kind)
 {
@@ -443,6 +439,11 @@ static void build_joint(Builder *b, const Stmt *s)
     }
     if (s->option) {
         j->option = build_lower(b, s->option, EXPR_TIMED);
+        double r;
+        /* a disk's contact point is R below its centre, on the plane */
+        if (s->joint == JOINT_S_ROLLING && dag_is_const(&m->dag, j->option, &r) && !(r > 0))
+            diag_fail(b->diag, s->option_pos, "the radius of rolling '%s' is %g: a disk's "
+                      "radius must be positive", s->name, r);
     }
     switch (info->level) {
     case LEVEL_POSITION: j->velocity = false; break;
@@ -692,86 +693,6 @@ const Body *model_find_body(const Model *m, const char *name)
         if (strcmp(m->bodies[i].name, name) == 0)
             return &m->bodies[i];
     return NULL;
-}
-
-/* What a path that is not a regular file names, for the refusal. */
-static const char *file_kind(mode_t mode)
-{
-    if (S_ISDIR(mode))
-        return "a directory";
-    if (S_ISFIFO(mode))
-        return "a named pipe";
-    if (S_ISCHR(mode) || S_ISBLK(mode))
-        return "a device";
-    if (S_ISSOCK(mode))
-        return "a socket";
-    return "not a regular file";
-}
-
-/* PATH opened for reading, or NULL with the reason in DIAG. O_NONBLOCK
-   because opening a named pipe with no writer blocks forever; only regular
-   files are read (stdin, "-", is the way to pipe a model in). */
-static FILE *open_model_file(const char *path, Diag *diag)
-{
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    struct stat st;
-    if (fd < 0 || fstat(fd, &st) != 0) {
-        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(errno));
-        if (fd >= 0)
-            close(fd);
-        return NULL;
-    }
-    if (!S_ISREG(st.st_mode)) {
-        diag_error_nopos(diag, "cannot read '%s': %s; give a regular file, or '-' for stdin",
-                         path, file_kind(st.st_mode));
-        close(fd);
-        return NULL;
-    }
-    FILE *f = fdopen(fd, "rb");
-    if (!f) {
-        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(errno));
-        close(fd);
-    }
-    return f;
-}
-
-char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag)
-{
-    FILE *f = strcmp(path, "-") == 0 ? stdin : open_model_file(path, diag);
-    if (!f)
-        return NULL;
-    size_t cap = 4096, n = 0;
-    char *buf = xmalloc(cap);
-    for (;;) {
-        if (n + 1 >= cap) {
-            cap *= 2;
-            buf = xrealloc(buf, cap, 1);
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (n > (size_t)limits->max_file_bytes) {
-            diag_error_nopos(diag, "'%s' is larger than the limit of %d bytes", path,
-                             limits->max_file_bytes);
-            free(buf);
-            if (f != stdin)
-                fclose(f);
-            return NULL;
-        }
-        if (got == 0)
-            break;
-    }
-    bool bad = ferror(f);
-    int err = errno;
-    if (f != stdin)
-        fclose(f);
-    if (bad) {
-        diag_error_nopos(diag, "cannot read '%s': %s", path, strerror(err));
-        free(buf);
-        return NULL;
-    }
-    buf[n] = '\0';
-    *len = (int)n;
-    return buf;
 }
 
 char *model_file_stem(Arena *arena, const char *path)

@@ -175,6 +175,10 @@ const Body *model_find_body(const Model *m, const char *name);
 /* Reads a whole file ("-" = stdin) into a NUL-terminated buffer (free()).
    Returns NULL with diag filled when it cannot be read or is too large. */
 char *model_read_file(const char *path, const MechLimits *limits, int *len, Diag *diag);
+/* model_read_file for a data file (a CSV): a NUL byte in it is refused at
+   its FILE:LINE:COL (the readers parse C strings, which would end there:
+   "1.4<NUL>" read as 1.4). */
+char *model_read_data_file(const char *path, const MechLimits *limits, int *len, Diag *diag);
 
 /* The file stem of a path: "dir/slider_crank.mech" -> "slider_crank". */
 char *model_file_stem(Arena *arena, const char *path);

@@ -450,3 +450,14 @@ def test_all_leaves_parts_out(four_bar):
     Q = np.stack([q, q])
     k = m.all(Q, Q, 0.3, out=(False, False, False, None))
     assert k.phi is None and np.array_equal(k.gamma, m.gamma(Q, Q, 0.3))
+
+
+def test_closed_model_raises():
+    # the outside corpus: a kernel called after close() passed
+    # NULL kernels to the library, which crashed (SIGSEGV)
+    m = mechc.loads("body b x = 1 y = 0 phi = 0\ndistance d: ground b length = 1\n")
+    m.close()
+    with pytest.raises(mechc.InputError):
+        m.phi(np.zeros(3))
+    with pytest.raises(mechc.InputError):
+        m.gamma(np.zeros((2, 3)), np.zeros((2, 3)))
