@@ -483,7 +483,7 @@ check "one row too many with a velocity-level row: points at the last statement"
 
 # ---- every example runs, or fails as its header says -----------------------
 for f in "$ex"/*.mech; do
-    name=$(basename "$f" .mech)
+    name=${f##*/}; name=${name%.mech}
     case $name in
         pendulum_distance|pendulum_constraint|pendulum_dynamics) want=2 ;;
         andrews|a01_pendulum|double_pendulum|heavy_top|spherical_pendulum) want=2 ;;   # not driven: mechc sim
@@ -571,7 +571,7 @@ check "an output that is NaN: warned once" err_has "warning: output 's' is not f
 # every example that assembles as written also assembles with every angle
 # guess 0, and with every initial value left out
 for f in "$ex"/*.mech; do
-    name=$(basename "$f" .mech)
+    name=${f##*/}; name=${name%.mech}
     run "$f" --steps 0 --csv /dev/null
     [ "$rc" = 0 ] || continue
     sed -E '/^body/ s/phi *= *[^ ]+/phi = 0/' "$f" > "$tmp/angles0.mech"

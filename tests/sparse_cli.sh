@@ -39,7 +39,7 @@ same_csv() {
 # ---- every example, dense against sparse ------------------------------------
 compared=0
 for f in "$ex"/*.mech; do
-    b=$(basename "$f" .mech)
+    b=${f##*/}; b=${b%.mech}
     run "$f" --linear dense --csv "$tmp/$b.d.csv"
     rd=$rc
     run "$f" --linear sparse --csv "$tmp/$b.s.csv"
