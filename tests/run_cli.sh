@@ -19,16 +19,9 @@ suite_begin run_cli "${1:-build/mechc}"
 # run ARGS...: mechc run ARGS (tests/lib.sh).
 run() { run_mechc run "$@"; }
 
-# column NAME FILE: the 1-based index of a CSV column.
-column() {
-    head -1 "$2" | tr ',' '\n' | grep -n -x -F -- "$1" | cut -d: -f1
-}
-
-# value_at T NAME FILE: the value of column NAME in the row whose t is T.
-value_at() {
-    c=$(column "$2" "$3")
-    awk -F, -v t="$1" -v c="$c" 'NR > 1 && $1 == t { print $c }' "$3"
-}
+# value_at T NAME FILE: the value of column NAME in the row whose t is T
+# (one awk, tests/lib.sh's; head, tr, grep and cut were four processes more).
+value_at() { csv_value_at "$@"; }
 
 # near A B TOL: |A - B| <= TOL
 near() {
