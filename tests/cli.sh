@@ -36,7 +36,7 @@ for c in gen run eval check info bench; do
     check "$c --help names options" [ -n "$opts" ]
     for o in $opts; do
         run "$c" "$o"
-        check "$c reads $o, which its --help names" sh -c "! grep -q 'unknown option' '$tmp/err'"
+        check "$c reads $o, which its --help names" err_lacks 'unknown option'
     done
 done
 
@@ -137,7 +137,10 @@ fi
 # ---- bad input: FILE:LINE:COL: error:, the source line, a caret, exit 2 ----
 
 # bad_input NAME LINE COL TEXT [MESSAGE]: TEXT (printf %b escapes) must be
-# rejected at LINE:COL, with MESSAGE in the error if given.
+# rejected at LINE:COL, with MESSAGE in the error if given. The lines are
+# read by the shell, not by head, sed and grep: 30 cases, and a process
+# costs 5 to 8 ms of CPU here.
+cr=$(printf '\r') blanks=$(printf ' \t')
 bad_input() {
     name=$1 line=$2 col=$3 text=$4 msg=${5:-}
     f=$tmp/$name.mech
@@ -145,17 +148,31 @@ bad_input() {
     run eval "$f"
     check "$name: exit 2" status_is 2
     check "$name: nothing on stdout" out_empty
-    check "$name: '$f:$line:$col: error: ' first" \
-        sh -c "head -n 1 '$tmp/err' | grep -F -q -- '$f:$line:$col: error: '"
+    err1= err2= caret=
+    { IFS= read -r err1; IFS= read -r err2; IFS= read -r caret; } < "$tmp/err"
+    check "$name: '$f:$line:$col: error: ' first" has_text "$err1" "$f:$line:$col: error: "
     if [ -n "$msg" ]; then
-        check "$name: message has '$msg'" sh -c "head -n 1 '$tmp/err' | grep -F -q -- \"\$1\"" sh "$msg"
+        check "$name: message has '$msg'" has_text "$err1" "$msg"
     fi
-    want_src="    $(sed -n "${line}p" "$f" | tr -d '\r')"
-    check "$name: the source line second" [ "$(sed -n 2p "$tmp/err")" = "$want_src" ]
-    caret=$(sed -n 3p "$tmp/err")
-    check "$name: a caret line third" sh -c "printf '%s\n' \"\$1\" | grep -E -q '^[ 	]*\^$'" sh "$caret"
-    check "$name: the caret under column $col" \
-        [ "$(printf '%s' "$caret" | LC_ALL=C wc -c | tr -d ' ')" = "$((col + 4))" ]
+    # line LINE of the file, its carriage returns removed
+    i=0 src=
+    while IFS= read -r src || [ -n "$src" ]; do
+        i=$((i + 1))
+        [ "$i" = "$line" ] && break
+        src=
+    done < "$f"
+    while :; do
+        case $src in *"$cr"*) src=${src%%"$cr"*}${src#*"$cr"} ;; *) break ;; esac
+    done
+    check "$name: the source line second" [ "$err2" = "    $src" ]
+    check "$name: a caret line third" is_caret "$caret"
+    check "$name: the caret under column $col" [ "${#caret}" = "$((col + 4))" ]
+}
+# has_text STRING TEXT: STRING holds TEXT; is_caret LINE: blanks, then ^.
+has_text() { case $1 in *"$2"*) return 0 ;; esac; return 1; }
+is_caret() {
+    case $1 in *^) ;; *) return 1 ;; esac
+    case ${1%^} in *[!"$blanks"]*) return 1 ;; esac
 }
 
 bad_input unknown_name      2 22 'point m x = 1\ndistance rod: ground mm length = 2\n' "unknown name 'mm'"

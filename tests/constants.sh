@@ -11,7 +11,7 @@
 suite_begin constants "${1:-build/mechc}"
 
 for f in "$root"/tests/constants/*.mech; do
-    name=$(basename "$f")
+    name=${f##*/}
     grep '^# expect: ' "$f" > "$tmp/expect"
     [ -s "$tmp/expect" ] || { bad "$name has no '# expect:' line"; continue; }
     while IFS='|' read -r args status text; do

@@ -57,7 +57,7 @@
 # compiles and inspects the written C.
 #
 # The last line is "firmware_rules: N passed, M failed"; the exit status is
-# non-zero on any failure. POSIX sh, awk, cc, nm, size, objdump.
+# non-zero on any failure. POSIX sh, awk, cc, nm, objdump.
 # Flag lists ($FLAGS, $arch ...) are split into words on purpose.
 # shellcheck disable=SC2086,SC2046
 set -u
@@ -92,7 +92,7 @@ try() {
     fi
 }
 
-for tool in "$CC" nm size objdump; do
+for tool in "$CC" nm objdump; do
     if ! have "$tool"; then
         echo "firmware_rules: $tool is missing" >&2
         fail=1
@@ -103,19 +103,20 @@ done
 
 # ---- helpers over objects ---------------------------------------------------
 
-# The rules on one object OBJ read three listings that object_rules
+# The rules on one object OBJ read two listings that object_rules
 # writes: OBJ.nm (nm: a defined symbol has three fields, an undefined one
-# two), OBJ.size (size -A: the sections) and OBJ.dis (objdump -dr
-# --no-show-raw-insn). nm is given the object's format (the disassembly's
-# header says it): guessing it, nm tries the linker plugins (LLVMgold
-# among them), eight times slower. Then one awk (rules.awk, then
+# two) and OBJ.dis (objdump -h -dr --no-show-raw-insn: the sections, then
+# the disassembly; one process, where size -A was a second). nm is given
+# the object's format (the disassembly's header says it): guessing it, nm
+# tries the linker plugins (LLVMgold among them), eight times slower. Then one awk (rules.awk, then
 # callgraph.awk) judges every rule and writes what breaks rule R to OBJ.R:
 #   undefined_only    every undefined symbol matches the regex ext;
 #   no_writable_data  no data/bss symbols, empty .data and .bss;
 #   defined_prefixed  every defined symbol matches the regex prefix (if set);
 #   call_graph        below.
 # One process per listing and one for the rules: this script runs them for
-# some 80 objects, and starting a process costs more than a rule.
+# some 120 objects, and starting a process costs more than a rule (5 to 8
+# ms of CPU on this project's machine).
 cat > "$tmp/rules.awk" <<'EOF'
 function broken(rule, why) { print why > (obj "." rule) }
 BEGIN {
@@ -130,32 +131,32 @@ FILENAME == obj ".nm" {
         broken("defined_prefixed", "foreign name: " $3)
     next
 }
-FILENAME == obj ".size" {
-    if ($1 ~ /^\.(data|bss)/ && $2 != 0) broken("no_writable_data", "section " $1 " has " $2 " bytes")
+# objdump -h's table: index, name, size (hex), ...
+FILENAME == obj ".dis" && /^ *[0-9]+ \./ && NF >= 7 {
+    if ($2 ~ /^\.(data|bss)/ && $3 !~ /^0+$/) broken("no_writable_data", "section " $2 " has 0x" $3 " bytes")
     next
 }
 EOF
 
-# object_rules OBJ NM SIZE OBJDUMP EXT PREFIX ALLOW_INDIRECT: OBJ's
+# object_rules OBJ NM OBJDUMP EXT PREFIX ALLOW_INDIRECT: OBJ's
 # listings and verdicts; OBJ.judged when all were written.
 object_rules() {
-    "$4" -dr --no-show-raw-insn "$1" > "$1.dis" || return 1
+    "$3" -h -dr --no-show-raw-insn "$1" > "$1.dis" || return 1
     { read -r line; read -r line; } < "$1.dis"
     case $line in
         *" file format "*) format=${line##* file format } ;;
         *) format= ;;
     esac
     "$2" ${format:+--target="$format"} "$1" > "$1.nm" &&
-    "$3" -A "$1" > "$1.size" &&
-    awk -v obj="$1" -v ext="$5" -v prefix="$6" -v allow_indirect="$7" \
-        -f "$tmp/rules.awk" -f "$tmp/callgraph.awk" "$1.nm" "$1.size" "$1.dis" &&
+    awk -v obj="$1" -v ext="$4" -v prefix="$5" -v allow_indirect="$6" \
+        -f "$tmp/rules.awk" -f "$tmp/callgraph.awk" "$1.nm" "$1.dis" &&
     : > "$1.judged"
 }
 
 # kept OBJ RULE: object_rules found OBJ keeping RULE; else prints why not.
 kept() {
     if [ ! -f "$1.judged" ]; then
-        echo "not judged: objdump, nm, size or the rules failed on $1"
+        echo "not judged: objdump, nm or the rules failed on $1"
         return 1
     fi
     [ -s "$1.$2" ] || return 0
@@ -285,7 +286,7 @@ source_rules() {
 }
 
 # ---- the toolchains ---------------------------------------------------------
-# name|compiler|arch flags|nm|size|objdump|reals|extra allowed symbols
+# name|compiler|arch flags|nm|objdump|reals|extra allowed symbols
 toolchains=
 host=0
 if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
@@ -293,7 +294,7 @@ if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
 elif [ "${FIRMWARE_RULES:-}" = cross ]; then
     skip "FIRMWARE_RULES=cross: the host's builds (make check runs them)"
 else
-    toolchains="host|$CC|-fno-pie|nm|size|objdump|double float|"
+    toolchains="host|$CC|-fno-pie|nm|objdump|double float|"
     host=1
 fi
 if [ -n "${MECHC_SKIP_GCC_ONLY:-}" ]; then
@@ -303,8 +304,8 @@ elif [ "${FIRMWARE_RULES:-}" = host ]; then
 elif command -v arm-none-eabi-gcc > /dev/null 2>&1; then
     a=arm-none-eabi-
     toolchains="$toolchains
-m4f|${a}gcc|-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard|${a}nm|${a}size|${a}objdump|float|__aeabi_[a-z0-9]+
-m3|${a}gcc|-mcpu=cortex-m3 -mthumb -mfloat-abi=soft|${a}nm|${a}size|${a}objdump|double|__aeabi_[a-z0-9]+"
+m4f|${a}gcc|-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard|${a}nm|${a}objdump|float|__aeabi_[a-z0-9]+
+m3|${a}gcc|-mcpu=cortex-m3 -mthumb -mfloat-abi=soft|${a}nm|${a}objdump|double|__aeabi_[a-z0-9]+"
 else
     echo "skip: arm-none-eabi-gcc missing: Cortex-M builds (sh .ci/deps firmware installs it)" >&2
 fi
@@ -352,9 +353,9 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
         four_bar | stewart | freudenstein | every_function | chain_rolled | chain_sparse_only \
         | heavy_top) batch=--batch ;;
     esac
+    mkdir -p "$tmp/$name-double" "$tmp/$name-float"     # one process for both
     for real in double float; do
         d=$tmp/$name-$real
-        mkdir -p "$d"
         try 5 "$name ($real): mechc gen" "$mechc" gen "$mech" --prefix "$prefix" --real "$real" --lu $batch \
             --roll "$roll" $only -o "$d/$prefix.c" --header "$d/$prefix.h" || continue
         if [ -n "$only" ]; then
@@ -365,13 +366,13 @@ for mech in "$root"/examples/*.mech "$tmp/every_function.mech" "$tmp/chain_rolle
         fi
         try 12 "$name ($real): source rules" source_rules "$d/$prefix.c" "$d/$prefix.h"
         if [ "$real" = float ]; then f=f; else f=; fi
-        while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+        while IFS='|' read -r tc cc arch nm_ objdump_ reals extra; do
             case " $reals " in *" $real "*) ;; *) continue ;; esac
             allowed="^(($LIBM)$f|$MEM${extra:+|$extra})\$"
             o=$d/$prefix-$tc.o
             try 10 "$name ($real, $tc): $cc $FLAGS $arch" \
                 $cc $FLAGS $arch -I"$d" -c "$d/$prefix.c" -o "$o" || continue
-            object_rules "$o" "$nm_" "$size_" "$objdump_" "$allowed" "^${prefix}_" 0
+            object_rules "$o" "$nm_" "$objdump_" "$allowed" "^${prefix}_" 0
             for rule in undefined_only no_writable_data defined_prefixed call_graph; do
                 try 10 "$name ($real, $tc): $rule" kept "$o" $rule
             done
@@ -393,7 +394,7 @@ exported_only() {
         awk -v re="$3" 'NF == 3 && $3 !~ re { print "exported: " $3; bad = 1 } END { exit bad }'
 }
 try 12 "runtime: includes and forbidden names" rt_src_rules $rt_sources "$root/runtime/mechrt.h"
-while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
+while IFS='|' read -r tc cc arch nm_ objdump_ reals extra; do
     for real in $reals; do
         d=$tmp/runtime-$real-$tc
         mkdir -p "$d"
@@ -415,7 +416,7 @@ while IFS='|' read -r tc cc arch nm_ size_ objdump_ reals extra; do
         fi
         ok
         allowed="^($MEM${extra:+|$extra})\$"
-        object_rules "$d/core.o" "$nm_" "$size_" "$objdump_" "$allowed" "" 1
+        object_rules "$d/core.o" "$nm_" "$objdump_" "$allowed" "" 1
         for rule in undefined_only no_writable_data call_graph; do
             try 10 "runtime ($real, $tc): $rule" kept "$d/core.o" $rule
         done

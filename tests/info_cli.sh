@@ -70,9 +70,9 @@ check "info on an impossible mechanism still prints the report" out_has "verdict
 
 for f in "$ex"/*.mech; do
     run info "$f"
-    check "info $(basename "$f") exits 0" status_is 0
+    check "info ${f##*/} exits 0" status_is 0
     run info "$f" --json
-    check "info --json $(basename "$f") exits 0" status_is 0
+    check "info --json ${f##*/} exits 0" status_is 0
 done
 
 # ---- parallelogram: rank 11 of 12, A2.y redundant ----
@@ -329,7 +329,7 @@ check "--state with velocity-level rows: the knife is free in 3 directions" \
 
 # ---- --linear: SuiteSparseQR gives the dense SVD's verdicts (doc/large.md) --
 for f in "$ex"/*.mech; do
-    n=$(basename "$f" .mech)
+    n=${f##*/}; n=${n%.mech}
     "$mechc" info "$f" --json --linear dense > "$tmp/$n.dense.json" 2>/dev/null
     "$mechc" info "$f" --json --linear sparse > "$tmp/$n.sparse.json" 2>/dev/null
 done

@@ -19,16 +19,9 @@ suite_begin run_cli "${1:-build/mechc}"
 # run ARGS...: mechc run ARGS (tests/lib.sh).
 run() { run_mechc run "$@"; }
 
-# column NAME FILE: the 1-based index of a CSV column.
-column() {
-    head -1 "$2" | tr ',' '\n' | grep -n -x -F -- "$1" | cut -d: -f1
-}
-
-# value_at T NAME FILE: the value of column NAME in the row whose t is T.
-value_at() {
-    c=$(column "$2" "$3")
-    awk -F, -v t="$1" -v c="$c" 'NR > 1 && $1 == t { print $c }' "$3"
-}
+# value_at T NAME FILE: the value of column NAME in the row whose t is T
+# (one awk, tests/lib.sh's; head, tr, grep and cut were four processes more).
+value_at() { csv_value_at "$@"; }
 
 # near A B TOL: |A - B| <= TOL
 near() {
@@ -483,7 +476,7 @@ check "one row too many with a velocity-level row: points at the last statement"
 
 # ---- every example runs, or fails as its header says -----------------------
 for f in "$ex"/*.mech; do
-    name=$(basename "$f" .mech)
+    name=${f##*/}; name=${name%.mech}
     case $name in
         pendulum_distance|pendulum_constraint|pendulum_dynamics) want=2 ;;
         andrews|a01_pendulum|double_pendulum|heavy_top|spherical_pendulum) want=2 ;;   # not driven: mechc sim
@@ -571,7 +564,7 @@ check "an output that is NaN: warned once" err_has "warning: output 's' is not f
 # every example that assembles as written also assembles with every angle
 # guess 0, and with every initial value left out
 for f in "$ex"/*.mech; do
-    name=$(basename "$f" .mech)
+    name=${f##*/}; name=${name%.mech}
     run "$f" --steps 0 --csv /dev/null
     [ "$rc" = 0 ] || continue
     sed -E '/^body/ s/phi *= *[^ ]+/phi = 0/' "$f" > "$tmp/angles0.mech"
