@@ -525,9 +525,9 @@ static int analyse(RunCli *c, const Model *m, mechc_kernels *k, const RunPicture
     mechc_result *r = lib_run_lending(k, &ro, &tune, lend, &d);
     progress_finish(&out.progress);
     int status = report(c, m, &out, pics, r, &d, &k->engine, &last);
-    if (sc && r && lib_result_run(r)->steps_done > 0)
-        sc->step_cpu_ns = 1e9 * lib_result_run(r)->step_cpu_seconds
-                          / lib_result_run(r)->steps_done;
+    const RunResult *res = r ? lib_result_run(r) : NULL;
+    if (sc && res && res->steps_done > 0)
+        sc->step_cpu_ns = 1e9 * res->step_cpu_seconds / res->steps_done;
     status = finish_output(c, out.csv, status);
     mechc_result_free(r);
     free(last.q), free(last.qd);
